@@ -1,0 +1,1 @@
+"""Experiments: scenario files, runs, sweeps, metrics, plots, and the ``tasker`` command line."""

@@ -1,0 +1,406 @@
+"""The dynamic agent (da): one requested task, run by the hierarchical FSM of Fig. 5.
+
+The agent owns the loop of its task; the task type (:mod:`tasker.task`) supplies
+hooks.  It is stepped by a clock (:mod:`tasker.loop`) at the times it asks for:
+
+* in ``compSP`` and ``wait`` at ``repRate`` (eqs. 22, 27): compute the schedule
+  parameters, check ``ic_term``, publish the report;
+* in ``exeTsk`` and ``exeSusp`` at ``taskExeRate`` (eq. 24): advance the running
+  stage; in ``exeTsk`` also at ``SPupRate``: recompute the parameters;
+* in ``upTsk`` and ``genSusp`` once, when the planning hook's simulated time is up;
+* at once, whenever the harmoniser delivers a command.
+
+Suspension follows eqs. 25-26: ``susp`` ends a suspendable stage at once; a
+blocking stage runs to its goal and the pending ``susp`` is honoured when the FSM
+reaches the next suspendable stage.  ``term`` while in ``cmd`` is handled as a safe
+suspension followed by ``end`` (a task is never dropped mid-manoeuvre).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from tasker import fsm
+from tasker.errors import ConfigError, PlanningFailed
+from tasker.messages import Command, Flag, FsmState, Report, ScheduleParams, SPRequest
+from tasker.protocols import CoreAgent, SkillState
+from tasker.stage import Purpose, Stage, StagePlan
+from tasker.task import TaskContext, TaskType
+from tasker.trace import Trace
+
+S = FsmState
+
+
+@dataclass(frozen=True, slots=True)
+class Rates:
+    """The agent's rates in Hz: ``repRate``, ``taskExeRate`` and ``SPupRate`` of the paper."""
+
+    rep_rate: float = 1.0
+    task_exe_rate: float = 10.0
+    sp_up_rate: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("rep_rate", "task_exe_rate", "sp_up_rate"):
+            v = getattr(self, name)
+            if not isinstance(v, int | float) or not math.isfinite(v) or v <= 0:
+                raise ConfigError(f"Rates.{name} must be a positive number of Hz, got {v!r}")
+
+
+class StageRunner:
+    """Runs one stage FSM (``exeTsk`` or ``exeSusp``) on a core agent; pure bookkeeping."""
+
+    __slots__ = ("plan", "index", "running")
+
+    def __init__(self, plan: StagePlan) -> None:
+        self.plan = plan
+        self.index = 0
+        self.running = False
+
+    @property
+    def stage(self) -> Stage | None:
+        return self.plan.stages[self.index] if self.index < len(self.plan.stages) else None
+
+
+class DynamicAgent:
+    """A task's dynamic agent.  Created by the harmoniser's ``pf_initDA``.
+
+    ``report`` is the agent's report buffer; the harmoniser reads it and sends
+    commands with :meth:`deliver`; ``request_sp`` answers argument-dependent
+    schedule-parameter requests synchronously (eqs. 20-21).
+    """
+
+    def __init__(
+        self,
+        agent_id: str,
+        task: TaskType,
+        ctx: TaskContext,
+        *,
+        trace: Trace,
+        rates: Rates | None = None,
+        core: CoreAgent | None = None,
+        world: Callable[[], Any] | None = None,
+        on_report: Callable[[DynamicAgent], None] | None = None,
+        waker: Callable[[DynamicAgent], None] | None = None,
+    ) -> None:
+        self.id = agent_id
+        self.task = task
+        self.ctx = ctx
+        self.rates = rates or Rates()
+        self.core = core
+        self._trace = trace
+        self._world = world
+        self._on_report = on_report
+        self._waker = waker
+        self.state = S.INIT_COMM
+        self.report: Report | None = None
+        self.end_reason: str | None = None
+        self.next_wake = ctx.request_time
+        self._inbox: list[Command] = []
+        self._ack = 0
+        self._pending_start = False
+        self._pending_susp = False
+        self._pending_term: str | None = None
+        self._runner: StageRunner | None = None
+        self._ready_at = 0.0  # end of a planning hook's simulated time
+        self._next_sp = 0.0
+        self._params: ScheduleParams | None = None
+
+    # -- the harmoniser's side ----------------------------------------------------------
+
+    def deliver(self, command: Command) -> None:
+        """Put a command in the agent's command buffer (eq. 13); it acts on its next step, now."""
+        self._inbox.append(command)
+        if self._waker is not None:
+            self._waker(self)
+
+    def update_args(self, args: dict[str, Any], requester: str, now: float) -> None:
+        """A requester changed the task's arguments (R2); parameters are recomputed at once."""
+        changed = {k: v for k, v in args.items() if self.ctx.args.get(k) != v}
+        self.ctx.args = dict(args)
+        self._trace.emit(now, "change", agent=self.id, args=changed, requester=requester)
+        if self._waker is not None:
+            self._waker(self)
+
+    def request_sp(self, request: SPRequest, now: float) -> Any:
+        """Answer ``[spID, args]`` with ``[scheduleParam]`` (eqs. 20-21, 23)."""
+        self._refresh(now)
+        return self.task.request_sp(self.ctx, request)
+
+    @property
+    def ended(self) -> bool:
+        return self.state is S.END
+
+    # -- stepping ---------------------------------------------------------------------------
+
+    def step(self, now: float) -> None:
+        """Run the transition functions due at ``now``; set :attr:`next_wake`."""
+        if self.state is S.END:
+            self.next_wake = math.inf
+            return
+        self._refresh(now)
+        self._read_inbox()
+        handler = _HANDLERS[self.state]
+        handler(self, now)
+
+    def _refresh(self, now: float) -> None:
+        self.ctx.now = now
+        if self._world is not None:
+            self.ctx.world = self._world()
+
+    def _read_inbox(self) -> None:
+        for cmd in self._inbox:
+            self._ack = cmd.seq
+            if cmd.flag is Flag.START:
+                self._pending_start = True
+            elif cmd.flag is Flag.SUSP:
+                self._pending_susp = True
+            elif cmd.flag is Flag.TERM:
+                self._pending_term = str(cmd.data.get("reason", "terminated by the harmoniser"))
+        self._inbox.clear()
+
+    # -- state behaviours ---------------------------------------------------------------
+
+    def _init_comm(self, now: float) -> None:
+        self.task.initialise(self.ctx)
+        self._go(S.COMP_SP, now)
+        self._comp_sp(now)
+
+    def _comp_sp(self, now: float) -> None:
+        """``compSP`` and ``wait``: f^compSP (eq. 22), f^wait = f^compSP (eq. 27)."""
+        if self._pending_term is not None:
+            self._end(now, self._pending_term, cause="term")
+            return
+        if self._pending_start:
+            self._pending_start = False
+            self._pending_susp = False  # a susp that reached a non-executing agent is void
+            self._start_up_tsk(now)
+            return
+        self._pending_susp = False
+        why = self.task.check_terminate(self.ctx)
+        if why:
+            self._end(now, why, cause="self")
+            return
+        self._params = self.task.compute_params(self.ctx)
+        self._publish()
+        self.next_wake = _next_tick_of(now, self.rates.rep_rate)
+
+    def _start_up_tsk(self, now: float) -> None:
+        self._go(S.UP_TSK, now)
+        try:
+            plan = self.task.update_task(self.ctx)
+        except PlanningFailed as exc:
+            self._end(now, f"upTsk {exc.status}: {exc}", cause="failed")
+            return
+        self._emit_plan(now, plan)
+        self.ctx.plan = plan
+        self.ctx.stage_index = 0
+        self._ready_at = now + plan.sim_time
+        if plan.sim_time > 0:
+            self.next_wake = self._ready_at
+        else:
+            self._up_tsk(now)
+
+    def _up_tsk(self, now: float) -> None:
+        if now < self._ready_at:
+            self.next_wake = self._ready_at
+            return
+        plan = self.ctx.plan
+        assert plan is not None
+        if not plan.stages:
+            self._go(S.END, now, check=True, reason="finished")
+            return
+        self._runner = StageRunner(plan)
+        self._go(S.EXE_TSK, now)
+        self._next_sp = _next_tick_of(now, self.rates.sp_up_rate)
+        self._enter_stage(now)
+
+    def _enter_stage(self, now: float) -> None:
+        """Start the runner's current stage, or suspend first if a susp is pending (eq. 26)."""
+        runner = self._runner
+        assert runner is not None
+        stage = runner.stage
+        if stage is None:
+            if self.state is S.EXE_TSK:
+                self._end(now, "finished", cause="finished")
+            else:
+                self._finish_susp(now)
+            return
+        in_task = self.state is S.EXE_TSK
+        if in_task and (self._pending_susp or self._pending_term) and not stage.blocking:
+            self.ctx.interrupted = stage
+            self._start_gen_susp(now)
+            return
+        if self.core is None:
+            raise ConfigError(f"agent {self.id}: a stage must run but no core agent was given")
+        self.core.begin(self.id, stage, now)
+        runner.running = True
+        if in_task:
+            self.ctx.stage_started = now
+        self._trace.emit(now, "stage", agent=self.id, fsm=self.state.value, index=runner.index,
+                         action=stage.action, args=list(stage.args), kind=stage.kind.value, status="begin")
+        self.next_wake = _next_tick_of(now, self.rates.task_exe_rate)
+
+    def _exe(self, now: float) -> None:
+        """``exeTsk`` / ``exeSusp``: f^stage,k at taskExeRate, f^compSP at SPupRate (eq. 24)."""
+        runner = self._runner
+        assert runner is not None and runner.stage is not None
+        stage = runner.stage
+        in_task = self.state is S.EXE_TSK
+        if in_task and (self._pending_susp or self._pending_term) and not stage.blocking:
+            assert self.core is not None
+            self.core.stop(self.id, stage, now)
+            runner.running = False
+            self.ctx.interrupted = stage
+            self.ctx.stage_started = None
+            self._stage_event(now, "stopped")
+            self._start_gen_susp(now)
+            return
+        if in_task and self._pending_start:
+            self._pending_start = False
+        assert self.core is not None
+        status = self.core.poll(self.id, stage, now)
+        if status.state is SkillState.FAILED:
+            runner.running = False
+            self._stage_event(now, "failed", reason=status.reason)
+            self._end(now, f"stage {stage.label} failed: {status.reason}", cause="failed")
+            return
+        if status.state is SkillState.SUCCEEDED:
+            runner.running = False
+            self._stage_event(now, "done")
+            if in_task:
+                self.ctx.stage_started = None
+                self.ctx.done.append(stage)
+                self.ctx.stage_index = runner.index + 1
+            self.task.on_stage_done(self.ctx, stage)
+            runner.index += 1
+            self._enter_stage(now)
+            if self.state is not S.EXE_TSK:
+                return
+        elif in_task:
+            why = self.task.check_terminate(self.ctx)
+            if why:
+                self.core.stop(self.id, stage, now)
+                self._end(now, why, cause="self")
+                return
+        if in_task and now >= self._next_sp:
+            self._params = self.task.compute_params(self.ctx)
+            self._publish()
+            self._next_sp = _next_tick_of(now, self.rates.sp_up_rate)
+        if runner.running:
+            self.next_wake = _next_tick_of(now, self.rates.task_exe_rate)
+
+    def _start_gen_susp(self, now: float) -> None:
+        self._pending_susp = False
+        self.ctx.suspended = True
+        self.ctx.terminating = self._pending_term is not None
+        self._go(S.GEN_SUSP, now)
+        try:
+            plan = self.task.generate_suspension(self.ctx)
+        except PlanningFailed as exc:
+            self._end(now, f"genSusp {exc.status}: {exc}", cause="failed")
+            return
+        self._emit_plan(now, plan)
+        self._runner = StageRunner(plan)
+        self._ready_at = now + plan.sim_time
+        if plan.sim_time > 0:
+            self.next_wake = self._ready_at
+        else:
+            self._gen_susp(now)
+
+    def _gen_susp(self, now: float) -> None:
+        if now < self._ready_at:
+            self.next_wake = self._ready_at
+            return
+        self._go(S.EXE_SUSP, now)
+        self._enter_stage(now)
+
+    def _finish_susp(self, now: float) -> None:
+        if self._pending_term is not None:
+            self._end(now, self._pending_term, cause="term")
+            return
+        self._pending_start = False
+        self._go(S.WAIT, now)
+        self._comp_sp(now)
+
+    # -- helpers ------------------------------------------------------------------------------
+
+    def _go(self, target: FsmState, now: float, *, check: bool = True, reason: str | None = None) -> None:
+        if check:
+            fsm.check(self.state, target)
+        self._trace.emit(now, "transition", agent=self.id, **{"from": self.state.value, "to": target.value})
+        self.state = target
+        if target is S.END:
+            self.end_reason = reason or "finished"
+            self.next_wake = math.inf
+            self._trace.emit(now, "end", agent=self.id, task_type=self.ctx.task_type,
+                             reason=self.end_reason, cause="finished" if reason == "finished" else "other")
+        self._publish()
+
+    def _end(self, now: float, reason: str, *, cause: str) -> None:
+        runner = self._runner
+        if runner is not None and runner.running and runner.stage is not None and self.core is not None:
+            self.core.stop(self.id, runner.stage, now)
+            runner.running = False
+        fsm.check(self.state, S.END)
+        self._trace.emit(now, "transition", agent=self.id, **{"from": self.state.value, "to": S.END.value})
+        self.state = S.END
+        self.end_reason = reason
+        self.next_wake = math.inf
+        self._trace.emit(now, "end", agent=self.id, task_type=self.ctx.task_type, reason=reason, cause=cause)
+        self._publish()
+
+    def _publish(self) -> None:
+        """pf^report: write the report buffer; tell the harmoniser only if it changed (newData)."""
+        report = Report(self.state, self._params, self._ack, self.end_reason if self.state is S.END else None)
+        if report != self.report:
+            self.report = report
+            if self._on_report is not None:
+                self._on_report(self)
+
+    def _stage_event(self, now: float, status: str, **extra: Any) -> None:
+        runner = self._runner
+        assert runner is not None and runner.stage is not None
+        stage = runner.stage
+        self._trace.emit(now, "stage", agent=self.id, fsm=self.state.value, index=runner.index,
+                         action=stage.action, args=list(stage.args), kind=stage.kind.value, status=status, **extra)
+
+    def _emit_plan(self, now: float, plan: StagePlan) -> None:
+        fields: dict[str, Any] = {
+            "agent": self.id,
+            "purpose": plan.purpose.value,
+            "strategy": plan.strategy,
+            "stages": [s.to_json() for s in plan.stages],
+        }
+        if plan.note:
+            fields["note"] = plan.note
+        if plan.info:
+            fields["info"] = dict(plan.info)
+        expected = Purpose.UP_TSK if self.state is S.UP_TSK else Purpose.GEN_SUSP
+        if plan.purpose is not expected:
+            raise ConfigError(
+                f"task type {self.ctx.task_type!r} returned a {plan.purpose.value} plan in {self.state.value}"
+            )
+        self._trace.emit(now, "plan", **fields)
+
+
+def _next_tick_of(now: float, rate: float) -> float:
+    """The next instant of ``timer(rate)``: timers fire on one grid shared by every agent.
+
+    Aligning all agents' timers makes their reports arrive in the same tick, so the
+    harmoniser schedules once per period rather than once per agent.
+    """
+    return (math.floor(now * rate + 1e-9) + 1) / rate
+
+
+_HANDLERS: dict[FsmState, Callable[[DynamicAgent, float], None]] = {
+    S.INIT_COMM: DynamicAgent._init_comm,
+    S.COMP_SP: DynamicAgent._comp_sp,
+    S.UP_TSK: DynamicAgent._up_tsk,
+    S.EXE_TSK: DynamicAgent._exe,
+    S.GEN_SUSP: DynamicAgent._gen_susp,
+    S.EXE_SUSP: DynamicAgent._exe,
+    S.WAIT: DynamicAgent._comp_sp,
+}

@@ -1,0 +1,259 @@
+"""The task harmoniser (tha): Fig. 7, ``f^harm`` of eq. 36, and Alg. 1.
+
+One :meth:`TaskHarmoniser.step` computes the composite transition function:
+
+* ``pf_initDA`` for every new request in the task buffers: a new agent joins
+  ``idleDA`` (``D_r``);
+* ``term_event`` (eq. 38): agents that reported ``end`` leave ``A_da`` (Alg. 1,
+  lines 15-16; done first, so a freed ``exeDA`` is refilled in the same step);
+* ``pf_schedule`` when ``timer(sFreq)`` fires or on ``shdl_event`` (eq. 37), only
+  while ``irrDA`` is empty; in constant-task (CT) harmonisation, or with a
+  non-preemptive algorithm, only while no agent executes;
+* ``pf_switchDA`` (Alg. 1) when ``irrDA`` is set or on ``term_event``: ``susp`` to
+  the executing agent, and once it reports ``wait`` (acknowledging that ``susp``),
+  ``start`` to ``irrDA``.
+
+The harmoniser never waits on an agent, and it enforces the invariant that at most
+one agent is in ``cmd``: every report updates the set of agents in ``cmd``, and a
+second member is an :class:`~tasker.errors.InvariantViolation`.
+
+Two departures from the letter of Alg. 1, both to keep its intent: ``susp`` is sent
+only when a replacement (``irrDA``) exists — on a bare ``term_event`` line 3 would
+suspend the executing task for nothing —, and it is sent once per switch rather
+than on every iteration.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from enum import StrEnum
+from typing import Any
+
+from tasker.agent import DynamicAgent
+from tasker.errors import ConfigError, InvariantViolation, TaskerError
+from tasker.messages import Command, Flag, FsmState, SPRequest
+from tasker.schedulers.base import Candidate, Scheduler, ScheduleView
+from tasker.trace import Trace
+
+
+class Mode(StrEnum):
+    """Task harmonisation: interruptible-task (IT) or constant-task (CT)."""
+
+    IT = "IT"
+    CT = "CT"
+
+
+@dataclass(frozen=True, slots=True)
+class Request:
+    """A task request from a requester (tra): a task type and its (validated) arguments."""
+
+    task_type: str
+    args: Mapping[str, Any] = field(default_factory=dict)
+    requester: str = "user"
+
+
+AgentFactory = Callable[[str, Request, float, Callable[[DynamicAgent], None]], DynamicAgent]
+
+
+class TaskHarmoniser:
+    """The robot's task harmoniser.  ``exe_da``, ``irr_da`` and ``idle_da`` are its roles."""
+
+    def __init__(
+        self,
+        scheduler: Scheduler,
+        agent_factory: AgentFactory,
+        *,
+        trace: Trace,
+        mode: Mode = Mode.IT,
+        s_freq: float = 1.0,
+    ) -> None:
+        if not isinstance(s_freq, int | float) or s_freq <= 0:
+            raise ConfigError(f"sFreq must be a positive number of Hz, got {s_freq!r}")
+        self.scheduler = scheduler
+        self.mode = Mode(mode)
+        self.s_freq = float(s_freq)
+        self._factory = agent_factory
+        self._trace = trace
+        self.agents: dict[str, DynamicAgent] = {}  # A_da
+        self.exe_da: str | None = None
+        self.irr_da: str | None = None
+        self._idle: dict[str, None] = {}  # D_r, in request order
+        self._requests: list[tuple[str, Request]] = []
+        self._terms: list[tuple[str, str]] = []
+        self._ended: list[str] = []
+        self._new_data = False
+        self._in_cmd: set[str] = set()
+        self._cands: dict[str, Candidate] = {}
+        self._order: dict[str, int] = {}
+        self._seq = 0
+        self._susp_seq: dict[str, int] = {}
+        self._count = 0
+        self._roles_dirty = False
+        self._last_roles: tuple[Any, ...] | None = None
+        self.now = 0.0
+
+    # -- the requesters' side (taskIF) -----------------------------------------------------
+
+    def submit(self, request: Request) -> str:
+        """Queue a request; ``pf_initDA`` creates its agent at the next step.  Returns its id."""
+        self._count += 1
+        agent_id = f"d{self._count}"
+        self._requests.append((agent_id, request))
+        return agent_id
+
+    def terminate(self, agent_id: str, reason: str = "terminated by the requester") -> None:
+        """Ask for a task to end (``term``).  An executing task first suspends safely."""
+        issued = agent_id[:1] == "d" and agent_id[1:].isdigit() and 1 <= int(agent_id[1:]) <= self._count
+        if not issued:
+            raise TaskerError(f"no task {agent_id!r}; active: {sorted(self.agents) or 'none'}")
+        self._terms.append((agent_id, reason))  # a task that has already ended is left alone
+
+    def set_mode(self, mode: Mode | str) -> None:
+        """Switch between IT and CT harmonisation while running (paper feature 8)."""
+        new = Mode(mode)
+        if new is not self.mode:
+            self.mode = new
+            self._trace.emit(self.now, "mode", mode=new.value)
+
+    @property
+    def idle_da(self) -> list[str]:
+        return list(self._idle)
+
+    @property
+    def in_cmd(self) -> frozenset[str]:
+        """Agents whose last report puts them in ``cmd`` (never more than one)."""
+        return frozenset(self._in_cmd)
+
+    @property
+    def busy(self) -> bool:
+        """True while any request is pending or any agent lives."""
+        return bool(self._requests or self.agents or self._terms)
+
+    # -- f^harm ------------------------------------------------------------------------------
+
+    def step(self, now: float, timer: bool = False) -> None:
+        """One iteration of ``f^harm`` (eq. 36) at simulated time ``now``."""
+        self.now = now
+        if self._requests:
+            self._pf_init_da(now)
+        if self._terms:
+            self._deliver_terms()
+        term_event = bool(self._ended)
+        if term_event:
+            self._remove_ended()
+        shdl_event = (self.exe_da is None and self.irr_da is None and bool(self._idle)) or self._new_data
+        self._new_data = False
+        if (timer or shdl_event) and self.irr_da is None:
+            if self.exe_da is None or (self.mode is Mode.IT and self.scheduler.preemptive):
+                self._pf_schedule(now)
+        if self.irr_da is not None or term_event:
+            self._pf_switch_da(now)
+        if self._roles_dirty:
+            self._emit_roles(now)
+
+    def _pf_init_da(self, now: float) -> None:
+        for agent_id, request in self._requests:
+            agent = self._factory(agent_id, request, now, self._on_report)
+            self.agents[agent_id] = agent
+            self._order[agent_id] = len(self._order)
+            self._idle[agent_id] = None
+            self._trace.emit(now, "request", agent=agent_id, task_type=request.task_type,
+                             args=dict(request.args), requester=request.requester)
+        self._requests.clear()
+        self._roles_dirty = True
+
+    def _deliver_terms(self) -> None:
+        for agent_id, reason in self._terms:
+            if agent_id in self.agents and not self.agents[agent_id].ended:
+                self._send(agent_id, Flag.TERM, {"reason": reason})
+        self._terms.clear()
+
+    def _remove_ended(self) -> None:
+        for agent_id in self._ended:
+            self.agents.pop(agent_id, None)
+            self._idle.pop(agent_id, None)
+            self._cands.pop(agent_id, None)
+            self._susp_seq.pop(agent_id, None)
+            if self.exe_da == agent_id:
+                self.exe_da = None
+            if self.irr_da == agent_id:
+                self.irr_da = None
+        self._ended.clear()
+        self._roles_dirty = True
+
+    def _pf_schedule(self, now: float) -> None:
+        exe = self._cands.get(self.exe_da) if self.exe_da is not None else None
+        candidates = [c for a in self._idle if (c := self._cands.get(a)) is not None]
+        if not candidates:
+            return
+        view = ScheduleView(now=now, exe=exe, candidates=candidates, req_sp=self._req_sp)
+        decision = self.scheduler.schedule(view)
+        if decision.record is not None:
+            self._trace.emit(now, "decision", **decision.record)
+        if decision.irr_da is not None:
+            if decision.irr_da not in self._idle:
+                raise InvariantViolation(
+                    f"scheduler {self.scheduler.name!r} chose {decision.irr_da!r}, which is not idle"
+                )
+            del self._idle[decision.irr_da]
+            self.irr_da = decision.irr_da
+            self._roles_dirty = True
+
+    def _pf_switch_da(self, now: float) -> None:
+        """Alg. 1."""
+        exe = self.exe_da
+        if exe is not None:
+            report = self.agents[exe].report
+            assert report is not None
+            state = report.fsm_state
+            if state.in_cmd:  # line 2
+                if self.irr_da is not None and exe not in self._susp_seq:
+                    self._susp_seq[exe] = self._send(exe, Flag.SUSP)  # line 3
+            elif state is FsmState.WAIT and exe in self._susp_seq and report.ack >= self._susp_seq[exe]:  # line 5
+                # a ``wait`` that does not acknowledge our ``susp`` predates the last ``start``: not a suspension
+                self._idle[exe] = None  # line 6
+                self._susp_seq.pop(exe, None)
+                self.exe_da = None  # line 7
+                self._roles_dirty = True
+        if self.exe_da is None and self.irr_da is not None:  # line 9
+            if self._in_cmd:
+                raise InvariantViolation(f"about to start {self.irr_da} while {sorted(self._in_cmd)} is in cmd")
+            self.exe_da, self.irr_da = self.irr_da, None  # lines 10-11
+            self._send(self.exe_da, Flag.START)  # line 12
+            self._roles_dirty = True
+
+    # -- agents' side -----------------------------------------------------------------------
+
+    def _send(self, agent_id: str, flag: Flag, data: Mapping[str, Any] | None = None) -> int:
+        self._seq += 1
+        self._trace.emit(self.now, "command", agent=agent_id, flag=flag.value)
+        self.agents[agent_id].deliver(Command(flag, self._seq, dict(data or {})))
+        return self._seq
+
+    def _req_sp(self, agent_id: str, request: SPRequest) -> Any:
+        return self.agents[agent_id].request_sp(request, self.now)
+
+    def _on_report(self, agent: DynamicAgent) -> None:
+        """A report buffer changed (newData, eq. 37)."""
+        report = agent.report
+        assert report is not None
+        self._new_data = True
+        if report.fsm_state.in_cmd:
+            self._in_cmd.add(agent.id)
+            if len(self._in_cmd) > 1:
+                raise InvariantViolation(f"agents {sorted(self._in_cmd)} are in cmd at once")
+        else:
+            self._in_cmd.discard(agent.id)
+        if report.fsm_state is FsmState.END:
+            self._ended.append(agent.id)
+        elif report.params is not None:
+            self._cands[agent.id] = Candidate(agent.id, agent.ctx.task_type, report.params,
+                                              agent.ctx.request_time, self._order.get(agent.id, 0))
+
+    def _emit_roles(self, now: float) -> None:
+        self._roles_dirty = False
+        roles = (self.exe_da, self.irr_da, tuple(self._idle))
+        if roles != self._last_roles:
+            self._last_roles = roles
+            self._trace.emit(now, "roles", exeDA=self.exe_da, irrDA=self.irr_da, idleDA=list(self._idle))

@@ -1,0 +1,207 @@
+"""The deterministic simulation loop: one simulated clock for everything.
+
+The harmoniser, the agents, the world and the scenario's scheduled events all run on
+an integer tick counter (``resolution`` seconds a tick, 1 ms by default).  The loop
+is a discrete-event simulation: it jumps to the next tick at which something is due,
+and within a tick it runs, in this fixed order,
+
+1. scheduled events (requests, terminations, changes), in the order they were added;
+2. the world's ``advance`` (at the world's rate);
+3. the agents that are due, in the order they were woken;
+4. the harmoniser's ``f^harm``, with ``timer(sFreq)`` when it is due.
+
+No threads, no wall clock: the same inputs and seed give the same trace, byte for
+byte.  A real-time runner can drive the same objects from a wall clock instead.
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+import math
+import random
+from collections.abc import Callable, Mapping
+from typing import Any
+
+from tasker.agent import DynamicAgent, Rates
+from tasker.errors import ConfigError
+from tasker.harmoniser import Mode, Request, TaskHarmoniser
+from tasker.protocols import CoreAgent, World
+from tasker.schedulers.base import Scheduler
+from tasker.store import TaskStore
+from tasker.task import Strategy, TaskContext
+from tasker.trace import Trace
+
+_EVENT, _WORLD, _AGENT, _TIMER = 0, 1, 2, 3
+
+
+class SimulationLoop:
+    """Builds the harmoniser and its agents and steps them on one simulated clock.
+
+    ``strategies`` maps a task type to its :class:`Strategy`; others use ``strategy``.
+    """
+
+    def __init__(
+        self,
+        store: TaskStore,
+        scheduler: Scheduler,
+        *,
+        seed: int = 0,
+        trace: Trace | None = None,
+        mode: Mode | str = Mode.IT,
+        s_freq: float = 1.0,
+        rates: Rates | None = None,
+        strategy: Strategy | None = None,
+        strategies: Mapping[str, Strategy] | None = None,
+        core: CoreAgent | None = None,
+        world: World | None = None,
+        motion: Any = None,
+        resolution: float = 0.001,
+        horizon: float = 24 * 3600.0,
+    ) -> None:
+        if not (isinstance(resolution, int | float) and 0 < resolution <= 1):
+            raise ConfigError(f"resolution must be in (0, 1] seconds, got {resolution!r}")
+        self.store = store
+        self.seed = int(seed)
+        self.trace = trace if trace is not None else Trace()
+        self.rates = rates or Rates()
+        self.strategy = strategy or Strategy()
+        self.strategies = dict(strategies or {})
+        self.core = core
+        self.world = world
+        self.motion = motion
+        self.resolution = float(resolution)
+        self.horizon = float(horizon)
+        self.harmoniser = TaskHarmoniser(scheduler, self._make_agent, trace=self.trace, mode=Mode(mode),
+                                         s_freq=s_freq)
+        self._heap: list[tuple[int, int, int, Any]] = []
+        self._seq = itertools.count()
+        self._tick = 0
+        self._pending_events = 0
+        self._tokens: dict[str, int] = {}
+        self._started = False
+
+    # -- time ---------------------------------------------------------------------------------
+
+    @property
+    def now(self) -> float:
+        return self._tick * self.resolution
+
+    def _to_tick(self, t: float) -> int:
+        return max(self._tick, math.ceil(round(t / self.resolution, 6)))
+
+    def _push(self, tick: int, phase: int, item: Any) -> None:
+        heapq.heappush(self._heap, (tick, phase, next(self._seq), item))
+
+    # -- scenario -----------------------------------------------------------------------------
+
+    def at(self, t: float, action: Callable[[], None]) -> None:
+        """Run ``action`` at simulated time ``t`` (before agents and harmoniser in that tick)."""
+        if not isinstance(t, int | float) or math.isnan(t) or t < 0:
+            raise ConfigError(f"event time must be a number >= 0, got {t!r}")
+        self._pending_events += 1
+        self._push(self._to_tick(t), _EVENT, action)
+
+    def request(self, t: float, task_type: str, args: Mapping[str, Any] | None = None,
+                requester: str = "user") -> Request:
+        """Schedule a task request at ``t``.  Type and arguments are checked now, before the run."""
+        checked = self.store.validate(task_type, args or {})
+        req = Request(task_type, checked, requester)
+        self.at(t, lambda: self._submit(req))
+        return req
+
+    def _submit(self, request: Request) -> None:
+        self.harmoniser.submit(request)
+
+    def terminate(self, t: float, agent_id: str, reason: str = "terminated by the requester") -> None:
+        self.at(t, lambda: self.harmoniser.terminate(agent_id, reason))
+
+    # -- agents ---------------------------------------------------------------------------------
+
+    def _make_agent(self, agent_id: str, request: Request, now: float,
+                    on_report: Callable[[DynamicAgent], None]) -> DynamicAgent:
+        task = self.store.get(request.task_type)
+        ctx = TaskContext(
+            agent=agent_id,
+            task_type=request.task_type,
+            args=dict(request.args),
+            request_time=now,
+            rng=random.Random(f"{self.seed}:{agent_id}"),
+            strategy=self.strategies.get(request.task_type, self.strategy),
+            now=now,
+            core=self.core,
+            motion=self.motion,
+        )
+        world = self.world.snapshot if self.world is not None else None
+        agent = DynamicAgent(agent_id, task, ctx, trace=self.trace, rates=self.rates, core=self.core,
+                             world=world, on_report=on_report, waker=self._wake_next_tick)
+        self._wake(agent, self._tick + 1)
+        return agent
+
+    def _wake(self, agent: DynamicAgent, tick: int) -> None:
+        token = self._tokens.get(agent.id, 0) + 1
+        self._tokens[agent.id] = token
+        self._push(tick, _AGENT, (agent, token))
+
+    def _wake_next_tick(self, agent: DynamicAgent) -> None:
+        self._wake(agent, self._tick + 1)
+
+    # -- running --------------------------------------------------------------------------------
+
+    def _start(self) -> None:
+        self._started = True
+        self.trace.emit(self.now, "run", seed=self.seed, scheduler=self.harmoniser.scheduler.name,
+                        mode=self.harmoniser.mode.value, sFreq=self.harmoniser.s_freq,
+                        repRate=self.rates.rep_rate, taskExeRate=self.rates.task_exe_rate,
+                        SPupRate=self.rates.sp_up_rate,
+                        update=self.strategy.update, suspension=self.strategy.suspension)
+        self._push(self._tick, _TIMER, None)
+        if self.world is not None:
+            self._push(self._tick, _WORLD, None)
+
+    def run(self, until: float | None = None) -> Trace:
+        """Run until every request is served and every agent has ended, or until ``until``.
+
+        Returns the trace.  Stops at ``horizon`` with a ``run`` event saying so.
+        """
+        if not self._started:
+            self._start()
+        stop_tick = self._to_tick(until) if until is not None else None
+        horizon_tick = self._to_tick(self.horizon)
+        harm = self.harmoniser
+        while self._heap:
+            if self._pending_events == 0 and not harm.busy and until is None:
+                break
+            tick = self._heap[0][0]
+            if stop_tick is not None and tick > stop_tick:
+                self._tick = stop_tick
+                break
+            if tick > horizon_tick:
+                self._tick = horizon_tick
+                self.trace.emit(self.now, "run", status="horizon reached", active=sorted(harm.agents))
+                break
+            self._tick = tick
+            now = tick * self.resolution
+            harm.now = now
+            timer = False
+            while self._heap and self._heap[0][0] == tick:
+                _, phase, _, item = heapq.heappop(self._heap)
+                if phase == _AGENT:
+                    agent, token = item
+                    if token != self._tokens.get(agent.id) or agent.ended:
+                        continue
+                    agent.step(now)
+                    if math.isfinite(agent.next_wake):
+                        self._wake(agent, max(tick + 1, self._to_tick(agent.next_wake)))
+                elif phase == _EVENT:
+                    self._pending_events -= 1
+                    item()
+                elif phase == _WORLD:
+                    assert self.world is not None
+                    self.world.advance(now)
+                    self._push(tick + max(1, round(1.0 / (self.world.rate_hz * self.resolution))), _WORLD, None)
+                else:
+                    timer = True
+                    self._push(tick + max(1, round(1.0 / (harm.s_freq * self.resolution))), _TIMER, None)
+            harm.step(now, timer)
+        return self.trace

@@ -1,0 +1,119 @@
+"""Alg. 2 of the paper, generalised: priority classes, then a cost comparison.
+
+The paper's algorithm has two classes, ``humanFell`` above ``guideHuman``:
+
+* the best candidate of the highest class present is the lowest-cost one;
+* if no agent executes, or the executing one is of a lower class, that candidate
+  becomes ``irrDA`` at once (lines 9-12);
+* if the executing agent is of the same class, the candidate ``dac`` is compared
+  with it (lines 20-33): each is asked (``reqSP``) for ``{cc, ccps}`` when started
+  from the other's ``endPose``, and
+
+      c_switch = cost_dac + cc_exeDA + cps_exeDA * cTime_dac
+      c_wait   = cost_exeDA + cc_dac + cps_dac * cTime_exeDA
+
+  and the switch is made when ``c_switch < hysteresis * c_wait`` (the paper: 1.0;
+  the original ROS code used 0.9);
+* an executing agent of a higher class is never preempted.
+
+Generalisation: ``classes`` is a list of lists of task-type names, highest first;
+types not listed form one implicit class below all others.  The paper's Alg. 2
+reads ``exeDA``'s parameters in lines 22-26 even when no agent executes; here an
+empty ``exeDA`` means the candidate is started directly, as lines 9-12 do for
+``humanFell``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from tasker.errors import ConfigError
+from tasker.messages import SP_COMPLETION, CompletionCost, SPRequest
+from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, ScheduleView
+
+DEFAULT_CLASSES: tuple[tuple[str, ...], ...] = (("human_fell",), ("guide_human",))
+
+
+def _mul(a: float, b: float) -> float:
+    """``a*b`` with ``0*inf = 0``: no cost growth times any duration adds nothing."""
+    return 0.0 if a == 0 or b == 0 else a * b
+
+
+class Alg2(Scheduler):
+    """The paper's Alg. 2 with configurable priority classes and hysteresis."""
+
+    name = "alg2"
+    preemptive = True
+
+    def __init__(self, classes: Sequence[Sequence[str]] = DEFAULT_CLASSES, hysteresis: float = 1.0) -> None:
+        if not isinstance(hysteresis, int | float) or not 0 < hysteresis <= 1:
+            raise ConfigError(f"alg2: hysteresis must be in (0, 1], got {hysteresis!r}")
+        rank: dict[str, int] = {}
+        for k, cls in enumerate(classes):
+            if isinstance(cls, str):
+                raise ConfigError(f"alg2: classes[{k}] must be a list of task types, got the string {cls!r}")
+            for t in cls:
+                if t in rank:
+                    raise ConfigError(f"alg2: task type {t!r} appears in two priority classes")
+                rank[t] = k
+        self.classes = tuple(tuple(c) for c in classes)
+        self.hysteresis = float(hysteresis)
+        self._rank = rank
+        self._lowest = len(self.classes)
+
+    def rank(self, task_type: str) -> int:
+        """Priority class of a task type: 0 is the highest."""
+        return self._rank.get(task_type, self._lowest)
+
+    def schedule(self, view: ScheduleView) -> Decision:
+        best: Candidate | None = None
+        best_key: tuple[int, float, int] | None = None
+        for c in view.candidates:  # one pass: lowest (class, cost, request order)
+            p = self.cost_params(c, self.name)
+            key = (self.rank(c.task_type), p.cost, c.order)
+            if best_key is None or key < best_key:
+                best, best_key = c, key
+        if best is None or best_key is None:
+            return NO_CHANGE
+        exe = view.exe
+        if exe is None:
+            return Decision(best.id)
+        r_exe = self.rank(exe.task_type)
+        if r_exe > best_key[0]:
+            record = {"algorithm": self.name, "dac": best.id, "exeDA": exe.id, "rule": "priority class",
+                      "switch": True}
+            return Decision(best.id, record)
+        if r_exe < best_key[0]:
+            return NO_CHANGE
+        return self._compare(view, best, exe)
+
+    def _compare(self, view: ScheduleView, dac: Candidate, exe: Candidate) -> Decision:
+        p_dac = self.cost_params(dac, self.name)
+        p_exe = self.cost_params(exe, self.name)
+        a_dac = self._completion(view, dac, p_exe.end_pose)
+        a_exe = self._completion(view, exe, p_dac.end_pose)
+        c_switch = p_dac.cost + a_exe.cc + _mul(p_exe.cps, p_dac.c_time)
+        c_wait = p_exe.cost + a_dac.cc + _mul(p_dac.cps, p_exe.c_time)
+        switch = bool(c_switch < self.hysteresis * c_wait) if not math.isnan(c_switch + c_wait) else False
+        record: dict[str, Any] = {
+            "algorithm": self.name, "dac": dac.id, "exeDA": exe.id, "rule": "cost",
+            "cost_dac": p_dac.cost, "cost_exeDA": p_exe.cost,
+            "cps_dac": p_dac.cps, "cps_exeDA": p_exe.cps,
+            "cTime_dac": p_dac.c_time, "cTime_exeDA": p_exe.c_time,
+            "cc_dac": a_dac.cc, "cc_exeDA": a_exe.cc,
+            "ccps_dac": a_dac.ccps, "ccps_exeDA": a_exe.ccps,
+            "c_switch": c_switch, "c_wait": c_wait, "hysteresis": self.hysteresis, "switch": switch,
+        }
+        return Decision(dac.id if switch else None, record)
+
+    @staticmethod
+    def _completion(view: ScheduleView, c: Candidate, pose: Any) -> CompletionCost:
+        answer = view.req_sp(c.id, SPRequest(SP_COMPLETION, {"pose": pose}))
+        if not isinstance(answer, CompletionCost):
+            raise ConfigError(
+                f"alg2: task type {c.task_type!r} answered reqSP {SP_COMPLETION!r} with "
+                f"{type(answer).__name__}, expected CompletionCost"
+            )
+        return answer

@@ -1,0 +1,88 @@
+"""What a schedule algorithm (``pf_schedule``, eq. 35) sees and returns.
+
+A scheduler reads a :class:`ScheduleView` (the report buffers ``B_report``, the
+``reqSP`` buffers ``B_reqSP`` as a call, and the harmoniser's roles) and returns a
+:class:`Decision`: the agent to put in ``irrDA``, or none, plus an optional record of
+the comparison it made (written to the trace as a ``decision`` event).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+from tasker.errors import ConfigError
+from tasker.messages import CostParams, ScheduleParams, SPRequest
+
+
+@dataclass(frozen=True, slots=True)
+class Candidate:
+    """An agent as a scheduler sees it: identity, type, request order and its latest parameters."""
+
+    id: str
+    task_type: str
+    params: ScheduleParams
+    request_time: float
+    order: int
+
+
+@dataclass(frozen=True, slots=True)
+class ScheduleView:
+    """Read-only input of ``pf_schedule``.
+
+    ``exe`` is the executing agent (``exeDA``) or None; ``candidates`` are the idle
+    agents (``D_r``) whose report is initialised, in request order.
+    """
+
+    now: float
+    exe: Candidate | None
+    candidates: Sequence[Candidate]
+    req_sp: Callable[[str, SPRequest], Any]
+
+
+@dataclass(frozen=True, slots=True)
+class Decision:
+    """Output of ``pf_schedule``: the new ``irrDA`` (or None) and what was compared."""
+
+    irr_da: str | None = None
+    record: Mapping[str, Any] | None = None
+
+
+NO_CHANGE = Decision()
+
+
+class Scheduler:
+    """Base of schedule algorithms.  Subclasses set :attr:`name` and implement :meth:`schedule`.
+
+    ``preemptive`` schedulers may pick a candidate while an agent executes (IT);
+    a non-preemptive one is only consulted when no agent executes.
+    """
+
+    name: ClassVar[str] = ""
+    preemptive: ClassVar[bool] = True
+
+    def schedule(self, view: ScheduleView) -> Decision:
+        raise NotImplementedError
+
+    @staticmethod
+    def cost_params(c: Candidate, algorithm: str) -> CostParams:
+        if not isinstance(c.params, CostParams):
+            raise ConfigError(
+                f"scheduler {algorithm!r} needs CostParams from task type {c.task_type!r} "
+                f"(agent {c.id}), got {type(c.params).__name__}"
+            )
+        return c.params
+
+
+@dataclass(frozen=True, slots=True)
+class Options:
+    """Scheduler options read from configuration, checked for unknown keys."""
+
+    values: Mapping[str, Any] = field(default_factory=dict)
+
+    def take(self, allowed: set[str], algorithm: str) -> dict[str, Any]:
+        unknown = sorted(set(self.values) - allowed)
+        if unknown:
+            raise ConfigError(f"scheduler {algorithm!r}: unknown option(s) {unknown}; allowed: {sorted(allowed)}")
+        return dict(self.values)

@@ -1,0 +1,37 @@
+"""Fixed-priority baseline: the highest priority runs, and preempts a lower one.
+
+A task's priority is ``CostParams.priority`` when its task type reports one, else
+``priorities[task_type]`` from configuration, else ``default``.  Ties go to the
+earlier request.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, ScheduleView
+
+
+class FixedPriority(Scheduler):
+    name = "priority"
+    preemptive = True
+
+    def __init__(self, priorities: Mapping[str, int] | None = None, default: int = 0) -> None:
+        self.priorities = dict(priorities or {})
+        self.default = default
+
+    def priority(self, c: Candidate) -> int:
+        p = getattr(c.params, "priority", None)
+        return p if p is not None else self.priorities.get(c.task_type, self.default)
+
+    def schedule(self, view: ScheduleView) -> Decision:
+        if not view.candidates:
+            return NO_CHANGE
+        best = min(view.candidates, key=lambda c: (-self.priority(c), c.order))
+        if view.exe is None:
+            return Decision(best.id)
+        p_dac, p_exe = self.priority(best), self.priority(view.exe)
+        switch = p_dac > p_exe
+        record = {"algorithm": self.name, "dac": best.id, "exeDA": view.exe.id,
+                  "priority_dac": p_dac, "priority_exeDA": p_exe, "switch": switch}
+        return Decision(best.id if switch else None, record)

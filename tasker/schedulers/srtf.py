@@ -1,0 +1,24 @@
+"""Shortest-remaining-time-first baseline: preempts when a waiting task is shorter
+than what remains of the executing one (its current ``cTime``)."""
+
+from __future__ import annotations
+
+from tasker.schedulers.base import NO_CHANGE, Decision, Scheduler, ScheduleView
+
+
+class ShortestRemainingTimeFirst(Scheduler):
+    name = "srtf"
+    preemptive = True
+
+    def schedule(self, view: ScheduleView) -> Decision:
+        if not view.candidates:
+            return NO_CHANGE
+        best = min(view.candidates, key=lambda c: (self.cost_params(c, self.name).c_time, c.order))
+        if view.exe is None:
+            return Decision(best.id)
+        t_dac = self.cost_params(best, self.name).c_time
+        t_exe = self.cost_params(view.exe, self.name).c_time
+        switch = t_dac < t_exe
+        record = {"algorithm": self.name, "dac": best.id, "exeDA": view.exe.id,
+                  "cTime_dac": t_dac, "cTime_exeDA": t_exe, "switch": switch}
+        return Decision(best.id if switch else None, record)

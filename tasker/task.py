@@ -1,0 +1,228 @@
+"""Task types: what a user writes to add a task to the store.
+
+A task type is a class with **hooks**; the dynamic agent owns the loop and calls them
+at the moments the paper defines.  Override the hooks you need:
+
+=====================  ===============================  ===================================
+hook                   called in (paper)                 returns
+=====================  ===============================  ===================================
+``initialise``         ``initComm``                      nothing; set up ``ctx.memory``
+``compute_params``     ``compSP``, ``wait`` (eq. 22,      :class:`~tasker.messages.ScheduleParams`
+                       27) and ``exeTsk`` (eq. 24)
+``request_sp``         on the harmoniser's ``reqSP``      the requested parameter, e.g.
+                       (eqs. 20-23)                       :class:`~tasker.messages.CompletionCost`
+``update_task``        ``upTsk``                         the ``exeTsk`` :class:`~tasker.stage.StagePlan`
+``generate_suspension`` ``genSusp``                      the ``exeSusp`` :class:`~tasker.stage.StagePlan`
+``check_terminate``    ``compSP``, ``exeTsk``, ``wait``   a reason to end itself (``ic_term``) or None
+``on_stage_done``      after each completed stage        nothing
+=====================  ===============================  ===================================
+
+``update_task`` and ``generate_suspension`` may raise
+:class:`~tasker.errors.PlanningFailed`: the agent then ends (upTsk) with the reason in
+the trace.  A task type that wants a fallback (e.g. a static suspension when the
+planner fails) does it inside the hook and says so in ``StagePlan.note``.
+
+The public method :meth:`TaskType.validate_args` checks a request's arguments against
+the declared :class:`ArgSpec` tuple; task types add checks in ``check_args``.
+"""
+
+from __future__ import annotations
+
+import random
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from tasker.errors import BadRequest, ConfigError
+from tasker.messages import CompletionCost, CostParams, ScheduleParams, SPRequest
+from tasker.stage import Purpose, Stage, StagePlan
+
+_ARG_TYPES: dict[str, type] = {"str": str, "float": float, "int": int, "bool": bool, "pose": tuple}
+
+
+@dataclass(frozen=True, slots=True)
+class ArgSpec:
+    """One argument of a task request: its name, type and whether it is required."""
+
+    name: str
+    type: str = "str"
+    required: bool = True
+    default: Any = None
+    help: str = ""
+    choices: tuple[Any, ...] | None = None
+
+    def __post_init__(self) -> None:
+        if not self.name.isidentifier():
+            raise ConfigError(f"ArgSpec.name must be an identifier, got {self.name!r}")
+        if self.type not in _ARG_TYPES:
+            raise ConfigError(f"ArgSpec {self.name!r}: type must be one of {sorted(_ARG_TYPES)}, got {self.type!r}")
+
+    def coerce(self, task: str, value: Any) -> Any:
+        """Check ``value`` and return it in its canonical form; raise :class:`BadRequest`."""
+        where = f"task {task!r}, argument {self.name!r}"
+        if self.type == "float":
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise BadRequest(f"{where}: expected a number, got {value!r}")
+            value = float(value)
+        elif self.type == "int":
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise BadRequest(f"{where}: expected an integer, got {value!r}")
+        elif self.type == "bool":
+            if not isinstance(value, bool):
+                raise BadRequest(f"{where}: expected true or false, got {value!r}")
+        elif self.type == "pose":
+            if not isinstance(value, list | tuple) or len(value) not in (2, 3) or not all(
+                isinstance(v, int | float) and not isinstance(v, bool) for v in value
+            ):
+                raise BadRequest(f"{where}: expected a pose [x, y] or [x, y, yaw], got {value!r}")
+            value = tuple(float(v) for v in value)
+        elif not isinstance(value, str) or not value:
+            raise BadRequest(f"{where}: expected a non-empty string, got {value!r}")
+        if self.choices is not None and value not in self.choices:
+            raise BadRequest(f"{where}: expected one of {list(self.choices)}, got {value!r}")
+        return value
+
+
+@dataclass(frozen=True, slots=True)
+class Strategy:
+    """How a task builds its FSMs: ``update`` in upTsk, ``suspension`` in genSusp.
+
+    Each is ``"planned"`` (call a planner on the world as it is) or ``"static"``
+    (the task's template ``exeTsk``, Alg. 3, and decision-tree ``exeSusp``, eq. 47).
+    """
+
+    update: str = "planned"
+    suspension: str = "planned"
+
+    def __post_init__(self) -> None:
+        for name in ("update", "suspension"):
+            if getattr(self, name) not in ("planned", "static"):
+                raise ConfigError(f"Strategy.{name} must be 'planned' or 'static', got {getattr(self, name)!r}")
+
+
+@dataclass(slots=True)
+class TaskContext:
+    """What a hook may read and write about its agent: the agent's memory ``c_dy``.
+
+    ``world`` is whatever the run's world offers (:meth:`tasker.protocols.World.snapshot`,
+    a :class:`~tasker.world.WorldState` for robots in this project, or ``None``
+    without a world); ``core`` is the robot's core agent and ``motion`` its
+    :class:`~tasker.world.MotionModel`, if any.  ``done``
+    lists the stages of ``exeTsk`` completed so far, across suspensions;
+    ``interrupted`` is the stage during which the last suspension happened;
+    ``suspended`` is true once the task has been suspended (Alg. 3's *suspended*);
+    ``stage_started`` is when the running stage of ``exeTsk`` began (None between stages).
+    """
+
+    agent: str
+    task_type: str
+    args: dict[str, Any]
+    request_time: float
+    rng: random.Random
+    strategy: Strategy = field(default_factory=Strategy)
+    now: float = 0.0
+    world: Any = None
+    core: Any = None
+    motion: Any = None
+    memory: dict[str, Any] = field(default_factory=dict)
+    plan: StagePlan | None = None
+    stage_index: int = 0
+    done: list[Stage] = field(default_factory=list)
+    interrupted: Stage | None = None
+    stage_started: float | None = None
+    suspended: bool = False
+    terminating: bool = False
+
+    @property
+    def current(self) -> Stage | None:
+        """The stage of ``exeTsk`` the agent is at (or would resume), if any."""
+        if self.plan is None or self.stage_index >= len(self.plan.stages):
+            return None
+        return self.plan.stages[self.stage_index]
+
+    @property
+    def remaining(self) -> tuple[Stage, ...]:
+        """Stages of the current ``exeTsk`` not yet completed (empty before the first upTsk)."""
+        if self.plan is None:
+            return ()
+        return self.plan.stages[self.stage_index :]
+
+    @property
+    def age(self) -> float:
+        """Seconds since the task was requested."""
+        return self.now - self.request_time
+
+
+class TaskType:
+    """Base class of a task type; see the module docstring for the hooks.
+
+    Subclasses set :attr:`name`, :attr:`arg_specs` and :attr:`description`, and
+    override hooks.  One instance serves every agent of the type, so per-agent state
+    belongs in ``ctx.memory``, never on ``self``.
+    """
+
+    name: str = ""
+    description: str = ""
+    arg_specs: tuple[ArgSpec, ...] = ()
+
+    # -- framework-owned ------------------------------------------------------------
+
+    def validate_args(self, args: Mapping[str, Any]) -> dict[str, Any]:
+        """Check a request's arguments; return them completed with defaults.
+
+        Raises :class:`~tasker.errors.BadRequest` naming the argument at fault.
+        """
+        if not isinstance(args, Mapping):
+            raise BadRequest(f"task {self.name!r}: arguments must be a mapping, got {type(args).__name__}")
+        known = {a.name: a for a in self.arg_specs}
+        unknown = sorted(set(args) - set(known))
+        if unknown:
+            raise BadRequest(
+                f"task {self.name!r}: unknown argument(s) {unknown}; expected {sorted(known) or 'none'}"
+            )
+        out: dict[str, Any] = {}
+        for spec in self.arg_specs:
+            if spec.name in args and not (args[spec.name] is None and not spec.required):
+                out[spec.name] = spec.coerce(self.name, args[spec.name])
+            elif spec.required:
+                raise BadRequest(f"task {self.name!r}: missing required argument {spec.name!r}")
+            else:
+                out[spec.name] = spec.default
+        self.check_args(out)
+        return out
+
+    # -- hooks ----------------------------------------------------------------------
+
+    def check_args(self, args: dict[str, Any]) -> None:
+        """Extra argument checks (e.g. a named person exists); raise BadRequest."""
+
+    def initialise(self, ctx: TaskContext) -> None:
+        """``initComm``: set up ``ctx.memory``."""
+
+    def compute_params(self, ctx: TaskContext) -> ScheduleParams:
+        """``compSP``: the schedule parameters now.  Default: cost = age, cTime = expected duration."""
+        remaining = ctx.remaining if ctx.plan is not None else ()
+        c_time = sum(s.duration for s in remaining)
+        return CostParams(self.name, cost=ctx.age + c_time, cps=1.0, c_time=c_time)
+
+    def request_sp(self, ctx: TaskContext, request: SPRequest) -> Any:
+        """``reqSP``: an argument-dependent parameter.  Default answers ``cc`` from ``compute_params``."""
+        params = self.compute_params(ctx)
+        if isinstance(params, CostParams):
+            return CompletionCost(cc=params.cost, ccps=params.cps)
+        raise NotImplementedError(f"task type {self.name!r} does not answer reqSP {request.sp_id!r}")
+
+    def update_task(self, ctx: TaskContext) -> StagePlan:
+        """``upTsk``: build ``exeTsk`` from the world as it is now."""
+        raise NotImplementedError(f"task type {self.name!r} does not implement update_task")
+
+    def generate_suspension(self, ctx: TaskContext) -> StagePlan:
+        """``genSusp``: build ``exeSusp``.  Default: nothing to do (the ``save`` behaviour of eq. 47)."""
+        return StagePlan((), Purpose.GEN_SUSP, strategy="static")
+
+    def check_terminate(self, ctx: TaskContext) -> str | None:
+        """``ic_term`` set by the agent itself: a reason to end, or None to go on."""
+        return None
+
+    def on_stage_done(self, ctx: TaskContext, stage: Stage) -> None:
+        """Called after a stage of ``exeTsk`` or ``exeSusp`` completes."""

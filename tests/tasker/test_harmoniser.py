@@ -1,0 +1,235 @@
+"""Alg. 1 and the dynamic agent's FSM, driven through the simulation loop."""
+
+from __future__ import annotations
+
+import pytest
+
+from tasker.errors import BadRequest, InvariantViolation, PlanningFailed, UnknownName
+from tasker.messages import FsmState, Report
+from tasker.stage import Purpose, StagePlan
+from tasker.synthetic import ManualExecutor, SyntheticTask
+from tasker.task import TaskContext
+
+from .helpers import BLOCK, first, guide, make_loop, st
+
+FELL = dict(classes=[["fell"], ["guide"]])
+
+
+def transitions(trace, agent):  # type: ignore[no-untyped-def]
+    return [(e["from"], e["to"]) for e in trace.of("transition", agent=agent)]
+
+
+def test_new_request_joins_idle_and_is_started() -> None:
+    loop = make_loop([guide()])
+    loop.request(0.0, "guide")
+    tr = loop.run()
+    assert first(tr.events, event="roles")["idleDA"] == ["d1"]
+    assert transitions(tr, "d1")[:4] == [("initComm", "compSP"), ("compSP", "upTsk"), ("upTsk", "exeTsk"),
+                                         ("exeTsk", "end")]
+    assert tr.of("end", agent="d1")[0]["reason"] == "finished"
+    assert tr.of("end")[0]["t"] == pytest.approx(19.0, abs=0.2)  # 5 + 2 + 10 + 2 s of stages
+
+
+def test_preemption_suspends_then_starts_then_resumes() -> None:
+    loop = make_loop([guide("guide"), SyntheticTask("fell", [st("approach", 3), st("check", 2)])], **FELL)
+    loop.request(0.0, "guide")
+    loop.request(2.0, "fell")
+    tr = loop.run()
+    cmds = [(e["agent"], e["flag"]) for e in tr.of("command")]
+    assert cmds == [("d1", "start"), ("d1", "susp"), ("d2", "start"), ("d1", "start")]
+    assert ("exeTsk", "genSusp") in transitions(tr, "d1") and ("exeSusp", "wait") in transitions(tr, "d1")
+    start_d2 = first(tr.events, event="command", agent="d2", flag="start")["t"]
+    wait_d1 = first(tr.events, event="transition", agent="d1", to="wait")["t"]
+    assert start_d2 >= wait_d1  # start only once exeDA reported wait
+    assert [e["reason"] for e in tr.of("end")] == ["finished", "finished"]
+
+
+def test_blocking_stage_delays_the_switch_to_the_next_suspendable_stage() -> None:
+    t = SyntheticTask("guide", [st("approach", 5), st("greet", 4, BLOCK), st("hand_over", 4, BLOCK), st("guide", 10)])
+    loop = make_loop([t, SyntheticTask("fell", [st("check", 2)])], **FELL)
+    loop.request(0.0, "guide")
+    loop.request(6.0, "fell")  # during the blocking "greet" (5..9), then blocking "hand_over" (9..13)
+    tr = loop.run()
+    susp = first(tr.events, event="command", agent="d1", flag="susp")["t"]
+    gen = first(tr.events, event="transition", agent="d1", to="genSusp")["t"]
+    assert susp == pytest.approx(6.0, abs=0.01)
+    assert gen == pytest.approx(13.0, abs=0.2)  # after both blocking stages, at the suspendable "guide"
+    done = [e["action"] for e in tr.of("stage", agent="d1", status="done") if e["t"] <= gen]
+    assert done == ["approach", "greet", "hand_over"]
+    assert not tr.of("stage", agent="d1", action="greet", status="stopped")
+
+
+def test_suspendable_stage_is_stopped_at_once() -> None:
+    loop = make_loop([guide(), SyntheticTask("fell", [st("check", 2)])], **FELL)
+    loop.request(0.0, "guide")
+    loop.request(2.5, "fell")
+    tr = loop.run()
+    stopped = first(tr.events, event="stage", agent="d1", status="stopped")
+    assert stopped["action"] == "approach" and stopped["t"] == pytest.approx(2.5, abs=0.01)
+
+
+def test_agent_ending_itself_before_it_starts_is_removed() -> None:
+    tasks = [guide("guide"), SyntheticTask("fell", [st("approach", 5), st("check", 5)])]
+    loop = make_loop(tasks, **FELL)
+    loop.request(0.0, "fell")  # d1 executes
+    loop.request(1.0, "fell", {"cancel_at": 5.0})  # d3: never started while d1 runs ...
+    loop.request(0.5, "guide")
+    tr = loop.run()
+    # ... so it ends itself from compSP; and the harmoniser removes it (Alg. 1, lines 15-16)
+    assert ("compSP", "end") in transitions(tr, "d3")
+    assert tr.of("end", agent="d3")[0]["reason"] == "no longer needed"
+    last_roles = tr.of("roles")[-1]
+    assert "d3" not in last_roles["idleDA"] and last_roles["exeDA"] != "d3"
+    assert "d3" not in loop.harmoniser.agents
+
+
+def test_agent_in_wait_ends_itself_and_the_rest_go_on() -> None:
+    tasks = [guide("guide"), SyntheticTask("fell", [st("approach", 5), st("check", 5)])]
+    loop = make_loop(tasks, **FELL)
+    loop.request(0.0, "guide", {"cancel_at": 8.0})
+    loop.request(2.0, "fell")  # preempts d1, which waits ...
+    tr = loop.run()
+    assert ("wait", "end") in transitions(tr, "d1")  # ... and ends itself from wait at t = 8
+    assert tr.of("end", agent="d1")[0]["t"] == pytest.approx(8.0, abs=1.01)
+    assert tr.of("end", agent="d2")[0]["reason"] == "finished"
+    assert not any(e["agent"] == "d1" for e in tr.of("command") if e["t"] > 8.0)
+    assert all("d1" not in r["idleDA"] for r in tr.of("roles") if r["t"] > 9.1)
+
+
+def test_ct_mode_never_preempts() -> None:
+    loop = make_loop([guide("guide"), SyntheticTask("fell", [st("check", 2)])], mode="CT", **FELL)
+    loop.request(0.0, "guide")
+    loop.request(2.0, "fell")
+    tr = loop.run()
+    assert [e["flag"] for e in tr.of("command")] == ["start", "start"]
+    assert first(tr.events, event="command", agent="d2")["t"] >= tr.of("end", agent="d1")[0]["t"]
+
+
+def test_switching_ct_to_it_online() -> None:
+    loop = make_loop([guide("guide"), SyntheticTask("fell", [st("check", 2)])], mode="CT", **FELL)
+    loop.request(0.0, "guide")
+    loop.request(2.0, "fell")
+    loop.at(7.0, lambda: loop.harmoniser.set_mode("IT"))
+    tr = loop.run()
+    susp = first(tr.events, event="command", flag="susp")
+    assert susp["agent"] == "d1" and susp["t"] == pytest.approx(7.0, abs=0.01)
+    assert first(tr.events, event="mode")["mode"] == "IT"
+
+
+def test_requester_terminates_an_executing_task_after_a_safe_suspension() -> None:
+    t = SyntheticTask("carry", [st("pick", 2, BLOCK), st("walk", 10)], suspension={"walk": [st("put_down", 3, BLOCK)]})
+    loop = make_loop([t])
+    loop.request(0.0, "carry")
+    loop.terminate(4.0, "d1", "user changed their mind")
+    tr = loop.run()
+    assert transitions(tr, "d1")[-3:] == [("exeTsk", "genSusp"), ("genSusp", "exeSusp"), ("exeSusp", "end")]
+    assert [e["action"] for e in tr.of("stage", agent="d1", status="done")] == ["pick", "put_down"]
+    assert tr.of("end", agent="d1")[0]["reason"] == "user changed their mind"
+
+
+def test_unsolvable_task_ends_with_its_reason_and_others_go_on() -> None:
+    class Unsolvable(SyntheticTask):
+        def update_task(self, ctx: TaskContext) -> StagePlan:
+            raise PlanningFailed("unsolvable", "no plan reaches (at john kitchen)")
+
+    loop = make_loop([Unsolvable("bad", [st("x", 1)]), guide()])
+    loop.request(0.0, "bad")
+    loop.request(0.0, "guide")
+    tr = loop.run()
+    bad = tr.of("end", agent="d1")[0]
+    assert bad["reason"] == "upTsk unsolvable: no plan reaches (at john kitchen)" and bad["cause"] == "failed"
+    assert tr.of("end", agent="d2")[0]["reason"] == "finished"
+
+
+def test_failing_stage_ends_the_task_and_others_go_on() -> None:
+    loop = make_loop([SyntheticTask("flaky", [st("grab", 1, fail="object gone")]), guide()])
+    loop.request(0.0, "flaky")
+    loop.request(0.0, "guide")
+    tr = loop.run()
+    assert tr.of("end", agent="d1")[0]["reason"] == "stage grab failed: object gone"
+    assert tr.of("end", agent="d2")[0]["reason"] == "finished"
+
+
+def test_resumed_task_does_not_redo_completed_stages_and_uses_alg3_prefix() -> None:
+    g = SyntheticTask("guide", [st("approach", 5), st("greet", 2, BLOCK), st("guide", 10)],
+                      resume_prefix=[st("greet_and_apologise", 2, BLOCK)])
+    loop = make_loop([g, SyntheticTask("fell", [st("check", 2)])], **FELL)
+    loop.request(0.0, "guide")
+    loop.request(9.0, "fell")  # during "guide"
+    tr = loop.run()
+    plans = tr.of("plan", agent="d1", purpose="upTsk")
+    assert [s["action"] for s in plans[0]["stages"]] == ["approach", "greet", "guide"]
+    assert [s["action"] for s in plans[1]["stages"]] == ["greet_and_apologise", "guide"]
+
+
+def test_bad_requests_change_nothing() -> None:
+    loop = make_loop([guide()])
+    with pytest.raises(UnknownName, match="known: guide"):
+        loop.request(0.0, "gide")
+    with pytest.raises(BadRequest, match="argument 'weight': expected a number"):
+        loop.request(0.0, "guide", {"weight": "heavy"})
+    with pytest.raises(BadRequest, match="unknown argument"):
+        loop.request(0.0, "guide", {"person": "john"})
+    assert loop.run().of("request") == []
+
+
+def test_requester_changes_a_parameter_and_the_schedule_follows() -> None:
+    from tasker.requester import Requester
+
+    loop = make_loop([guide("a"), guide("b")], scheduler="priority")
+    loop.request(0.0, "a")
+    loop.request(1.0, "b")
+    req = Requester(loop.store, loop.harmoniser, "nurse")
+    loop.at(3.0, lambda: req.change("d2", {"priority": 5}))
+    tr = loop.run()
+    assert first(tr.events, event="change")["args"] == {"priority": 5}
+    assert first(tr.events, event="command", flag="susp")["t"] == pytest.approx(3.0, abs=0.01)
+
+
+def test_two_agents_in_cmd_is_an_invariant_violation() -> None:
+    loop = make_loop([guide()])
+    loop.request(0.0, "guide")
+    loop.request(0.0, "guide")
+    loop.run(until=0.5)
+    h = loop.harmoniser
+    a, b = (h.agents[x] for x in ("d1", "d2"))
+    assert h.in_cmd == {"d1"}
+    b.report = Report(FsmState.EXE_TSK)
+    with pytest.raises(InvariantViolation, match="in cmd at once"):
+        h._on_report(b)
+    assert a.state.in_cmd
+
+
+def test_a_stale_wait_report_is_not_taken_for_a_suspension() -> None:
+    loop = make_loop([guide("a"), guide("b")], scheduler="priority", priorities={"b": 1})
+    loop.request(0.0, "a")
+    loop.run(until=1.0)
+    h = loop.harmoniser
+    h._susp_seq["d1"] = 99  # a susp the agent has not acknowledged yet
+    h.agents["d1"].report = Report(FsmState.WAIT, ack=1)
+    h.irr_da = "dX"
+    h._pf_switch_da(1.0)
+    assert h.exe_da == "d1"  # still the executing agent: no second start
+
+
+def test_manual_executor_drives_stages() -> None:
+    core = ManualExecutor()
+    loop = make_loop([guide()], core=core)
+    loop.request(0.0, "guide")
+    loop.run(until=100.0)
+    assert loop.harmoniser.agents["d1"].state is FsmState.EXE_TSK  # nothing finishes by itself
+    for _ in range(4):
+        core.finish()
+        loop.run(until=loop.now + 1.0)
+    assert loop.trace.of("end", agent="d1")[0]["reason"] == "finished"
+
+
+def test_plan_purpose_is_checked() -> None:
+    class Wrong(SyntheticTask):
+        def update_task(self, ctx: TaskContext) -> StagePlan:
+            return StagePlan((), Purpose.GEN_SUSP)
+
+    loop = make_loop([Wrong("w", [st("x", 1)])])
+    loop.request(0.0, "w")
+    with pytest.raises(Exception, match="returned a genSusp plan in upTsk"):
+        loop.run()

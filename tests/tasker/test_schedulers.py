@@ -1,0 +1,91 @@
+"""Every registered scheduler honours the contract; baselines decide as their names say."""
+
+from __future__ import annotations
+
+import pytest
+
+from tasker import schedulers
+from tasker.errors import UnknownName
+from tasker.messages import CompletionCost, CostParams, SPRequest
+from tasker.schedulers.base import Candidate, Decision, ScheduleView
+
+
+def cand(agent: str, order: int, *, cost: float = 1, c_time: float = 1, deadline: float | None = None,
+         priority: int | None = None, task_type: str = "t") -> Candidate:
+    return Candidate(agent, task_type, CostParams(task_type, cost=cost, cps=1, c_time=c_time, end_pose=(0.0, 0.0),
+                                                  deadline=deadline, priority=priority), float(order), order)
+
+
+def answer(agent: str, req: SPRequest) -> CompletionCost:
+    return CompletionCost(1.0, 1.0)
+
+
+def v(exe: Candidate | None, cands: list[Candidate]) -> ScheduleView:
+    return ScheduleView(0.0, exe, cands, answer)
+
+
+@pytest.mark.parametrize("name", schedulers.names())
+def test_contract(name: str) -> None:
+    s = schedulers.create(name)
+    assert s.schedule(v(None, [])) == Decision()
+    cands = [cand("d2", 1, cost=3, c_time=3, deadline=9), cand("d3", 2, cost=2, c_time=2, deadline=8)]
+    d = s.schedule(v(None, cands))
+    assert d.irr_da in {"d2", "d3"}  # with no agent executing, something is started
+    d = s.schedule(v(cand("d1", 0, cost=9, c_time=9, deadline=99), cands))
+    assert d.irr_da is None or d.irr_da in {"d2", "d3"}
+    if not s.preemptive:
+        assert d.irr_da is None
+
+
+def test_unknown_name_lists_known_ones() -> None:
+    with pytest.raises(UnknownName) as err:
+        schedulers.create("round-robin")
+    assert "round-robin" in str(err.value)
+    for n in ("alg2", "edf", "fifo", "priority", "sjf", "srtf"):
+        assert n in str(err.value)
+
+
+def test_fifo_runs_in_request_order() -> None:
+    assert schedulers.create("fifo").schedule(v(None, [cand("d3", 2), cand("d2", 1)])).irr_da == "d2"
+
+
+def test_sjf_picks_shortest_and_never_preempts() -> None:
+    s = schedulers.create("sjf")
+    assert s.schedule(v(None, [cand("d2", 1, c_time=5), cand("d3", 2, c_time=2)])).irr_da == "d3"
+    assert s.schedule(v(cand("d1", 0, c_time=100), [cand("d3", 2, c_time=1)])).irr_da is None
+
+
+def test_srtf_preempts_for_shorter_remaining_time() -> None:
+    s = schedulers.create("srtf")
+    assert s.schedule(v(cand("d1", 0, c_time=10), [cand("d2", 1, c_time=4)])).irr_da == "d2"
+    assert s.schedule(v(cand("d1", 0, c_time=3), [cand("d2", 1, c_time=4)])).irr_da is None
+
+
+def test_edf_preempts_for_earlier_deadline_and_puts_none_last() -> None:
+    s = schedulers.create("edf")
+    assert s.schedule(v(cand("d1", 0, deadline=50), [cand("d2", 1, deadline=20)])).irr_da == "d2"
+    assert s.schedule(v(cand("d1", 0, deadline=10), [cand("d2", 1, deadline=20)])).irr_da is None
+    assert s.schedule(v(None, [cand("d2", 1), cand("d3", 2, deadline=1e9)])).irr_da == "d3"
+
+
+def test_fixed_priority_from_config_and_from_params() -> None:
+    s = schedulers.create("priority", priorities={"fell": 10, "guide": 1})
+    exe = cand("d1", 0, task_type="guide")
+    assert s.schedule(v(exe, [cand("d2", 1, task_type="fell")])).irr_da == "d2"
+    assert s.schedule(v(cand("d1", 0, task_type="fell"), [cand("d2", 1, task_type="guide")])).irr_da is None
+    assert s.schedule(v(exe, [cand("d2", 1, task_type="guide", priority=5)])).irr_da == "d2"
+
+
+def test_registering_a_scheduler() -> None:
+    class Never(schedulers.Scheduler):
+        name = "never"
+
+        def schedule(self, view: ScheduleView) -> Decision:
+            return Decision()
+
+    schedulers.register("never", Never)
+    try:
+        assert isinstance(schedulers.create("never"), Never)
+        assert "never" in schedulers.names()
+    finally:
+        schedulers._registry.pop("never")
