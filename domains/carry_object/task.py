@@ -1,0 +1,23 @@
+"""Problem-builder hooks of carry_object: passages without doors, and doors to close."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from tasker.task import TaskContext
+from tasker.world import Fact, WorldState
+
+
+def extra_facts(ctx: TaskContext, world: WorldState) -> Iterable[Fact]:
+    """Every ordered pair of places with no door between them is a free passage."""
+    places = sorted(n for n, t in world.objects.items() if t == "place")
+    doors = {(f[2], f[3]) for f in world.matching("door_between") if len(f) == 4}
+    for a in places:
+        for b in places:
+            if a != b and (a, b) not in doors:
+                yield ("free_passage", a, b)
+
+
+def suspension_goal(ctx: TaskContext, world: WorldState, goal: list[tuple[str, ...]]) -> list[tuple[str, ...]]:
+    """Whatever the branch asks, plus: every door left open is closed."""
+    return list(goal) + [("not", "open", f[1]) for f in world.matching("open") if len(f) == 2]

@@ -1,0 +1,63 @@
+; cook: put a pan on the cooker, cook, turn the cooker off and put the hot pan down.
+(define (domain cook)
+  (:requirements :strips :typing :negative-preconditions :action-costs)
+  (:types locatable place - object
+          robot pan cooker - locatable)
+  (:predicates
+    (at ?x - locatable ?p - place)
+    (connected ?from ?to - place)
+    (holding ?r - robot ?k - pan)
+    (hand_empty ?r - robot)
+    (on_counter ?k - pan)
+    (on_cooker ?k - pan ?c - cooker)
+    (cooker_on ?c - cooker)
+    (cooked ?k - pan))
+  (:functions
+    (travel-time ?from ?to - place) - number
+    (total-cost) - number)
+
+  (:action navigate
+    :parameters (?r - robot ?from ?to - place)
+    :precondition (and (at ?r ?from) (connected ?from ?to))
+    :effect (and (not (at ?r ?from)) (at ?r ?to)
+                 (increase (total-cost) (travel-time ?from ?to))))
+
+  (:action pick_pan
+    :parameters (?r - robot ?k - pan ?p - place)
+    :precondition (and (at ?r ?p) (at ?k ?p) (on_counter ?k) (hand_empty ?r))
+    :effect (and (holding ?r ?k) (not (hand_empty ?r)) (not (on_counter ?k)) (not (at ?k ?p))
+                 (increase (total-cost) 6)))
+
+  (:action put_on_cooker
+    :parameters (?r - robot ?k - pan ?c - cooker ?p - place)
+    :precondition (and (at ?r ?p) (at ?c ?p) (holding ?r ?k))
+    :effect (and (on_cooker ?k ?c) (at ?k ?p) (hand_empty ?r) (not (holding ?r ?k))
+                 (increase (total-cost) 5)))
+
+  (:action take_off_cooker
+    :parameters (?r - robot ?k - pan ?c - cooker ?p - place)
+    :precondition (and (at ?r ?p) (on_cooker ?k ?c) (at ?k ?p) (hand_empty ?r))
+    :effect (and (holding ?r ?k) (not (hand_empty ?r)) (not (on_cooker ?k ?c)) (not (at ?k ?p))
+                 (increase (total-cost) 5)))
+
+  (:action put_down
+    :parameters (?r - robot ?k - pan ?p - place)
+    :precondition (and (at ?r ?p) (holding ?r ?k))
+    :effect (and (at ?k ?p) (on_counter ?k) (hand_empty ?r) (not (holding ?r ?k))
+                 (increase (total-cost) 5)))
+
+  (:action turn_on
+    :parameters (?r - robot ?c - cooker ?p - place)
+    :precondition (and (at ?r ?p) (at ?c ?p) (not (cooker_on ?c)))
+    :effect (and (cooker_on ?c) (increase (total-cost) 2)))
+
+  (:action turn_off
+    :parameters (?r - robot ?c - cooker ?p - place)
+    :precondition (and (at ?r ?p) (at ?c ?p) (cooker_on ?c))
+    :effect (and (not (cooker_on ?c)) (increase (total-cost) 2)))
+
+  (:action cook_food
+    :parameters (?r - robot ?k - pan ?c - cooker ?p - place)
+    :precondition (and (at ?r ?p) (at ?c ?p) (on_cooker ?k ?c) (cooker_on ?c) (not (cooked ?k)))
+    :effect (and (cooked ?k) (increase (total-cost) 120)))
+)

@@ -1,0 +1,181 @@
+"""Load and check PDDL before anything runs: errors name the file, the line and the fault.
+
+unified-planning's ``PDDLReader`` does the reading (it is built on pyparsing): a syntax
+error is a ``pyparsing.ParseBaseException`` carrying ``lineno``/``col``, a semantic
+one (unknown predicate, wrong arity, undefined type or object, missing goal) a
+``SyntaxError`` whose message holds ``line: N, col M``.  The domain is read alone
+first, so an error is blamed on the right file.  Requirements that Fast Downward
+cannot handle are refused from the domain's ``:requirements`` and from the problem
+kind UP computes.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import re
+import threading
+import warnings
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import pyparsing
+import unified_planning as up
+from unified_planning.environment import get_environment
+from unified_planning.io import PDDLReader
+from unified_planning.io.pddl_reader import PDDLGrammar
+from unified_planning.io.utils import parse_string
+
+from planners.engine import TaskerFastDownward
+from tasker.errors import TaskerError
+
+SUPPORTED_REQUIREMENTS = frozenset({
+    ":strips", ":typing", ":negative-preconditions", ":disjunctive-preconditions", ":equality",
+    ":existential-preconditions", ":universal-preconditions", ":quantified-preconditions",
+    ":conditional-effects", ":adl", ":action-costs",
+})
+"""PDDL requirements the classical planners here (Fast Downward) accept."""
+
+# Numbers read from PDDL are Real to UP; integral ones are fine for Fast Downward.
+_TOLERATED_FEATURES = frozenset({"REAL_NUMBERS_IN_ACTIONS_COST", "UNDEFINED_INITIAL_NUMERIC"})
+_LINE_RE = re.compile(r"line:?\s*(\d+),\s*col:?\s*(\d+)")
+_SPAN_RE = re.compile(
+    r"[\s.,]*(?:Error from|found at|from|From)?\s*line:?\s*\d+,\s*col:?\s*\d+\s*to\s*line:?\s*\d+,\s*col:?\s*\d+\.?"
+)
+_WRAPPED_RE = re.compile(r"UP\w+Error\('(.*)'\)")
+_grammar: PDDLGrammar | None = None
+_names_lock = threading.Lock()
+
+
+@contextlib.contextmanager
+def _lenient_names() -> Iterator[None]:
+    """PDDL keeps types and objects in separate namespaces (an object ``robot`` of type
+    ``robot`` is fine); UP refuses that unless ``error_used_name`` is off while reading."""
+    env = get_environment()
+    with _names_lock, warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=".*already defined.*")
+        warnings.filterwarnings("ignore", message=".*'parseString' deprecated.*")  # inside UP's reader
+        old, env.error_used_name = env.error_used_name, False
+        try:
+            yield
+        finally:
+            env.error_used_name = old
+
+
+class DefinitionError(TaskerError, ValueError):
+    """A task definition (PDDL file, ``task.toml``, ``task.py``) is malformed.
+
+    ``file`` names it, ``line``/``col`` locate the fault when known, ``reason`` says
+    what is wrong; ``str()`` gives ``file:line:col: reason`` like a compiler.
+    """
+
+    def __init__(self, file: str | Path, reason: str, line: int | None = None, col: int | None = None) -> None:
+        self.file = str(file)
+        self.reason = reason
+        self.line = line
+        self.col = col
+        where = self.file + (f":{line}" if line is not None else "") + (f":{col}" if col is not None else "")
+        super().__init__(f"{where}: {reason}")
+
+
+class PddlError(DefinitionError):
+    """A PDDL domain or problem is malformed or needs a feature no planner here supports."""
+
+
+def _read(path: str | Path) -> str:
+    p = Path(path)
+    if not p.is_file():
+        raise PddlError(p, "no such file")
+    try:
+        return p.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise PddlError(p, f"cannot read: {exc}") from None
+
+
+def _located(file: str | Path, exc: BaseException) -> PddlError:
+    """Turn a reader exception into a :class:`PddlError` with the line when there is one."""
+    if isinstance(exc, pyparsing.ParseBaseException):
+        return PddlError(file, f"syntax error: {exc.msg}", exc.lineno, exc.col)
+    text = str(exc).strip()
+    m = _LINE_RE.search(text)
+    reason = _SPAN_RE.sub("", text)
+    reason = _WRAPPED_RE.sub(r"\1", reason)
+    reason = reason.replace("Not able to handle:", "unknown predicate or invalid expression:")
+    reason = reason.replace("Found invalid expression:", "unknown object or invalid expression:")
+    reason = re.sub(r"\s+", " ", reason).strip(" .,:")
+    line, col = (int(m.group(1)), int(m.group(2))) if m else (None, None)
+    return PddlError(file, reason or type(exc).__name__, line, col)
+
+
+def declared_requirements(domain_text: str, file: str | Path = "<domain>") -> tuple[str, ...]:
+    """The ``:requirements`` a domain declares, read with UP's own PDDL grammar."""
+    global _grammar
+    if _grammar is None:
+        _grammar = PDDLGrammar()
+    try:
+        res = parse_string(_grammar.domain, domain_text.replace("\t", " ").lower(), parse_all=True)
+    except pyparsing.ParseBaseException as exc:
+        raise _located(file, exc) from None
+    return tuple(str(f) for f in res.get("features", []) if str(f) != ":requirements")
+
+
+def check_requirements(domain_text: str, file: str | Path) -> None:
+    """Refuse a domain that declares a requirement Fast Downward cannot handle."""
+    bad = [r for r in declared_requirements(domain_text, file) if r not in SUPPORTED_REQUIREMENTS]
+    if bad:
+        line = next((i for i, s in enumerate(domain_text.splitlines(), 1) if bad[0] in s.lower()), None)
+        raise PddlError(file, f"unsupported requirement(s) {' '.join(bad)}; supported: "
+                              f"{' '.join(sorted(SUPPORTED_REQUIREMENTS))}", line)
+
+
+def check_kind(problem: up.model.Problem, file: str | Path) -> None:
+    """Refuse a problem whose UP problem kind needs features the planner lacks."""
+    supported = set(TaskerFastDownward.supported_kind().features)
+    extra = sorted(set(problem.kind.features) - supported - _TOLERATED_FEATURES)
+    if extra:
+        raise PddlError(file, f"unsupported PDDL features for a classical planner: {', '.join(extra)}")
+
+
+@dataclass(frozen=True, slots=True)
+class CheckedDomain:
+    """A domain that parsed and passed the checks: its text and UP's domain-only model."""
+
+    path: Path
+    text: str
+    model: up.model.Problem
+
+    @property
+    def name(self) -> str:
+        return self.model.name
+
+
+def load_domain(path: str | Path) -> CheckedDomain:
+    """Read and check a ``domain.pddl``; raise :class:`PddlError` naming the file and line."""
+    text = _read(path)
+    check_requirements(text, path)
+    try:
+        with _lenient_names():
+            model = PDDLReader().parse_problem_string(text)
+    except (pyparsing.ParseBaseException, SyntaxError, up.exceptions.UPException, KeyError, ValueError) as exc:
+        raise _located(path, exc) from None
+    return CheckedDomain(Path(path), text, model)
+
+
+def load_problem_text(
+    domain: CheckedDomain, problem_text: str, problem_file: str | Path = "<problem>"
+) -> up.model.Problem:
+    """Parse a problem against a checked domain; check its goal and problem kind."""
+    try:
+        with _lenient_names():
+            problem = PDDLReader().parse_problem_string(domain.text, problem_text)
+    except (pyparsing.ParseBaseException, SyntaxError, up.exceptions.UPException, KeyError, ValueError) as exc:
+        raise _located(problem_file, exc) from None
+    check_kind(problem, problem_file)
+    return problem
+
+
+def load_problem(domain_path: str | Path, problem_path: str | Path) -> tuple[CheckedDomain, str, up.model.Problem]:
+    """Load and check a domain/problem pair; return the domain, the problem text and UP's model."""
+    domain = load_domain(domain_path)
+    text = _read(problem_path)
+    return domain, text, load_problem_text(domain, text, problem_path)

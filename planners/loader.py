@@ -1,0 +1,136 @@
+"""Load task folders into task types, checking everything before any run.
+
+A task folder holds ``task.toml``, ``domain.pddl`` and optionally ``task.py``.  Loading
+checks the PDDL (syntax, predicates, arity, types, requirements), that ``task.toml``
+and the domain agree (every action has a skill, literals use declared predicates with
+the right arity, static templates name real actions with the right arity), and, when
+the folder ships an ``[example]`` world, that the problem built from it is valid PDDL.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+from typing import Any
+
+from planners.checks import DefinitionError, load_domain, load_problem_text
+from planners.pddl_task import PddlTaskType
+from planners.problem import DomainModel
+from planners.results import PlanStatus
+from planners.stages import Bindings
+from planners.taskspec import TaskSpec, read_task_toml
+
+HOOK_NAMES = ("extra_facts", "suspension_goal", "check_args")
+"""Functions a ``task.py`` may define (see ``docs/domains.md``)."""
+
+
+def _load_hooks(spec: TaskSpec) -> dict[str, Any]:
+    path = spec.folder / "task.py"
+    if not path.is_file():
+        return {}
+    mod_name = f"tasker_tasks_{spec.name}"
+    module_spec = importlib.util.spec_from_file_location(mod_name, path)
+    assert module_spec is not None and module_spec.loader is not None
+    module = importlib.util.module_from_spec(module_spec)
+    try:
+        module_spec.loader.exec_module(module)
+    except SyntaxError as exc:
+        raise DefinitionError(path, f"syntax error: {exc.msg}", exc.lineno, exc.offset) from None
+    except Exception as exc:  # noqa: BLE001 - any import-time failure is a definition error
+        raise DefinitionError(path, f"failed to import: {type(exc).__name__}: {exc}") from None
+    sys.modules[mod_name] = module
+    hooks = {n: getattr(module, n) for n in HOOK_NAMES if callable(getattr(module, n, None))}
+    unknown = sorted(n for n in vars(module) if not n.startswith("_") and n not in HOOK_NAMES
+                     and callable(vars(module)[n]) and getattr(vars(module)[n], "__module__", "") == mod_name)
+    if unknown:
+        raise DefinitionError(path, f"unknown hook(s) {unknown}; a task.py may define {list(HOOK_NAMES)}")
+    return hooks
+
+
+def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
+    toml = spec.folder / "task.toml"
+    missing = sorted(set(dm.actions) - set(spec.actions))
+    if missing:
+        raise DefinitionError(toml, f"[actions] no entry for domain action(s) {missing}: say which skill runs each")
+    extra = sorted(set(spec.actions) - set(dm.actions))
+    if extra:
+        raise DefinitionError(toml, f"[actions] {extra} not in {spec.domain_file.name}; "
+                                    f"its actions: {sorted(dm.actions)}")
+    for name, a in spec.actions.items():
+        params = {f"?{p}" for p in dm.actions[name].params}
+        for ref in [*(a.travel or ()), *([a.to] if a.to and a.to.startswith("?") else [])]:
+            if ref not in params:
+                raise DefinitionError(toml, f"[actions.{name}] {ref} is not a parameter of {name} {sorted(params)}")
+    lits = [("problem.goal", spec.goal), ("problem.facts", spec.facts),
+            ("problem.suspended_facts", spec.suspended_facts)]
+    lits += [(f"suspension[{k}]", b.when + b.goal) for k, b in enumerate(spec.suspension)]
+    lits += [(f"static.suspension[{k}].when", b.when) for k, b in enumerate(spec.static_suspension)]
+    for where, group in lits:
+        for lit in group:
+            try:
+                dm.check_literal(lit, where)
+            except DefinitionError as exc:
+                raise DefinitionError(toml, exc.reason) from None
+    templates = [("static.update", t) for t in spec.static_update]
+    templates += [(f"static.suspension[{k}]", t) for k, b in enumerate(spec.static_suspension) for t in b.stages]
+    for where, t in templates:
+        for action in filter(None, (t.action, t.suspended)):
+            if action not in dm.actions:
+                raise DefinitionError(toml, f"[{where}] unknown action {action!r}; known: {sorted(dm.actions)}")
+            if len(t.args) != len(dm.actions[action].params):
+                raise DefinitionError(toml, f"[{where}] {action} takes {len(dm.actions[action].params)} "
+                                            f"argument(s), got {len(t.args)}")
+
+
+def _check_example(task: PddlTaskType) -> None:
+    from planners.examples import example_context
+
+    ctx = example_context(task)
+    if ctx is None:
+        return
+    b = Bindings(ctx.args, ctx.world)
+    text, _, _ = task.problem_text(ctx, ctx.world, b.literals(task.spec.goal), b.literals(task.spec.facts))
+    where = f"{task.spec.folder / 'task.toml'} [example] problem"
+    load_problem_text(task.domain.checked, text.problem, where)
+    result = task.planner.solve(text, timeout=task.timeout)
+    if result.status is PlanStatus.ERROR:  # e.g. a feature the optimal search cannot handle (axioms)
+        raise DefinitionError(task.spec.domain_file, f"the planner fails on the {where}: {result.message}")
+
+
+def load_task(folder: str | Path) -> PddlTaskType:
+    """Load one task folder; raise :class:`~planners.checks.DefinitionError` naming the faulty file."""
+    folder = Path(folder)
+    spec = read_task_toml(folder / "task.toml")
+    dm = DomainModel(load_domain(spec.domain_file))
+    _cross_check(spec, dm)
+    task = PddlTaskType(spec, dm, hooks=_load_hooks(spec))
+    _check_example(task)
+    return task
+
+
+def load_task_folder(path: str | Path) -> list[PddlTaskType]:
+    """Task types from ``path``: a task folder, or a folder of task folders (sorted by name)."""
+    path = Path(path)
+    if (path / "task.toml").is_file():
+        return [load_task(path)]
+    if not path.is_dir():
+        raise DefinitionError(path, "not a task folder (no task.toml) nor a folder of task folders")
+    tasks = [load_task(p) for p in sorted(path.iterdir()) if (p / "task.toml").is_file()]
+    if not tasks:
+        raise DefinitionError(path, "holds no task folder (a subfolder with a task.toml)")
+    names = [t.name for t in tasks]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise DefinitionError(path, f"duplicate task name(s) {dup}")
+    return tasks
+
+
+
+def store_loader(folder: str | Path) -> list[PddlTaskType]:
+    """The ``tasker.loaders`` entry point: task folders in ``folder``, or none (never an error
+    for a folder holding only ``*.py`` task types); malformed task folders still raise."""
+    path = Path(folder)
+    if (path / "task.toml").is_file() or any((p / "task.toml").is_file() for p in path.iterdir() if p.is_dir()):
+        return load_task_folder(path)
+    return []

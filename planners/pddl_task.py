@@ -1,0 +1,249 @@
+"""A :class:`~tasker.task.TaskType` built from a task folder (``domain.pddl`` + ``task.toml``).
+
+Hooks, and what they do here:
+
+* ``update_task`` (upTsk) — ``planned``: a PDDL problem from ``ctx.world`` as it is now
+  (R6: what the robot or a person already did is not redone), solved optimally;
+  ``static``: the template ``exeTsk`` of ``[static] update`` (Alg. 3).
+* ``generate_suspension`` (genSusp) — ``planned``: the first ``[[suspension]]`` branch
+  whose ``when`` holds in the state at interruption gives the goal, planned from that
+  state; ``static``: the decision list ``[[static.suspension]]`` (eq. 47).
+* ``compute_params`` / ``request_sp`` — ``cost = cps * (age + cTime)``: the discomfort
+  accumulated by completion, with ``cTime`` walked over the remaining stages (or the
+  static template) with ``ctx.motion``; unreachable means ``inf``.
+
+An unsolvable task raises :class:`~tasker.errors.PlanningFailed`; an unsolvable
+suspension or a planner time-out falls back to the static strategy, said in the note.
+``sim_time`` is the declared ``planning_time_s``/``static_time_s``: never wall time.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+from planners.planner import PddlText, Planner
+from planners.problem import DomainModel, holds, render_problem, travel_table
+from planners.results import PlanResult, PlanStatus
+from planners.stages import Bindings, StageBuilder, robot_name
+from planners.taskspec import Branch, Literal, TaskSpec
+from tasker.errors import PlanningFailed, UnknownName
+from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
+from tasker.stage import Purpose, Stage, StagePlan
+from tasker.task import TaskContext, TaskType
+from tasker.world import Pose, WorldState
+
+INTERRUPTION_KEY = "interruption_s"
+"""``ctx.memory`` key: expected length of an interruption (s); unknown means long."""
+
+_shared_planner: Planner | None = None
+
+
+def default_planner() -> Planner:
+    """The planner task types share (so they share its cache)."""
+    global _shared_planner
+    if _shared_planner is None:
+        _shared_planner = Planner()
+    return _shared_planner
+
+
+class PddlTaskType(TaskType):
+    """A task type defined by a folder; one instance serves every agent of the type."""
+
+    def __init__(self, spec: TaskSpec, domain: DomainModel, hooks: dict[str, Callable[..., Any]] | None = None,
+                 planner: Planner | None = None, timeout: float | None = None) -> None:
+        self.name = spec.name
+        self.description = spec.description
+        self.arg_specs = spec.args
+        self.spec = spec
+        self.domain = domain
+        self.hooks = hooks or {}
+        self.builder = StageBuilder(spec, domain)
+        self._planner = planner
+        self.timeout = spec.timeout_s if timeout is None else timeout
+
+    @property
+    def planner(self) -> Planner:
+        return self._planner or default_planner()
+
+    # -- hooks ----------------------------------------------------------------------
+
+    def check_args(self, args: dict[str, Any]) -> None:
+        if "check_args" in self.hooks:
+            self.hooks["check_args"](args)
+
+    def update_task(self, ctx: TaskContext) -> StagePlan:
+        if ctx.strategy.update == "static":
+            return self.static_update(ctx)
+        world, goal, extra = self.update_inputs(ctx)
+        outcome = self._plan(ctx, world, goal, extra, Purpose.UP_TSK)
+        if isinstance(outcome, StagePlan):
+            return outcome
+        if outcome.status is PlanStatus.UNSOLVABLE:
+            raise PlanningFailed("unsolvable", f"{self.name}: no plan reaches the goal {goal} from the world now")
+        if outcome.status is PlanStatus.TIMEOUT:
+            return self._fallback(self.static_update(ctx), "planner timed out for upTsk")
+        raise PlanningFailed("error", f"{self.name}: planner error: {outcome.message}")
+
+    def generate_suspension(self, ctx: TaskContext) -> StagePlan:
+        if ctx.strategy.suspension == "static":
+            return self.static_suspension(ctx)
+        world, goal, branch = self.suspension_inputs(ctx)
+        outcome = self._plan(ctx, world, goal, [], Purpose.GEN_SUSP, label=branch.label)
+        if isinstance(outcome, StagePlan):
+            return outcome
+        why = {PlanStatus.UNSOLVABLE: "suspension goal unsolvable", PlanStatus.TIMEOUT: "planner timed out"}
+        return self._fallback(self.static_suspension(ctx),
+                              f"{why.get(outcome.status, 'planner error')} for {goal}")
+
+    def compute_params(self, ctx: TaskContext) -> CostParams:
+        c_time, end = self.estimate(ctx, None)
+        cost = self.spec.cps * (ctx.age + c_time) if math.isfinite(c_time) else math.inf
+        return CostParams(self.name, cost=cost, cps=self.spec.cps, c_time=c_time, end_pose=end)
+
+    def request_sp(self, ctx: TaskContext, request: SPRequest) -> CompletionCost:
+        if request.sp_id != SP_COMPLETION:
+            raise UnknownName("schedule parameter", request.sp_id, [SP_COMPLETION])
+        pose = next((request.args[k] for k in ("pose", "start_pose", "end_pose") if request.args.get(k)), None)
+        start = (float(pose[0]), float(pose[1]), float(pose[2]) if len(pose) > 2 else 0.0) if pose else None
+        c_time, _ = self.estimate(ctx, start)
+        cc = self.spec.cps * (ctx.age + c_time) if math.isfinite(c_time) else math.inf
+        return CompletionCost(cc=cc, ccps=self.spec.cps)
+
+    # -- planning inputs (public for tests and tools) -----------------------------------
+
+    def update_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], list[Literal]]:
+        """upTsk: the world, the goal and the extra init facts (request, Alg. 3, task.py)."""
+        world = self._world(ctx)
+        b = Bindings(ctx.args, world)
+        extra = b.literals(self.spec.facts) + (b.literals(self.spec.suspended_facts) if ctx.suspended else [])
+        if "extra_facts" in self.hooks:
+            extra += [tuple(f) for f in self.hooks["extra_facts"](ctx, world)]
+        return world, b.literals(self.spec.goal), extra
+
+    def suspension_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], Branch]:
+        """genSusp: the world at interruption, the suspension goal and the branch that chose it."""
+        world = self._world(ctx)
+        b = Bindings(ctx.args, world)
+        branch = self._branch(self.spec.suspension, b, world, ctx)
+        goal = b.literals(branch.goal)
+        if "suspension_goal" in self.hooks:
+            goal = [tuple(g) for g in self.hooks["suspension_goal"](ctx, world, goal)]
+        return world, goal, branch
+
+    def planning_problem(self, ctx: TaskContext, purpose: Purpose) -> PddlText:
+        """The PDDL problem the planned strategy solves for ``purpose`` in this context."""
+        if purpose is Purpose.UP_TSK:
+            world, goal, extra = self.update_inputs(ctx)
+        else:
+            (world, goal, _), extra = self.suspension_inputs(ctx), []
+        return self.problem_text(ctx, world, goal, extra)[0]
+
+    # -- strategies -------------------------------------------------------------------
+
+    def static_update(self, ctx: TaskContext) -> StagePlan:
+        """The template ``exeTsk`` (Alg. 3): fixed stages, variants chosen by ``ctx.suspended``."""
+        world = self._world(ctx)
+        stages = self._template_stages(ctx, world, travel_table(world, ctx.motion, self.spec.travel_s))
+        return StagePlan(stages, Purpose.UP_TSK, strategy="static", sim_time=self.spec.static_time_s,
+                         note="template exeTsk" + (" (suspended variant)" if ctx.suspended else ""))
+
+    def _template_stages(self, ctx: TaskContext, world: WorldState,
+                         travel: dict[tuple[str, str], float]) -> tuple[Stage, ...]:
+        return self.builder.from_templates(self.spec.static_update, Bindings(ctx.args, world), travel, ctx.suspended)
+
+    def static_suspension(self, ctx: TaskContext) -> StagePlan:
+        """The decision list ``exeSusp`` (eq. 47): the first branch whose condition holds."""
+        world = self._world(ctx)
+        b = Bindings(ctx.args, world)
+        branch = self._branch(self.spec.static_suspension, b, world, ctx)
+        travel = travel_table(world, ctx.motion, self.spec.travel_s)
+        stages = self.builder.from_templates(branch.stages, b, travel, ctx.suspended)
+        return StagePlan(stages, Purpose.GEN_SUSP, strategy="static", sim_time=self.spec.static_time_s,
+                         note=f"decision tree: {branch.label or ('save' if not stages else 'branch')}")
+
+    # -- helpers ----------------------------------------------------------------------
+
+    def _world(self, ctx: TaskContext) -> WorldState:
+        if not isinstance(ctx.world, WorldState):
+            raise PlanningFailed("error", f"{self.name}: needs a WorldState, got {type(ctx.world).__name__}")
+        return ctx.world
+
+    def _branch(self, branches: tuple[Branch, ...], b: Bindings, world: WorldState, ctx: TaskContext) -> Branch:
+        expected = ctx.memory.get(INTERRUPTION_KEY)
+        length = math.inf if expected is None else float(expected)
+        for br in branches:
+            if length >= br.min_interruption_s and holds(world.facts, b.literals(br.when)):
+                return br
+        return branches[-1]
+
+    def problem_text(self, ctx: TaskContext, world: WorldState, goal: list[Literal],
+                     extra: list[Literal]) -> tuple[PddlText, frozenset[Literal], dict[tuple[str, str], float]]:
+        """The PDDL text, its init facts and the travel table for a goal in a world."""
+        travel = travel_table(world, ctx.motion, self.spec.travel_s)
+        for lit in goal:
+            self.domain.check_literal(lit, f"goal of task {self.name!r}")
+        text, init = render_problem(self.domain, world, goal, extra_facts=extra, travel=travel, name=self.name)
+        return PddlText(self.domain.checked.text, text), init, travel
+
+    def _plan(self, ctx: TaskContext, world: WorldState, goal: list[tuple[str, ...]],
+              extra: list[tuple[str, ...]], purpose: Purpose, label: str = "") -> StagePlan | PlanResult:
+        """A planned StagePlan, or the failed PlanResult for the caller to handle."""
+        text, init, travel = self.problem_text(ctx, world, goal, extra)
+        if holds(init, goal):
+            note = "goal already holds" + (f" ({label})" if label else "")
+            return StagePlan((), purpose, strategy="planned", sim_time=self.spec.static_time_s, note=note)
+        result = self.planner.solve(text, timeout=self.timeout)
+        if not result.solved:
+            return result
+        assert result.plan is not None
+        stages = self.builder.from_steps(result.plan, travel, ctx.args)
+        return StagePlan(stages, purpose, strategy="planned", sim_time=self.spec.planning_time_s,
+                         note=label or None,
+                         info={"planner": result.planner, "cost": result.cost, "cached": result.cached,
+                               "planner_time_s": result.wall_time_s})
+
+    @staticmethod
+    def _fallback(plan: StagePlan, why: str) -> StagePlan:
+        return StagePlan(plan.stages, plan.purpose, strategy="static", sim_time=plan.sim_time,
+                         note=f"fallback to static: {why}", info=plan.info)
+
+    def _declared_template_time(self) -> float:
+        """Without a world: the static template's declared durations, travel at ``travel_s``."""
+        total = 0.0
+        for t in self.spec.static_update:
+            a, model = self.spec.actions[t.action], self.domain.actions[t.action]
+            if a.travel is not None:
+                total += self.spec.travel_s
+            else:
+                total += a.duration if a.duration is not None else (model.constant_cost or 0.0)
+        return total
+
+    def estimate(self, ctx: TaskContext, start: Pose | None) -> tuple[float, Pose | None]:
+        """Seconds to complete the task from ``start`` (the robot's pose if None) and the end pose."""
+        world = ctx.world if isinstance(ctx.world, WorldState) else None
+        stages: tuple[Stage, ...]
+        if ctx.plan is not None and ctx.plan.purpose is Purpose.UP_TSK:
+            stages = ctx.remaining
+        elif world is not None:
+            try:  # no travel table: the walk below asks the motion model for each leg only
+                stages = self._template_stages(ctx, world, {})
+            except PlanningFailed:
+                return math.inf, None
+        else:
+            return self._declared_template_time(), None
+        pose = start if start is not None else (world.poses.get(robot_name(world)) if world else None)
+        total = 0.0
+        for s in stages:
+            target = world.poses.get(str(s.data.get("to"))) if (world and s.skill == "navigate") else None
+            if target is not None and pose is not None and ctx.motion is not None:
+                est = ctx.motion.estimate(pose, target)
+                if not est.reachable:
+                    return math.inf, None
+                total += est.time_s
+                pose = est.end_pose or target
+            else:
+                total += s.duration
+                pose = target or pose
+        return total, pose

@@ -1,0 +1,172 @@
+"""The :class:`Planner` facade: any UP one-shot engine by name, a typed result, an LRU cache.
+
+``Planner().solve(problem)`` takes a unified-planning ``Problem`` or a :class:`PddlText`
+(a domain and a problem as PDDL text, what task types build) and returns a
+:class:`~planners.results.PlanResult`.  The default engine is ``tasker-fd``
+(:mod:`planners.engine`); given PDDL text it goes straight to Fast Downward without
+building a UP model at all.  Results are cached on the PDDL text (domain + problem),
+so a repeated identical problem is answered from memory; time-outs and errors are
+never cached.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+import weakref
+from collections import OrderedDict
+from dataclasses import dataclass, replace
+
+import unified_planning as up
+from unified_planning.environment import get_environment
+from unified_planning.io import PDDLReader, PDDLWriter
+from unified_planning.shortcuts import OneshotPlanner, PlanValidator
+
+from planners.engine import ENGINE_NAME, register_engine
+from planners.fd import OPTIMAL_SEARCH, FDExit, run_fast_downward
+from planners.results import PlanResult, PlanStatus
+from tasker.errors import UnknownName
+
+DEFAULT_PLANNER = ENGINE_NAME
+"""The engine a :class:`Planner` uses unless told otherwise."""
+
+_FD_STATUS = {FDExit.UNSOLVABLE: PlanStatus.UNSOLVABLE, FDExit.TIMEOUT: PlanStatus.TIMEOUT,
+              FDExit.MEMOUT: PlanStatus.ERROR, FDExit.ERROR: PlanStatus.ERROR}
+
+
+@dataclass(frozen=True, slots=True)
+class PddlText:
+    """A planning problem as PDDL text: what any PDDL planner reads unchanged."""
+
+    domain: str
+    problem: str
+
+
+def oneshot_planners() -> list[str]:
+    """Names of the one-shot planning engines installed in UP's factory."""
+    register_engine()
+    factory = get_environment().factory
+    return sorted(n for n in factory.engines if _is_oneshot(factory.engine(n)))
+
+
+def _is_oneshot(cls: type) -> bool:
+    try:
+        return bool(getattr(cls, "is_oneshot_planner")())  # noqa: B009 - engines are duck-typed
+    except Exception:  # noqa: BLE001 - meta-engine wrappers may refuse the question
+        return False
+
+
+def plan_steps(plan: up.plans.SequentialPlan) -> tuple[tuple[str, ...], ...]:
+    """A UP sequential plan as tuples of strings: ``("action", "arg", ...)``."""
+    return tuple((a.action.name, *(str(p) for p in a.actual_parameters)) for a in plan.actions)
+
+
+class Planner:
+    """Solve planning problems with a named engine, cache the answers.
+
+    ``name`` is any one-shot engine in UP's factory (``tasker-fd``, ``fast-downward-opt``,
+    ``fast-downward``, ...): an unknown name raises :class:`~tasker.errors.UnknownName`
+    listing the known ones.  ``timeout`` (seconds) is the default per call;
+    ``cache_size`` bounds the LRU cache (0 disables it).  Thread-safe.
+    """
+
+    def __init__(self, name: str = DEFAULT_PLANNER, *, timeout: float | None = 30.0, cache_size: int = 512,
+                 search: str = OPTIMAL_SEARCH) -> None:
+        known = oneshot_planners()
+        if name not in known:
+            raise UnknownName("planner", name, known)
+        if cache_size < 0:
+            raise ValueError(f"cache_size must be >= 0, got {cache_size}")
+        self.name = name
+        self.timeout = timeout
+        self.search = search
+        self.cache_size = cache_size
+        self._cache: OrderedDict[tuple[str, str, str], PlanResult] = OrderedDict()
+        self._keys: dict[int, tuple[weakref.ref[up.model.Problem], int, PddlText]] = {}
+        self._lock = threading.Lock()
+        self.hits = 0
+        self.misses = 0
+
+    # -- public ----------------------------------------------------------------------
+
+    def solve(self, problem: up.model.Problem | PddlText, timeout: float | None = None) -> PlanResult:
+        """Solve ``problem``; never raises for an unsolvable or failing problem (see the status)."""
+        timeout = self.timeout if timeout is None else timeout
+        text = problem if isinstance(problem, PddlText) else self._text_of(problem)
+        key = (self.name, text.domain, text.problem)
+        if self.cache_size:
+            with self._lock:
+                hit = self._cache.get(key)
+                if hit is not None:
+                    self._cache.move_to_end(key)
+                    self.hits += 1
+                    return replace(hit, cached=True)
+                self.misses += 1
+        start = time.perf_counter()
+        if self.name == ENGINE_NAME:
+            result = self._solve_fd(text, timeout, start)
+        else:
+            model = problem if isinstance(problem, up.model.Problem) else self._parse(text)
+            result = self._solve_up(model, timeout, start)
+        if self.cache_size and result.status in (PlanStatus.SOLVED, PlanStatus.UNSOLVABLE):
+            with self._lock:
+                self._cache[key] = result
+                while len(self._cache) > self.cache_size:
+                    self._cache.popitem(last=False)
+        return result
+
+    def clear_cache(self) -> None:
+        with self._lock:
+            self._cache.clear()
+            self._keys.clear()
+
+    # -- private ---------------------------------------------------------------------
+
+    def _text_of(self, problem: up.model.Problem) -> PddlText:
+        """PDDL text of a UP problem; remembered per live object so a repeat costs one hash."""
+        h = hash(problem)
+        with self._lock:
+            known = self._keys.get(id(problem))
+        if known is not None and known[0]() is problem and known[1] == h:
+            return known[2]
+        writer = PDDLWriter(problem)
+        text = PddlText(writer.get_domain(), writer.get_problem())
+        with self._lock:
+            if len(self._keys) > 4 * max(self.cache_size, 1):
+                self._keys.clear()
+            self._keys[id(problem)] = (weakref.ref(problem), h, text)
+        return text
+
+    @staticmethod
+    def _parse(text: PddlText) -> up.model.Problem:
+        return PDDLReader().parse_problem_string(text.domain, text.problem)
+
+    def _solve_fd(self, text: PddlText, timeout: float | None, start: float) -> PlanResult:
+        out = run_fast_downward(text.domain, text.problem, search=self.search, timeout=timeout)
+        wall = time.perf_counter() - start
+        if out.exit is FDExit.SOLVED:
+            cost = out.cost if out.cost is not None else float(len(out.plan or ()))
+            return PlanResult(PlanStatus.SOLVED, out.plan, cost, self.name, wall)
+        return PlanResult(_FD_STATUS[out.exit], None, None, self.name, wall, message=out.message)
+
+    def _solve_up(self, problem: up.model.Problem, timeout: float | None, start: float) -> PlanResult:
+        with OneshotPlanner(name=self.name) as engine:
+            engine.skip_checks = True  # problems are checked when loaded (planners.checks)
+            res = engine.solve(problem, timeout=timeout)
+        wall = time.perf_counter() - start
+        status = PlanStatus.from_up(res.status)
+        if status is not PlanStatus.SOLVED or res.plan is None:
+            msg = "; ".join(m.message for m in (res.log_messages or ()))[-300:]
+            return PlanResult(status if status is not PlanStatus.SOLVED else PlanStatus.ERROR, None, None,
+                              self.name, wall, message=msg or res.status.name)
+        return PlanResult(PlanStatus.SOLVED, plan_steps(res.plan), plan_cost(problem, res.plan), self.name, wall)
+
+
+def plan_cost(problem: up.model.Problem, plan: up.plans.SequentialPlan) -> float:
+    """The plan's metric value as UP's validator computes it (its length without a metric)."""
+    if not problem.quality_metrics:
+        return float(len(plan.actions))
+    with PlanValidator(name="sequential_plan_validator") as validator:
+        res = validator.validate(problem, plan)
+    values = list(res.metric_evaluations.values()) if res.metric_evaluations else []
+    return float(values[0]) if values else float(len(plan.actions))

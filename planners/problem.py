@@ -1,0 +1,191 @@
+"""From a world state to a PDDL problem, and from a plan step back to its grounded effects.
+
+:class:`DomainModel` reads what task types need from UP's model of a checked domain
+(predicates and their types, each action's parameters, effects and constant cost).
+:func:`render_problem` writes a standard PDDL problem: the world's objects whose type
+the domain knows, the facts over them, travel times between places, and the goal.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+
+import unified_planning as up
+
+from planners.checks import CheckedDomain, PddlError
+from tasker.world import Fact, MotionModel, WorldState
+
+PLACE_TYPE = "place"
+TRAVEL_FUNCTION = "travel-time"
+CONNECTED = "connected"
+UNREACHABLE_COST = 1_000_000
+"""``travel-time`` written for a pair that is not connected (it can never be used)."""
+
+
+@dataclass(frozen=True, slots=True)
+class EffectTemplate:
+    """One unconditional Boolean effect of an action: ``(fluent, args, positive)``.
+
+    ``args`` holds parameter names prefixed with ``?`` or object names.
+    """
+
+    fluent: str
+    args: tuple[str, ...]
+    positive: bool
+
+
+@dataclass(frozen=True, slots=True)
+class ActionModel:
+    """What a task type needs of one PDDL action."""
+
+    name: str
+    params: tuple[str, ...]
+    effects: tuple[EffectTemplate, ...]
+    constant_cost: float | None
+
+
+class DomainModel:
+    """Read-only view of a checked domain, built once when a task folder is loaded."""
+
+    def __init__(self, domain: CheckedDomain) -> None:
+        m = domain.model
+        self.checked = domain
+        self.name = m.name
+        self.types: dict[str, set[str]] = {}
+        for t in m.user_types:
+            chain, cur = set(), t
+            while cur is not None:
+                chain.add(cur.name)
+                cur = cur.father
+            self.types[t.name] = chain
+        self.predicates: dict[str, tuple[str, ...]] = {
+            f.name: tuple(p.type.name if p.type.is_user_type() else "" for p in f.signature)
+            for f in m.fluents if f.type.is_bool_type()
+        }
+        self.functions = {f.name for f in m.fluents if not f.type.is_bool_type()}
+        self.actions = {a.name: self._action(a) for a in m.actions}
+
+    @staticmethod
+    def _action(a: up.model.InstantaneousAction) -> ActionModel:
+        def ref(e: up.model.FNode) -> str:
+            return f"?{e.parameter().name}" if e.is_parameter_exp() else e.object().name
+
+        effects, cost = [], None
+        for e in a.effects:
+            if e.is_increase() and e.fluent.fluent().name == "total-cost":
+                cost = float(e.value.constant_value()) if e.value.is_constant() else None
+            elif not (e.is_conditional() or e.is_forall() or e.is_increase() or e.is_decrease()) \
+                    and e.value.is_bool_constant():
+                args = tuple(ref(x) for x in e.fluent.args)
+                effects.append(EffectTemplate(e.fluent.fluent().name, args, e.value.bool_constant_value()))
+        return ActionModel(a.name, tuple(p.name for p in a.parameters), tuple(effects), cost)
+
+    def has_type(self, obj_type: str, wanted: str) -> bool:
+        return wanted == "" or wanted in self.types.get(obj_type, ())
+
+    def check_literal(self, lit: Sequence[str], where: str) -> None:
+        """Raise if a literal names an unknown predicate or has the wrong arity."""
+        atom = lit[1:] if lit[0] == "not" else lit
+        if atom[0] not in self.predicates:
+            raise PddlError(self.checked.path, f"{where}: unknown predicate {atom[0]!r}; the domain declares "
+                                               f"{sorted(self.predicates)}")
+        if len(atom) - 1 != len(self.predicates[atom[0]]):
+            raise PddlError(self.checked.path, f"{where}: {atom[0]!r} takes {len(self.predicates[atom[0]])} "
+                                               f"argument(s), got {len(atom) - 1}: {list(lit)}")
+
+    def ground(self, action: str, args: Sequence[str]) -> tuple[list[Fact], list[Fact]]:
+        """``(add, delete)`` of an action applied with ``args`` (PDDL semantics: delete first)."""
+        model = self.actions[action]
+        binding = {f"?{p}": a for p, a in zip(model.params, args, strict=True)}
+        add = [(e.fluent, *(binding.get(x, x) for x in e.args)) for e in model.effects if e.positive]
+        delete = [(e.fluent, *(binding.get(x, x) for x in e.args)) for e in model.effects if not e.positive]
+        return add, [d for d in delete if d not in add]
+
+
+def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float) -> dict[tuple[str, str], float]:
+    """Seconds between every ordered pair of places; ``inf`` when the motion model says unreachable.
+
+    Without a motion model (or a pose) the declared ``travel_s`` is used, never zero.
+    """
+    places = sorted(n for n, t in world.objects.items() if t == PLACE_TYPE)
+    out: dict[tuple[str, str], float] = {}
+    for a in places:
+        for b in places:
+            if a == b:
+                continue
+            if motion is not None and a in world.poses and b in world.poses:
+                out[a, b] = float(motion.estimate(world.poses[a], world.poses[b]).time_s)
+            else:
+                out[a, b] = float(travel_s)
+    return out
+
+
+def _atom(fact: Iterable[str]) -> str:
+    return "(" + " ".join(fact) + ")"
+
+
+def render_problem(
+    domain: DomainModel,
+    world: WorldState,
+    goal: Sequence[Sequence[str]],
+    *,
+    extra_facts: Iterable[Fact] = (),
+    travel: Mapping[tuple[str, str], float] | None = None,
+    name: str = "task",
+) -> tuple[str, frozenset[Fact]]:
+    """A PDDL problem for ``domain`` from ``world``; also returns the init facts used.
+
+    Objects of types the domain does not know, and facts over predicates it does not
+    declare, are left out: the world holds facts for every task.  A fact with the right
+    predicate but the wrong arity is an error.
+    """
+    objects = {n: t for n, t in sorted(world.objects.items()) if t in domain.types}
+    init: set[Fact] = set()
+    for fact in [*world.facts, *extra_facts]:
+        sig = domain.predicates.get(fact[0]) if fact else None
+        if sig is None:
+            continue
+        if len(fact) - 1 != len(sig):
+            raise PddlError(domain.checked.path, f"world fact {list(fact)}: {fact[0]!r} takes {len(sig)} argument(s)")
+        if all(a in objects and domain.has_type(objects[a], t) for a, t in zip(fact[1:], sig, strict=True)):
+            init.add(tuple(fact))
+    numeric = []
+    if travel is not None and TRAVEL_FUNCTION in domain.functions:
+        places = [n for n, t in objects.items() if domain.has_type(t, PLACE_TYPE)]
+        for a in places:
+            for b in places:
+                # Every pair gets a value so UP's simulator and validator accept the problem;
+                # pairs that are not `connected` (itself, unreachable) can never be travelled.
+                secs = travel.get((a, b), math.inf)
+                if math.isfinite(secs):
+                    if CONNECTED in domain.predicates:
+                        init.add((CONNECTED, a, b))
+                    value = max(1, math.ceil(secs))
+                else:
+                    value = 0 if a == b else UNREACHABLE_COST
+                numeric.append(f"(= ({TRAVEL_FUNCTION} {a} {b}) {value})")
+    by_type: dict[str, list[str]] = {}
+    for n, t in objects.items():
+        by_type.setdefault(t, []).append(n)
+    lines = [f"(define (problem {name})", f"  (:domain {domain.name})", "  (:objects"]
+    lines += [f"    {' '.join(ns)} - {t}" for t, ns in sorted(by_type.items())]
+    lines.append("  )")
+    lines.append("  (:init")
+    lines += [f"    {_atom(f)}" for f in sorted(init)]
+    lines += [f"    {n}" for n in numeric]
+    if "total-cost" in domain.functions:
+        lines.append("    (= (total-cost) 0)")
+    lines.append("  )")
+    goals = [f"(not {_atom(g[1:])})" if g[0] == "not" else _atom(g) for g in goal]
+    lines.append(f"  (:goal (and {' '.join(goals)}))")
+    if "total-cost" in domain.functions:
+        lines.append("  (:metric minimize (total-cost))")
+    lines.append(")")
+    return "\n".join(lines) + "\n", frozenset(init)
+
+
+def holds(facts: frozenset[Fact] | set[Fact], literals: Iterable[Sequence[str]]) -> bool:
+    """True if every literal holds among ``facts`` (``["not", ...]`` means absent)."""
+    return all((tuple(lit[1:]) not in facts) if lit[0] == "not" else (tuple(lit) in facts) for lit in literals)

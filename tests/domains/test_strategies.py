@@ -1,0 +1,137 @@
+"""Static strategies (Alg. 3, eq. 47), fallbacks, failures, and R6 for the bundled task types."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from planners.examples import StraightLineMotion
+from planners.pddl_task import INTERRUPTION_KEY, PddlTaskType
+from planners.planner import Planner
+from planners.taskspec import Branch
+from tasker.errors import PlanningFailed
+from tasker.stage import Purpose
+from tests.domains.conftest import apply, make_ctx, steps
+
+
+def test_static_update_is_the_template(task: PddlTaskType) -> None:
+    plan = task.update_task(make_ctx(task, strategy="static"))
+    assert plan.strategy == "static" and plan.sim_time == task.spec.static_time_s
+    assert [s.action for s in plan.stages] == [t.action for t in task.spec.static_update]
+
+
+def test_static_suspension_is_the_decision_list(task: PddlTaskType) -> None:
+    plan = task.generate_suspension(make_ctx(task, strategy="static"))
+    assert plan.strategy == "static" and plan.purpose is Purpose.GEN_SUSP and plan.note.startswith("decision tree")
+
+
+def _with_unsolvable_suspension(task: PddlTaskType) -> PddlTaskType:
+    # `connected` never holds from a place to itself and no action adds it
+    spec = dataclasses.replace(task.spec, suspension=(Branch(goal=(("connected", "$at:robot", "$at:robot"),)),))
+    return PddlTaskType(spec, task.domain, task.hooks)
+
+
+def test_unsolvable_suspension_falls_back_to_static(task: PddlTaskType) -> None:
+    broken = _with_unsolvable_suspension(task)
+    plan = broken.generate_suspension(make_ctx(broken))
+    assert plan.strategy == "static" and plan.note.startswith("fallback to static: suspension goal unsolvable")
+    assert plan.stages == task.generate_suspension(make_ctx(task, strategy="static")).stages
+
+
+def test_planner_timeout_falls_back_to_static(task: PddlTaskType) -> None:
+    slow = PddlTaskType(task.spec, task.domain, task.hooks, planner=Planner(cache_size=0), timeout=1e-6)
+    plan = slow.update_task(make_ctx(slow))
+    assert plan.strategy == "static" and "timed out" in plan.note
+    assert [s.action for s in plan.stages] == [t.action for t in task.spec.static_update]
+    assert "timed out" in slow.generate_suspension(make_ctx(slow, world=_mid_world(task))).note
+
+
+def _mid_world(task: PddlTaskType):  # noqa: ANN202 - a WorldState
+    ctx = make_ctx(task)
+    exe = task.update_task(ctx)
+    return apply(ctx.world, exe.stages[: len(exe.stages) - 1])
+
+
+def test_unsolvable_task_raises(task: PddlTaskType) -> None:
+    ctx = make_ctx(task)
+    blocked = StraightLineMotion(blocked=frozenset(ctx.world.poses.values()))
+    with pytest.raises(PlanningFailed) as info:
+        task.update_task(make_ctx(task, motion=blocked))
+    assert info.value.status == "unsolvable"
+
+
+def test_no_world_is_an_error(task: PddlTaskType) -> None:
+    ctx = make_ctx(task)
+    ctx.world = None
+    with pytest.raises(PlanningFailed) as info:
+        task.update_task(ctx)
+    assert info.value.status == "error"
+
+
+# -- task-specific behaviour ---------------------------------------------------------------------
+
+
+def test_guide_alg3_greets_and_apologises_after_suspension(tasks: dict[str, PddlTaskType]) -> None:
+    t = tasks["guide_human"]
+    for strategy in ("planned", "static"):
+        actions = [s.action for s in t.update_task(make_ctx(t, strategy=strategy, suspended=True)).stages]
+        assert "greet_and_apologise" in actions and "greet" not in actions
+        actions = [s.action for s in t.update_task(make_ctx(t, strategy=strategy)).stages]
+        assert "greet" in actions and "greet_and_apologise" not in actions
+
+
+def test_guide_eq47_save_or_apologise(tasks: dict[str, PddlTaskType]) -> None:
+    t = tasks["guide_human"]
+    ctx = make_ctx(t, strategy="static")
+    assert t.generate_suspension(ctx).stages == ()  # not greeted: save
+    greeted = make_ctx(t, strategy="static", world=ctx.world.updated([("greeted", "john")]))
+    assert [s.action for s in t.generate_suspension(greeted).stages] == ["ask_to_wait"]
+
+
+def test_guide_r6_person_already_there(tasks: dict[str, PddlTaskType]) -> None:
+    t = tasks["guide_human"]
+    world = make_ctx(t).world.updated([("at", "john", "kitchen")], [("at", "john", "hall")])
+    plan = t.update_task(make_ctx(t, world=world))
+    assert plan.stages == () and plan.note == "goal already holds"
+
+
+def test_human_fell_r6_person_got_up(tasks: dict[str, PddlTaskType]) -> None:
+    t = tasks["human_fell"]
+    world = make_ctx(t).world.updated(delete=[("fallen", "peter")])
+    assert t.update_task(make_ctx(t, world=world)).stages == ()
+
+
+def test_carry_r6_door_opened_by_someone_else(tasks: dict[str, PddlTaskType]) -> None:
+    t = tasks["carry_object"]
+    assert "open_door" in [s.action for s in t.update_task(make_ctx(t)).stages]
+    world = make_ctx(t).world.updated([("open", "door1")])
+    assert "open_door" not in [s.action for s in t.update_task(make_ctx(t, world=world)).stages]
+
+
+def test_carry_suspension_places_safely_and_closes_door(tasks: dict[str, PddlTaskType]) -> None:
+    t = tasks["carry_object"]
+    ctx = make_ctx(t)
+    exe = t.update_task(ctx)
+    k = [s.action for s in exe.stages].index("pick") + 1  # holding the vase, the door is open
+    susp = t.generate_suspension(make_ctx(t, world=apply(ctx.world, exe.stages[:k])))
+    actions = [s.action for s in susp.stages]
+    assert "place" in actions and actions[-1] == "close_door"  # hands free before the door
+    place = susp.stages[actions.index("place")]
+    assert ("surface", place.args[2]) in ctx.world.facts  # only ever put down on a surface
+
+
+def test_cook_suspension_depends_on_interruption_length(tasks: dict[str, PddlTaskType]) -> None:
+    t = tasks["cook"]
+    ctx = make_ctx(t)
+    exe = t.update_task(ctx)
+    k = [s.action for s in exe.stages].index("cook_food")  # cooker on, pan on it
+    world = apply(ctx.world, exe.stages[:k])
+    long_ctx, short_ctx = make_ctx(t, world=world), make_ctx(t, world=world)
+    short_ctx.memory[INTERRUPTION_KEY] = 10.0
+    assert steps(t.generate_suspension(long_ctx).stages) == [("turn_off", "robot", "stove", "kitchen")]
+    assert t.generate_suspension(short_ctx).stages == ()
+    k = [s.action for s in exe.stages].index("put_down")  # hot pan held
+    held = make_ctx(t, world=apply(ctx.world, exe.stages[:k]))
+    held.memory[INTERRUPTION_KEY] = 10.0
+    assert [s.action for s in t.generate_suspension(held).stages] == ["put_down"]

@@ -1,0 +1,106 @@
+"""The ``tasker-fd`` engine and the Planner facade: results, cache, engines by name."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import pytest
+from unified_planning.shortcuts import OneshotPlanner
+
+import planners  # noqa: F401 - registers tasker-fd
+from planners.checks import load_problem
+from planners.planner import PddlText, Planner, oneshot_planners
+from planners.results import PlanResult, PlanStatus
+from planners.validate import validate_plan
+from tasker.errors import UnknownName
+from tests.planners.conftest import DOMAIN, problem_text
+
+
+def test_engine_is_registered_and_found_by_name(pddl_files: tuple[Path, Path]) -> None:
+    assert "tasker-fd" in oneshot_planners()
+    _, _, problem = load_problem(*pddl_files)
+    with OneshotPlanner(name="tasker-fd") as engine:
+        engine.skip_checks = True
+        res = engine.solve(problem)
+    assert res.status.name == "SOLVED_OPTIMALLY"
+    steps = [(a.action.name, *(str(p) for p in a.actual_parameters)) for a in res.plan.actions]
+    check = validate_plan(problem, steps)
+    assert check.valid and check.cost == 6
+
+
+@pytest.mark.parametrize("name", ["tasker-fd", "fast-downward-opt"])
+def test_planner_by_name_same_optimal_cost(name: str, pddl_files: tuple[Path, Path]) -> None:
+    _, _, problem = load_problem(*pddl_files)
+    result = Planner(name).solve(problem)
+    assert result.status is PlanStatus.SOLVED and result.cost == 6 and result.planner == name
+    assert validate_plan(problem, result.plan).valid
+
+
+def test_unknown_planner_lists_known() -> None:
+    with pytest.raises(UnknownName, match="tasker-fd"):
+        Planner("no-such-planner")
+
+
+def test_cache_hit_is_fast_and_marked() -> None:
+    planner = Planner()
+    text = PddlText(DOMAIN, problem_text())
+    first = planner.solve(text)
+    assert not first.cached
+    t0 = time.perf_counter()
+    again = planner.solve(PddlText(DOMAIN, problem_text()))
+    elapsed = time.perf_counter() - t0
+    assert again.cached and again.plan == first.plan and elapsed <= 1e-3
+    assert planner.hits == 1 and planner.misses == 1
+
+
+def test_cache_is_bounded_lru() -> None:
+    planner = Planner(cache_size=2)
+    texts = [PddlText(DOMAIN, problem_text(extra_init=f"; {k}\n")) for k in range(3)]
+    for t in texts:
+        planner.solve(t)
+    assert len(planner._cache) == 2
+    assert not planner.solve(texts[0]).cached  # evicted first
+    assert planner.solve(texts[2]).cached
+
+
+def test_up_problem_repeat_is_cached(pddl_files: tuple[Path, Path]) -> None:
+    _, _, problem = load_problem(*pddl_files)
+    planner = Planner()
+    planner.solve(problem)
+    t0 = time.perf_counter()
+    assert planner.solve(problem).cached
+    assert time.perf_counter() - t0 <= 1e-3
+
+
+def test_timeouts_are_not_cached() -> None:
+    planner = Planner()
+    text = PddlText(DOMAIN, problem_text())
+    assert planner.solve(text, timeout=1e-6).status is PlanStatus.TIMEOUT
+    assert planner.solve(text).status is PlanStatus.SOLVED
+
+
+def test_unsolvable_status() -> None:
+    res = Planner().solve(PddlText(DOMAIN, problem_text(goal="(holding cup) (item-at cup c)")))
+    assert res.status is PlanStatus.UNSOLVABLE and res.plan is None
+
+
+def test_plan_result_checks_fire() -> None:
+    with pytest.raises(ValueError, match="needs a plan"):
+        PlanResult(PlanStatus.SOLVED, None, 1.0, "x", 0.0)
+    with pytest.raises(ValueError, match="needs a cost"):
+        PlanResult(PlanStatus.SOLVED, (), None, "x", 0.0)
+    with pytest.raises(ValueError, match="must not carry a plan"):
+        PlanResult(PlanStatus.UNSOLVABLE, (), None, "x", 0.0)
+    with pytest.raises(TypeError, match="PlanStatus"):
+        PlanResult("solved", (), 0.0, "x", 0.0)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="tuples"):
+        PlanResult(PlanStatus.SOLVED, ((),), 0.0, "x", 0.0)
+    with pytest.raises(ValueError, match="wall_time_s"):
+        PlanResult(PlanStatus.SOLVED, (), 0.0, "x", -1.0)
+
+
+def test_deterministic() -> None:
+    a = Planner(cache_size=0).solve(PddlText(DOMAIN, problem_text()))
+    b = Planner(cache_size=0).solve(PddlText(DOMAIN, problem_text()))
+    assert a.plan == b.plan and a.cost == b.cost

@@ -1,0 +1,106 @@
+"""Malformed task folders are refused at load time, naming the file and what is wrong."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+import domains
+from planners.bundled import task_types
+from planners.checks import DefinitionError
+from planners.loader import load_task, load_task_folder, store_loader
+
+GUIDE = domains.BUNDLED / "guide_human"
+
+
+def _copy(tmp_path: Path, name: str = "guide_human") -> Path:
+    dst = tmp_path / name
+    shutil.copytree(domains.BUNDLED / name, dst, ignore=shutil.ignore_patterns("__pycache__"))
+    return dst
+
+
+def _edit(path: Path, old: str, new: str) -> None:
+    text = path.read_text()
+    assert old in text, old
+    path.write_text(text.replace(old, new, 1))
+
+
+TOML_CASES = [
+    ('skill = "say"\nkind = "blocking"\ntext = "Hello {h}', 'skill = "talk"\nkind = "blocking"\ntext = "Hello {h}',
+     "'skill' must be one of"),
+    ('[actions.say_goodbye]\nskill = "say"\n', '[actions.say_goodbye]\nskill = "say"\nkind = "sometimes"\n', "'kind'"),
+    ('["not", "told_to_wait", "$person"]]', '["not", "told_to", "$person"]]', "unknown predicate 'told_to'"),
+    ('goal = [["at", "$person", "$destination"]', 'goal = [["at", "$person"]', "takes 2 argument(s)"),
+    ('{ action = "say_goodbye", args = ["$robot", "$person", "$destination"] }',
+     '{ action = "wave", args = ["$robot"] }', "unknown action 'wave'"),
+    ('{ action = "say_goodbye", args = ["$robot", "$person", "$destination"] }',
+     '{ action = "say_goodbye", args = ["$robot"] }', "takes 3 argument(s)"),
+    ('[actions.ask_to_wait]\nskill = "say"\nkind = "blocking"\ntext = "Sorry {h}, I have an urgent task. '
+     'Please wait here, I will come back."\n', "", "no entry for domain action(s) ['ask_to_wait']"),
+    ('travel = ["?from", "?to"]', 'travel = ["?from", "?nowhere"]', "?nowhere is not a parameter"),
+    ('[[suspension]]\nlabel = "save"\ngoal = []', '[[suspension]]\nlabel = "save"\nwhen = [["greeted", "$person"]]\n'
+     'goal = []', "the last branch must have no 'when'"),
+    ('name = "guide_human"', 'name = "guide human"', "'name' must be an identifier"),
+    ('[task]', '[task', "TOML syntax error"),
+]
+
+
+@pytest.mark.parametrize(("old", "new", "fragment"), TOML_CASES)
+def test_bad_task_toml(old: str, new: str, fragment: str, tmp_path: Path) -> None:
+    folder = _copy(tmp_path)
+    _edit(folder / "task.toml", old, new)
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder)
+    assert info.value.file.endswith("task.toml") and fragment in str(info.value)
+
+
+def test_bad_domain_in_folder_names_domain(tmp_path: Path) -> None:
+    folder = _copy(tmp_path)
+    _edit(folder / "domain.pddl", "(apology_due ?h - person))", "(apology_due ?h - person)")
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder)
+    assert info.value.file.endswith("domain.pddl") and info.value.line is not None
+
+
+def test_axioms_fall_back_to_an_optimal_search_that_handles_them(tmp_path: Path) -> None:
+    folder = _copy(tmp_path)
+    _edit(folder / "domain.pddl", "(not (following ?h)))\n    :effect (and (not (at ?r ?from))",
+          "(forall (?x - person) (not (following ?x))))\n    :effect (and (not (at ?r ?from))")
+    _edit(folder / "domain.pddl", ":negative-preconditions", ":negative-preconditions :universal-preconditions")
+    task = load_task(folder)  # LM-cut refuses axioms (exit 34); A* + blind search takes over
+    from planners.examples import example_context
+
+    plan = task.update_task(example_context(task))
+    assert [s.action for s in plan.stages][:2] == ["approach", "greet"]
+
+
+def test_bad_task_py(tmp_path: Path) -> None:
+    folder = _copy(tmp_path, "carry_object")
+    (folder / "task.py").write_text("def extra_facts(ctx, world)\n    return []\n")
+    with pytest.raises(DefinitionError, match="syntax error") as info:
+        load_task(folder)
+    assert info.value.file.endswith("task.py") and info.value.line == 1
+    (folder / "task.py").write_text("def extra_fact(ctx, world):\n    return []\n")
+    with pytest.raises(DefinitionError, match="unknown hook"):
+        load_task(folder)
+
+
+def test_folder_of_folders_and_store_loader(tmp_path: Path) -> None:
+    _copy(tmp_path, "cook")
+    _copy(tmp_path, "human_fell")
+    assert [t.name for t in load_task_folder(tmp_path)] == ["cook", "human_fell"]
+    assert [t.name for t in store_loader(tmp_path)] == ["cook", "human_fell"]
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert store_loader(empty) == []
+    with pytest.raises(DefinitionError, match="no task folder"):
+        load_task_folder(empty)
+
+
+def test_task_types_with_user_folder(tmp_path: Path) -> None:
+    folder = _copy(tmp_path, "cook")
+    _edit(folder / "task.toml", 'name = "cook"', 'name = "cook_pasta"')
+    names = [t.name for t in task_types([folder])]
+    assert names[-1] == "cook_pasta" and "cook" in names
