@@ -1,0 +1,133 @@
+"""People in the apartment: scripted walks, postures, and the reactions tasks rely on.
+
+Each person is moved kinematically on the simulation clock (deterministic, no
+randomness).  What a person does in a step, in order of precedence:
+
+1. **fallen** people lie still;
+2. ``("told_to_wait", NAME)`` in the symbolic state: stand still;
+3. ``("following", NAME)``: walk along the robot's trail and stop ``FOLLOW_GAP``
+   metres (along the trail) behind the robot — the trail keeps them off walls;
+4. otherwise the **script**: ``walk`` waypoints ``(t, x, y)`` say where the person is
+   at time ``t``; the person heads for the scripted position of *now* at their walking
+   speed, so after a reaction ends they walk back onto the script instead of jumping.
+
+Posture changes come from the script's ``events`` ``(t, posture)`` or from
+:meth:`Person.set_posture`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+
+from robot.spec import PersonSpec
+from tasker.world import Fact, Pose
+
+FOLLOW_GAP = 0.9  # metres behind the robot, along its trail
+TRAIL_STEP = 0.05  # metres between recorded trail points
+
+
+class Person:
+    """One person's state: pose, posture, where the script and the reactions put them."""
+
+    def __init__(self, spec: PersonSpec) -> None:
+        self.spec = spec
+        self.name = spec.name
+        self.x, self.y, self.yaw = spec.pose
+        self.posture = spec.posture
+        self._event = 0
+        self._trail: list[tuple[float, float]] = []
+
+    @property
+    def pose(self) -> Pose:
+        return (self.x, self.y, self.yaw)
+
+    def set_posture(self, posture: str) -> None:
+        self.posture = posture
+
+    def scripted(self, t: float) -> tuple[float, float] | None:
+        """Where the script wants the person at time ``t`` (None: no walk scripted)."""
+        walk = self.spec.walk
+        if not walk:
+            return None
+        if t <= walk[0][0]:
+            return None  # before the first waypoint the person stays where they are
+        for (t0, x0, y0), (t1, x1, y1) in zip(walk, walk[1:], strict=False):
+            if t <= t1:
+                f = (t - t0) / (t1 - t0)
+                return (x0 + f * (x1 - x0), y0 + f * (y1 - y0))
+        return walk[-1][1], walk[-1][2]
+
+    def _walk_to(self, tx: float, ty: float, dt: float, stop_at: float = 0.0) -> None:
+        dx, dy = tx - self.x, ty - self.y
+        d = math.hypot(dx, dy)
+        step = min(self.spec.speed * dt, max(0.0, d - stop_at))
+        if step > 1e-9:
+            self.x += dx / d * step
+            self.y += dy / d * step
+            self.yaw = math.atan2(dy, dx)
+
+    def _follow(self, robot: tuple[float, float], dt: float) -> None:
+        trail = self._trail
+        if not trail:
+            trail.append((self.x, self.y))
+        if math.hypot(robot[0] - trail[-1][0], robot[1] - trail[-1][1]) >= TRAIL_STEP:
+            trail.append(robot)
+        # the trail point FOLLOW_GAP behind the robot, measured along the trail
+        back, k = 0.0, len(trail) - 1
+        while k > 0 and back < FOLLOW_GAP:
+            back += math.hypot(trail[k][0] - trail[k - 1][0], trail[k][1] - trail[k - 1][1])
+            k -= 1
+        budget = self.spec.speed * dt
+        while budget > 1e-9 and len(trail) > 1 and k > 0:
+            nx, ny = trail[1]
+            d = math.hypot(nx - self.x, ny - self.y)
+            if d <= budget:
+                self.x, self.y = nx, ny
+                budget -= d
+                trail.pop(0)
+                k -= 1
+                continue
+            self._walk_to(nx, ny, budget / self.spec.speed)
+            break
+
+    def step(self, t: float, dt: float, facts: frozenset[Fact] | set[Fact], robot: tuple[float, float]) -> None:
+        """Move the person from ``t - dt`` to ``t``."""
+        events = self.spec.events
+        while self._event < len(events) and events[self._event][0] <= t:
+            self.posture = events[self._event][1]
+            self._event += 1
+        following = ("following", self.name) in facts
+        if not following:
+            self._trail = []
+        if self.posture == "fallen" or ("told_to_wait", self.name) in facts:
+            return
+        if following:
+            self._follow(robot, dt)
+            return
+        target = self.scripted(t)
+        if target is not None:
+            self._walk_to(target[0], target[1], dt)
+
+
+class People:
+    """Everyone in the world, stepped together in name order (deterministic)."""
+
+    def __init__(self, specs: Iterable[PersonSpec]) -> None:
+        self.by_name = {p.name: Person(p) for p in sorted(specs, key=lambda s: s.name)}
+
+    def __getitem__(self, name: str) -> Person:
+        return self.by_name[name]
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.by_name
+
+    def __iter__(self):  # type: ignore[no-untyped-def]
+        return iter(self.by_name.values())
+
+    def step(self, t: float, dt: float, facts: frozenset[Fact] | set[Fact], robot: tuple[float, float]) -> None:
+        for p in self.by_name.values():
+            p.step(t, dt, facts, robot)
+
+    def facts(self) -> set[Fact]:
+        return {("posture", p.name, p.posture) for p in self.by_name.values()}

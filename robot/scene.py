@@ -1,0 +1,215 @@
+"""The 2-D collision scene the base planner works in: boxes, doors and people as discs.
+
+TIAGo's base is round, so base planning happens in R² with the robot as a disc of
+radius ``radius`` (the footprint of the whole robot with its arm tucked, taken from the
+Pinocchio model, plus a margin).  The scene has two layers:
+
+* **static**: walls and furniture, which never move.  The roadmap is grown over this
+  layer only, so it never has to be rebuilt.
+* **dynamic**: closed doors and people.  Every change to this layer bumps
+  :attr:`Scene.version`; anything cached from it (blocked roadmap edges, cost
+  estimates) is keyed on that version and so is never stale.
+
+Distances are exact (point/segment against axis-aligned box or disc), not sampled,
+and vectorised over obstacles and segments with numpy.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from robot.spec import Box, WorldSpec
+
+PERSON_RADIUS = {"standing": 0.25, "sitting": 0.35, "fallen": 0.6}
+
+
+@dataclass(frozen=True, slots=True)
+class Disc:
+    """A round obstacle in the plane: a person, with the radius of their posture."""
+
+    name: str
+    x: float
+    y: float
+    r: float
+
+
+def point_box_distance(px: np.ndarray, py: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    """Distance from points ``(P,)`` to boxes ``(M, 4)``: an array ``(P, M)``, 0 inside."""
+    x0, y0, x1, y1 = (boxes[:, k][None, :] for k in range(4))
+    dx = np.maximum(np.maximum(x0 - px[:, None], px[:, None] - x1), 0.0)
+    dy = np.maximum(np.maximum(y0 - py[:, None], py[:, None] - y1), 0.0)
+    return np.hypot(dx, dy)
+
+
+def point_segment_distance(px: np.ndarray, py: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance from points ``(P,)`` to segments ``a→b`` ``(S, 2)``: an array ``(S, P)``."""
+    d = b - a
+    L2 = np.maximum((d * d).sum(axis=1), 1e-18)[:, None]
+    t = np.clip(((px[None, :] - a[:, :1]) * d[:, :1] + (py[None, :] - a[:, 1:]) * d[:, 1:]) / L2, 0.0, 1.0)
+    return np.hypot(a[:, :1] + t * d[:, :1] - px[None, :], a[:, 1:] + t * d[:, 1:] - py[None, :])
+
+
+def pair_distance(a: np.ndarray, b: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    """Exact distance from segment ``a[i]→b[i]`` to box ``boxes[i]``, element-wise: ``(P,)``.
+
+    Two disjoint convex polygons are closest at a vertex of one of them, so the
+    distance is the least of the endpoints-to-box and corners-to-segment distances,
+    or 0 when the segment crosses the box (slab test).
+    """
+    x0, y0, x1, y1 = boxes[:, 0], boxes[:, 1], boxes[:, 2], boxes[:, 3]
+    d = b - a
+    dist = np.minimum(_point_box(a, boxes), _point_box(b, boxes))
+    corners = np.stack([np.stack([x0, y0], 1), np.stack([x1, y0], 1), np.stack([x0, y1], 1),
+                        np.stack([x1, y1], 1)], 1)  # (P, 4, 2)
+    L2 = np.maximum((d * d).sum(axis=1), 1e-18)[:, None]
+    rel = corners - a[:, None, :]
+    t = np.clip((rel * d[:, None, :]).sum(axis=2) / L2, 0.0, 1.0)
+    gap = rel - t[:, :, None] * d[:, None, :]
+    dist = np.minimum(dist, np.sqrt((gap * gap).sum(axis=2).min(axis=1)))
+    # slab test: does the segment cross the box?
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / d
+        tx0, tx1 = (x0 - a[:, 0]) * inv[:, 0], (x1 - a[:, 0]) * inv[:, 0]
+        ty0, ty1 = (y0 - a[:, 1]) * inv[:, 1], (y1 - a[:, 1]) * inv[:, 1]
+    par_x, par_y = d[:, 0] == 0, d[:, 1] == 0
+    in_x = (a[:, 0] >= x0) & (a[:, 0] <= x1)
+    in_y = (a[:, 1] >= y0) & (a[:, 1] <= y1)
+    lo_x = np.where(par_x, np.where(in_x, -np.inf, np.inf), np.minimum(tx0, tx1))
+    hi_x = np.where(par_x, np.where(in_x, np.inf, -np.inf), np.maximum(tx0, tx1))
+    lo_y = np.where(par_y, np.where(in_y, -np.inf, np.inf), np.minimum(ty0, ty1))
+    hi_y = np.where(par_y, np.where(in_y, np.inf, -np.inf), np.maximum(ty0, ty1))
+    cross = np.maximum(np.maximum(lo_x, lo_y), 0.0) <= np.minimum(np.minimum(hi_x, hi_y), 1.0)
+    return np.where(cross, 0.0, dist)
+
+
+def _point_box(p: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    dx = np.maximum(np.maximum(boxes[:, 0] - p[:, 0], p[:, 0] - boxes[:, 2]), 0.0)
+    dy = np.maximum(np.maximum(boxes[:, 1] - p[:, 1], p[:, 1] - boxes[:, 3]), 0.0)
+    return np.sqrt(dx * dx + dy * dy)
+
+
+def segment_box_distance(a: np.ndarray, b: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    """Exact distance from segments ``a→b`` ``(S, 2)`` to boxes ``(M, 4)``: ``(S, M)``."""
+    S, M = len(a), len(boxes)
+    si, mi = np.repeat(np.arange(S), M), np.tile(np.arange(M), S)
+    return pair_distance(a[si], b[si], boxes[mi]).reshape(S, M)
+
+
+def segments_clear(a: np.ndarray, b: np.ndarray, boxes: np.ndarray, r: float) -> np.ndarray:
+    """Which segments stay at least ``r`` from every box: a cheap bounding-box filter,
+    then the exact distance for the few (segment, box) pairs that pass it."""
+    ok = np.ones(len(a), dtype=bool)
+    if not len(a) or not len(boxes):
+        return ok
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    near = ((lo[:, None, 0] < boxes[None, :, 2] + r) & (hi[:, None, 0] > boxes[None, :, 0] - r)
+            & (lo[:, None, 1] < boxes[None, :, 3] + r) & (hi[:, None, 1] > boxes[None, :, 1] - r))
+    si, mi = np.nonzero(near)
+    if len(si):
+        ok[si[pair_distance(a[si], b[si], boxes[mi]) < r]] = False
+    return ok
+
+
+class Scene:
+    """The plane as the base planner sees it; a disc robot of ``radius`` metres.
+
+    Mutators (:meth:`set_door`, :meth:`set_person`) bump :attr:`version` whenever
+    the dynamic layer really changes.
+    """
+
+    def __init__(self, spec: WorldSpec, radius: float) -> None:
+        self.radius = float(radius)
+        (self.xmin, self.ymin), (self.xmax, self.ymax) = spec.bounds
+        self.static = np.array([o.box for o in spec.obstacles], dtype=float).reshape(-1, 4)
+        self._static_list: list[Box] = [o.box for o in spec.obstacles]
+        self.door_boxes: dict[str, Box] = {n: d.box for n, d in spec.doors.items()}
+        self.door_open: dict[str, bool] = {n: d.open for n, d in spec.doors.items()}
+        self.people: dict[str, Disc] = {}
+        self.version = 0
+        self._closed = np.zeros((0, 4))
+        self._refresh_doors()
+
+    # ---- dynamic layer -------------------------------------------------------------
+    def _refresh_doors(self) -> None:
+        self._closed = np.array([self.door_boxes[n] for n, o in sorted(self.door_open.items()) if not o],
+                                dtype=float).reshape(-1, 4)
+
+    def set_door(self, name: str, is_open: bool) -> None:
+        if self.door_open[name] != is_open:
+            self.door_open[name] = is_open
+            self._refresh_doors()
+            self.version += 1
+
+    def set_person(self, name: str, x: float, y: float, posture: str) -> None:
+        disc = Disc(name, round(x, 3), round(y, 3), PERSON_RADIUS[posture])
+        if self.people.get(name) != disc:
+            self.people[name] = disc
+            self.version += 1
+
+    def remove_person(self, name: str) -> None:
+        if self.people.pop(name, None) is not None:
+            self.version += 1
+
+    def closed_doors(self) -> np.ndarray:
+        return self._closed
+
+    def discs(self, ignore: tuple[str, ...] = ()) -> list[Disc]:
+        return [d for n, d in sorted(self.people.items()) if n not in ignore]
+
+    # ---- queries ---------------------------------------------------------------------
+    def in_bounds(self, x: float, y: float) -> bool:
+        r = self.radius
+        return self.xmin + r <= x <= self.xmax - r and self.ymin + r <= y <= self.ymax - r
+
+    def static_free(self, x: float, y: float) -> bool:
+        """Is the disc at ``(x, y)`` clear of walls and furniture?  Plain Python: OMPL calls it."""
+        if not self.in_bounds(x, y):
+            return False
+        r2 = self.radius * self.radius
+        for x0, y0, x1, y1 in self._static_list:
+            dx = x0 - x if x < x0 else (x - x1 if x > x1 else 0.0)
+            dy = y0 - y if y < y0 else (y - y1 if y > y1 else 0.0)
+            if dx * dx + dy * dy < r2:
+                return False
+        return True
+
+    def blocking_discs(self, points: list[tuple[float, float]]) -> tuple[str, ...]:
+        """People whose disc overlaps the robot at any of ``points`` (the robot is beside them)."""
+        out = []
+        for d in self.discs():
+            if any(math.hypot(px - d.x, py - d.y) < d.r + self.radius for px, py in points):
+                out.append(d.name)
+        return tuple(out)
+
+    def free(self, x: float, y: float, ignore: tuple[str, ...] = ()) -> bool:
+        """Static and dynamic layers: walls, furniture, closed doors, people (less ``ignore``)."""
+        if not self.static_free(x, y):
+            return False
+        p = np.array([x]), np.array([y])
+        if len(self._closed) and point_box_distance(*p, self._closed).min() < self.radius:
+            return False
+        return all(math.hypot(x - d.x, y - d.y) >= d.r + self.radius for d in self.discs(ignore))
+
+    def segments_free(self, a: np.ndarray, b: np.ndarray, dynamic: bool = True, static: bool = True,
+                      ignore: tuple[str, ...] = ()) -> np.ndarray:
+        """Which segments ``a[i]→b[i]`` the disc robot can sweep along (exact, vectorised)."""
+        a, b = np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2)
+        ok = np.ones(len(a), dtype=bool)
+        r = self.radius
+        if static:
+            ok &= (a[:, 0] >= self.xmin + r) & (a[:, 0] <= self.xmax - r) & (b[:, 0] >= self.xmin + r)
+            ok &= (b[:, 0] <= self.xmax - r) & (a[:, 1] >= self.ymin + r) & (a[:, 1] <= self.ymax - r)
+            ok &= (b[:, 1] >= self.ymin + r) & (b[:, 1] <= self.ymax - r)
+            ok &= segments_clear(a, b, self.static, r)
+        if dynamic:
+            ok &= segments_clear(a, b, self._closed, r)
+            discs = self.discs(ignore)
+            if discs:
+                px = np.array([d.x for d in discs])
+                py = np.array([d.y for d in discs])
+                rr = np.array([d.r for d in discs]) + r
+                ok &= (point_segment_distance(px, py, a, b) >= rr[None, :]).all(axis=1)
+        return ok

@@ -1,0 +1,148 @@
+"""The simulated robot and its world: one object that is both the TaskER ``World`` and ``CoreAgent``.
+
+:class:`Simulation` owns the MuJoCo apartment, the people, the 2-D scene, the
+planner and the symbolic state, and steps them together on the simulated clock:
+
+* :meth:`advance` (``World``) runs fixed control ticks (``CONTROL_DT``), each one
+  moving the people, updating the scene, asking the running skill for a base command
+  and stepping MuJoCo ``CONTROL_DT / TIMESTEP`` times.  Same inputs, same trajectory.
+* :meth:`begin` / :meth:`poll` / :meth:`stop` (``CoreAgent``) run the skills of
+  :mod:`robot.skills`; :meth:`poll` advances the world to ``now`` first, so the
+  simulation also works when nobody else calls :meth:`advance`.
+
+The symbolic state starts from the world file's facts, device states
+(``("state", device, value)``) and ``("at", "robot", place)`` when the robot starts on
+a place; skills change it through their stage's ``add``/``delete`` lists.  Postures are
+physical and reported as ``("posture", person, posture)``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from pathlib import Path
+
+from robot.control import STOP
+from robot.mjworld import TIMESTEP, MjApartment
+from robot.people import People
+from robot.planner import BasePlanner, DriveLimits, MotionEstimator
+from robot.scene import Scene
+from robot.skills import SKILLS, Skill
+from robot.spec import WorldSpec, load_world
+from robot.tiago import robot_dimensions
+from tasker.protocols import RUNNING, SkillState, SkillStatus, failed
+from tasker.stage import Stage
+from tasker.world import Fact, Pose, WorldState
+
+CONTROL_DT = 0.02  # seconds: the base controller and the people run at 50 Hz
+AT_TOLERANCE = 0.3  # metres: the robot starts "at" a place this close
+
+
+class Simulation:
+    """TIAGo in a MuJoCo apartment: ``tasker.protocols.World`` and ``CoreAgent`` in one.
+
+    ``rate_hz`` is the rate the loop should call :meth:`advance` at; physics and
+    control run at their own fixed rates underneath.
+    """
+
+    def __init__(self, world: str | Path | WorldSpec, seed: int = 1, rate_hz: float = 10.0,
+                 milestones: int | None = None) -> None:
+        self.spec = world if isinstance(world, WorldSpec) else load_world(world)
+        self.seed = seed
+        self.rate_hz = float(rate_hz)
+        _, _, radius = robot_dimensions()
+        self.scene = Scene(self.spec, radius)
+        self.people = People(self.spec.people.values())
+        self.planner = BasePlanner(self.spec, self.scene, seed=seed, milestones=milestones)
+        self.limits = DriveLimits.of(self.spec.robot)
+        self.motion = MotionEstimator(self.planner, self.limits)
+        self.mj = MjApartment(self.spec)
+        self.time = 0.0
+        self.facts: set[Fact] = set(self.spec.facts)
+        self.facts |= {("state", d.name, d.state) for d in self.spec.devices.values()}
+        x, y, _ = self.spec.robot.pose
+        for name, (px, py, _) in sorted(self.spec.places.items()):
+            if math.hypot(px - x, py - y) < AT_TOLERANCE and not any(f[:2] == ("at", "robot") for f in self.facts):
+                self.facts.add(("at", "robot", name))
+        self.skill: Skill | None = None
+        self._owner: tuple[str, Stage] | None = None
+        self._applied = False
+        self.trajectory: list[tuple[float, float, float, float]] = []
+        self._sync_people()
+
+    # ---- World -----------------------------------------------------------------------
+    def robot_pose(self) -> Pose:
+        return self.mj.pose()
+
+    def objects(self) -> dict[str, str]:
+        out = {"robot": "robot"}
+        out |= {n: "place" for n in self.spec.places}
+        out |= {n: "person" for n in self.spec.people}
+        out |= {n: d.type for n, d in self.spec.devices.items()}
+        out |= {n: "door" for n in self.spec.doors}
+        return out
+
+    def _sync_people(self) -> None:
+        for p in self.people:
+            self.scene.set_person(p.name, p.x, p.y, p.posture)
+            self.mj.set_person(p.name, p.x, p.y, p.yaw, p.posture)
+
+    def _tick(self) -> None:
+        t = self.time + CONTROL_DT
+        x, y, _ = self.mj.pose()
+        self.people.step(t, CONTROL_DT, self.facts, (x, y))
+        self._sync_people()
+        cmd = self.skill.control(t, CONTROL_DT) if self.skill is not None else STOP
+        self.mj.command(cmd.v, cmd.w)
+        self.mj.step(round(CONTROL_DT / TIMESTEP))
+        self.time = t
+        self.trajectory.append((t, *self.mj.pose()))
+
+    def advance(self, now: float) -> None:
+        """Step control and physics in fixed ticks up to simulated time ``now``."""
+        while self.time + CONTROL_DT <= now + 1e-9:
+            self._tick()
+
+    def set_door(self, name: str, is_open: bool) -> None:
+        """Open or close a door: the scene (and so every cached estimate) and MuJoCo follow."""
+        self.scene.set_door(name, is_open)
+        self.mj.set_door(name, is_open)
+
+    def snapshot(self) -> WorldState:
+        poses: dict[str, Pose] = {"robot": self.robot_pose()}
+        poses |= {p.name: p.pose for p in self.people}
+        poses |= dict(self.spec.places)
+        facts = frozenset(self.facts | self.people.facts())
+        return WorldState(facts, poses, self.objects(), self.time)
+
+    def apply(self, add: Iterable[Iterable[str]] = (), delete: Iterable[Iterable[str]] = ()) -> None:
+        """Change the symbolic state: ``delete`` first, then ``add`` (lists of ground facts)."""
+        self.facts -= {tuple(f) for f in delete}
+        self.facts |= {tuple(f) for f in add}
+
+    # ---- CoreAgent -------------------------------------------------------------------
+    def begin(self, agent: str, stage: Stage, now: float) -> None:
+        self.advance(now)
+        kind = SKILLS.get(stage.skill)
+        self._owner = (agent, stage)
+        self._applied = False
+        if kind is None:
+            self.skill = Skill(self, stage, now)
+            self.skill.result = failed(f"unknown skill {stage.skill!r}; known: {', '.join(sorted(SKILLS))}")
+            return
+        self.skill = kind(self, stage, now)
+
+    def poll(self, agent: str, stage: Stage, now: float) -> SkillStatus:
+        self.advance(now)
+        if self.skill is None or self._owner != (agent, stage):
+            return failed(f"stage {stage.label} of {agent} was not begun")
+        status = self.skill.result
+        if status.state is SkillState.SUCCEEDED and not self._applied:
+            self._applied = True
+            self.apply(stage.data.get("add", []), stage.data.get("delete", []))
+        return status
+
+    def stop(self, agent: str, stage: Stage, now: float) -> None:
+        self.advance(now)
+        if self.skill is not None and self._owner == (agent, stage) and self.skill.result is RUNNING:
+            self.skill.stop(now)

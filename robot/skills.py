@@ -1,0 +1,177 @@
+"""The skills the core agent runs: ``navigate``, ``say``, ``manipulate``, ``wait``.
+
+A skill is started by :meth:`Simulation.begin <robot.sim.Simulation.begin>`, gets a
+:meth:`Skill.control` call at every control tick of the physics loop (the base
+command, for ``navigate``), and reports its :class:`~tasker.protocols.SkillStatus`.
+Contract with the task types (``Stage.data``):
+
+* ``navigate``: ``data["to"]`` is a place, a person (the robot stops ``APPROACH``
+  metres from them, facing them) or a pose ``[x, y, yaw]``.  Fails when no path
+  exists or when people block the way for longer than ``BLOCK_TIMEOUT``.
+* ``say``: ``data["text"]``; takes ``stage.duration`` seconds.
+* ``manipulate``: takes ``stage.duration`` seconds; fails if ``data["object"]``
+  names something the world no longer has.
+* ``wait``: takes ``stage.duration`` seconds.
+
+On success the simulation applies ``data["add"]`` and ``data["delete"]``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from robot.control import STOP, Command, PathFollower
+from tasker.protocols import RUNNING, SUCCEEDED, SkillStatus, failed
+from tasker.stage import Stage
+from tasker.world import Pose
+
+if TYPE_CHECKING:
+    from robot.sim import Simulation
+
+APPROACH = 0.9  # metres from a person's centre when navigating "to" them
+BLOCK_TIMEOUT = 5.0  # seconds a blocked path is retried before the skill fails
+CHECK_PERIOD = 0.2  # seconds between checks of the path ahead
+
+
+class Skill:
+    """A running skill: timed by default; subclasses override :meth:`control`/:meth:`status`."""
+
+    def __init__(self, sim: Simulation, stage: Stage, now: float) -> None:
+        self.sim = sim
+        self.stage = stage
+        self.started = now
+        self.result: SkillStatus = RUNNING
+
+    def control(self, now: float, dt: float) -> Command:
+        if self.result is RUNNING and now - self.started >= self.stage.duration - 1e-9:
+            self.result = SUCCEEDED
+        return STOP
+
+    def stop(self, now: float) -> None:
+        if self.result is RUNNING:
+            self.result = failed("stopped")
+
+
+class Manipulate(Skill):
+    """A timed manipulation; fails at once if its object is gone."""
+
+    def __init__(self, sim: Simulation, stage: Stage, now: float) -> None:
+        super().__init__(sim, stage, now)
+        obj = stage.data.get("object")
+        if obj is not None and obj not in sim.objects():
+            self.result = failed(f"object {obj!r} is gone")
+
+
+class Navigate(Skill):
+    """Drive the base along a planned path to a place, a person or a pose."""
+
+    def __init__(self, sim: Simulation, stage: Stage, now: float) -> None:
+        super().__init__(sim, stage, now)
+        self.target = stage.data.get("to")
+        self.follower: PathFollower | None = None
+        self.goal: Pose | None = None
+        self.person_at: tuple[float, float] | None = None
+        self.blocked_since: float | None = None
+        self.next_check = now
+        self.stopping = False
+        why = self._replan()
+        if why:
+            self.result = failed(why)
+
+    def _goal(self) -> Pose | str:
+        t = self.target
+        sim = self.sim
+        if isinstance(t, str):
+            if t in sim.spec.places:
+                return sim.spec.places[t]
+            if t in sim.people:
+                return self._approach(t)
+            return f"unknown navigation target {t!r}"
+        if isinstance(t, list | tuple) and len(t) in (2, 3) and all(isinstance(v, int | float) for v in t):
+            return (float(t[0]), float(t[1]), float(t[2]) if len(t) == 3 else math.nan)
+        return f"navigate needs data['to'] = a place, a person or [x, y, yaw]; got {t!r}"
+
+    def _approach(self, name: str) -> Pose | str:
+        """The reachable pose ``APPROACH`` metres from the person, facing them, cheapest first."""
+        p = self.sim.people[name]
+        self.person_at = (p.x, p.y)
+        rx, ry, ryaw = self.sim.robot_pose()
+        best: tuple[float, Pose] | None = None
+        for k in range(16):
+            a = 2 * math.pi * k / 16
+            gx, gy = p.x + APPROACH * math.cos(a), p.y + APPROACH * math.sin(a)
+            if not self.sim.scene.free(gx, gy, ignore=(name,)):
+                continue
+            goal = (gx, gy, math.atan2(p.y - gy, p.x - gx))
+            est = self.sim.motion.estimate((rx, ry, ryaw), goal)
+            if est.reachable and (best is None or est.time_s < best[0]):
+                best = (est.time_s, goal)
+        return best[1] if best else f"no reachable pose next to {name}"
+
+    def _replan(self) -> str | None:
+        goal = self._goal()
+        if isinstance(goal, str):
+            return goal
+        x, y, yaw = self.sim.robot_pose()
+        path = self.sim.planner.plan((x, y), (goal[0], goal[1]))
+        if path is None:
+            return f"no path to {self.target!r}"
+        self.goal = goal
+        self.follower = PathFollower(path, None if math.isnan(goal[2]) else goal[2], self.sim.limits)
+        return None
+
+    def _path_ahead_blocked(self) -> bool:
+        f = self.follower
+        assert f is not None
+        x, y, _ = self.sim.robot_pose()
+        ahead = [(x, y)] + f.path[f.leg + 1 :]
+        if len(ahead) < 2:
+            return False
+        scene = self.sim.scene
+        ignore = scene.blocking_discs([(x, y), ahead[-1]])
+        pts = np.asarray(ahead)
+        return not scene.segments_free(pts[:-1], pts[1:], static=False, ignore=ignore).all()
+
+    def control(self, now: float, dt: float) -> Command:
+        f = self.follower
+        if f is None:
+            return STOP
+        if self.result is not RUNNING:  # finished, failed or stopped: brake (a no-op once done)
+            f.brake()
+            x, y, yaw = self.sim.robot_pose()
+            return f.command(x, y, yaw, dt)
+        if not self.stopping and now >= self.next_check:
+            self.next_check = now + CHECK_PERIOD
+            moved = (self.person_at is not None and isinstance(self.target, str)
+                     and math.dist(self.person_at, self.sim.people[self.target].pose[:2]) > 0.5)
+            if moved or self._path_ahead_blocked():
+                why = self._replan()
+                if why is None:
+                    self.blocked_since = None
+                else:
+                    self.blocked_since = self.blocked_since if self.blocked_since is not None else now
+                    if now - self.blocked_since > BLOCK_TIMEOUT:
+                        self.result = failed(f"path to {self.target!r} blocked: {why}")
+                    self.follower.brake()
+                f = self.follower
+        x, y, yaw = self.sim.robot_pose()
+        cmd = f.command(x, y, yaw, dt)
+        if f.done and self.blocked_since is None and not self.stopping and self.result is RUNNING:
+            self.result = SUCCEEDED
+        return cmd
+
+    def stop(self, now: float) -> None:
+        """Brake to a standstill at the acceleration limits (the physics loop keeps braking)."""
+        self.stopping = True
+        if self.follower is not None:
+            self.follower.brake()
+        super().stop(now)
+
+    def braking(self) -> bool:
+        return self.stopping and self.follower is not None and not self.follower.done
+
+
+SKILLS: dict[str, type[Skill]] = {"navigate": Navigate, "say": Skill, "manipulate": Manipulate, "wait": Skill}

@@ -1,0 +1,104 @@
+"""Base planning: collision-free against the real robot, unreachable is infinite, deterministic."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from robot import roadmap
+from robot.planner import BasePlanner, DriveLimits, profile_time
+from robot.scene import Scene
+from robot.tiago import RobotCollision, robot_dimensions
+from tasker.world import UNREACHABLE, MotionModel
+
+
+def _dense(path, step=0.02):
+    out = []
+    for (x0, y0), (x1, y1) in itertools.pairwise(path):
+        n = max(1, math.ceil(math.hypot(x1 - x0, y1 - y0) / step))
+        yaw = math.atan2(y1 - y0, x1 - x0)
+        out += [(x0 + (x1 - x0) * k / n, y0 + (y1 - y0) * k / n, yaw) for k in range(n + 1)]
+    return out
+
+
+def test_paths_are_collision_free_against_the_tiago_mesh_model(paper, paper_motion) -> None:
+    assert isinstance(paper_motion, MotionModel)
+    boxes = [(*o.box, o.height) for o in paper.obstacles]
+    robot = RobotCollision(boxes)
+    names = sorted(paper.places)
+    checked = 0
+    for a, b in itertools.islice(itertools.permutations(names, 2), 0, None, 4):
+        est = paper_motion.estimate(paper.places[a], paper.places[b])
+        assert est.reachable, (a, b)
+        for x, y, yaw in _dense(est.path):
+            for turn in (0.0, math.pi / 2):  # the base turns in place at corners: any yaw
+                assert not robot.collides(x, y, yaw + turn), (a, b, x, y)
+                checked += 1
+    assert checked > 1000
+
+
+def test_walled_off_and_closed_door_goals_are_unreachable(flat, flat_motion) -> None:
+    living = flat.places["living"]
+    assert flat_motion.estimate(living, flat.places["storage"]) == UNREACHABLE
+    behind_door = flat_motion.estimate(living, flat.places["bedroom"])
+    assert not behind_door.reachable and math.isinf(behind_door.time_s)
+    scene = flat_motion.planner.scene
+    version = scene.version
+    scene.set_door("bedroom_door", True)
+    try:
+        assert scene.version != version
+        opened = flat_motion.estimate(living, flat.places["bedroom"])
+        assert opened.reachable and 0 < opened.time_s < math.inf
+    finally:
+        scene.set_door("bedroom_door", False)
+    assert not flat_motion.estimate(living, flat.places["bedroom"]).reachable
+
+
+def test_goal_in_collision_or_outside_is_unreachable(paper, paper_motion) -> None:
+    hall = paper.places["hall"]
+    assert not paper_motion.estimate(hall, (1.5, 2.1, 0.0)).reachable  # on the coffee table
+    assert not paper_motion.estimate(hall, (-3.0, 2.0, 0.0)).reachable
+
+
+def test_estimate_counts_rotation(paper_motion) -> None:
+    a = paper_motion.estimate((6.0, 3.0, 0.0), (6.0, 3.0, math.pi / 2))
+    assert a.reachable and a.distance_m == 0 and a.time_s == pytest.approx(profile_time(math.pi / 2, 1.0, 2.0))
+    straight = paper_motion.estimate((6.0, 3.0, math.pi / 2), (6.0, 5.0, math.pi / 2))
+    turning = paper_motion.estimate((6.0, 3.0, -math.pi / 2), (6.0, 5.0, math.pi / 2))
+    assert turning.time_s > straight.time_s + 2.0
+
+
+def test_same_seed_same_roadmap_and_path(paper) -> None:
+    radius = robot_dimensions()[2]
+    saved = dict(roadmap._CACHE)
+    roadmap._CACHE.clear()
+    try:
+        paths = []
+        for _ in range(2):
+            roadmap._CACHE.clear()
+            planner = BasePlanner(paper, Scene(paper, radius), seed=5, milestones=600)
+            paths.append((planner.roadmap.nodes.copy(), planner.plan((6.0, 1.0), (1.0, 6.75))))
+        assert np.array_equal(paths[0][0], paths[1][0])
+        assert paths[0][1] == paths[1][1] and paths[0][1] is not None
+    finally:
+        roadmap._CACHE.clear()
+        roadmap._CACHE.update(saved)
+
+
+def test_people_block_and_cache_follows_the_scene(paper) -> None:
+    scene = Scene(paper, robot_dimensions()[2])
+    planner = BasePlanner(paper, scene)
+    clear = planner.plan((6.0, 1.0), (6.0, 7.0))
+    assert clear is not None
+    scene.set_person("john", 6.0, 4.0, "fallen")  # lying across the hall
+    assert planner.plan((6.0, 1.0), (6.0, 7.0)) != clear
+    scene.remove_person("john")
+    assert planner.plan((6.0, 1.0), (6.0, 7.0)) == clear
+
+
+def test_drive_limits_reject_nonsense() -> None:
+    with pytest.raises(ValueError, match="v_max"):
+        DriveLimits(v_max=0)

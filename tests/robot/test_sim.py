@@ -1,0 +1,117 @@
+"""The simulation: MuJoCo agrees with the estimates, skills keep their contract, people react."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from robot.sim import Simulation
+from tasker.protocols import CoreAgent, SkillState, World
+from tasker.stage import Stage
+from tasker.world import WorldState
+
+
+def run(sim: Simulation, stage: Stage, now: float, limit: float = 200.0, dt: float = 0.1):
+    sim.begin("d1", stage, now)
+    while True:
+        now += dt
+        status = sim.poll("d1", stage, now)
+        if status.state is not SkillState.RUNNING or now > limit:
+            return status, now
+
+
+def nav(to, **data) -> Stage:
+    return Stage("navigate", ("robot", str(to)), skill="navigate", data={"to": to, **data})
+
+
+def test_protocols(paper) -> None:
+    sim = Simulation(paper)
+    assert isinstance(sim, World) and isinstance(sim, CoreAgent)
+    snap = sim.snapshot()
+    assert isinstance(snap, WorldState)
+    assert snap.holds("at", "robot", "hall") or snap.holds("posture", "john", "standing")
+    assert snap.objects["john"] == "person" and snap.objects["cooker"] == "cooker"
+    assert "robot" in snap.poses and "kitchen" in snap.poses
+
+
+@pytest.mark.parametrize(("a", "b"), [("hall", "kitchen"), ("kitchen", "bedroom"), ("bedroom", "stove"),
+                                      ("stove", "bathroom"), ("bathroom", "alice_destination")])
+def test_estimates_match_mujoco_time(paper, a: str, b: str) -> None:
+    start = paper.places[a]
+    world = type(paper)(**{**{f: getattr(paper, f) for f in paper.__dataclass_fields__},
+                           "people": {}, "robot": type(paper.robot)(pose=start)})
+    sim = Simulation(world)
+    est = sim.motion.estimate(start, paper.places[b])
+    status, t = run(sim, nav(b), 0.0, dt=0.02)
+    assert status.state is SkillState.SUCCEEDED
+    x, y, yaw = sim.robot_pose()
+    assert math.hypot(x - paper.places[b][0], y - paper.places[b][1]) < 0.1
+    assert abs(t - est.time_s) <= 0.15 * est.time_s, (t, est.time_s)
+    assert sim.mj.contacts_with_world() == 0
+
+
+def test_stop_brings_the_base_to_rest(paper) -> None:
+    sim = Simulation(paper)
+    stage = nav("bedroom")
+    sim.begin("d1", stage, 0.0)
+    sim.advance(6.0)
+    assert sim.mj.velocity()[0] > 0.1 or abs(sim.mj.velocity()[1]) > 0.1
+    sim.stop("d1", stage, 6.0)
+    sim.advance(8.0)
+    v, w = sim.mj.velocity()
+    assert v < 0.01 and abs(w) < 0.01
+    parked = sim.robot_pose()
+    sim.advance(10.0)
+    assert math.dist(parked[:2], sim.robot_pose()[:2]) < 0.005
+    assert sim.poll("d1", stage, 10.0).state is SkillState.FAILED
+
+
+def test_person_asked_to_follow_ends_near_the_destination(paper) -> None:
+    sim = Simulation(paper)
+    status, now = run(sim, nav("john", add=[["met", "robot", "john"]]), 0.0)
+    assert status.state is SkillState.SUCCEEDED and sim.snapshot().holds("met", "robot", "john")
+    sim.apply(add=[["following", "john"]])
+    status, now = run(sim, nav("john_destination"), now)
+    assert status.state is SkillState.SUCCEEDED
+    sim.advance(now + 3.0)
+    john = sim.people["john"]
+    assert math.dist((john.x, john.y), paper.places["john_destination"][:2]) < 1.5
+
+
+def test_told_to_wait_stops_a_walking_person(paper) -> None:
+    sim = Simulation(paper)
+    sim.advance(20.0)
+    sim.apply(add=[["told_to_wait", "john"]])
+    here = sim.people["john"].pose
+    sim.advance(30.0)
+    assert sim.people["john"].pose == here
+    sim.apply(delete=[["told_to_wait", "john"]])
+    sim.advance(35.0)
+    assert sim.people["john"].pose != here
+
+
+def test_timed_skills_apply_effects_and_fail_cleanly(flat) -> None:
+    sim = Simulation(flat)
+    say = Stage("say", ("robot", "anna"), skill="say", duration=2.0,
+                data={"text": "hello", "add": [["greeted", "anna"]], "delete": [["at", "robot", "living"]]})
+    status, now = run(sim, say, 0.0)
+    assert status.state is SkillState.SUCCEEDED and 1.9 <= now <= 2.2
+    snap = sim.snapshot()
+    assert snap.holds("greeted", "anna") and not snap.holds("at", "robot", "living")
+    gone = Stage("grab", skill="manipulate", duration=1.0, data={"object": "cup"})
+    assert run(sim, gone, now)[0].reason == "object 'cup' is gone"
+    assert "no path" in run(sim, nav("storage"), now)[0].reason
+    assert "unknown skill" in run(sim, Stage("dance", skill="dance"), now)[0].reason
+    assert "unknown navigation target" in run(sim, nav("moon"), now)[0].reason
+
+
+def test_same_seed_same_trajectory(paper) -> None:
+    trajectories = []
+    for _ in range(2):
+        sim = Simulation(paper, seed=1)
+        run(sim, nav("kitchen"), 0.0, limit=12.0)
+        trajectories.append((np.array(sim.trajectory), sim.mj.state()))
+    assert np.array_equal(trajectories[0][0], trajectories[1][0])
+    assert np.array_equal(trajectories[0][1], trajectories[1][1])
