@@ -109,11 +109,28 @@ class Simulation:
         self.mj.set_door(name, is_open)
 
     def snapshot(self) -> WorldState:
+        """The world as task hooks see it: symbolic facts plus the facts read off the physics.
+
+        People's symbolic place is always derived from where they physically are (the
+        nearest named place), never from a skill's effects: a person walks by themself
+        (John toward his destination), follows the robot, or stays.  A fallen person is
+        ``("fallen", name)``.
+        """
         poses: dict[str, Pose] = {"robot": self.robot_pose()}
         poses |= {p.name: p.pose for p in self.people}
         poses |= dict(self.spec.places)
-        facts = frozenset(self.facts | self.people.facts())
-        return WorldState(facts, poses, self.objects(), self.time)
+        names = set(self.spec.people)
+        facts = {f for f in self.facts if not (f[0] == "at" and len(f) == 3 and f[1] in names)}
+        for p in self.people:
+            facts.add(("at", p.name, self.nearest_place(p.x, p.y)))
+            if p.posture == "fallen":
+                facts.add(("fallen", p.name))
+        return WorldState(frozenset(facts | self.people.facts()), poses, self.objects(), self.time)
+
+    def nearest_place(self, x: float, y: float) -> str:
+        """The named place closest to ``(x, y)`` (ties broken by name, so deterministic)."""
+        return min(self.spec.places, key=lambda n: (math.hypot(self.spec.places[n][0] - x,
+                                                               self.spec.places[n][1] - y), n))
 
     def apply(self, add: Iterable[Iterable[str]] = (), delete: Iterable[Iterable[str]] = ()) -> None:
         """Change the symbolic state: ``delete`` first, then ``add`` (lists of ground facts)."""

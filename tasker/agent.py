@@ -33,6 +33,10 @@ from tasker.trace import Trace
 
 S = FsmState
 
+VOLATILE_INFO = frozenset({"planner_time_s", "cached", "wall_time_s"})
+"""Keys of ``StagePlan.info`` that vary from run to run: kept out of the trace (it must be
+reproducible byte for byte) and collected in :attr:`DynamicAgent.planner_calls` instead."""
+
 
 @dataclass(frozen=True, slots=True)
 class Rates:
@@ -107,6 +111,7 @@ class DynamicAgent:
         self._ready_at = 0.0  # end of a planning hook's simulated time
         self._next_sp = 0.0
         self._params: ScheduleParams | None = None
+        self.planner_calls: list[dict[str, Any]] = []
 
     # -- the harmoniser's side ----------------------------------------------------------
 
@@ -157,6 +162,8 @@ class DynamicAgent:
                 self._pending_start = True
             elif cmd.flag is Flag.SUSP:
                 self._pending_susp = True
+                if "expected_s" in cmd.data:  # how long the interruption is expected to last
+                    self.ctx.memory["interruption_s"] = float(cmd.data["expected_s"])
             elif cmd.flag is Flag.TERM:
                 self._pending_term = str(cmd.data.get("reason", "terminated by the harmoniser"))
         self._inbox.clear()
@@ -377,7 +384,11 @@ class DynamicAgent:
         if plan.note:
             fields["note"] = plan.note
         if plan.info:
-            fields["info"] = dict(plan.info)
+            stable = {k: v for k, v in plan.info.items() if k not in VOLATILE_INFO}
+            if stable:
+                fields["info"] = stable
+            self.planner_calls.append({"t": now, "agent": self.id, "purpose": plan.purpose.value,
+                                       "strategy": plan.strategy, **dict(plan.info)})
         expected = Purpose.UP_TSK if self.state is S.UP_TSK else Purpose.GEN_SUSP
         if plan.purpose is not expected:
             raise ConfigError(

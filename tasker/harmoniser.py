@@ -17,10 +17,12 @@ The harmoniser never waits on an agent, and it enforces the invariant that at mo
 one agent is in ``cmd``: every report updates the set of agents in ``cmd``, and a
 second member is an :class:`~tasker.errors.InvariantViolation`.
 
-Two departures from the letter of Alg. 1, both to keep its intent: ``susp`` is sent
-only when a replacement (``irrDA``) exists — on a bare ``term_event`` line 3 would
-suspend the executing task for nothing —, and it is sent once per switch rather
-than on every iteration.
+Departures from the letter of Alg. 1, all to keep its intent: ``susp`` is sent only
+when a replacement (``irrDA``) exists — on a bare ``term_event`` line 3 would suspend
+the executing task for nothing —, and once per switch rather than on every
+iteration; and ``pf_switchDA`` also runs while the executing agent is suspending,
+so that if ``irrDA`` ends meanwhile the suspended agent still leaves ``exeDA``
+(eq. 36 would never trigger it again: found by the property test).
 """
 
 from __future__ import annotations
@@ -147,8 +149,13 @@ class TaskHarmoniser:
         if (timer or shdl_event) and self.irr_da is None:
             if self.exe_da is None or (self.mode is Mode.IT and self.scheduler.preemptive):
                 self._pf_schedule(now)
-        if self.irr_da is not None or term_event:
+        suspending = self.exe_da is not None and self.exe_da in self._susp_seq
+        if self.irr_da is not None or term_event or suspending:
             self._pf_switch_da(now)
+            if self.exe_da is None and self.irr_da is None and self._idle:  # freed: shdl_event at once
+                self._pf_schedule(now)
+                if self.irr_da is not None:
+                    self._pf_switch_da(now)
         if self._roles_dirty:
             self._emit_roles(now)
 
@@ -209,7 +216,7 @@ class TaskHarmoniser:
             state = report.fsm_state
             if state.in_cmd:  # line 2
                 if self.irr_da is not None and exe not in self._susp_seq:
-                    self._susp_seq[exe] = self._send(exe, Flag.SUSP)  # line 3
+                    self._susp_seq[exe] = self._send(exe, Flag.SUSP, self._susp_data(self.irr_da))  # line 3
             elif state is FsmState.WAIT and exe in self._susp_seq and report.ack >= self._susp_seq[exe]:  # line 5
                 # a ``wait`` that does not acknowledge our ``susp`` predates the last ``start``: not a suspension
                 self._idle[exe] = None  # line 6
@@ -230,6 +237,18 @@ class TaskHarmoniser:
         self._trace.emit(self.now, "command", agent=agent_id, flag=flag.value)
         self.agents[agent_id].deliver(Command(flag, self._seq, dict(data or {})))
         return self._seq
+
+    def _susp_data(self, replacement: str) -> dict[str, Any]:
+        """``data`` of a ``susp``: who takes over and how long it is expected to take (its cTime).
+
+        A task's suspension may depend on it (a cooker left on for a short interruption).
+        """
+        data: dict[str, Any] = {"by": replacement}
+        cand = self._cands.get(replacement)
+        c_time = getattr(cand.params, "c_time", None) if cand is not None else None
+        if c_time is not None:
+            data["expected_s"] = c_time
+        return data
 
     def _req_sp(self, agent_id: str, request: SPRequest) -> Any:
         return self.agents[agent_id].request_sp(request, self.now)

@@ -233,3 +233,15 @@ def test_plan_purpose_is_checked() -> None:
     loop.request(0.0, "w")
     with pytest.raises(Exception, match="returned a genSusp plan in upTsk"):
         loop.run()
+
+
+def test_replacement_ending_while_exe_suspends_does_not_strand_it() -> None:
+    """Regression (found by the property test): irrDA ends while exeDA runs its exeSusp."""
+    t = SyntheticTask("lo", [st("go", 5)], suspension={"go": [st("put_down", 3, BLOCK)]})
+    loop = make_loop([t, SyntheticTask("hi", [st("check", 2)])], classes=[["hi"], ["lo"]])
+    loop.request(0.0, "lo")
+    loop.request(1.0, "hi")  # d2 preempts d1, which puts down what it holds (1..4) ...
+    loop.terminate(2.0, "d2", "not needed after all")  # ... while d2 is cancelled
+    tr = loop.run()
+    assert ("exeSusp", "wait") in transitions(tr, "d1") and ("wait", "upTsk") in transitions(tr, "d1")
+    assert tr.of("end", agent="d1")[0]["reason"] == "finished"

@@ -55,7 +55,7 @@ def check(loop, created: dict[str, DynamicAgent], ends: Counter[str]) -> None:  
     assert all(n == 1 for n in ends.values()), f"a task ended twice: {ends}"
 
 
-@settings(max_examples=2500, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=2500, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st_.lists(ops, min_size=1, max_size=25), st_.sampled_from(["alg2", "priority", "fifo", "srtf", "edf"]))
 def test_random_interleavings_keep_the_invariants(program, scheduler) -> None:  # type: ignore[no-untyped-def]
     core = ManualExecutor()
