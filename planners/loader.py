@@ -21,7 +21,7 @@ from planners.results import PlanStatus
 from planners.stages import Bindings
 from planners.taskspec import TaskSpec, read_task_toml
 
-HOOK_NAMES = ("extra_facts", "suspension_goal", "check_args")
+HOOK_NAMES = ("extra_facts", "suspension_goal", "check_args", "check_terminate")
 """Functions a ``task.py`` may define (see ``docs/domains.md``)."""
 
 

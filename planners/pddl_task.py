@@ -73,6 +73,14 @@ class PddlTaskType(TaskType):
         if "check_args" in self.hooks:
             self.hooks["check_args"](args)
 
+    def check_terminate(self, ctx: TaskContext) -> str | None:
+        """``ic_term``: the folder's ``task.py`` may say the task is no longer needed."""
+        hook = self.hooks.get("check_terminate")
+        if hook is None or ctx.world is None:
+            return None
+        why = hook(ctx, ctx.world)
+        return str(why) if why else None
+
     def update_task(self, ctx: TaskContext) -> StagePlan:
         if ctx.strategy.update == "static":
             return self.static_update(ctx)

@@ -36,6 +36,7 @@ from tasker.world import Fact, Pose, WorldState
 
 CONTROL_DT = 0.02  # seconds: the base controller and the people run at 50 Hz
 AT_TOLERANCE = 0.3  # metres: the robot starts "at" a place this close
+TOGETHER = 1.5  # metres: a person this close to the robot is symbolically at the robot's place
 
 
 class Simulation:
@@ -111,21 +112,39 @@ class Simulation:
     def snapshot(self) -> WorldState:
         """The world as task hooks see it: symbolic facts plus the facts read off the physics.
 
-        People's symbolic place is always derived from where they physically are (the
-        nearest named place), never from a skill's effects: a person walks by themself
-        (John toward his destination), follows the robot, or stays.  A fallen person is
+        Symbolic places are read off the physics, never kept from a skill's effects (an
+        interrupted navigation leaves the robot between places; people walk by
+        themselves, follow the robot, or stay): the robot is at its nearest named place;
+        a person who follows the robot or stands within ``TOGETHER`` metres of it is at
+        the robot's place, anyone else at :meth:`person_place`.  A fallen person is
         ``("fallen", name)``.
         """
         poses: dict[str, Pose] = {"robot": self.robot_pose()}
         poses |= {p.name: p.pose for p in self.people}
         poses |= dict(self.spec.places)
-        names = set(self.spec.people)
+        names = set(self.spec.people) | {"robot"}
         facts = {f for f in self.facts if not (f[0] == "at" and len(f) == 3 and f[1] in names)}
+        rx, ry, _ = poses["robot"]
+        robot_place = self.nearest_place(rx, ry)
+        facts.add(("at", "robot", robot_place))
         for p in self.people:
-            facts.add(("at", p.name, self.nearest_place(p.x, p.y)))
+            with_robot = ("following", p.name) in self.facts or math.hypot(p.x - rx, p.y - ry) <= TOGETHER
+            facts.add(("at", p.name, robot_place if with_robot else self.person_place(p.x, p.y)))
             if p.posture == "fallen":
                 facts.add(("fallen", p.name))
         return WorldState(frozenset(facts | self.people.facts()), poses, self.objects(), self.time)
+
+    def person_place(self, x: float, y: float) -> str:
+        """Where a person is, symbolically: the nearest place in the same room, not counting
+        the places of devices (people are not "at the stove"); the nearest such place
+        anywhere if their room has none."""
+        device_places = {d.place for d in self.spec.devices.values()}
+        spots = {n: p for n, p in self.spec.places.items() if n not in device_places} or dict(self.spec.places)
+        room = next((b for _, b in sorted(self.spec.rooms.items()) if b[0] <= x <= b[2] and b[1] <= y <= b[3]), None)
+        if room is not None:
+            inside = {n: p for n, p in spots.items() if room[0] <= p[0] <= room[2] and room[1] <= p[1] <= room[3]}
+            spots = inside or spots
+        return min(spots, key=lambda n: (math.hypot(spots[n][0] - x, spots[n][1] - y), n))
 
     def nearest_place(self, x: float, y: float) -> str:
         """The named place closest to ``(x, y)`` (ties broken by name, so deterministic)."""

@@ -4,6 +4,7 @@
   (:types locatable place - object
           robot person - locatable)
   (:predicates
+    (target ?h - person)
     (at ?x - locatable ?p - place)
     (connected ?from ?to - place)
     (fallen ?h - person)
@@ -16,7 +17,7 @@
 
   (:action approach
     :parameters (?r - robot ?h - person ?from ?to - place)
-    :precondition (and (at ?r ?from) (at ?h ?to) (connected ?from ?to))
+    :precondition (and (target ?h) (at ?r ?from) (at ?h ?to) (connected ?from ?to))
     :effect (and (not (at ?r ?from)) (at ?r ?to)
                  (increase (total-cost) (travel-time ?from ?to))))
 

@@ -14,3 +14,15 @@ def extra_facts(ctx: TaskContext, world: WorldState) -> Iterable[Fact]:
     if not world.holds("fallen", person):
         yield ("checked", person)
         yield ("help_called", person)
+
+
+def check_terminate(ctx: TaskContext, world: WorldState) -> str | None:
+    """``ic_term`` (paper, Appendix B): the person got up before the robot came, so nothing is needed.
+
+    Only while the task is not executing a check (``compSP``, ``wait``); once the robot has
+    checked the person the task finishes normally.
+    """
+    person = ctx.args["person"]
+    if not world.holds("fallen", person) and not ctx.done:
+        return f"{person} is fine"
+    return None
