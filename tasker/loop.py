@@ -80,6 +80,7 @@ class SimulationLoop:
         self._pending_events = 0
         self._tokens: dict[str, int] = {}
         self._started = False
+        self.all_agents: list[DynamicAgent] = []  # every agent created, ended ones included
 
     # -- time ---------------------------------------------------------------------------------
 
@@ -136,6 +137,7 @@ class SimulationLoop:
         agent = DynamicAgent(agent_id, task, ctx, trace=self.trace, rates=self.rates, core=self.core,
                              world=world, on_report=on_report, waker=self._wake_next_tick)
         self._wake(agent, self._tick + 1)
+        self.all_agents.append(agent)
         return agent
 
     def _wake(self, agent: DynamicAgent, tick: int) -> None:
@@ -158,6 +160,12 @@ class SimulationLoop:
         self._push(self._tick, _TIMER, None)
         if self.world is not None:
             self._push(self._tick, _WORLD, None)
+
+    @property
+    def planner_calls(self) -> list[dict[str, Any]]:
+        """Every planning hook call with its volatile info (wall time, cache hits), in order."""
+        calls = [c for a in self.all_agents for c in a.planner_calls]
+        return sorted(calls, key=lambda c: (c["t"], c["agent"]))
 
     def run(self, until: float | None = None) -> Trace:
         """Run until every request is served and every agent has ended, or until ``until``.

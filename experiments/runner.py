@@ -1,0 +1,229 @@
+"""Run one scenario: build the system, run it on the simulated clock, save what happened.
+
+:func:`run_scenario` is what ``tasker run`` and the sweeps call.  A robot scenario
+gets the TIAGo simulation (:class:`robot.sim.Simulation`, both the world and the core
+agent), the OMPL motion model, and the bundled PDDL task types; a synthetic one gets
+timed stages.  In ``out`` it writes ``trace.jsonl`` (reproducible byte for byte),
+``run.json`` (the record: scenario, seed, settings, planner, host, date, version),
+``metrics.json`` and the pictures.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime as _dt
+import json
+import platform
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import tasker
+from experiments import scenario as scenarios
+from experiments import synthetic
+from tasker import schedulers
+from tasker.agent import Rates
+from tasker.harmoniser import Mode
+from tasker.loop import SimulationLoop
+from tasker.requester import Requester
+from tasker.store import TaskStore
+from tasker.task import Strategy
+from tasker.trace import Trace
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """What one run produced: its record, its metrics and its trace."""
+
+    record: dict[str, Any]
+    metrics: dict[str, Any]
+    trace: Trace
+    trajectory: tuple[tuple[float, float, float, float], ...] = ()
+
+
+def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None = None,
+                suspension: str | None = None, scheduler: str | None = None,
+                trace: Trace | None = None) -> tuple[SimulationLoop, Any]:
+    """The loop and the simulation for a robot scenario, with every request and event scheduled."""
+    from planners.bundled import task_types
+    from robot.sim import Simulation
+    from robot.spec import load_world
+
+    spec = load_world(scn.world)
+    if scn.people:
+        people = dict(spec.people)
+        for name, entry in scn.people.items():
+            if name not in people:
+                raise scenarios.ScenarioError(f"{scn.source}: people.{name}: no such person in world {scn.world!r}; "
+                                              f"known: {sorted(people)}")
+            changes: dict[str, Any] = {}
+            if "pose" in entry:
+                changes["pose"] = tuple(entry["pose"])
+            if "walk" in entry:
+                changes["walk"] = tuple(tuple(w) for w in entry["walk"])
+            people[name] = dataclasses.replace(people[name], **changes)
+        spec = dataclasses.replace(spec, people=people)
+    sim = Simulation(spec, seed=seed)
+    store = TaskStore(task_types())
+    default = Strategy(update or scn.update, suspension or scn.suspension)
+    per_type = {t: Strategy(update or s.get("update", default.update), suspension or s.get("suspension",
+                                                                                           default.suspension))
+                for t, s in scn.strategies.items()}
+    options = scn.scheduler_options if scheduler in (None, scn.scheduler) else {}
+    loop = SimulationLoop(
+        store, schedulers.create(scheduler or scn.scheduler, **options), seed=seed, trace=trace,
+        mode=Mode(scn.mode), s_freq=scn.s_freq, rates=Rates(scn.rep_rate, scn.task_exe_rate, scn.sp_up_rate),
+        strategy=default, strategies=per_type, core=sim, world=sim, motion=sim.motion, horizon=scn.horizon,
+    )
+    requester = Requester(store, loop.harmoniser, "scenario")
+    for a in scn.actions:
+        loop.at(a.t, _action(loop, sim, requester, a, scn))
+        if a.kind == "request":
+            store.validate(a.fields["task"], a.fields["args"])  # bad requests fail before the run
+    return loop, sim
+
+
+def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: synthetic.TimedAction,
+            scn: scenarios.RobotScenario) -> Callable[[], None]:
+    f = a.fields
+    if a.kind == "request":
+        return lambda: loop._submit(tasker.Request(f["task"], loop.store.validate(f["task"], f["args"]), "scenario"))
+    if a.kind == "terminate":
+        return lambda: requester.terminate(f["agent"], f["reason"])
+    if a.kind == "change":
+        return lambda: synthetic._change(loop, requester, f["agent"], f["args"])
+    if a.kind == "mode":
+        return lambda: loop.harmoniser.set_mode(f["mode"])
+
+    def world_event() -> None:
+        what, value = f["what"], f["value"]
+        if what == "posture":
+            sim.people[value[0]].set_posture(value[1])
+        elif what == "door":
+            sim.set_door(value[0], value[1])
+        elif what == "add":
+            sim.apply(add=value)
+        else:
+            sim.apply(delete=value)
+        loop.trace.emit(loop.now, "world", what=what, value=value, note=f.get("note", ""))
+
+    return world_event
+
+
+def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | None = None,
+                 update: str | None = None, suspension: str | None = None, scheduler: str | None = None,
+                 mode: str | None = None, out: Path | None = None, randomize: bool = False,
+                 progress: bool = False, pictures: bool = True) -> RunResult:
+    """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced."""
+    if isinstance(source, scenarios.RobotScenario):
+        kind, scn_path = "robot", Path(source.source)
+    else:
+        scn_path = scenarios.resolve(source)
+        kind = scenarios.kind_of(scn_path)
+    t0 = time.perf_counter()
+    trajectory: tuple[tuple[float, float, float, float], ...] = ()
+    if kind == "synthetic":
+        syn = synthetic.load(scn_path)
+        run_seed = syn.seed if seed is None else seed
+        loop = synthetic.build(syn, seed=run_seed, scheduler=scheduler, mode=mode)
+        spec_json: dict[str, Any] = {"kind": "synthetic", "name": syn.name, "source": str(scn_path)}
+        sim = None
+    elif kind == "robot":
+        scn = source if isinstance(source, scenarios.RobotScenario) else scenarios.load(scn_path)
+        run_seed = scn.seed if seed is None else seed
+        if randomize:
+            scn = scenarios.randomize(scn, run_seed)
+        if mode is not None:
+            scn = dataclasses.replace(scn, mode=mode)
+        loop, sim = build_robot(scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler)
+        spec_json = {"kind": "robot", **scn.to_json()}
+    else:
+        raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")
+    _run(loop, progress)
+    wall = time.perf_counter() - t0
+    trace = loop.trace
+    world_spec = None
+    if sim is not None:
+        trajectory = tuple(sim.trajectory)
+        world_spec = sim.spec
+    calls = loop.planner_calls
+    record = {
+        "scenario": spec_json, "seed": run_seed,
+        "settings": {"scheduler": loop.harmoniser.scheduler.name, "mode": loop.harmoniser.mode.value,
+                     # synthetic task types have only static strategies: say what was used
+                     "update": "static" if kind == "synthetic" else (update or loop.strategy.update),
+                     "suspension": "static" if kind == "synthetic" else (suspension or loop.strategy.suspension),
+                     "randomized": randomize},
+        "planner": _planner_config() if kind == "robot" else None,
+        "host": platform.node(), "platform": platform.platform(), "python": sys.version.split()[0],
+        "date": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "tasker_version": tasker.__version__,
+        "wall_time_s": round(wall, 3),
+    }
+    metrics = _metrics(trace, calls, wall)
+    if out is not None:
+        _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures)
+    return RunResult(record, metrics, trace, trajectory)
+
+
+def _run(loop: SimulationLoop, progress: bool) -> None:
+    if not progress:
+        loop.run()
+        return
+    from tqdm import tqdm
+
+    horizon = loop.horizon
+    with tqdm(total=round(horizon), unit="sim s", desc="simulating", leave=False, file=sys.stderr) as bar:
+        while True:
+            before = loop.now
+            loop.run(until=loop.now + 10.0)
+            bar.update(round(loop.now) - bar.n)
+            if not loop.harmoniser.busy and loop._pending_events == 0 or loop.now <= before or loop.now >= horizon:
+                break
+
+
+def _planner_config() -> dict[str, Any]:
+    from planners.pddl_task import default_planner
+
+    p = default_planner()
+    return {"engine": getattr(p, "name", "tasker-fd"), "unified_planning": _version("unified-planning"),
+            "up_fast_downward": _version("up-fast-downward")}
+
+
+def _version(dist: str) -> str | None:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version(dist)
+    except PackageNotFoundError:
+        return None
+
+
+def _metrics(trace: Trace, calls: list[dict[str, Any]], wall: float) -> dict[str, Any]:
+    from experiments import metrics
+
+    m = metrics.compute(trace.events)
+    sim_time = trace.events[-1]["t"] if trace.events else 0.0
+    m["planner_wall_time_s"] = round(sum(float(c.get("planner_time_s", 0.0)) for c in calls), 6)
+    m["planner_cache_hits"] = sum(1 for c in calls if c.get("cached"))
+    m["wall_time_s"] = round(wall, 3)
+    m["real_time_factor"] = round(sim_time / wall, 2) if wall > 0 else None
+    return m
+
+
+def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Trace,
+          trajectory: tuple[tuple[float, float, float, float], ...], world: Any, pictures: bool) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    trace.write(out / "trace.jsonl")
+    (out / "run.json").write_text(json.dumps(record, indent=2, sort_keys=True, default=str) + "\n")
+    (out / "metrics.json").write_text(json.dumps(metrics_, indent=2, sort_keys=True) + "\n")
+    if not pictures:
+        return
+    from experiments import plots
+
+    plots.timeline(trace.events, out / "timeline.png")
+    plots.gantt(trace.events, out / "gantt.png")
+    if world is not None:
+        plots.world_path(world, list(trajectory), out / "world.png")
