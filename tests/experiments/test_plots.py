@@ -1,0 +1,88 @@
+"""Plots write real PNGs from synthetic and hand-built traces, and survive empty ones."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from experiments import plots, synthetic
+
+DEMO = Path(__file__).resolve().parents[2] / "experiments" / "scenarios" / "synthetic_demo.toml"
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture(scope="module")
+def events() -> list[dict[str, Any]]:
+    return synthetic.run(synthetic.load(DEMO), seed=1).events
+
+
+def is_png(path: Path, min_bytes: int = 2000) -> bool:
+    data = path.read_bytes()
+    return data[:8] == PNG and len(data) >= min_bytes
+
+
+TINY = [
+    {"t": 0.0, "event": "run", "seed": 1},
+    {"t": 0.0, "event": "request", "agent": "d1", "task_type": "cook", "args": {}, "requester": "x"},
+]
+
+
+@pytest.mark.parametrize("plot", [plots.timeline, plots.gantt])
+def test_plots_of_the_demo(plot: Any, events: list[dict[str, Any]], tmp_path: Path) -> None:
+    out = plot(events, tmp_path / "sub" / "p.png")
+    assert out == tmp_path / "sub" / "p.png"
+    assert is_png(out, 10_000)
+
+
+@pytest.mark.parametrize("plot", [plots.timeline, plots.gantt])
+@pytest.mark.parametrize("trace", [[], TINY], ids=["empty", "tiny"])
+def test_plots_of_empty_and_tiny_traces(plot: Any, trace: list[dict[str, Any]], tmp_path: Path) -> None:
+    assert is_png(plot(trace, tmp_path / "p.png"))
+
+
+def test_same_events_same_bytes(events: list[dict[str, Any]], tmp_path: Path) -> None:
+    a = plots.timeline(events, tmp_path / "a.png").read_bytes()
+    b = plots.timeline(events, tmp_path / "b.png").read_bytes()
+    assert a == b
+
+
+def test_timeline_with_infinite_costs_and_priority_decisions(tmp_path: Path) -> None:
+    trace = TINY + [
+        {"t": 1.0, "event": "decision", "algorithm": "alg2", "dac": "d2", "exeDA": "d1", "rule": "cost",
+         "cost_dac": "inf", "c_switch": 3.0, "c_wait": 2.0, "switch": False},
+        {"t": 2.0, "event": "decision", "algorithm": "alg2", "dac": "d2", "exeDA": "d1", "rule": "priority class",
+         "switch": True},
+        {"t": 2.0, "event": "roles", "exeDA": "d1", "irrDA": "d2", "idleDA": []},
+        {"t": 2.0, "event": "command", "agent": "d1", "flag": "susp"},
+    ]
+    assert is_png(plots.timeline(trace, tmp_path / "t.png"))
+
+
+def test_role_spans_follow_roles_events() -> None:
+    roles = [
+        {"t": 0.0, "event": "roles", "exeDA": None, "irrDA": None, "idleDA": ["d1"]},
+        {"t": 1.0, "event": "roles", "exeDA": "d1", "irrDA": None, "idleDA": ["d2"]},
+        {"t": 4.0, "event": "roles", "exeDA": "d1", "irrDA": "d2", "idleDA": []},
+    ]
+    assert plots._role_spans(roles, 6.0) == [
+        ("d1", "idleDA", 0.0, 1.0), ("d2", "idleDA", 1.0, 4.0), ("d1", "exeDA", 1.0, 6.0), ("d2", "irrDA", 4.0, 6.0),
+    ]
+
+
+def test_state_spans_from_transitions(events: list[dict[str, Any]]) -> None:
+    spans = plots._state_spans(events, 100.0)
+    assert [s[0] for s in spans["d1"]] == ["initComm", "compSP", "upTsk", "exeTsk", "genSusp", "exeSusp", "wait",
+                                           "upTsk", "exeTsk"]
+    assert spans["d1"][-1][2] == 69.5  # ends at its end transition, not at the given end
+
+
+def test_world_path(tmp_path: Path) -> None:
+    trajectory = [(0.0, 4.0, 3.0, 0.0), (1.0, 3.0, 2.5, 0.3), (2.0, 2.0, 2.0, 0.6)]
+    assert is_png(plots.world_path("paper", trajectory, tmp_path / "w.png"), 10_000)
+    assert is_png(plots.world_path("flat", [], tmp_path / "w0.png"), 10_000)
+
+
+def test_all_plots(events: list[dict[str, Any]], tmp_path: Path) -> None:
+    assert [p.name for p in plots.all_plots(events, tmp_path)] == ["timeline.png", "gantt.png"]
