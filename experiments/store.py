@@ -1,0 +1,215 @@
+"""The results database of a sweep: one SQLite file, one row per finished run.
+
+A run is identified by its job key ``(scenario, seed, strategy)``; the key is UNIQUE
+in the table, so a run is stored at most once.  Each run is written in its own
+transaction as soon as it finishes, and the database is in WAL mode with full
+synchronisation, so a sweep that is killed loses nothing it had finished, and a
+resumed sweep runs only the keys the table does not hold yet.
+
+Only the process that drives a sweep writes to the database (workers return their
+results to it); any number of readers (``tasker report``) may read meanwhile.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sqlite3
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import contextmanager
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from enum import StrEnum
+from pathlib import Path
+from typing import Any
+
+from tasker.errors import TaskerError
+
+SCHEMA_VERSION = 1
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS meta (
+    key   TEXT PRIMARY KEY,
+    value TEXT NOT NULL
+);
+CREATE TABLE IF NOT EXISTS runs (
+    id       INTEGER PRIMARY KEY,
+    scenario TEXT NOT NULL,
+    seed     INTEGER NOT NULL,
+    strategy TEXT NOT NULL,
+    status   TEXT NOT NULL CHECK (status IN ('ok', 'error')),
+    error    TEXT,
+    record   TEXT NOT NULL,
+    metrics  TEXT NOT NULL,
+    wall     REAL,
+    worker   TEXT,
+    finished TEXT NOT NULL,
+    UNIQUE (scenario, seed, strategy)
+);
+CREATE TABLE IF NOT EXISTS sweeps (
+    id       INTEGER PRIMARY KEY,
+    started  TEXT NOT NULL,
+    spec     TEXT NOT NULL,
+    setup    TEXT NOT NULL
+);
+"""
+
+JobKey = tuple[str, int, str]
+"""``(scenario, seed, strategy)``: what identifies one run of a sweep."""
+
+
+class StoreError(TaskerError, RuntimeError):
+    """The results database cannot be opened or does not have the expected schema."""
+
+
+class Status(StrEnum):
+    """How a run ended."""
+
+    OK = "ok"
+    ERROR = "error"
+
+
+@dataclass(frozen=True)
+class RunRow:
+    """One stored run: its key, how it ended, and what it recorded."""
+
+    scenario: str
+    seed: int
+    strategy: str
+    status: Status
+    record: dict[str, Any]
+    metrics: dict[str, Any]
+    error: str | None = None
+    wall: float | None = None
+    worker: str | None = None
+    finished: str = ""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.status, Status):
+            raise ValueError(f"RunRow.status: expected a Status, got {self.status!r}")
+        if self.status is Status.ERROR and not self.error:
+            raise ValueError("RunRow.error: a run with status 'error' needs a message")
+
+    @property
+    def key(self) -> JobKey:
+        return (self.scenario, self.seed, self.strategy)
+
+
+def _now() -> str:
+    return datetime.now(UTC).isoformat(timespec="seconds")
+
+
+def _finite(value: Any) -> Any:
+    """Non-finite floats as the strings ``"inf"``, ``"-inf"``, ``"nan"`` (as in the trace): JSON has none."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf")
+    if isinstance(value, Mapping):
+        return {str(k): _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    return value
+
+
+def _dumps(value: Any) -> str:
+    return json.dumps(_finite(value), sort_keys=True, allow_nan=False, default=str)
+
+
+class ResultStore:
+    """The SQLite results database at ``path`` (created on first use).
+
+    Use as a context manager, or call :meth:`close`.
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        if self.path.parent and not self.path.parent.exists():
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            # isolation_level=None: we issue BEGIN/COMMIT ourselves, one transaction per run
+            self._db = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
+            self._db.execute("PRAGMA journal_mode=WAL")
+            self._db.execute("PRAGMA synchronous=FULL")
+            self._db.executescript(_SCHEMA)
+            version = self._db.execute("SELECT value FROM meta WHERE key='schema_version'").fetchone()
+        except sqlite3.DatabaseError as exc:
+            raise StoreError(f"{self.path}: not a results database: {exc}") from None
+        if version is None:
+            self._db.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),))
+        elif int(version[0]) != SCHEMA_VERSION:
+            raise StoreError(f"{self.path}: schema version {version[0]}, this tasker reads {SCHEMA_VERSION}")
+
+    def __enter__(self) -> ResultStore:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        self._db.close()
+
+    @contextmanager
+    def _transaction(self) -> Iterator[sqlite3.Connection]:
+        self._db.execute("BEGIN IMMEDIATE")
+        try:
+            yield self._db
+        except BaseException:
+            self._db.execute("ROLLBACK")
+            raise
+        self._db.execute("COMMIT")
+
+    def add(self, row: RunRow) -> bool:
+        """Store one finished run in its own transaction.
+
+        Returns ``False`` (and changes nothing) if a run with the same key is already
+        stored: the first result of a key is the one kept.
+        """
+        try:
+            with self._transaction() as db:
+                db.execute(
+                    "INSERT INTO runs (scenario, seed, strategy, status, error, record, metrics, wall, worker,"
+                    " finished) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                    (row.scenario, row.seed, row.strategy, row.status.value, row.error, _dumps(row.record),
+                     _dumps(row.metrics), row.wall, row.worker, row.finished or _now()),
+                )
+        except sqlite3.IntegrityError:
+            return False
+        return True
+
+    def keys(self, status: Status | None = None) -> set[JobKey]:
+        """The keys of the stored runs (of one status, if given)."""
+        sql = "SELECT scenario, seed, strategy FROM runs"
+        args: tuple[Any, ...] = ()
+        if status is not None:
+            sql += " WHERE status = ?"
+            args = (status.value,)
+        return {(s, int(n), k) for s, n, k in self._db.execute(sql, args)}
+
+    def forget(self, keys: Iterable[JobKey]) -> int:
+        """Delete the runs with these keys (to run them again); returns how many were deleted."""
+        with self._transaction() as db:
+            return sum(db.execute("DELETE FROM runs WHERE scenario=? AND seed=? AND strategy=?", k).rowcount
+                       for k in keys)
+
+    def rows(self, status: Status | None = None) -> list[RunRow]:
+        """The stored runs in key order (of one status, if given)."""
+        sql = ("SELECT scenario, seed, strategy, status, error, record, metrics, wall, worker, finished FROM runs"
+               + (" WHERE status = ?" if status is not None else "") + " ORDER BY scenario, seed, strategy")
+        args = (status.value,) if status is not None else ()
+        return [
+            RunRow(s, int(n), k, Status(st), json.loads(rec), json.loads(met), err, wall, worker, fin)
+            for s, n, k, st, err, rec, met, wall, worker, fin in self._db.execute(sql, args)
+        ]
+
+    def count(self) -> int:
+        return int(self._db.execute("SELECT COUNT(*) FROM runs").fetchone()[0])
+
+    def log_sweep(self, spec: Mapping[str, Any], setup: Mapping[str, Any]) -> None:
+        """Record that a sweep (or a resumption of one) started: its spec and how it runs."""
+        with self._transaction() as db:
+            db.execute("INSERT INTO sweeps (started, spec, setup) VALUES (?, ?, ?)",
+                       (_now(), _dumps(spec), _dumps(setup)))
+
+    def sweeps(self) -> list[dict[str, Any]]:
+        """Every logged sweep start, oldest first: ``started``, ``spec``, ``setup``."""
+        return [{"started": st, "spec": json.loads(sp), "setup": json.loads(se)}
+                for st, sp, se in self._db.execute("SELECT started, spec, setup FROM sweeps ORDER BY id")]

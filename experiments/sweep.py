@@ -1,0 +1,396 @@
+"""Sweeps: many runs of scenarios × seeds × strategies, in parallel, resumable.
+
+A :class:`SweepSpec` (usually read from a small TOML file by :func:`load_spec`)
+expands to a list of :class:`Job`; :func:`run_sweep` runs those whose key is not in
+the results database yet, on local worker processes or on a Dask cluster, and the
+driving process stores each result (:mod:`experiments.store`) the moment it
+arrives.  Killing a sweep loses only the runs in flight; running it again resumes.
+
+The function that runs one job is injectable (``run_fn``): a picklable top-level
+function ``job -> (record, metrics)``.  The default, :func:`run_job`, calls
+:func:`experiments.runner.run_scenario` with ``randomize=True``, so each seed is a
+different randomised variant of the scenario.  See ``docs/sweeps.md``.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import platform
+import socket
+import sys
+import time
+import tomllib
+import traceback
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import tasker
+from experiments.store import JobKey, ResultStore, RunRow, Status
+from tasker.errors import TaskerError
+
+STRATEGY_VALUES = ("static", "planned")
+
+RunFn = Callable[["Job"], tuple[Mapping[str, Any], Mapping[str, Any]]]
+"""Runs one job and returns ``(record, metrics)``; must be a picklable top-level function."""
+
+
+class SpecError(TaskerError, ValueError):
+    """A sweep spec is malformed; the message names the file and the field."""
+
+
+class SweepError(TaskerError, RuntimeError):
+    """A sweep could not go on (e.g. a worker process died); what finished is stored."""
+
+
+@dataclass(frozen=True)
+class Strategy:
+    """The strategies a run compares: how ``upTsk`` and ``genSusp`` build their plans, and the scheduler.
+
+    ``None`` leaves the scenario's own setting.
+    """
+
+    update: str | None = None
+    suspension: str | None = None
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("update", "suspension"):
+            value = getattr(self, name)
+            if value is not None and value not in STRATEGY_VALUES:
+                raise ValueError(f"{name}: expected one of {list(STRATEGY_VALUES)}, got {value!r}")
+        if self.scheduler is not None and (not isinstance(self.scheduler, str) or not self.scheduler):
+            raise ValueError(f"scheduler: expected a scheduler name, got {self.scheduler!r}")
+
+    @property
+    def label(self) -> str:
+        """The key of the strategy in the results database, e.g. ``update=planned,suspension=static``."""
+        parts = [f"{k}={v}" for k, v in self.items()]
+        return ",".join(parts) if parts else "default"
+
+    def items(self) -> list[tuple[str, str]]:
+        return [(k, v) for k in ("update", "suspension", "scheduler") if (v := getattr(self, k)) is not None]
+
+    @classmethod
+    def parse(cls, text: str) -> Strategy:
+        """The inverse of :attr:`label`: ``"update=planned,suspension=static,scheduler=alg2"``."""
+        if text.strip() == "default":
+            return cls()
+        fields: dict[str, str] = {}
+        for part in text.split(","):
+            key, sep, value = part.partition("=")
+            key, value = key.strip(), value.strip()
+            if not sep or key not in ("update", "suspension", "scheduler") or not value:
+                raise ValueError(f"expected 'update=…,suspension=…[,scheduler=…]', got {text!r}")
+            if key in fields:
+                raise ValueError(f"{key} given twice in {text!r}")
+            fields[key] = value
+        return cls(**fields)
+
+
+@dataclass(frozen=True)
+class Job:
+    """One run of a sweep: a scenario (as named in the spec and where to read it), a seed, a strategy."""
+
+    scenario: str
+    source: str
+    seed: int
+    strategy: Strategy
+
+    @property
+    def key(self) -> JobKey:
+        return (self.scenario, self.seed, self.strategy.label)
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """Scenarios × seeds × strategies.  ``sources`` maps a scenario (as written) to the file to run."""
+
+    scenarios: tuple[str, ...]
+    seeds: tuple[int, ...]
+    strategies: tuple[Strategy, ...]
+    name: str = "sweep"
+    sources: Mapping[str, str] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not self.scenarios:
+            raise ValueError("scenarios: expected at least one scenario")
+        if not self.seeds:
+            raise ValueError("seeds: expected at least one seed")
+        if not self.strategies:
+            raise ValueError("strategies: expected at least one strategy")
+        for what, items in (("scenarios", self.scenarios), ("seeds", self.seeds),
+                            ("strategies", [s.label for s in self.strategies])):
+            if len(set(items)) != len(items):
+                raise ValueError(f"{what}: duplicates in {list(items)}")
+
+    def jobs(self) -> list[Job]:
+        """Every job, scenario-major then seed then strategy (so paired runs finish close together)."""
+        return [Job(sc, self.sources.get(sc, sc), seed, st)
+                for sc in self.scenarios for seed in self.seeds for st in self.strategies]
+
+    def to_json(self) -> dict[str, Any]:
+        return {"name": self.name, "scenarios": list(self.scenarios), "seeds": list(self.seeds),
+                "strategies": [s.label for s in self.strategies], "sources": dict(self.sources)}
+
+
+@dataclass(frozen=True)
+class SweepSummary:
+    """What :func:`run_sweep` did: ``total`` jobs in the spec, ``skipped`` because stored, and the rest."""
+
+    total: int
+    skipped: int
+    ran: int
+    ok: int
+    errors: int
+    not_run: int
+    wall: float
+    backend: str
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a worker sends back for one job."""
+
+    key: JobKey
+    status: Status
+    record: Mapping[str, Any]
+    metrics: Mapping[str, Any]
+    error: str | None
+    wall: float
+    worker: str
+
+
+# ----------------------------------------------------------------------------------------- spec files
+
+
+def _looks_like_path(text: str) -> bool:
+    return "/" in text or os.sep in text or text.endswith((".toml", ".json"))
+
+
+def load_spec(path: str | Path) -> SweepSpec:
+    """Read and check a sweep spec (TOML).  Relative scenario paths are relative to the spec file.
+
+    Fields: ``name`` (optional), ``scenarios`` (list of files), ``seeds`` (a count, seeds
+    ``seed_start`` … ``seed_start + count - 1``, or a list), ``seed_start`` (optional, default 0),
+    ``strategies`` (list of ``"update=…,suspension=…[,scheduler=…]"`` strings or tables).
+    """
+    p = Path(path)
+    src = str(p)
+    try:
+        raw = tomllib.loads(p.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise SpecError(f"{src}: cannot read: {exc.strerror}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(f"{src}: not valid TOML: {exc}") from None
+
+    def err(key: str, msg: str) -> SpecError:
+        return SpecError(f"{src}: {key}: {msg}")
+
+    known = {"name", "scenarios", "seeds", "seed_start", "strategies"}
+    for key in raw:
+        if key not in known:
+            raise err(key, f"unknown field; expected one of {sorted(known)}")
+    for key in ("scenarios", "seeds", "strategies"):
+        if key not in raw:
+            raise err(key, "missing (required)")
+    name = raw.get("name", p.stem)
+    if not isinstance(name, str):
+        raise err("name", f"expected a string, got {name!r}")
+
+    scenarios = raw["scenarios"]
+    if not isinstance(scenarios, list) or not scenarios:
+        raise err("scenarios", f"expected a non-empty list of scenario files, got {scenarios!r}")
+    sources: dict[str, str] = {}
+    for i, sc in enumerate(scenarios):
+        if not isinstance(sc, str) or not sc:
+            raise err(f"scenarios[{i}]", f"expected a file name, got {sc!r}")
+        if _looks_like_path(sc):
+            file = Path(sc) if Path(sc).is_absolute() else p.parent / sc
+            if not file.is_file():
+                raise err(f"scenarios[{i}]", f"no such file: {file}")
+            sources[sc] = str(file)
+    if len(set(scenarios)) != len(scenarios):
+        raise err("scenarios", f"duplicates in {scenarios}")
+
+    seeds_raw, start = raw["seeds"], raw.get("seed_start", 0)
+    if isinstance(start, bool) or not isinstance(start, int):
+        raise err("seed_start", f"expected an integer, got {start!r}")
+    if isinstance(seeds_raw, int) and not isinstance(seeds_raw, bool):
+        if seeds_raw < 1:
+            raise err("seeds", f"expected a positive count, got {seeds_raw}")
+        seeds = tuple(range(start, start + seeds_raw))
+    elif isinstance(seeds_raw, list) and seeds_raw:
+        for i, s in enumerate(seeds_raw):
+            if isinstance(s, bool) or not isinstance(s, int):
+                raise err(f"seeds[{i}]", f"expected an integer, got {s!r}")
+        if "seed_start" in raw:
+            raise err("seed_start", "only with a count of seeds, not a list")
+        if len(set(seeds_raw)) != len(seeds_raw):
+            raise err("seeds", f"duplicates in {seeds_raw}")
+        seeds = tuple(seeds_raw)
+    else:
+        raise err("seeds", f"expected a count or a non-empty list of integers, got {seeds_raw!r}")
+
+    strategies_raw = raw["strategies"]
+    if not isinstance(strategies_raw, list) or not strategies_raw:
+        raise err("strategies", f"expected a non-empty list, got {strategies_raw!r}")
+    strategies = []
+    for i, st in enumerate(strategies_raw):
+        try:
+            if isinstance(st, str):
+                strategies.append(Strategy.parse(st))
+            elif isinstance(st, dict):
+                extra = set(st) - {"update", "suspension", "scheduler"}
+                if extra:
+                    raise ValueError(f"unknown field {sorted(extra)[0]!r}; expected update, suspension, scheduler")
+                strategies.append(Strategy(**st))
+            else:
+                raise ValueError(f"expected a string or a table, got {st!r}")
+        except (ValueError, TypeError) as exc:
+            raise err(f"strategies[{i}]", str(exc)) from None
+    labels = [s.label for s in strategies]
+    if len(set(labels)) != len(labels):
+        raise err("strategies", f"duplicates in {labels}")
+    return SweepSpec(tuple(scenarios), seeds, tuple(strategies), name=name, sources=sources)
+
+
+# ----------------------------------------------------------------------------------------- running
+
+
+def run_job(job: Job) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The default ``run_fn``: a randomised run of the job's scenario with its seed and strategy."""
+    from experiments.runner import run_scenario  # imported in the worker, never shared across processes
+
+    result = run_scenario(job.source, seed=job.seed, update=job.strategy.update,
+                          suspension=job.strategy.suspension, scheduler=job.strategy.scheduler, randomize=True)
+    return dict(result.record), dict(result.metrics)
+
+
+def execute(run_fn: RunFn, job: Job) -> Outcome:
+    """Run one job in a worker; an exception becomes an ``error`` outcome with its message."""
+    worker = f"{socket.gethostname()}:{os.getpid()}"
+    start = time.perf_counter()
+    try:
+        record, metrics = run_fn(job)
+    except Exception as exc:  # a failing run is a result, and the sweep goes on
+        tb = traceback.format_exc(limit=-3)
+        return Outcome(job.key, Status.ERROR, {}, {}, f"{type(exc).__name__}: {exc}\n{tb}",
+                       time.perf_counter() - start, worker)
+    return Outcome(job.key, Status.OK, dict(record), dict(metrics), None, time.perf_counter() - start, worker)
+
+
+def _mp_context() -> multiprocessing.context.BaseContext:
+    # never fork: MuJoCo and OMPL objects (and threads) of the parent must not leak into workers
+    method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+    return multiprocessing.get_context(method)
+
+
+def _local(run_fn: RunFn, jobs: Sequence[Job], workers: int) -> Iterator[Outcome]:
+    """Outcomes as they finish from a pool of local worker processes (at most 2×workers queued)."""
+    with ProcessPoolExecutor(max_workers=workers, mp_context=_mp_context()) as pool:
+        todo = iter(jobs)
+        pending: dict[Future[Outcome], Job] = {}
+        try:
+            while True:
+                while len(pending) < 2 * workers and (job := next(todo, None)) is not None:
+                    pending[pool.submit(execute, run_fn, job)] = job
+                if not pending:
+                    return
+                done, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for fut in done:
+                    pending.pop(fut)
+                    yield fut.result()
+        finally:
+            for fut in pending:
+                fut.cancel()
+
+
+def _dask(run_fn: RunFn, jobs: Sequence[Job], address: str) -> Iterator[Outcome]:
+    """Outcomes as they finish from the Dask cluster at ``address``."""
+    import distributed
+
+    with distributed.Client(address, set_as_default=False) as client:
+        futures = [client.submit(execute, run_fn, job, pure=False) for job in jobs]
+        try:
+            for fut in distributed.as_completed(futures, loop=client.loop):
+                yield fut.result()
+        finally:
+            client.cancel([f for f in futures if not f.done()])
+
+
+def _setup(workers: int, address: str | None) -> dict[str, Any]:
+    return {"backend": "dask" if address else "local", "workers": None if address else workers,
+            "scheduler_address": address,
+            "host": socket.gethostname(), "platform": platform.platform(), "python": sys.version.split()[0],
+            "tasker": tasker.__version__, "date": datetime.now(UTC).isoformat(timespec="seconds")}
+
+
+def run_sweep(
+    spec: SweepSpec | Iterable[Job],
+    db_path: str | Path,
+    *,
+    workers: int | None = None,
+    scheduler_address: str | None = None,
+    run_fn: RunFn = run_job,
+    retry_errors: bool = False,
+    max_jobs: int | None = None,
+    progress: bool = True,
+) -> SweepSummary:
+    """Run the jobs of ``spec`` that ``db_path`` does not hold yet; store each as it finishes.
+
+    ``workers`` local processes (default: the CPU count) unless ``scheduler_address``
+    names a Dask scheduler, whose workers are used instead.  A job that raises is stored
+    with status ``error`` and its message; it is run again only with ``retry_errors``.
+    ``max_jobs`` stops after starting that many jobs (the rest stay missing, for a later
+    resumption).  Results are written by this process only, one transaction per run.
+    """
+    jobs = spec.jobs() if isinstance(spec, SweepSpec) else list(spec)
+    keys = [j.key for j in jobs]
+    if len(set(keys)) != len(keys):
+        raise SweepError("two jobs have the same key (scenario, seed, strategy)")
+    if workers is not None and workers < 1:
+        raise SweepError(f"workers: expected a positive number, got {workers}")
+    n_workers = workers or os.cpu_count() or 1
+    start = time.perf_counter()
+    backend = "dask" if scheduler_address else "local"
+    with ResultStore(db_path) as store:
+        if retry_errors:
+            store.forget(set(keys) & store.keys(Status.ERROR))
+        stored = store.keys()
+        todo = [j for j in jobs if j.key not in stored]
+        missing = len(todo)
+        if max_jobs is not None:
+            todo = todo[:max(0, max_jobs)]
+        spec_json = spec.to_json() if isinstance(spec, SweepSpec) else {"jobs": [list(k) for k in keys]}
+        store.log_sweep(spec_json, _setup(n_workers, scheduler_address) | {"to_run": len(todo)})
+        ok = errors = 0
+        if todo:
+            from tqdm import tqdm
+
+            outcomes = (_dask(run_fn, todo, scheduler_address) if scheduler_address
+                        else _local(run_fn, todo, n_workers))
+            by_key = {j.key: j for j in todo}
+            with tqdm(total=len(todo), unit="run", disable=not progress, desc=f"sweep ({backend})") as bar:
+                try:
+                    for out in outcomes:
+                        job = by_key[out.key]
+                        store.add(RunRow(job.scenario, job.seed, job.strategy.label, out.status,
+                                         dict(out.record), dict(out.metrics), out.error, out.wall, out.worker))
+                        if out.status is Status.OK:
+                            ok += 1
+                        else:
+                            errors += 1
+                        bar.update()
+                        bar.set_postfix(errors=errors, refresh=False)
+                except BrokenProcessPool as exc:
+                    raise SweepError(f"a worker process died ({exc}); {ok + errors} of {len(todo)} runs are "
+                                     f"stored in {db_path}; run the sweep again to resume") from exc
+    ran = ok + errors
+    return SweepSummary(total=len(jobs), skipped=len(jobs) - missing, ran=ran, ok=ok, errors=errors,
+                        not_run=missing - ran, wall=time.perf_counter() - start, backend=backend)
