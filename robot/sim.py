@@ -61,6 +61,11 @@ class Simulation:
         self.time = 0.0
         self.facts: set[Fact] = set(self.spec.facts)
         self.facts |= {("state", d.name, d.state) for d in self.spec.devices.values()}
+        # devices are where their place is; a cooker that is on is ("cooker_on", name) for the domains
+        self.facts |= {("at", d.name, d.place) for d in self.spec.devices.values()}
+        self.facts |= {("cooker_on", d.name) for d in self.spec.devices.values() if d.type == "cooker"
+                       and d.state == "on"}
+        self.facts |= {("open", n) for n, d in self.spec.doors.items() if d.open}
         x, y, _ = self.spec.robot.pose
         for name, (px, py, _) in sorted(self.spec.places.items()):
             if math.hypot(px - x, py - y) < AT_TOLERANCE and not any(f[:2] == ("at", "robot") for f in self.facts):
@@ -81,6 +86,7 @@ class Simulation:
         out |= {n: "person" for n in self.spec.people}
         out |= {n: d.type for n, d in self.spec.devices.items()}
         out |= {n: "door" for n in self.spec.doors}
+        out |= dict(self.spec.objects)
         return out
 
     def _sync_people(self) -> None:
@@ -153,8 +159,16 @@ class Simulation:
 
     def apply(self, add: Iterable[Iterable[str]] = (), delete: Iterable[Iterable[str]] = ()) -> None:
         """Change the symbolic state: ``delete`` first, then ``add`` (lists of ground facts)."""
-        self.facts -= {tuple(f) for f in delete}
-        self.facts |= {tuple(f) for f in add}
+        delete = [tuple(f) for f in delete]
+        add = [tuple(f) for f in add]
+        self.facts -= set(delete)
+        self.facts |= set(add)
+        for f in delete:  # the physical world follows the symbolic doors and devices
+            if f[0] == "open" and len(f) == 2 and f[1] in self.spec.doors:
+                self.set_door(f[1], False)
+        for f in add:
+            if f[0] == "open" and len(f) == 2 and f[1] in self.spec.doors:
+                self.set_door(f[1], True)
 
     # ---- CoreAgent -------------------------------------------------------------------
     def begin(self, agent: str, stage: Stage, now: float) -> None:

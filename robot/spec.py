@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -103,6 +103,7 @@ class WorldSpec:
     robot: RobotSpec
     facts: tuple[tuple[str, ...], ...]
     description: str = ""
+    objects: Mapping[str, str] = field(default_factory=dict)
 
 
 class _Reader:
@@ -199,7 +200,7 @@ def parse_world(data: Mapping[str, Any], source: str) -> WorldSpec:
     """Check a parsed world table and build a :class:`WorldSpec`; ``source`` names it in errors."""
     r = _Reader(source)
     known = {"name", "description", "bounds", "rooms", "walls", "furniture", "doors", "places",
-             "devices", "people", "robot", "facts"}
+             "devices", "people", "robot", "facts", "objects"}
     r.unknown_keys(data, "", known)
     for required in ("bounds", "robot"):
         if required not in data:
@@ -247,6 +248,11 @@ def parse_world(data: Mapping[str, Any], source: str) -> WorldSpec:
     clash = sorted((set(places) & set(people)) | (set(places) & set(devices)) | (set(people) & set(devices)))
     if clash or "robot" in set(places) | set(people) | set(devices):
         raise r.fail(clash[0] if clash else "robot", "a name is used twice (places, people, devices, 'robot')")
+    objects = {n: r.string(v, f"objects.{n}") for n, v in r.table(data.get("objects", {}), "objects").items()}
+    taken = set(places) | set(people) | set(devices) | {"robot"}
+    if taken & set(objects):
+        raise r.fail(f"objects.{sorted(taken & set(objects))[0]}", "a name is used twice (objects and places, "
+                     "people, devices or 'robot')")
     facts = []
     for k, f in enumerate(data.get("facts", [])):
         if not isinstance(f, list) or not f or not all(isinstance(a, str) and a for a in f):
@@ -256,7 +262,7 @@ def parse_world(data: Mapping[str, Any], source: str) -> WorldSpec:
     return WorldSpec(
         name=r.string(name, "name"), source=source, bounds=((lo[0], lo[1]), (hi[0], hi[1])), rooms=rooms,
         obstacles=tuple(obstacles), doors=doors, places=places, devices=devices, people=people,
-        robot=_robot(r, data["robot"]), facts=tuple(facts),
+        robot=_robot(r, data["robot"]), facts=tuple(facts), objects=objects,
         description=r.string(data.get("description", "-"), "description"),
     )
 

@@ -196,6 +196,7 @@ class DynamicAgent:
 
     def _start_up_tsk(self, now: float) -> None:
         self._go(S.UP_TSK, now)
+        self._refresh(now)  # plan from the world as it is now, after any effect applied this step
         try:
             plan = self.task.update_task(self.ctx)
         except PlanningFailed as exc:
@@ -304,6 +305,7 @@ class DynamicAgent:
         self.ctx.suspended = True
         self.ctx.terminating = self._pending_term is not None
         self._go(S.GEN_SUSP, now)
+        self._refresh(now)  # the stage that just ended may have changed the world (a pan put on the cooker)
         try:
             plan = self.task.generate_suspension(self.ctx)
         except PlanningFailed as exc:
