@@ -24,6 +24,7 @@ from typing import Any
 import tasker
 from experiments import scenario as scenarios
 from experiments import synthetic
+from experiments.actions import TimedAction
 from tasker import schedulers
 from tasker.agent import Rates
 from tasker.harmoniser import Mode
@@ -86,7 +87,7 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
     return loop, sim
 
 
-def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: synthetic.TimedAction,
+def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: TimedAction,
             scn: scenarios.RobotScenario) -> Callable[[], None]:
     f = a.fields
     if a.kind == "request":

@@ -18,12 +18,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from experiments.synthetic import ScenarioError, TimedAction, _Fields
+from experiments.actions import TimedAction, read_actions
+from experiments.fields import Fields as _Fields
+from experiments.fields import ScenarioError
 from tasker import schedulers
 
 SCENARIOS = Path(__file__).resolve().parent / "scenarios"
-
-WORLD_EVENT_KINDS = ("posture", "door", "add", "delete")
 
 
 @dataclass(frozen=True)
@@ -105,7 +105,7 @@ def load(path: str | Path) -> RobotScenario:
         strategies[task] = {k: _strategy(t, k) for k in ("update", "suspension") if k in t.table}
         t.done()
     strategies_f.done()
-    actions = _actions(top, source)
+    actions = read_actions(top, world_events=True)
     people_f = top.sub("people", {})
     people: dict[str, dict[str, Any]] = {}
     for name in list(people_f.table):
@@ -153,50 +153,6 @@ def _numbers(f: _Fields, key: str, n: int) -> list[float]:
     if len(value) != n or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in value):
         raise f.error(key, f"expected {n} numbers, got {value!r}")
     return [float(v) for v in value]
-
-
-def _actions(top: _Fields, source: str) -> tuple[TimedAction, ...]:
-    out: list[TimedAction] = []
-    n_requests = 0
-    for key, kind in (("requests", "request"), ("terminations", "terminate"), ("changes", "change"),
-                      ("mode_changes", "mode"), ("world_events", "world")):
-        for i, item in enumerate(top.get(key, list, [])):
-            f = _Fields(source, f"{key}[{i}]", item)
-            t = f.get("t", float)
-            if t < 0:
-                raise f.error("t", f"expected >= 0, got {t}")
-            fields: dict[str, Any] = {}
-            if kind == "request":
-                n_requests += 1
-                fields = {"task": f.get("task", str), "args": f.get("args", dict, {})}
-            elif kind in ("terminate", "change"):
-                fields["agent"] = f.get("agent", str)
-                if kind == "change":
-                    fields["args"] = f.get("args", dict)
-                else:
-                    fields["reason"] = f.get("reason", str, "terminated by the requester")
-            elif kind == "mode":
-                fields["mode"] = _choice(f, "mode", ("IT", "CT"), "IT")
-            else:
-                given = [k for k in WORLD_EVENT_KINDS if k in f.table]
-                if len(given) != 1:
-                    raise f.error("", f"a world event has exactly one of {list(WORLD_EVENT_KINDS)}, got {given}")
-                k = given[0]
-                value = f.get(k, list)
-                if k == "posture" and (len(value) != 2 or not all(isinstance(v, str) for v in value)):
-                    raise f.error(k, f"expected [person, posture], got {value!r}")
-                if k == "door" and (len(value) != 2 or not isinstance(value[0], str) or not isinstance(value[1], bool)):
-                    raise f.error(k, f"expected [door, true|false], got {value!r}")
-                if k in ("add", "delete") and not all(isinstance(x, list) and all(isinstance(a, str) for a in x)
-                                                      for x in value):
-                    raise f.error(k, f"expected a list of facts (lists of strings), got {value!r}")
-                fields = {"what": k, "value": value}
-                fields["note"] = f.get("note", str, "")
-            f.done()
-            out.append(TimedAction(t, kind, fields))
-    if n_requests == 0:
-        raise top.error("requests", "a scenario needs at least one request")
-    return tuple(sorted(out, key=lambda a: a.t))
 
 
 def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, pose_jitter: float = 0.5

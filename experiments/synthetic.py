@@ -14,26 +14,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from experiments.actions import TimedAction, read_actions
+from experiments.fields import Fields as _Fields
+from experiments.fields import ScenarioError
 from tasker import schedulers
 from tasker.agent import Rates
-from tasker.errors import TaskerError
 from tasker.harmoniser import Mode
 from tasker.loop import SimulationLoop
 from tasker.stage import Stage, StageKind
 from tasker.store import TaskStore
 from tasker.synthetic import SyntheticTask, TimedExecutor
 from tasker.trace import Trace
-
-
-class ScenarioError(TaskerError, ValueError):
-    """A scenario file is malformed; the message names the file and the field."""
-
-
-@dataclass(frozen=True)
-class TimedAction:
-    t: float
-    kind: str  # request | terminate | change | mode
-    fields: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -51,46 +42,6 @@ class SyntheticScenario:
     jitter: float = 0.0
     seed: int = 0
     horizon: float = 24 * 3600.0
-
-
-class _Fields:
-    """Reads one table of a scenario file, naming ``file: path.to.field`` in every error."""
-
-    def __init__(self, source: str, where: str, table: Any) -> None:
-        if not isinstance(table, dict):
-            raise ScenarioError(f"{source}: {where or 'top level'}: expected a table, got {type(table).__name__}")
-        self.source, self.where, self.table = source, where, table
-        self.used: set[str] = set()
-
-    def path(self, key: str) -> str:
-        return f"{self.where}.{key}" if self.where else key
-
-    def error(self, key: str, msg: str) -> ScenarioError:
-        return ScenarioError(f"{self.source}: {self.path(key)}: {msg}")
-
-    def get(self, key: str, kind: type | tuple[type, ...], default: Any = ..., *, positive: bool = False) -> Any:
-        self.used.add(key)
-        if key not in self.table:
-            if default is ...:
-                raise self.error(key, "missing (required)")
-            return default
-        value = self.table[key]
-        if kind is float and isinstance(value, int) and not isinstance(value, bool):
-            value = float(value)
-        if isinstance(value, bool) and kind is not bool or not isinstance(value, kind):
-            names = kind.__name__ if isinstance(kind, type) else " or ".join(k.__name__ for k in kind)
-            raise self.error(key, f"expected {names}, got {value!r}")
-        if positive and value <= 0:
-            raise self.error(key, f"expected a positive number, got {value!r}")
-        return value
-
-    def sub(self, key: str, default: Any = ...) -> _Fields:
-        return _Fields(self.source, self.path(key), self.get(key, dict, default))
-
-    def done(self) -> None:
-        extra = sorted(set(self.table) - self.used)
-        if extra:
-            raise self.error(extra[0], f"unknown field; expected one of {sorted(self.used)}")
 
 
 def _stage(f: _Fields) -> Stage:
@@ -151,44 +102,7 @@ def load(path: str | Path) -> SyntheticScenario:
             planning_time=t.get("planning_time", float, 0.0),
         ))
         t.done()
-    names = {t.name for t in tasks}
-    actions: list[TimedAction] = []
-    for key, kind_name in (("requests", "request"), ("terminations", "terminate"), ("changes", "change"),
-                           ("mode_changes", "mode")):
-        for i, item in enumerate(top.get(key, list, [])):
-            f = _Fields(source, f"{key}[{i}]", item)
-            t_ = f.get("t", float)
-            if t_ < 0:
-                raise f.error("t", f"expected >= 0, got {t_}")
-            fields: dict[str, Any] = {}
-            if kind_name == "request":
-                fields["task"] = f.get("task", str)
-                if fields["task"] not in names:
-                    raise f.error("task", f"unknown task type {fields['task']!r}; defined: {sorted(names)}")
-                fields["args"] = f.get("args", dict, {})
-            elif kind_name in ("terminate", "change"):
-                fields["agent"] = f.get("agent", str)
-                if kind_name == "change":
-                    fields["args"] = f.get("args", dict)
-                else:
-                    fields["reason"] = f.get("reason", str, "terminated by the requester")
-            else:
-                fields["mode"] = f.get("mode", str)
-                if fields["mode"] not in ("IT", "CT"):
-                    raise f.error("mode", f"expected 'IT' or 'CT', got {fields['mode']!r}")
-            f.done()
-            actions.append(TimedAction(t_, kind_name, fields))
-    request_times = [a.t for a in sorted(actions, key=lambda a: a.t) if a.kind == "request"]
-    for a in actions:
-        if a.kind in ("terminate", "change"):
-            agent = a.fields["agent"]
-            k = int(agent[1:]) if agent[:1] == "d" and agent[1:].isdigit() else 0
-            key = "terminations" if a.kind == "terminate" else "changes"
-            if not 1 <= k <= len(request_times) or request_times[k - 1] > a.t:
-                raise ScenarioError(
-                    f"{source}: {key}: agent {agent!r} at t={a.t}: agents are d1..d{len(request_times)} "
-                    "in request order, and must be requested before they are changed or terminated"
-                )
+    actions = read_actions(top, task_names={t.name for t in tasks})
     mode = settings.get("mode", str, "IT")
     if mode not in ("IT", "CT"):
         raise settings.error("mode", f"expected 'IT' or 'CT', got {mode!r}")
@@ -198,7 +112,7 @@ def load(path: str | Path) -> SyntheticScenario:
     scenario = SyntheticScenario(
         name=top.get("name", str, p.stem),
         tasks=tuple(tasks),
-        actions=tuple(sorted(actions, key=lambda a: a.t)),
+        actions=actions,
         scheduler=scheduler,
         scheduler_options=settings.get("scheduler_options", dict, {}),
         mode=mode,

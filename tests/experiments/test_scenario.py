@@ -65,6 +65,12 @@ def test_bad_world_event_is_named(tmp_path: Path) -> None:
         scenarios.load(write(tmp_path, text))
 
 
+def test_terminating_an_agent_never_requested_is_refused(tmp_path: Path) -> None:
+    text = GOOD + '[[terminations]]\nt = 3.0\nagent = "d7"\n'
+    with pytest.raises(ScenarioError, match="agent 'd7' at t=3.0: agents are d1..d1"):
+        scenarios.load(write(tmp_path, text))
+
+
 def test_unknown_scenario_name_lists_shipped_ones() -> None:
     with pytest.raises(ScenarioError, match="paper"):
         scenarios.resolve("no_such_scenario")
