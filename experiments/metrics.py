@@ -156,10 +156,12 @@ class TaskCollector:
         resumptions = [d for v in tasks.values() for d in v["resumption_s"]]
         totals = {
             "requested": len(tasks), "ended": len(ended), "unfinished": len(tasks) - len(ended),
-            "finished": causes.get("finished", 0), "failed": len(ended) - causes.get("finished", 0),
+            # a task that ended itself (ic_term: "Peter is fine") or was cancelled did not fail
+            "finished": causes.get("finished", 0), "failed": causes.get("failed", 0) + causes.get("other", 0),
+            "ended_by_itself": causes.get("self", 0), "terminated": causes.get("term", 0),
             "by_cause": dict(sorted(causes.items())),
             "failure_reasons": [f"{a}: {v['reason']}" for a, v in tasks.items()
-                                if v["end_t"] is not None and v["cause"] != "finished"],
+                                if v["end_t"] is not None and v["cause"] in ("failed", "other")],
             "duration_s": _stats(durations), "makespan_s": last - first if tasks else 0.0,
             "suspensions": sum(v["suspensions"] for v in tasks.values()),
             "suspended_s": math.fsum(v["suspended_s"] for v in tasks.values()),

@@ -159,16 +159,13 @@ class Simulation:
 
     def apply(self, add: Iterable[Iterable[str]] = (), delete: Iterable[Iterable[str]] = ()) -> None:
         """Change the symbolic state: ``delete`` first, then ``add`` (lists of ground facts)."""
-        delete = [tuple(f) for f in delete]
-        add = [tuple(f) for f in add]
-        self.facts -= set(delete)
-        self.facts |= set(add)
-        for f in delete:  # the physical world follows the symbolic doors and devices
-            if f[0] == "open" and len(f) == 2 and f[1] in self.spec.doors:
-                self.set_door(f[1], False)
-        for f in add:
-            if f[0] == "open" and len(f) == 2 and f[1] in self.spec.doors:
-                self.set_door(f[1], True)
+        removed: list[Fact] = [tuple(f) for f in delete]
+        added: list[Fact] = [tuple(f) for f in add]
+        self.facts -= set(removed)
+        self.facts |= set(added)
+        for fact, is_open in [(f, False) for f in removed] + [(f, True) for f in added]:
+            if fact[0] == "open" and len(fact) == 2 and fact[1] in self.spec.doors:
+                self.set_door(fact[1], is_open)  # the physical door follows the symbolic one
 
     # ---- CoreAgent -------------------------------------------------------------------
     def begin(self, agent: str, stage: Stage, now: float) -> None:
