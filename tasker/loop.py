@@ -89,7 +89,8 @@ class SimulationLoop:
         return self._tick * self.resolution
 
     def _to_tick(self, t: float) -> int:
-        return max(self._tick, math.ceil(round(t / self.resolution, 6)))
+        # the first tick at or after t (a hair of tolerance absorbs float noise in t / resolution)
+        return max(self._tick, math.ceil(t / self.resolution - 1e-6))
 
     def _push(self, tick: int, phase: int, item: Any) -> None:
         heapq.heappush(self._heap, (tick, phase, next(self._seq), item))

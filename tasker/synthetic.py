@@ -70,6 +70,7 @@ class SyntheticTask(TaskType):
         self.name = name
         self.description = description or f"synthetic task of {len(stages)} stages"
         self.stages = tuple(stages)
+        self._total = sum(s.duration for s in self.stages)
         self.speed = float(speed)
         self.suspension = suspension
         self.resume_prefix = tuple(resume_prefix)
@@ -93,8 +94,14 @@ class SyntheticTask(TaskType):
 
     def _remaining(self, ctx: TaskContext) -> float:
         if ctx.plan is None:
-            return sum(s.duration for s in self.stages)
-        total = sum(s.duration for s in ctx.remaining)
+            return self._total
+        cached = ctx.memory.get("_suffix")
+        if cached is None or cached[0] is not ctx.plan:  # suffix sums of the current plan's durations
+            suffix = [0.0]
+            for stage in reversed(ctx.plan.stages):
+                suffix.append(suffix[-1] + stage.duration)
+            cached = ctx.memory["_suffix"] = (ctx.plan, suffix[::-1])
+        total = cached[1][min(ctx.stage_index, len(ctx.plan.stages))]
         if ctx.stage_started is not None and ctx.current is not None:  # progress of the running stage
             total -= min(ctx.current.duration, ctx.now - ctx.stage_started)
         return total
