@@ -26,7 +26,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from unified_planning.shortcuts import OneshotPlanner  # noqa: E402
 
-import domains  # noqa: E402
+from planners.bundled import task_types  # noqa: E402
 from planners.checks import load_problem_text  # noqa: E402
 from planners.examples import StraightLineMotion, example_context  # noqa: E402
 from planners.pddl_task import PddlTaskType  # noqa: E402
@@ -89,7 +89,7 @@ def main(argv: list[str] | None = None) -> int:
     mismatches = 0
     print(f"{'domain':14s} {'problem':12s} {'Planner ms':>10s} {'tasker-fd ms':>12s} {'fd-opt ms':>10s} "
           f"{'ratio':>6s} {'cost':>6s}")
-    for task in domains.task_types():
+    for task in task_types():
         assert isinstance(task, PddlTaskType)
         dom_ratios = []
         for label, text in problems_of(task):
@@ -108,7 +108,7 @@ def main(argv: list[str] | None = None) -> int:
         ratios += dom_ratios
 
     cached = Planner()
-    task = domains.task_types()[0]
+    task = task_types()[0]
     assert isinstance(task, PddlTaskType)
     label, text = problems_of(task)[0]
     cached.solve(text)
