@@ -218,7 +218,7 @@ class DynamicAgent:
         plan = self.ctx.plan
         assert plan is not None
         if not plan.stages:
-            self._go(S.END, now, check=True, reason="finished")
+            self._end(now, "finished", cause="finished")  # nothing left to do (R6: done by someone else)
             return
         self._runner = StageRunner(plan)
         self._go(S.EXE_TSK, now)
@@ -336,16 +336,11 @@ class DynamicAgent:
 
     # -- helpers ------------------------------------------------------------------------------
 
-    def _go(self, target: FsmState, now: float, *, check: bool = True, reason: str | None = None) -> None:
-        if check:
-            fsm.check(self.state, target)
+    def _go(self, target: FsmState, now: float) -> None:
+        """A transition of Fig. 5 (checked), traced and reported.  Ending goes through :meth:`_end`."""
+        fsm.check(self.state, target)
         self._trace.emit(now, "transition", agent=self.id, **{"from": self.state.value, "to": target.value})
         self.state = target
-        if target is S.END:
-            self.end_reason = reason or "finished"
-            self.next_wake = math.inf
-            self._trace.emit(now, "end", agent=self.id, task_type=self.ctx.task_type,
-                             reason=self.end_reason, cause="finished" if reason == "finished" else "other")
         self._publish()
 
     def _end(self, now: float, reason: str, *, cause: str) -> None:
