@@ -26,7 +26,8 @@ class Fields:
     def error(self, key: str, msg: str) -> ScenarioError:
         return ScenarioError(f"{self.source}: {self.path(key)}: {msg}")
 
-    def get(self, key: str, kind: type | tuple[type, ...], default: Any = ..., *, positive: bool = False) -> Any:
+    def get(self, key: str, kind: type[Any] | tuple[type[Any], ...], default: Any = ..., *,
+            positive: bool = False) -> Any:
         self.used.add(key)
         if key not in self.table:
             if default is ...:

@@ -9,7 +9,7 @@ from pathlib import Path
 from tasker import schedulers
 
 
-def register(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("run", help="run a scenario: trace.jsonl, metrics.json, run.json and pictures in DIR",
                        description="Run a scenario (a shipped name such as 'paper', or a .toml file) on the "
                                    "simulated clock and write trace.jsonl, run.json, metrics.json, timeline.png, "

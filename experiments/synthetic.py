@@ -10,9 +10,10 @@ from __future__ import annotations
 
 import json
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from experiments.actions import TimedAction, read_actions
 from experiments.fields import Fields as _Fields
@@ -25,6 +26,9 @@ from tasker.stage import Stage, StageKind
 from tasker.store import TaskStore
 from tasker.synthetic import SyntheticTask, TimedExecutor
 from tasker.trace import Trace
+
+if TYPE_CHECKING:
+    from tasker.requester import Requester
 
 
 @dataclass(frozen=True)
@@ -148,17 +152,30 @@ def build(scenario: SyntheticScenario, *, seed: int, scheduler: str | None = Non
             loop.request(a.t, a.fields["task"], a.fields["args"], requester="scenario")
         elif a.kind == "terminate":
             agent, reason = a.fields["agent"], a.fields["reason"]
-            loop.at(a.t, lambda agent=agent, reason=reason: requester.terminate(agent, reason))
+            loop.at(a.t, _terminate_event(requester, agent, reason))
         elif a.kind == "change":
             agent, args = a.fields["agent"], a.fields["args"]
-            loop.at(a.t, lambda agent=agent, args=args: _change(loop, requester, agent, args))
+            loop.at(a.t, _change_event(loop, requester, agent, args))
         else:
             m = a.fields["mode"]
-            loop.at(a.t, lambda m=m: loop.harmoniser.set_mode(m))
+            loop.at(a.t, _mode_event(loop, m))
     return loop
 
 
-def _change(loop: SimulationLoop, requester: Any, agent: str, args: dict[str, Any]) -> None:
+# The event builders bind each action's own arguments (a bare lambda in the loop would see the last ones).
+def _terminate_event(requester: Requester, agent: str, reason: str) -> Callable[[], None]:
+    return lambda: requester.terminate(agent, reason)
+
+
+def _change_event(loop: SimulationLoop, requester: Requester, agent: str, args: dict[str, Any]) -> Callable[[], None]:
+    return lambda: _change(loop, requester, agent, args)
+
+
+def _mode_event(loop: SimulationLoop, mode: str) -> Callable[[], None]:
+    return lambda: loop.harmoniser.set_mode(mode)
+
+
+def _change(loop: SimulationLoop, requester: Requester, agent: str, args: dict[str, Any]) -> None:
     if agent in loop.harmoniser.agents:
         requester.change(agent, args)
     else:

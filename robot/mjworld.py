@@ -13,17 +13,21 @@ commands give the same trajectory.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from robot.spec import WorldSpec
 from robot.tiago import robot_dimensions, tiago_mjspec
 
+if TYPE_CHECKING:  # imported lazily at run time; MuJoCo ships no type stubs, so this is Any to mypy
+    import mujoco
+
 TIMESTEP = 0.002
 _COLOURS = {"wall": [0.75, 0.72, 0.68, 1], "furniture": [0.55, 0.4, 0.25, 1], "door": [0.4, 0.3, 0.2, 1]}
 
 
-def build_model(spec: WorldSpec) -> object:
+def build_model(spec: WorldSpec) -> mujoco.MjModel:
     """Compile the MuJoCo model of ``spec`` with the robot at its start pose."""
     import mujoco
 

@@ -149,14 +149,15 @@ class Navigate(Skill):
                      and math.dist(self.person_at, self.sim.people[self.target].pose[:2]) > 0.5)
             if moved or self._path_ahead_blocked():
                 why = self._replan()
+                f = self.follower
+                assert f is not None  # _replan installs a new follower or keeps the old one, never clears it
                 if why is None:
                     self.blocked_since = None
                 else:
                     self.blocked_since = self.blocked_since if self.blocked_since is not None else now
                     if now - self.blocked_since > BLOCK_TIMEOUT:
                         self.result = failed(f"path to {self.target!r} blocked: {why}")
-                    self.follower.brake()
-                f = self.follower
+                    f.brake()
         x, y, yaw = self.sim.robot_pose()
         cmd = f.command(x, y, yaw, dt)
         if f.done and self.blocked_since is None and not self.stopping and self.result is RUNNING:

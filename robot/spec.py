@@ -165,7 +165,7 @@ def _person(r: _Reader, name: str, data: Any) -> PersonSpec:
     r.unknown_keys(t, where, {"pose", "posture", "speed", "walk", "events"})
     if "pose" not in t:
         raise r.fail(f"{where}.pose", "missing; expected [x, y, yaw]")
-    walk = []
+    walk: list[tuple[float, float, float]] = []
     for k, wp in enumerate(t.get("walk", [])):
         wt, wx, wy = r.numbers(wp, f"{where}.walk[{k}]", 3, "[t, x, y]")
         if walk and wt <= walk[-1][0]:

@@ -20,8 +20,13 @@ import math
 import re
 from functools import lru_cache
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:  # imported lazily at run time; neither library ships type stubs, so these are Any to mypy
+    import mujoco
+    import pinocchio as pin
 
 TUCK = {"torso_lift_joint": 0.15, "arm_1_joint": 0.20, "arm_2_joint": -1.34, "arm_3_joint": -0.20,
         "arm_4_joint": 1.94, "arm_5_joint": -1.57, "arm_6_joint": 1.37, "arm_7_joint": 0.0}
@@ -39,7 +44,7 @@ def urdf_path() -> Path:
 
 
 @lru_cache(maxsize=1)
-def _pin_models() -> tuple[object, object]:
+def _pin_models() -> tuple[pin.Model, pin.GeometryModel]:
     import pinocchio as pin
 
     urdf = urdf_path()
@@ -183,7 +188,7 @@ def _quat_mul(a: np.ndarray, b: np.ndarray) -> list[float]:
             w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2]
 
 
-def tiago_mjspec() -> object:
+def tiago_mjspec() -> mujoco.MjSpec:
     """A fresh MuJoCo spec of TIAGo: free base, wheel velocity actuators, everything else rigid.
 
     Robot geoms collide with the world only (``contype=2, conaffinity=1``).
