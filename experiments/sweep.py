@@ -5,6 +5,8 @@ expands to a list of :class:`Job`; :func:`run_sweep` runs those whose key is not
 the results database yet, on local worker processes or on a Dask cluster, and the
 driving process stores each result (:mod:`experiments.store`) the moment it
 arrives.  Killing a sweep loses only the runs in flight; running it again resumes.
+A job that raises, or that kills its worker process, is stored as an ``error`` run
+and the sweep goes on.
 
 The function that runs one job is injectable (``run_fn``): a picklable top-level
 function ``job -> (record, metrics)``.  The default, :func:`run_job`, calls
@@ -14,16 +16,21 @@ different randomised variant of the scenario.  See ``docs/sweeps.md``.
 
 from __future__ import annotations
 
+import itertools
+import logging
 import multiprocessing
 import os
 import platform
+import signal
 import socket
 import sys
+import tempfile
 import time
 import tomllib
 import traceback
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from collections import deque
+from collections.abc import Callable, Generator, Iterable, Iterator, Mapping, Sequence
+from concurrent.futures import FIRST_COMPLETED, CancelledError, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -36,6 +43,8 @@ from tasker.errors import TaskerError
 
 STRATEGY_VALUES = ("static", "planned")
 
+log = logging.getLogger(__name__)
+
 RunFn = Callable[["Job"], tuple[Mapping[str, Any], Mapping[str, Any]]]
 """Runs one job and returns ``(record, metrics)``; must be a picklable top-level function."""
 
@@ -45,7 +54,7 @@ class SpecError(TaskerError, ValueError):
 
 
 class SweepError(TaskerError, RuntimeError):
-    """A sweep could not go on (e.g. a worker process died); what finished is stored."""
+    """A sweep cannot run (bad arguments, two jobs with the same key)."""
 
 
 @dataclass(frozen=True)
@@ -278,11 +287,20 @@ def execute(run_fn: RunFn, job: Job) -> Outcome:
     start = time.perf_counter()
     try:
         record, metrics = run_fn(job)
-    except Exception as exc:  # a failing run is a result, and the sweep goes on
+    except (Exception, SystemExit) as exc:  # a failing run is a result, and the sweep goes on
         tb = traceback.format_exc(limit=-3)
         return Outcome(job.key, Status.ERROR, {}, {}, f"{type(exc).__name__}: {exc}\n{tb}",
                        time.perf_counter() - start, worker)
     return Outcome(job.key, Status.OK, dict(record), dict(metrics), None, time.perf_counter() - start, worker)
+
+
+def _failed(job: Job, error: str, wall: float = 0.0, worker: str = "") -> Outcome:
+    """An ``error`` outcome made by the driving process (the worker could not send one)."""
+    return Outcome(job.key, Status.ERROR, {}, {}, error, wall, worker)
+
+
+def _exception_message(exc: BaseException) -> str:
+    return f"{type(exc).__name__}: {exc}"
 
 
 def _mp_context() -> multiprocessing.context.BaseContext:
@@ -291,35 +309,178 @@ def _mp_context() -> multiprocessing.context.BaseContext:
     return multiprocessing.get_context(method)
 
 
-def _local(run_fn: RunFn, jobs: Sequence[Job], workers: int) -> Iterator[Outcome]:
-    """Outcomes as they finish from a pool of local worker processes (at most 2×workers queued)."""
-    with ProcessPoolExecutor(max_workers=workers, mp_context=_mp_context()) as pool:
-        todo = iter(jobs)
-        pending: dict[Future[Outcome], Job] = {}
+def _execute_marked(run_fn: RunFn, job: Job, mark: str) -> Outcome:
+    """:func:`execute`, after leaving a file at ``mark``: the driver then knows the job had started."""
+    try:
+        Path(mark).write_text(str(os.getpid()), encoding="utf-8")
+    except OSError:  # only a hint; without it the driver suspects every job the broken pool held
+        pass
+    return execute(run_fn, job)
+
+
+def _died(exitcode: int | None) -> str:
+    """The message of a job whose worker process died while running it alone."""
+    if exitcode is None:
+        how = "exit code unknown"
+    elif exitcode < 0:
         try:
-            while True:
-                while len(pending) < 2 * workers and (job := next(todo, None)) is not None:
-                    pending[pool.submit(execute, run_fn, job)] = job
+            name = signal.Signals(-exitcode).name
+        except ValueError:
+            name = f"signal {-exitcode}"
+        how = f"killed by {name}, exit code {exitcode}"
+    else:
+        how = f"exit code {exitcode}"
+    return (f"worker process died ({how}) while running this job alone "
+            "(a crash in native code, os._exit, or the OOM killer)")
+
+
+def _alone_child(conn: Any, run_fn: RunFn, job: Job) -> None:
+    """The body of the process that runs one job alone: send its outcome back, or die trying."""
+    out = execute(run_fn, job)
+    try:
+        conn.send(out)
+    except Exception as exc:  # e.g. a record that cannot be pickled
+        conn.send(_failed(job, f"the result could not be sent back: {_exception_message(exc)}", out.wall,
+                          out.worker))
+    conn.close()
+
+
+def _alone(run_fn: RunFn, job: Job, ctx: multiprocessing.context.BaseContext) -> Outcome:
+    """Run one job alone in a fresh worker process; if the process dies, an ``error`` outcome that says so."""
+    start = time.perf_counter()
+    receiver, sender = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_alone_child, args=(sender, run_fn, job), name=f"tasker-sweep-alone-{job.seed}")
+    proc.start()
+    sender.close()  # so that receiving ends (EOFError) when the process dies without sending
+    out: Outcome | None = None
+    try:
+        out = receiver.recv()
+    except EOFError:  # it died without sending: wait for its exit code
+        proc.join(timeout=30)
+    finally:
+        receiver.close()
+        if proc.is_alive():  # interrupted (Ctrl-C), or it closed the pipe and kept going
+            proc.terminate()
+        proc.join()
+    if out is not None:
+        return out
+    return _failed(job, _died(proc.exitcode), time.perf_counter() - start, f"{socket.gethostname()}:{proc.pid}")
+
+
+def _pool_pass(run_fn: RunFn, queue: deque[Job], workers: int, ctx: multiprocessing.context.BaseContext,
+               marks: Path, serial: Iterator[int]) -> Generator[Outcome, None, list[Job]]:
+    """Run jobs from ``queue`` on one pool of ``workers`` processes, yielding outcomes as they finish.
+
+    Returns ``[]`` when the queue is empty and every job finished.  If a worker process
+    dies (the pool breaks), returns the jobs that had started and sent no result (those
+    that may have killed it), after yielding every result that did arrive and putting
+    the jobs that had not started back at the front of ``queue``.
+    """
+    pending: dict[Future[Outcome], tuple[Job, Path]] = {}
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        try:
+            broken = False
+            while not broken:
+                while len(pending) < 2 * workers and queue:
+                    job = queue.popleft()
+                    mark = marks / str(next(serial))
+                    try:
+                        fut = pool.submit(_execute_marked, run_fn, job, str(mark))
+                    except BrokenProcessPool:
+                        queue.appendleft(job)
+                        broken = True
+                        break
+                    pending[fut] = (job, mark)
                 if not pending:
-                    return
-                done, _ = wait(pending, return_when=FIRST_COMPLETED)
-                for fut in done:
-                    pending.pop(fut)
-                    yield fut.result()
+                    return []
+                if not broken:
+                    done, _ = wait(pending, return_when=FIRST_COMPLETED)
+                    for fut in done:
+                        try:
+                            out = fut.result()
+                        except BrokenProcessPool:
+                            broken = True
+                            continue
+                        except Exception as exc:  # e.g. a result that could not be pickled
+                            out = _failed(pending[fut][0], _exception_message(exc))
+                        pending.pop(fut)
+                        yield out
+            # The pool is broken: every future it held fails at once.  Keep what did arrive.
+            wait(pending, timeout=60)
+            started: list[Job] = []
+            not_started: list[Job] = []
+            for fut, (job, mark) in pending.items():  # in the order submitted
+                exc = fut.exception(timeout=0) if fut.done() and not fut.cancelled() else BrokenProcessPool()
+                if exc is None:
+                    yield fut.result()  # finished before the pool broke
+                elif not isinstance(exc, BrokenProcessPool):
+                    yield _failed(job, _exception_message(exc))
+                else:
+                    (started if mark.exists() else not_started).append(job)
+            pending.clear()
+            if not started:  # no job says it started (e.g. a worker died before taking one): suspect them all
+                started, not_started = not_started, []
+            queue.extendleft(reversed(not_started))
+            return started
         finally:
             for fut in pending:
                 fut.cancel()
 
 
+def _local(run_fn: RunFn, jobs: Sequence[Job], workers: int) -> Iterator[Outcome]:
+    """Outcomes as they finish from a pool of local worker processes (at most 2×workers queued).
+
+    A job that kills its worker process breaks the pool.  Then the jobs that were in
+    flight are run again one at a time, each alone in a fresh process: one that kills
+    that process too becomes an ``error`` outcome that says so, the others run normally;
+    and the remaining jobs go on in a fresh pool.  Every job thus ends with an outcome.
+    """
+    ctx = _mp_context()
+    queue = deque(jobs)
+    serial = itertools.count()
+    with tempfile.TemporaryDirectory(prefix="tasker-sweep-") as marks:
+        while queue:
+            suspects = yield from _pool_pass(run_fn, queue, workers, ctx, Path(marks), serial)
+            if suspects:
+                log.warning("a worker process died; running the %d job(s) that were in flight one at a time to "
+                            "find the one that kills it", len(suspects))
+            for job in suspects:
+                out = _alone(run_fn, job, ctx)
+                if out.status is Status.ERROR and out.error and out.error.startswith("worker process died"):
+                    log.warning("%s: %s", job.key, out.error)
+                yield out
+
+
 def _dask(run_fn: RunFn, jobs: Sequence[Job], address: str) -> Iterator[Outcome]:
-    """Outcomes as they finish from the Dask cluster at ``address``."""
+    """Outcomes as they finish from the Dask cluster at ``address``.
+
+    A job whose worker process dies is retried by Dask on other workers (up to the
+    scheduler's ``allowed-failures``); when Dask gives up (``KilledWorker``), or the
+    job's future fails otherwise, the job gets an ``error`` outcome.  A cancelled
+    future (e.g. the cluster restarted) leaves its job for a later resumption.
+    """
     import distributed
+    from distributed.scheduler import KilledWorker
 
     with distributed.Client(address, set_as_default=False) as client:
-        futures = [client.submit(execute, run_fn, job, pure=False) for job in jobs]
+        futures = {client.submit(execute, run_fn, job, pure=False): job for job in jobs}
         try:
-            for fut in distributed.as_completed(futures, loop=client.loop):
-                yield fut.result()
+            for fut in distributed.as_completed(list(futures), loop=client.loop):
+                job = futures[fut]
+                if fut.cancelled():
+                    log.warning("%s: Dask cancelled the job; it stays for a later resumption", job.key)
+                    continue
+                try:
+                    out = fut.result()
+                except KilledWorker as exc:
+                    out = _failed(job, f"worker process died while running this job, on every worker Dask "
+                                       f"tried ({_exception_message(exc)})")
+                except CancelledError:
+                    log.warning("%s: Dask cancelled the job; it stays for a later resumption", job.key)
+                    continue
+                except Exception as exc:  # the future failed outside run_fn (e.g. a result that did not pickle)
+                    out = _failed(job, _exception_message(exc))
+                yield out
         finally:
             client.cancel([f for f in futures if not f.done()])
 
@@ -347,6 +508,10 @@ def run_sweep(
     ``workers`` local processes (default: the CPU count) unless ``scheduler_address``
     names a Dask scheduler, whose workers are used instead.  A job that raises is stored
     with status ``error`` and its message; it is run again only with ``retry_errors``.
+    So is a job that kills its worker process (a segfault, ``os._exit``, the OOM
+    killer): locally, the jobs that were in flight are run again one at a time, each
+    alone in a fresh process, to find it (the others are stored as they end), and the
+    sweep goes on in a fresh pool; on Dask, once Dask gives up retrying it (``KilledWorker``).
     ``max_jobs`` stops after starting that many jobs (the rest stay missing, for a later
     resumption).  Results are written by this process only, one transaction per run.
     """
@@ -377,20 +542,16 @@ def run_sweep(
                         else _local(run_fn, todo, n_workers))
             by_key = {j.key: j for j in todo}
             with tqdm(total=len(todo), unit="run", disable=not progress, desc=f"sweep ({backend})") as bar:
-                try:
-                    for out in outcomes:
-                        job = by_key[out.key]
-                        store.add(RunRow(job.scenario, job.seed, job.strategy.label, out.status,
-                                         dict(out.record), dict(out.metrics), out.error, out.wall, out.worker))
-                        if out.status is Status.OK:
-                            ok += 1
-                        else:
-                            errors += 1
-                        bar.update()
-                        bar.set_postfix(errors=errors, refresh=False)
-                except BrokenProcessPool as exc:
-                    raise SweepError(f"a worker process died ({exc}); {ok + errors} of {len(todo)} runs are "
-                                     f"stored in {db_path}; run the sweep again to resume") from exc
+                for out in outcomes:
+                    job = by_key[out.key]
+                    store.add(RunRow(job.scenario, job.seed, job.strategy.label, out.status,
+                                     dict(out.record), dict(out.metrics), out.error, out.wall, out.worker))
+                    if out.status is Status.OK:
+                        ok += 1
+                    else:
+                        errors += 1
+                    bar.update()
+                    bar.set_postfix(errors=errors, refresh=False)
     ran = ok + errors
     return SweepSummary(total=len(jobs), skipped=len(jobs) - missing, ran=ran, ok=ok, errors=errors,
                         not_run=missing - ran, wall=time.perf_counter() - start, backend=backend)

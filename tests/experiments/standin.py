@@ -60,3 +60,14 @@ def flaky_run(job: Job) -> tuple[dict[str, Any], dict[str, Any]]:
     if job.seed == 1:
         raise ValueError(f"seed {job.seed} is cursed")
     return run(job)
+
+
+CRASH_SEED = 4
+
+
+def crashing_run(job: Job) -> tuple[dict[str, Any], dict[str, Any]]:
+    """:func:`run`, except that seed ``CRASH_SEED`` kills its worker process (as a segfault in native code would)."""
+    if job.seed == CRASH_SEED:
+        os._exit(3)
+    time.sleep(0.05)  # so that other jobs are in flight when the worker dies
+    return run(job)

@@ -153,6 +153,48 @@ def test_failing_runs_are_stored_as_errors_and_retried_only_when_asked(tmp_path:
         assert store.keys(Status.OK) == _all_keys(small_spec)
 
 
+def test_a_job_that_kills_its_worker_is_stored_as_an_error_and_the_sweep_goes_on(tmp_path: Path) -> None:
+    db = tmp_path / "r.db"
+    spec = SweepSpec(("demo",), (1, 2, 3, 4, 5, 6), (Strategy("static", "static"),),
+                     sources={"demo": str(standin.DEMO)})
+    crasher = ("demo", standin.CRASH_SEED, "update=static,suspension=static")
+    first = run_sweep(spec, db, workers=2, run_fn=standin.crashing_run, progress=False)
+    assert (first.ran, first.ok, first.errors, first.not_run) == (6, 5, 1, 0)
+    with ResultStore(db) as store:
+        rows = store.rows()
+        assert len(rows) == store.count() == 6 and {r.key for r in rows} == _all_keys(spec)
+        (error,) = store.rows(Status.ERROR)
+        assert error.key == crasher
+        assert error.error and error.error.startswith("worker process died (exit code 3) while running this job")
+        assert store.keys(Status.OK) == _all_keys(spec) - {crasher}  # those in flight alongside it ran normally
+        before = {r.key: r for r in rows}
+    again = run_sweep(spec, db, workers=2, run_fn=standin.crashing_run, progress=False)
+    assert (again.skipped, again.ran) == (6, 0)  # the crasher does not stop a resumption: nothing is left to run
+    retried = run_sweep(spec, db, workers=2, run_fn=standin.crashing_run, retry_errors=True, progress=False)
+    assert (retried.skipped, retried.ran, retried.errors) == (5, 1, 1)
+    with ResultStore(db) as store:
+        rows = store.rows()
+        assert len(rows) == 6 and all(before[r.key] == r for r in rows if r.key != crasher)
+        assert [r.key for r in rows if r.status is Status.ERROR] == [crasher]
+
+
+def test_a_job_that_kills_its_dask_worker_is_stored_as_an_error(tmp_path: Path) -> None:
+    import dask
+    from distributed import LocalCluster
+
+    db = tmp_path / "r.db"
+    spec = SweepSpec(("demo",), (3, 4, 5), (Strategy("static", "static"),), sources={"demo": str(standin.DEMO)})
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
+            LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        summary = run_sweep(spec, db, scheduler_address=cluster.scheduler_address, run_fn=standin.crashing_run,
+                            progress=False)
+    assert (summary.ran, summary.ok, summary.errors) == (3, 2, 1)
+    with ResultStore(db) as store:
+        (error,) = store.rows(Status.ERROR)
+    assert error.seed == standin.CRASH_SEED
+    assert error.error and error.error.startswith("worker process died") and "KilledWorker" in error.error
+
+
 def test_sweep_on_dask_stopped_half_way_and_resumed(tmp_path: Path, small_spec: SweepSpec) -> None:
     from distributed import LocalCluster
 
