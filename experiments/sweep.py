@@ -345,7 +345,7 @@ def _alone_child(conn: Any, run_fn: RunFn, job: Job) -> None:
     conn.close()
 
 
-def _alone(run_fn: RunFn, job: Job, ctx: multiprocessing.context.BaseContext) -> Outcome:
+def _alone(run_fn: RunFn, job: Job, ctx: Any) -> Outcome:  # a multiprocessing context (spawn or forkserver)
     """Run one job alone in a fresh worker process; if the process dies, an ``error`` outcome that says so."""
     start = time.perf_counter()
     receiver, sender = ctx.Pipe(duplex=False)
@@ -410,11 +410,11 @@ def _pool_pass(run_fn: RunFn, queue: deque[Job], workers: int, ctx: multiprocess
             started: list[Job] = []
             not_started: list[Job] = []
             for fut, (job, mark) in pending.items():  # in the order submitted
-                exc = fut.exception(timeout=0) if fut.done() and not fut.cancelled() else BrokenProcessPool()
-                if exc is None:
+                error = fut.exception(timeout=0) if fut.done() and not fut.cancelled() else BrokenProcessPool()
+                if error is None:
                     yield fut.result()  # finished before the pool broke
-                elif not isinstance(exc, BrokenProcessPool):
-                    yield _failed(job, _exception_message(exc))
+                elif not isinstance(error, BrokenProcessPool):
+                    yield _failed(job, _exception_message(error))
                 else:
                     (started if mark.exists() else not_started).append(job)
             pending.clear()

@@ -98,7 +98,8 @@ class PddlTaskType(TaskType):
         if ctx.strategy.suspension == "static":
             return self.static_suspension(ctx)
         world, goal, branch = self.suspension_inputs(ctx)
-        outcome = self._plan(ctx, world, goal, [], Purpose.GEN_SUSP, label=branch.label)
+        outcome = self._plan(ctx, world, goal, self.suspension_facts(ctx, world), Purpose.GEN_SUSP,
+                             label=branch.label)
         if isinstance(outcome, StagePlan):
             return outcome
         why = {PlanStatus.UNSOLVABLE: "suspension goal unsolvable", PlanStatus.TIMEOUT: "planner timed out"}
@@ -140,12 +141,22 @@ class PddlTaskType(TaskType):
             goal = [tuple(g) for g in self.hooks["suspension_goal"](ctx, world, goal)]
         return world, goal, branch
 
+    def suspension_facts(self, ctx: TaskContext, world: WorldState) -> list[Literal]:
+        """genSusp's extra init facts: the request's and ``task.py``'s (e.g. carry_object's
+        door-free passages), as for upTsk, but not Alg. 3's ``suspended_facts``."""
+        b = Bindings(ctx.args, world)
+        extra = b.literals(self.spec.facts)
+        if "extra_facts" in self.hooks:
+            extra += [tuple(f) for f in self.hooks["extra_facts"](ctx, world)]
+        return extra
+
     def planning_problem(self, ctx: TaskContext, purpose: Purpose) -> PddlText:
         """The PDDL problem the planned strategy solves for ``purpose`` in this context."""
         if purpose is Purpose.UP_TSK:
             world, goal, extra = self.update_inputs(ctx)
         else:
-            (world, goal, _), extra = self.suspension_inputs(ctx), []
+            world, goal, _ = self.suspension_inputs(ctx)
+            extra = self.suspension_facts(ctx, world)
         return self.problem_text(ctx, world, goal, extra)[0]
 
     # -- strategies -------------------------------------------------------------------

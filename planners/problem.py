@@ -108,15 +108,22 @@ def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float)
     """Seconds between every ordered pair of places; ``inf`` when the motion model says unreachable.
 
     Without a motion model (or a pose) the declared ``travel_s`` is used, never zero.
+    Pairs joined by a ``door_between`` fact are timed with the motion model's optional
+    ``estimate_ignoring_doors`` (``robot.planner.MotionEstimator`` has it).
     """
     places = sorted(n for n, t in world.objects.items() if t == PLACE_TYPE)
+    # places joined by a door the domain models: the plan decides whether the door is open, so
+    # their travel time is the geometry's with the door open (if the motion model can say it)
+    through_door = {(f[2], f[3]) for f in world.matching("door_between") if len(f) == 4}
+    ignoring_doors = getattr(motion, "estimate_ignoring_doors", None)
     out: dict[tuple[str, str], float] = {}
     for a in places:
         for b in places:
             if a == b:
                 continue
             if motion is not None and a in world.poses and b in world.poses:
-                out[a, b] = float(motion.estimate(world.poses[a], world.poses[b]).time_s)
+                estimate = ignoring_doors if (a, b) in through_door and ignoring_doors else motion.estimate
+                out[a, b] = float(estimate(world.poses[a], world.poses[b]).time_s)
             else:
                 out[a, b] = float(travel_s)
     return out

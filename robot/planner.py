@@ -211,12 +211,24 @@ class MotionEstimator:
     :data:`tasker.world.UNREACHABLE`: infinite time, never zero.
     """
 
-    def __init__(self, planner: BasePlanner, limits: DriveLimits) -> None:
+    def __init__(self, planner: BasePlanner, limits: DriveLimits, open_planner: BasePlanner | None = None) -> None:
         self.planner = planner
         self.limits = limits
+        self.open_planner = open_planner
 
     def estimate(self, start: Pose, goal: Pose) -> MotionEstimate:
-        path = self.planner.plan((start[0], start[1]), (goal[0], goal[1]))
+        return self._estimate(self.planner, start, goal)
+
+    def estimate_ignoring_doors(self, start: Pose, goal: Pose) -> MotionEstimate:
+        """As :meth:`estimate` with every door open and nobody in the way.
+
+        A task domain that models doors (``door_between``, ``open``) needs the geometry
+        behind a closed door: whether the door is open is the plan's business.
+        """
+        return self._estimate(self.open_planner or self.planner, start, goal)
+
+    def _estimate(self, planner: BasePlanner, start: Pose, goal: Pose) -> MotionEstimate:
+        path = planner.plan((start[0], start[1]), (goal[0], goal[1]))
         if path is None:
             return UNREACHABLE
         pts = list(path)
@@ -233,4 +245,14 @@ def motion_model(spec: WorldSpec, seed: int = 1, people: bool = True) -> MotionE
     if people:
         for p in spec.people.values():
             scene.set_person(p.name, p.pose[0], p.pose[1], p.posture)
-    return MotionEstimator(BasePlanner(spec, scene, seed=seed), DriveLimits.of(spec.robot))
+    return MotionEstimator(BasePlanner(spec, scene, seed=seed), DriveLimits.of(spec.robot),
+                           open_planner(spec, scene.radius, seed))
+
+
+def open_planner(spec: WorldSpec, radius: float, seed: int = 1, milestones: int | None = None) -> BasePlanner:
+    """A planner over the same roadmap with every door open and no people (see
+    :meth:`MotionEstimator.estimate_ignoring_doors`)."""
+    scene = Scene(spec, radius)
+    for name in spec.doors:
+        scene.set_door(name, True)
+    return BasePlanner(spec, scene, seed=seed, milestones=milestones)

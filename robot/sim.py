@@ -25,7 +25,7 @@ from pathlib import Path
 from robot.control import STOP
 from robot.mjworld import TIMESTEP, MjApartment
 from robot.people import People
-from robot.planner import BasePlanner, DriveLimits, MotionEstimator
+from robot.planner import BasePlanner, DriveLimits, MotionEstimator, open_planner
 from robot.scene import Scene
 from robot.skills import SKILLS, Skill
 from robot.spec import WorldSpec, load_world
@@ -56,7 +56,7 @@ class Simulation:
         self.people = People(self.spec.people.values())
         self.planner = BasePlanner(self.spec, self.scene, seed=seed, milestones=milestones)
         self.limits = DriveLimits.of(self.spec.robot)
-        self.motion = MotionEstimator(self.planner, self.limits)
+        self.motion = MotionEstimator(self.planner, self.limits, open_planner(self.spec, radius, seed, milestones))
         self.mj = MjApartment(self.spec)
         self.time = 0.0
         self.facts: set[Fact] = set(self.spec.facts)
