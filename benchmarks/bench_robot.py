@@ -26,7 +26,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from robot.planner import BasePlanner, DriveLimits, MotionEstimator  # noqa: E402
-from robot.roadmap import path_length  # noqa: E402
+from robot.roadmap import ompl_setup, path_length  # noqa: E402
 from robot.scene import Scene  # noqa: E402
 from robot.sim import Simulation  # noqa: E402
 from robot.spec import load_world  # noqa: E402
@@ -41,20 +41,10 @@ class FreshRRTConnect:
         self.scene = scene
 
     def plan(self, a: tuple[float, float], b: tuple[float, float]) -> list[tuple[float, float]] | None:
-        from ompl import base as ob
         from ompl import geometric as og
 
-        sc = self.scene
-        space = ob.RealVectorStateSpace(2)
-        bounds = ob.RealVectorBounds(2)
-        bounds.setLow(0, sc.xmin)
-        bounds.setHigh(0, sc.xmax)
-        bounds.setLow(1, sc.ymin)
-        bounds.setHigh(1, sc.ymax)
-        space.setBounds(bounds)
-        setup = og.SimpleSetup(space)
-        setup.setStateValidityChecker(lambda s: sc.static_free(s[0], s[1]))
-        setup.getSpaceInformation().setStateValidityCheckingResolution(0.005)  # ~7 cm, as in the probes
+        setup = ompl_setup(self.scene, 0.005)  # ~7 cm, as in the probes; the same checker as ours
+        space = setup.getStateSpace()
         setup.setPlanner(og.RRTConnect(setup.getSpaceInformation()))
         s, g = space.allocState(), space.allocState()
         s[0], s[1], g[0], g[1] = a[0], a[1], b[0], b[1]

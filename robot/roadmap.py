@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -46,14 +47,14 @@ class RoadmapStats:
     dropped_edges: int
 
 
-def _grow_with_ompl(scene: Scene, seed: int, milestones: int) -> tuple[np.ndarray, list[tuple[int, int]]]:
-    """Grow a PRM with OMPL and return its vertices ``(N, 2)`` and undirected edges."""
+def ompl_setup(scene: Scene, resolution: float) -> Any:
+    """An OMPL ``SimpleSetup`` for the base in R² over ``scene``'s static layer (walls, furniture).
+
+    ``resolution`` is OMPL's validity-checking resolution, a fraction of the space's extent.
+    """
     from ompl import base as ob
     from ompl import geometric as og
-    from ompl import util as ou
 
-    ou.setLogLevel(ou.LOG_NONE)  # setSeed complains if RNGs already exist; the reseed still works
-    ou.RNG.setSeed(seed)
     space = ob.RealVectorStateSpace(2)
     bounds = ob.RealVectorBounds(2)
     bounds.setLow(0, scene.xmin)
@@ -62,9 +63,21 @@ def _grow_with_ompl(scene: Scene, seed: int, milestones: int) -> tuple[np.ndarra
     bounds.setHigh(1, scene.ymax)
     space.setBounds(bounds)
     setup = og.SimpleSetup(space)
-    si = setup.getSpaceInformation()
     setup.setStateValidityChecker(lambda s: scene.static_free(s[0], s[1]))
-    si.setStateValidityCheckingResolution(0.01)  # coarse: every edge is re-checked exactly afterwards
+    setup.getSpaceInformation().setStateValidityCheckingResolution(resolution)
+    return setup
+
+
+def _grow_with_ompl(scene: Scene, seed: int, milestones: int) -> tuple[np.ndarray, list[tuple[int, int]]]:
+    """Grow a PRM with OMPL and return its vertices ``(N, 2)`` and undirected edges."""
+    from ompl import base as ob
+    from ompl import geometric as og
+    from ompl import util as ou
+
+    ou.setLogLevel(ou.LOG_NONE)  # setSeed complains if RNGs already exist; the reseed still works
+    ou.RNG.setSeed(seed)
+    setup = ompl_setup(scene, 0.01)  # coarse: every edge is re-checked exactly afterwards
+    si = setup.getSpaceInformation()
     prm = og.PRM(si)
     setup.setPlanner(prm)
     setup.setup()
@@ -75,7 +88,7 @@ def _grow_with_ompl(scene: Scene, seed: int, milestones: int) -> tuple[np.ndarra
     verts = np.array([[data.getVertex(i).getState()[0], data.getVertex(i).getState()[1]] for i in range(n)])
     edges = [(i, int(j)) for i in range(n) for j in data.getEdges(i) if i < j]
     ou.setLogLevel(ou.LOG_WARN)
-    del prm, setup, si, data, space
+    del prm, setup, si, data
     return verts.reshape(-1, 2), edges
 
 
