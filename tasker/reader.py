@@ -23,6 +23,7 @@ import json
 import math
 import re
 import tomllib
+import warnings
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
@@ -39,15 +40,33 @@ _TOML_POS = re.compile(r"\(at line (\d+), column (\d+)\)")
 
 
 class InputError(TaskerError, ValueError):
-    """A user's file is malformed.  ``str()`` is ``file:line: field: message``."""
+    """A user's file is malformed.  ``str()`` is ``file:line: field: message``.
 
-    def __init__(self, file: str | Path, message: str, *, line: int | None = None, field: str = "") -> None:
+    ``InputError(text)`` with a single argument is a whole message (the older subclasses
+    :class:`~experiments.scenario.ScenarioError` and :class:`~robot.spec.WorldFileError`
+    were raised that way, and still may be).
+    """
+
+    def __init__(self, file: str | Path, message: str | None = None, *, line: int | None = None,
+                 field: str = "") -> None:
+        if message is None:
+            self.file, self.line, self.field, self.message = "", None, "", str(file)
+            super().__init__(str(file))
+            return
         self.file = str(file)
         self.line = line
         self.field = field
         self.message = message
-        where = f"{self.file}:{line}" if line else self.file
-        super().__init__(f"{where}: {field}: {message}" if field else f"{where}: {message}")
+        super().__init__(_where(self.file, line, field, message))
+
+
+class InputWarning(UserWarning):
+    """A user's file is accepted but probably not what was meant (a request after the horizon)."""
+
+
+def _where(file: str, line: int | None, field: str, message: str) -> str:
+    where = f"{file}:{line}" if line else file
+    return f"{where}: {field}: {message}" if field else f"{where}: {message}"
 
 
 def suggest(name: str, known: Iterable[str]) -> str:
@@ -105,12 +124,14 @@ class _LineIndex:
 class Table:
     """One table of a file, read strictly.  Keys asked for are remembered for :meth:`done`."""
 
-    def __init__(self, file: str | Path, data: Any, path: PathKey = (), index: _LineIndex | None = None) -> None:
+    def __init__(self, file: str | Path, data: Any, path: PathKey = (), index: _LineIndex | None = None,
+                 error_class: type[InputError] = InputError) -> None:
         self.file = str(file)
         self.path = path
         self._index = index
+        self.error_class = error_class
         if not isinstance(data, dict):
-            raise InputError(self.file, f"expected a table, got {_kind(data)}", line=self.line(),
+            raise error_class(self.file, f"expected a table, got {_kind(data)}", line=self.line(),
                              field=self.field() or "top level")
         self.data: dict[str, Any] = data
         self.used: set[str] = set()
@@ -129,7 +150,17 @@ class Table:
         return self._index.line((*self.path, *(() if key is None else (key,))))
 
     def error(self, key: str | int | None, message: str) -> InputError:
-        return InputError(self.file, message, line=self.line(key), field=self.field(key))
+        return self.error_class(self.file, message, line=self.line(key), field=self.field(key))
+
+    def warn(self, key: str | int | None, message: str) -> str:
+        """Emit an :class:`InputWarning` located like :meth:`error`; returns its text."""
+        text = _where(self.file, self.line(key), self.field(key), message)
+        warnings.warn(InputWarning(text), stacklevel=2)
+        return text
+
+    def at(self, key: str | int, data: Any) -> Table:
+        """A table at ``key`` below this one whose value is ``data`` (e.g. an element of an array)."""
+        return Table(self.file, data, (*self.path, key), self._index, self.error_class)
 
     # -- access ---------------------------------------------------------------------
     def __contains__(self, key: str) -> bool:
@@ -178,7 +209,7 @@ class Table:
     def table(self, key: str, default: Any = _MISSING) -> Table:
         """A sub-table; a missing optional one reads as empty."""
         value = self.raw(key, default)
-        return Table(self.file, {} if value is None else value, (*self.path, key), self._index)
+        return Table(self.file, {} if value is None else value, (*self.path, key), self._index, self.error_class)
 
     def tables(self, key: str, default: Any = _MISSING) -> list[Table]:
         """An array of tables (``[[key]]``)."""
@@ -187,7 +218,33 @@ class Table:
             return []
         if not isinstance(value, list):
             raise self.error(key, f"expected an array of tables ([[{key}]]), got {_show(value)}")
-        return [Table(self.file, v, (*self.path, key, i), self._index) for i, v in enumerate(value)]
+        return [Table(self.file, v, (*self.path, key, i), self._index, self.error_class) for i, v in enumerate(value)]
+
+    def array(self, key: str, default: Any = _MISSING, *, nonempty: bool = False) -> Any:
+        """A list (``[]`` or ``default`` when absent)."""
+        value = self.raw(key, default)
+        if key not in self.data:
+            return value
+        if not isinstance(value, list):
+            raise self.error(key, f"expected an array, got {_show(value)}")
+        if nonempty and not value:
+            raise self.error(key, "expected a non-empty array")
+        return value
+
+    def numbers(self, key: str, n: int, shape: str, default: Any = _MISSING) -> Any:
+        """``n`` finite numbers, e.g. a pose ``[x, y, yaw]`` (``shape`` says which)."""
+        value = self.raw(key, default)
+        if key not in self.data:
+            return value
+        return check_numbers(self, key, value, n, shape)
+
+    def named(self, key: str) -> list[tuple[str, Table]]:
+        """A table of named tables (``[people.NAME]``): ``(name, table)`` pairs, empty when absent."""
+        t = self.table(key, {})
+        out = []
+        for name, value in t.items():
+            out.append((name, t.at(name, value)))
+        return out
 
     def items(self) -> list[tuple[str, Any]]:
         """Every key, marked as used (for tables whose keys are names: people, places)."""
@@ -231,6 +288,17 @@ def check_number(t: Table, key: str | int, value: Any, *, min: float | None = No
     return value if integer else float(value)
 
 
+def check_numbers(t: Table, key: str | int, value: Any, n: int, shape: str) -> tuple[float, ...]:
+    """``n`` finite numbers (``shape`` names them in the error, e.g. ``[x, y, yaw]``)."""
+    if not isinstance(value, list) or len(value) != n or any(
+            isinstance(v, bool) or not isinstance(v, int | float) for v in value):
+        raise t.error(key, f"expected {shape}, got {_show(value)}")
+    for v in value:
+        if not math.isfinite(v):
+            raise t.error(key, f"expected {shape} of finite numbers, got {value!r}")
+    return tuple(float(v) for v in value)
+
+
 def check_name(t: Table, key: str | int, value: str, known: Iterable[str], what: str) -> None:
     """``value`` must be one of ``known`` (e.g. a person of the world)."""
     known = sorted(set(known))
@@ -255,27 +323,27 @@ def _show(value: Any) -> str:
     return f"{_kind(value)} {value!r}"
 
 
-def read_text(path: str | Path) -> str:
+def read_text(path: str | Path, error_class: type[InputError] = InputError) -> str:
     """A user's file as text: missing, binary and non-UTF-8 files are clean errors."""
     p = Path(path)
     try:
         data = p.read_bytes()
     except FileNotFoundError:
-        raise InputError(p, "no such file") from None
+        raise error_class(p, "no such file") from None
     except IsADirectoryError:
-        raise InputError(p, "is a directory, expected a file") from None
+        raise error_class(p, "is a directory, expected a file") from None
     except OSError as exc:
-        raise InputError(p, f"cannot read: {exc.strerror or exc}") from None
+        raise error_class(p, f"cannot read: {exc.strerror or exc}") from None
     if b"\x00" in data:
-        raise InputError(p, "is a binary file, expected UTF-8 text")
+        raise error_class(p, "is a binary file, expected UTF-8 text")
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
-        raise InputError(p, f"is not UTF-8 text (byte {data[exc.start]:#04x})", line=line) from None
+        raise error_class(p, f"is not UTF-8 text (byte {data[exc.start]:#04x})", line=line) from None
 
 
-def loads(text: str, file: str | Path = "<string>") -> Table:
+def loads(text: str, file: str | Path = "<string>", error_class: type[InputError] = InputError) -> Table:
     """Parse TOML text into a strict :class:`Table` (syntax errors name the line)."""
     try:
         data = tomllib.loads(text)
@@ -283,17 +351,20 @@ def loads(text: str, file: str | Path = "<string>") -> Table:
         m = _TOML_POS.search(str(exc))
         msg = _TOML_POS.sub("", str(exc)).strip()
         line = int(m.group(1)) if m else (text.count("\n") + 1 if "end of document" in msg else None)
-        raise InputError(file, f"not valid TOML: {msg}", line=line) from None
-    return Table(file, data, (), _LineIndex(text))
+        raise error_class(file, f"not valid TOML: {msg}", line=line) from None
+    return Table(file, data, (), _LineIndex(text), error_class)
 
 
-def load(path: str | Path) -> Table:
-    """Read a user's TOML (or ``.json``) file into a strict :class:`Table`."""
-    text = read_text(path)
+def load(path: str | Path, error_class: type[InputError] = InputError) -> Table:
+    """Read a user's TOML (or ``.json``) file into a strict :class:`Table`.
+
+    ``error_class`` (a subclass of :class:`InputError`) is what every fault of this file raises.
+    """
+    text = read_text(path, error_class)
     if str(path).endswith(".json"):
         try:
             data = json.loads(text, parse_constant=lambda c: float(c))
         except json.JSONDecodeError as exc:
-            raise InputError(path, f"not valid JSON: {exc.msg}", line=exc.lineno) from None
-        return Table(path, data)
-    return loads(text, path)
+            raise error_class(path, f"not valid JSON: {exc.msg}", line=exc.lineno) from None
+        return Table(path, data, (), None, error_class)
+    return loads(text, path, error_class)
