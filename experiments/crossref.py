@@ -78,6 +78,14 @@ def arg_types(task: TaskType) -> dict[str, set[str]]:
     return out
 
 
+def _most_specific(domain: Any, wanted: set[str]) -> set[str]:
+    """``{"locatable", "person"}`` -> ``{"person"}``: drop a type that another wanted type already implies."""
+    types: Mapping[str, set[str]] = getattr(domain, "types", {}) or {}
+    out = {w for w in wanted if w}
+    out = {w for w in out if not any(w != o and w in types.get(o, ()) for o in out)}
+    return out or {""}
+
+
 class _Checker:
     """Checks one scenario; collects its warnings."""
 
@@ -151,8 +159,9 @@ class _Checker:
         wanted = types.get(name)
         if wanted is None:
             return
-        what = f"{'default of ' if default else ''}argument {name!r} of task type {task.name!r}"
         domain = getattr(task, "domain", None)
+        wanted = _most_specific(domain, wanted)
+        what = f"{'default of ' if default else ''}argument {name!r} of task type {task.name!r}"
         problem = None
         if not isinstance(value, str):
             problem = f"expected the name of an object of the world (the {what}), got {value!r}"
@@ -251,7 +260,7 @@ class _Checker:
                 self.warn(located(self.top, later), "task",
                           f"the same request as d{i + 1} (requests[{earlier.origin[1]}], t={earlier.t:g}: "
                           f"{earlier.fields['task']} {args_i}) while d{i + 1} may still run: two agents would "
-                          "pursue one goal and preempt each other; terminate d{0} first or drop one".format(i + 1))
+                          f"pursue one goal and preempt each other; terminate d{i + 1} first or drop one")
                 break
 
 

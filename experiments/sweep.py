@@ -322,13 +322,17 @@ def _exception_message(exc: BaseException) -> str:
 
 
 def _alive(pid: int) -> bool:
+    """Is ``pid`` running (a zombie, killed but not yet reaped by its parent, is not)?"""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
     except PermissionError:
         return True
-    return True
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):  # no /proc (not Linux): the signal test alone
+        return True
 
 
 def die_with_parent(driver: int) -> None:
