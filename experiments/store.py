@@ -139,8 +139,12 @@ class ResultStore:
             if not self.path.is_file():
                 raise StoreError(f"{self.path}: no such results database")
             try:
-                # mode=ro: a reader never creates, migrates or journals anything
-                self._db = sqlite3.connect(f"{self.path.resolve().as_uri()}?mode=ro", uri=True, timeout=30.0,
+                # mode=ro: a reader never creates, migrates or journals anything.  Without a live
+                # writer (no -wal file: a sweep removes it when it closes) the file is opened
+                # immutable, else SQLite would leave -wal and -shm files beside it.
+                live = Path(f"{self.path}-wal").exists()
+                flags = "mode=ro" if live else "mode=ro&immutable=1"
+                self._db = sqlite3.connect(f"{self.path.resolve().as_uri()}?{flags}", uri=True, timeout=30.0,
                                            isolation_level=None)
                 self._check_schema(must_exist=True)
             except sqlite3.DatabaseError as exc:
