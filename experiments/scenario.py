@@ -155,7 +155,8 @@ def load(path: str | Path, *, check: bool = True) -> RobotScenario:
         task_exe_rate=fields.rate(s, "task_exe_rate", 10.0), sp_up_rate=fields.rate(s, "sp_up_rate", 1.0),
         update=str(s.string("update", "planned", choices=STRATEGIES)),
         suspension=str(s.string("suspension", "planned", choices=STRATEGIES)), strategies=strategies,
-        seed=int(top.number("seed", 1, integer=True)), horizon=float(s.number("horizon", 1800.0, positive=True)),
+        seed=int(top.number("seed", 1, integer=True, min=0, max=reader.MAX_SEED)),
+        horizon=float(s.number("horizon", 1800.0, positive=True)),
         people=people, objects=objects, policy=str(s.string("policy", "strict", choices=POLICIES)),
     )
     s.done()

@@ -233,18 +233,21 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
                 scenarios.resolve(sc)
             except reader.InputError as exc:
                 raise at.error(i, exc.message) from None
-    start = int(top.number("seed_start", 0, integer=True))
+    start = int(top.number("seed_start", 0, integer=True, min=0, max=reader.MAX_SEED))
     seeds_raw = top.raw("seeds")
     if isinstance(seeds_raw, int) and not isinstance(seeds_raw, bool):
         if seeds_raw < 1:
             raise top.error("seeds", f"expected a positive count, got {seeds_raw}")
         if seeds_raw > limit:
             raise top.error("seeds", f"{seeds_raw} seeds is more than the {limit} jobs a sweep may have")
+        if start + seeds_raw - 1 > reader.MAX_SEED:
+            raise top.error("seeds", f"seeds {start}..{start + seeds_raw - 1} go past the largest seed, "
+                                     f"{reader.MAX_SEED}")
         seeds = tuple(range(start, start + seeds_raw))
     elif isinstance(seeds_raw, list) and seeds_raw:
         st = top.at("seeds", {})
         for i, s in enumerate(seeds_raw):
-            reader.check_number(st, i, s, integer=True)
+            reader.check_number(st, i, s, integer=True, min=0, max=reader.MAX_SEED)
         if "seed_start" in top:
             raise top.error("seed_start", "only with a count of seeds, not a list")
         dup = sorted({s for s in seeds_raw if seeds_raw.count(s) > 1})

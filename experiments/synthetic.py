@@ -114,7 +114,7 @@ def load(path: str | Path) -> SyntheticScenario:
         rates=Rates(fields.rate(settings, "rep_rate", 1.0), fields.rate(settings, "task_exe_rate", 10.0),
                     fields.rate(settings, "sp_up_rate", 1.0)),
         jitter=float(settings.number("jitter", 0.0, min=0, max=1)),
-        seed=int(top.number("seed", 0, integer=True)),
+        seed=int(top.number("seed", 0, integer=True, min=0, max=reader.MAX_SEED)),
         horizon=float(settings.number("horizon", 24 * 3600.0, positive=True)),
     )
     settings.done()

@@ -250,6 +250,18 @@ def _check_geometry(spec: WorldSpec, top: Table) -> None:
     def check(t: Table, key: str | int, x: float, y: float) -> None:
         check_point(spec, t, key, x, y)
 
+    (bx0, by0), (bx1, by1) = spec.bounds
+    for what, boxes in (("rooms", spec.rooms), ("doors", {n: d.box for n, d in spec.doors.items()}),
+                        ("furniture", {o.name: o.box for o in spec.obstacles if o.kind == "furniture"})):
+        t = top.table(what, {})
+        for n, (x0, y0, x1, y1) in boxes.items():
+            if x0 < bx0 or y0 < by0 or x1 > bx1 or y1 > by1:
+                key: str | int = n
+                owner = t
+                if what != "rooms":
+                    owner, key = t.at(n, t.data[n]), "box"
+                raise owner.error(key, f"{[x0, y0, x1, y1]} reaches outside the world's bounds "
+                                       f"[[{bx0:g}, {by0:g}], [{bx1:g}, {by1:g}]]")
     places_t = top.table("places", {})
     for n, (x, y, _) in spec.places.items():
         check(places_t, n, x, y)

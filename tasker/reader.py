@@ -32,6 +32,9 @@ from tasker.errors import TaskerError
 
 PathKey = tuple[str | int, ...]
 
+MAX_SEED = 2**32 - 1
+"""Seeds are integers in ``[0, MAX_SEED]``: OMPL's random generator takes no other."""
+
 _MISSING: Any = object()
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
 _KEY = r"""(?:[A-Za-z0-9_\-]+|"[^"]*"|'[^']*')"""

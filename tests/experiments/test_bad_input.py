@@ -74,6 +74,7 @@ ROBOT_CASES = [
     # wrong types
     ('t = 0.0', 't = "soon"', "requests[0].t", "expected a number"),
     ('seed = 1', 'seed = 1.5', "seed", "expected an integer"),
+    ('seed = 1', 'seed = -1', "seed", ">= 0"),
     ('horizon = 600.0', 'horizon = "long"', "settings.horizon", "expected a number"),
     ('horizon = 600.0', 'horizon = true', "settings.horizon", "expected a number"),
     ('args = { person = "peter" }', 'args = ["peter"]', "requests[1].args", "expected a table"),
@@ -304,6 +305,9 @@ WORLD = 'bounds = [[0, 0], [6, 6]]\nwalls = [[0, 2.9, 2, 3.1]]\n[robot]\npose = 
     (WORLD.replace("bounds", "bound"), "bound", "did you mean 'bounds'"),
     (WORLD + '[furniture.sofa]\nbox = [1, 1, 2, 2]\nheigth = 1\n', "furniture.sofa.heigth", "did you mean 'height'"),
     (WORLD + '[furniture.sofa]\nbox = [1, 1, 2, 2]\nheight = -1\n', "furniture.sofa.height", "> 0"),
+    (WORLD + '[furniture.sofa]\nbox = [5, 5, 7, 7]\n', "furniture.sofa.box", "outside the world's bounds"),
+    (WORLD + '[rooms]\nhall = [-1, 0, 3, 3]\n', "rooms.hall", "outside the world's bounds"),
+    (WORLD + '[doors.d]\nbox = [5, 5, 7, 6]\n', "doors.d.box", "outside the world's bounds"),
 ])
 def test_bad_world_field_is_named(tmp_path: Path, text: str, field: str, fragment: str) -> None:
     _fails(_write(tmp_path, text, "w.toml"), load_world, field, fragment, WorldFileError)
@@ -329,6 +333,8 @@ def test_a_scenario_on_a_bad_world_names_the_world_file(tmp_path: Path) -> None:
     ('scenarios = ["paper"]\nseeds = 100000000\nstrategies = ["default"]', "seeds", "more than"),
     ('scenarios = ["paper", "carry"]\nseeds = 60000\nstrategies = ["default"]', "seeds", "jobs, more than"),
     ('scenarios = ["paper"]\nseeds = 2.5\nstrategies = ["default"]', "seeds", "expected a count"),
+    ('scenarios = ["paper"]\nseeds = [1, -2]\nstrategies = ["default"]', "seeds[1]", ">= 0"),
+    ('scenarios = ["paper"]\nseeds = 2\nseed_start = 4294967295\nstrategies = ["default"]', "seeds", "largest seed"),
     ('scenarios = ["paper"]\nseeds = [1, nan]\nstrategies = ["default"]', "seeds", "finite"),
     ('scenarios = ["paper"]\nseeds = 2\nseed_start = -inf\nstrategies = ["default"]', "seed_start", "finite"),
     ('scenarios = ["paper"]\nseeds = 2\nstrategies = [{scheduler = "alg"}]', "strategies[0]",

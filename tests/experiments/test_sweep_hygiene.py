@@ -158,7 +158,7 @@ def test_dask_sweep_with_a_relative_spec_path_and_workers_started_elsewhere(
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     monkeypatch.chdir(elsewhere)  # the workers start here, where no scenarios/ folder exists
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
         monkeypatch.chdir(d)  # the driver reads the spec by a relative path
         spec = load_spec("spec.toml")
         relative = [Job("rel", "scenarios/demo.toml", 7, Strategy("static", "static"))]
