@@ -21,7 +21,7 @@ from tasker.agent import Rates
 from tasker.errors import TaskerError
 from tasker.harmoniser import Mode
 from tasker.loop import SimulationLoop
-from tasker.reader import Table
+from tasker.reader import Table, check_name
 from tasker.stage import Stage, StageKind
 from tasker.store import TaskStore
 from tasker.synthetic import SyntheticTask, TimedExecutor
@@ -88,10 +88,14 @@ def load(path: str | Path) -> SyntheticScenario:
     tasks_f = top.table("tasks")
     tasks = []
     for name, t in [(n, tasks_f.at(n, v)) for n, v in tasks_f.items()]:
+        stages = _stages(t, "stages")
         susp_f = t.table("suspension", {})
+        actions_of = sorted({st.action for st in stages})
+        for action in susp_f.keys():  # keyed by the action of the interrupted stage (eq. 47)
+            check_name(susp_f, action, action, actions_of, f"action in the stages of {name!r}")
         suspension = {action: _stages(susp_f, action) for action in susp_f.keys()}
         tasks.append(SyntheticTask(
-            name, _stages(t, "stages"),
+            name, stages,
             weight=float(t.number("weight", 1.0, min=0)), speed=float(t.number("speed", 1.0, positive=True)),
             site=_site(t) if "site" in t else None,
             suspension=suspension or None,

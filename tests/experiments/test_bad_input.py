@@ -267,6 +267,8 @@ SYN = standin.DEMO.read_text()
     ('site = [6.0, 2.0]\nstages', 'site = [6.0]\nstages', "tasks.guide_human.site", "expected [x, y]"),
     ('task = "guide_human"', 'task = "guide"', "requests[0].task", "did you mean 'guide_human'"),
     ('seed = 1', 'seed = "one"', "seed", "expected an integer"),
+    ('guide = [{ action = "ask_to_wait"', 'guid = [{ action = "ask_to_wait"', "tasks.guide_human.suspension.guid",
+     "did you mean 'guide'"),
     ('kind = "synthetic"', 'kind = "robot"', "world", "missing"),
 ])
 def test_bad_synthetic_scenario_field_is_named(tmp_path: Path, old: str, new: str, field: str, fragment: str) -> None:
