@@ -157,8 +157,10 @@ class Table:
 
     def warn(self, key: str | int | None, message: str) -> str:
         """Emit an :class:`InputWarning` located like :meth:`error`; returns its text."""
-        text = _where(self.file, self.line(key), self.field(key), message)
-        warnings.warn(InputWarning(text), stacklevel=2)
+        line = self.line(key)
+        text = _where(self.file, line, self.field(key), message)
+        # located at the user's file and line (not at the reader's code), so Python shows that line
+        warnings.warn_explicit(InputWarning(text), InputWarning, self.file, line or 0, module="tasker.reader")
         return text
 
     def at(self, key: str | int, data: Any) -> Table:
