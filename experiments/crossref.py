@@ -78,6 +78,23 @@ def arg_types(task: TaskType) -> dict[str, set[str]]:
     return out
 
 
+def validate_request(f: Table, task: TaskType, args: Mapping[str, Any]) -> dict[str, Any]:
+    """A request's (or change's) arguments checked by the task type, the fault located at ``f.args.NAME``."""
+    try:
+        return task.validate_args(args)
+    except TaskerError as exc:
+        msg = str(exc)
+        known = [a.name for a in task.arg_specs]
+        unknown = [k for k in args if k not in known]
+        at = f.table("args", {})
+        if unknown:
+            raise at.error(unknown[0], f"task type {task.name!r} has no argument {unknown[0]!r}"
+                                       f"{suggest(unknown[0], known)} (arguments: {', '.join(known) or 'none'})"
+                           ) from None
+        bad = next((n for n in known if repr(n) in msg), None)
+        raise (at.error(bad, msg) if bad else f.error("args", msg)) from None
+
+
 def _most_specific(domain: Any, wanted: set[str]) -> set[str]:
     """``{"locatable", "person"}`` -> ``{"person"}``: drop a type that another wanted type already implies."""
     types: Mapping[str, set[str]] = getattr(domain, "types", {}) or {}
@@ -196,18 +213,7 @@ class _Checker:
                 self.arg(f, task, name, value, types, default=True)
 
     def validate(self, f: Table, task: TaskType, args: Mapping[str, Any]) -> dict[str, Any]:
-        try:
-            return task.validate_args(args)
-        except TaskerError as exc:
-            msg = str(exc)
-            unknown = [k for k in args if k not in {a.name for a in task.arg_specs}]
-            if unknown:
-                known = [a.name for a in task.arg_specs]
-                raise f.table("args", {}).error(unknown[0], f"task type {task.name!r} has no argument "
-                                                            f"{unknown[0]!r}{suggest(unknown[0], known)} "
-                                                            f"(arguments: {', '.join(known) or 'none'})") from None
-            bad = next((a.name for a in task.arg_specs if repr(a.name) in msg), None)
-            raise (f.table("args", {}).error(bad, msg) if bad else f.error("args", msg)) from None
+        return validate_request(f, task, args)
 
     def actions(self) -> None:
         from robot.spec import POSTURES

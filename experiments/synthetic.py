@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 from experiments import fields
 from experiments.actions import TABLES, TimedAction, located, read_actions
+from experiments.crossref import validate_request
 from experiments.fields import MODES, ScenarioError
 from tasker import reader, schedulers
 from tasker.agent import Rates
@@ -126,8 +127,12 @@ def load(path: str | Path) -> SyntheticScenario:
     for a in actions:
         if a.t > scenario.horizon:
             located(top, a).warn("t", f"t={a.t:g} is after the horizon ({scenario.horizon:g} s): it never happens")
+    by_name = {t.name: t for t in tasks}
+    for a in actions:
+        if a.kind == "request":
+            validate_request(located(top, a), by_name[a.fields["task"]], a.fields["args"])
     try:
-        build(scenario, seed=scenario.seed)  # checks request arguments now, before any run
+        build(scenario, seed=scenario.seed)  # the rest (changes, the scheduler) now, before any run
     except TaskerError as exc:
         raise ScenarioError(str(p), f"{exc}") from None
     return scenario
