@@ -13,8 +13,10 @@ from collections.abc import Collection
 from dataclasses import dataclass, field
 from typing import Any
 
-from experiments.fields import MODES
+from experiments.fields import MODES, ScenarioError
 from tasker.reader import Table, check_name, suggest
+
+__all__ = ["TABLES", "WORLD_EVENT_KINDS", "ScenarioError", "TimedAction", "located", "read_actions"]
 
 WORLD_EVENT_KINDS = ("posture", "door", "add", "delete")
 

@@ -11,6 +11,11 @@ misspelled names.  Reading is strict by default:
 * :meth:`Table.done` refuses keys nobody asked for, listing the valid ones, so
   ``kindd = "blocking"`` or ``[shedule]`` cannot be silently ignored.
 
+Each reader of a file format passes its own subclass of :class:`InputError` as
+``error_class`` (``ScenarioError``, ``WorldFileError``, ``SpecError``), so callers can
+catch either.  What is valid but doubtful is an :class:`InputWarning`
+(:meth:`Table.warn`), located at the user's file and line.
+
 Line numbers come from a light index of the source text (table headers and ``key =``
 lines); for a key written inside an inline table the line of the enclosing key is named.
 Stdlib only, like the rest of :mod:`tasker`.
