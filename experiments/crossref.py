@@ -51,8 +51,9 @@ def arg_types(task: TaskType) -> dict[str, set[str]]:
     """For each argument a task type uses as a PDDL object, the types it must have (``""``: any object).
 
     Read from the literals of its ``task.toml`` (goal, facts, suspension ``when`` and
-    ``goal``) and the parameter types of the predicates in its domain; ``$at:name``
-    makes ``name`` an object of any type.  A task type without a PDDL domain gives ``{}``.
+    ``goal``) with the parameter types of the predicates in its domain, and from its
+    static stages with the parameter types of their PDDL actions; ``$at:name`` makes
+    ``name`` an object of any type.  A task type without a PDDL domain gives ``{}``.
     """
     spec, domain = getattr(task, "spec", None), getattr(task, "domain", None)
     predicates: Mapping[str, Sequence[str]] = getattr(domain, "predicates", {}) or {}
@@ -64,13 +65,27 @@ def arg_types(task: TaskType) -> dict[str, set[str]]:
         literals.extend(branch.when)
         literals.extend(branch.goal)
     out: dict[str, set[str]] = {}
+    model: Any = getattr(getattr(domain, "checked", None), "model", None)
+    templates = [*getattr(spec, "static_update", ())]
+    for branch in getattr(spec, "static_suspension", ()):
+        templates.extend(branch.stages)
+    for template in templates:  # static stages: the PDDL action's parameter types, by position
+        try:
+            params = [p.type.name if p.type.is_user_type() else "" for p in model.action(template.action).parameters]
+        except Exception:  # no such action, or not a unified-planning model: the planner's checks say so
+            continue
+        for i, a in enumerate(template.args):
+            if a.startswith("$at:") and a != "$at:robot":
+                out.setdefault(a[4:], set()).add("")
+            elif a.startswith("$") and a != "$robot" and i < len(params):
+                out.setdefault(a[1:], set()).add(params[i])
     for lit in literals:
         lit = tuple(lit[1:]) if lit and lit[0] == "not" else tuple(lit)
         if not lit:
             continue
         signature = predicates.get(lit[0])
         for i, a in enumerate(lit[1:]):
-            if a.startswith("$at:"):
+            if a.startswith("$at:") and a != "$at:robot":
                 out.setdefault(a[4:], set()).add("")
             elif a.startswith("$") and a != "$robot":
                 wanted = signature[i] if signature is not None and i < len(signature) else ""
