@@ -356,3 +356,56 @@ def test_bad_sweep_spec_field_is_named(tmp_path: Path, body: str, field: str, fr
 def test_a_non_utf8_spec_is_a_clean_error(tmp_path: Path) -> None:
     with pytest.raises(SpecError, match="not UTF-8"):
         load_spec(_write(tmp_path, b'name = "\xff"\n', "spec.toml"))
+
+
+# ----------------------------------------------------------------------------------------- typed arguments, generally
+
+def _typed_cases() -> list[tuple[str, str, str, str]]:
+    """(world, task, argument, PDDL type) for each typed argument of each bundled task type, in
+    each shipped world that has objects of every type the task's arguments need."""
+    from experiments.crossref import _most_specific, arg_types, world_objects
+    from planners.bundled import task_types
+
+    out = []
+    for world in ("paper", "flat"):
+        objects = world_objects(load_world(world))
+        for task in task_types():
+            domain = task.domain  # type: ignore[attr-defined]
+            typed = {a: _most_specific(domain, ts) for a, ts in arg_types(task).items()
+                     if a in {s.name for s in task.arg_specs}}
+            if all(any(all(domain.has_type(ty, w) for w in ts) for ty in objects.values()) for ts in typed.values()):
+                out.extend((world, task.name, a, sorted(ts)[0]) for a, ts in sorted(typed.items()) if ts != {""})
+    return out
+
+
+@pytest.mark.parametrize(("world", "task", "arg", "pddl_type"), _typed_cases())
+def test_every_typed_argument_must_name_a_world_object_of_its_type(tmp_path: Path, world: str, task: str, arg: str,
+                                                                   pddl_type: str) -> None:
+    """The general rule: an argument used as a PDDL object of type T names a world object of type T."""
+    from experiments.crossref import arg_types, world_objects
+    from planners.bundled import task_types
+
+    tt = next(t for t in task_types() if t.name == task)
+    objects = world_objects(load_world(world))
+    domain = tt.domain  # type: ignore[attr-defined]
+    args = {name: sorted(n for n, ty in objects.items() if all(domain.has_type(ty, w) for w in types))[0]
+            for name, types in arg_types(tt).items() if name in {a.name for a in tt.arg_specs}}
+    wrong = sorted(n for n, ty in objects.items() if not domain.has_type(ty, pddl_type))[0]
+
+    def scenario(value: str) -> Path:
+        given = {**args, arg: value}
+        text = (f'kind = "robot"\nworld = "{world}"\n[[requests]]\nt = 0.0\ntask = "{task}"\nargs = {{ '
+                + ", ".join(f'{k} = "{v}"' for k, v in given.items()) + " }\n")
+        return _write(tmp_path, text)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", InputWarning)
+        scenarios.load(scenario(args[arg]))  # the right type loads
+    _fails(scenario(wrong), scenarios.load, f"requests[0].args.{arg}", f"expected a {pddl_type}", ScenarioError)
+    _fails(scenario("nobody_here"), scenarios.load, f"requests[0].args.{arg}", "'nobody_here'", ScenarioError)
+
+
+def test_typed_cases_cover_every_bundled_task_type() -> None:
+    from planners.bundled import task_types
+
+    assert {c[1] for c in _typed_cases()} == {t.name for t in task_types()}
