@@ -152,8 +152,10 @@ class ResultStore:
             return
         if self.path.is_dir():
             raise StoreError(f"{self.path}: is a directory, expected a results database file")
-        if self.path.parent and not self.path.parent.exists():
+        try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise StoreError(f"{self.path}: cannot create its folder: {exc.strerror or exc}") from None
         try:
             # isolation_level=None: we issue BEGIN/COMMIT ourselves, one transaction per run
             self._db = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
