@@ -295,11 +295,11 @@ class DynamicAgent:
             return
         if self.core is None:
             raise ConfigError(f"agent {self.id}: a stage must run but no core agent was given")
-        self.core.begin(self.id, stage, now)
-        runner.running = True
+        runner.running = True  # before begin: a begin that raises still gets a guarded stop and its closing event
         if in_task:
             self.ctx.stage_started = now
         self._stage_event(now, "begin")
+        self.core.begin(self.id, stage, now)
         self.next_wake = _next_tick_of(now, self.rates.task_exe_rate)
 
     def _exe(self, now: float) -> None:
