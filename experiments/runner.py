@@ -170,6 +170,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         "date": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "tasker_version": tasker.__version__,
         "wall_time_s": round(wall, 3),
     }
+    reason = ""
     if error is None:
         metrics = _metrics(trace, calls, wall)
     else:
@@ -183,7 +184,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures and error is None)
     result = RunResult(record, metrics, trace, trajectory)
     if error is not None:
-        raise RunAborted(record["error"], result) from error
+        raise RunAborted(reason, result) from error
     return result
 
 
