@@ -5,7 +5,9 @@ gets the TIAGo simulation (:class:`robot.sim.Simulation`, both the world and the
 agent), the OMPL motion model, and the bundled PDDL task types; a synthetic one gets
 timed stages.  In ``out`` it writes ``trace.jsonl`` (reproducible byte for byte),
 ``run.json`` (the record: scenario, seed, settings, planner, host, date, version),
-``metrics.json`` and the pictures.
+``metrics.json`` and the pictures.  If the run raises, the trace so far, ``run.json``
+(with ``status: "aborted"`` and the ``error``) and ``metrics.json`` are still written,
+then :class:`tasker.errors.RunAborted` is raised carrying the partial :class:`RunResult`.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from experiments import synthetic
 from experiments.actions import TimedAction
 from tasker import schedulers
 from tasker.agent import Rates
+from tasker.errors import RunAborted
 from tasker.harmoniser import Mode
 from tasker.loop import SimulationLoop
 from tasker.requester import Requester
@@ -143,7 +146,11 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         spec_json = {"kind": "robot", **scn.to_json()}
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")
-    _run(loop, progress)
+    error: Exception | None = None
+    try:
+        _run(loop, progress)
+    except Exception as exc:  # the trace so far, run.json and metrics.json are still written, then it propagates
+        error = exc
     wall = time.perf_counter() - t0
     trace = loop.trace
     world_spec = None
@@ -163,10 +170,22 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         "date": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "tasker_version": tasker.__version__,
         "wall_time_s": round(wall, 3),
     }
-    metrics = _metrics(trace, calls, wall)
+    reason = ""
+    if error is None:
+        metrics = _metrics(trace, calls, wall)
+    else:
+        reason = error.reason if isinstance(error, RunAborted) else f"{type(error).__name__}: {error}"
+        record["status"], record["error"] = "aborted", reason
+        try:
+            metrics = _metrics(trace, calls, wall)
+        except Exception as exc:  # metrics of a cut trace may not compute: say so, keep the rest
+            metrics = {"error": f"metrics failed on the partial trace: {type(exc).__name__}: {exc}"}
     if out is not None:
-        _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures)
-    return RunResult(record, metrics, trace, trajectory)
+        _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures and error is None)
+    result = RunResult(record, metrics, trace, trajectory)
+    if error is not None:
+        raise RunAborted(reason, result) from error
+    return result
 
 
 def _run(loop: SimulationLoop, progress: bool) -> None:
