@@ -109,7 +109,7 @@ def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float)
 
     Without a motion model (or a pose) the declared ``travel_s`` is used, never zero.
     Pairs joined by a ``door_between`` fact are timed with the motion model's optional
-    ``estimate_ignoring_doors`` (``robot.planner.MotionEstimator`` has it).
+    ``estimate_ignoring_doors`` (``robot.motion.MotionEstimator`` has it).
     """
     places = sorted(n for n, t in world.objects.items() if t == PLACE_TYPE)
     # places joined by a door the domain models: the plan decides whether the door is open, so

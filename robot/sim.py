@@ -24,8 +24,8 @@ from pathlib import Path
 
 from robot.control import STOP
 from robot.mjworld import TIMESTEP, MjApartment
+from robot.motion import BasePlanner, DriveLimits, MotionEstimator, open_planner
 from robot.people import People
-from robot.planner import BasePlanner, DriveLimits, MotionEstimator, open_planner
 from robot.scene import Scene
 from robot.skills import SKILLS, Skill
 from robot.spec import WorldSpec, load_world
