@@ -31,7 +31,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from robot.roadmap import Roadmap, heading, path_length
-from robot.scene import Scene
+from robot.scene import Disc, Scene, point_box_distance, point_segment_distance, segments_clear
 from robot.spec import RobotSpec, WorldSpec
 from tasker.world import UNREACHABLE, MotionEstimate, Pose
 
@@ -92,8 +92,30 @@ class DriveLimits:
         return t
 
 
+Layer = tuple[tuple[str, ...], tuple[Disc, ...]]  # closed doors, people in the way
+RING = 16  # milestones around a person in the way
+SNAP_STEP = 0.01  # metres between the rings searched for a free start
+SNAP_REACH = 0.6  # metres: a start deeper in collision than this is not snapped
+
+
 class BasePlanner:
-    """Collision-free paths for the disc robot in ``scene``, from the world's roadmap."""
+    """Collision-free paths for the disc robot in ``scene``, from the world's roadmap.
+
+    A query ``plan(start, goal)`` is answered in layers, each cached by exactly what it
+    depends on, so a change in the scene invalidates only what it can affect:
+
+    1. the **door layer** (walls, furniture, closed doors): a Dijkstra tree from the
+       start over the roadmap less the edges closed doors block, cached by
+       (start, closed doors); the goal is linked to it, the route shortened;
+    2. if that path is clear of people, it is the answer (people only add constraints,
+       so it is still the shortest);
+    3. otherwise the **people layer**: the roadmap less the edges people block, plus a
+       ring of milestones around each person in the way (so the path hugs them), searched
+       from the start and cached by (start, closed doors, people in the way).
+
+    A start in collision (braked next to a door jamb, pushed against a wall) is snapped
+    to the nearest free point first; the path then starts with that short move.
+    """
 
     def __init__(self, spec: WorldSpec, scene: Scene, seed: int = 1, milestones: int | None = None,
                  cache_size: int = 4096) -> None:
@@ -101,55 +123,143 @@ class BasePlanner:
         self.roadmap = Roadmap.for_world(spec, scene, seed, milestones)
         self._cache: OrderedDict[tuple[object, ...], tuple[Point, ...] | None] = OrderedDict()
         self._cache_size = cache_size
-        self._blocked: dict[tuple[int, tuple[str, ...]], tuple[bool, np.ndarray]] = {}
+        self._door_masks: dict[tuple[str, ...], np.ndarray] = {}
+        self._disc_masks: OrderedDict[Disc, np.ndarray] = OrderedDict()
+        self._rings: OrderedDict[tuple[Disc, tuple[str, ...]], tuple[np.ndarray, np.ndarray]] = OrderedDict()
+        self._trees: OrderedDict[tuple[object, ...], tuple[np.ndarray, np.ndarray, np.ndarray]] = OrderedDict()
+        self.searches = 0  # Dijkstra runs so far (benchmarks and tests read it)
 
-    def _links(self, s: Point, g: Point, ignore: tuple[str, ...], k: int = 12) -> tuple[
-            bool, tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
-        """Is ``s→g`` free, and which nearest nodes each end sees: one vectorised test."""
-        si, sd = self.roadmap.nearest(s[0], s[1], k)
-        gi, gd = self.roadmap.nearest(g[0], g[1], k)
-        nodes = self.roadmap.nodes
-        a = np.vstack([[s], np.repeat([s], len(si), axis=0), np.repeat([g], len(gi), axis=0)])
-        b = np.vstack([[g], nodes[si], nodes[gi]])
-        ok = self.scene.segments_free(a, b, ignore=ignore)
-        ok_s, ok_g = ok[1 : 1 + len(si)], ok[1 + len(si) :]
-        return bool(ok[0]), (si[ok_s], sd[ok_s]), (gi[ok_g], gd[ok_g])
+    # ---- the scene, by layer -----------------------------------------------------------
+    def _doors(self) -> tuple[str, ...]:
+        return tuple(n for n, o in sorted(self.scene.door_open.items()) if not o)
 
-    def _blocked_graph(self, ignore: tuple[str, ...]) -> tuple[bool, np.ndarray]:
-        key = (self.scene.version, ignore)
-        if key not in self._blocked:
-            if len(self._blocked) > 64:
-                self._blocked.clear()
-            mask = self.roadmap.blocked_edges(self.scene, ignore)
-            self._blocked[key] = (bool(mask.any()), mask)
-        return self._blocked[key]
+    def _free_segments(self, a: np.ndarray, b: np.ndarray, discs: tuple[Disc, ...]) -> np.ndarray:
+        """Which segments are clear of walls, furniture, closed doors and ``discs``."""
+        scene = self.scene
+        ok = scene.segments_free(a, b, dynamic=False)
+        ok &= segments_clear(np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2),
+                             scene.closed_doors(), scene.radius)
+        if discs and ok.any():
+            a2, b2 = np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2)
+            px, py = np.array([d.x for d in discs]), np.array([d.y for d in discs])
+            rr = np.array([d.r for d in discs]) + scene.radius
+            ok &= (point_segment_distance(px, py, a2, b2) >= rr[None, :]).all(axis=1)
+        return ok
 
-    def _search(self, src: tuple[np.ndarray, np.ndarray], dst: tuple[np.ndarray, np.ndarray],
-                ignore: tuple[str, ...]) -> list[int] | None:
+    def _free_points(self, pts: np.ndarray, discs: tuple[Disc, ...]) -> np.ndarray:
+        scene, r = self.scene, self.scene.radius
+        x, y = pts[:, 0], pts[:, 1]
+        ok = (x >= scene.xmin + r) & (x <= scene.xmax - r) & (y >= scene.ymin + r) & (y <= scene.ymax - r)
+        if len(scene.static):
+            ok &= point_box_distance(x, y, scene.static).min(axis=1) >= r
+        if len(scene.closed_doors()):
+            ok &= point_box_distance(x, y, scene.closed_doors()).min(axis=1) >= r
+        for d in discs:
+            ok &= np.hypot(x - d.x, y - d.y) >= d.r + r
+        return ok
+
+    def _door_mask(self, doors: tuple[str, ...]) -> np.ndarray:
+        if doors not in self._door_masks:
+            boxes = np.array([self.scene.door_boxes[n] for n in doors], dtype=float).reshape(-1, 4)
+            self._door_masks[doors] = self.roadmap.box_blocked(boxes, self.scene.radius)
+        return self._door_masks[doors]
+
+    def _disc_mask(self, d: Disc) -> np.ndarray:
+        if d not in self._disc_masks:
+            self._disc_masks[d] = self.roadmap.disc_blocked(d.x, d.y, d.r + self.scene.radius)
+            if len(self._disc_masks) > 256:
+                self._disc_masks.popitem(last=False)
+        return self._disc_masks[d]
+
+    def _ring(self, d: Disc, doors: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """Milestones around person ``d`` and their edges (ring-local index, roadmap node or
+        ``-1 - ring index``), clear of walls, furniture and closed doors."""
+        key = (d, doors)
+        if key not in self._rings:
+            radius = (d.r + self.scene.radius) / math.cos(math.pi / RING) + 0.005
+            ang = 2 * math.pi * np.arange(RING) / RING
+            pts = np.stack([d.x + radius * np.cos(ang), d.y + radius * np.sin(ang)], axis=1)
+            keep = self._free_points(pts, ())
+            pts = pts[keep]
+            local = np.flatnonzero(keep)
+            rm = self.roadmap
+            a_idx, b_idx = [], []
+            for k in range(len(pts)):  # neighbours on the ring, then nearby roadmap nodes
+                nxt = np.flatnonzero(local == (local[k] + 1) % RING)
+                if len(nxt):
+                    a_idx.append(k)
+                    b_idx.append(-1 - int(nxt[0]))
+                near, _ = rm.nearest(pts[k, 0], pts[k, 1], 24)
+                a_idx += [k] * len(near)
+                b_idx += [int(n) for n in near]
+            a_arr, b_arr = np.array(a_idx, dtype=int), np.array(b_idx, dtype=int)
+            ends = np.where(b_arr[:, None] >= 0, rm.nodes[np.maximum(b_arr, 0)], pts[-1 - np.minimum(b_arr, -1)])
+            ok = self._free_segments(pts[a_arr], ends, ()) if len(a_arr) else np.zeros(0, dtype=bool)
+            self._rings[key] = (pts, np.stack([a_arr[ok], b_arr[ok]], axis=1).reshape(-1, 2))
+            if len(self._rings) > 256:
+                self._rings.popitem(last=False)
+        return self._rings[key]
+
+    # ---- search ------------------------------------------------------------------------
+    def _graph(self, layer: Layer) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Nodes, undirected edges and lengths of the roadmap as ``layer`` leaves it."""
+        doors, discs = layer
         rm = self.roadmap
-        any_blocked, mask = self._blocked_graph(ignore)
-        (si, sd), (gi, gd) = src, dst
-        if not any_blocked:
-            total = sd[:, None] + rm.dist[np.ix_(si, gi)] + gd[None, :]
-            a, b = np.unravel_index(int(np.argmin(total)), total.shape)
-            if not math.isfinite(total[a, b]):
-                return None
-            return rm.route(int(si[a]), int(gi[b]))
-        keep = ~mask
+        blocked = self._door_mask(doors).copy()
+        for d in discs:
+            blocked |= self._disc_mask(d)
+        nodes, edges = [rm.nodes], [rm.edges[~blocked]]
         n = len(rm.nodes)
-        e, w = rm.edges[keep], rm.lengths[keep]
-        rows = np.concatenate([e[:, 0], e[:, 1], np.full(len(si), n), gi])
-        cols = np.concatenate([e[:, 1], e[:, 0], si, np.full(len(gi), n + 1)])
-        graph = csr_matrix((np.concatenate([w, w, sd + 1e-9, gd + 1e-9]), (rows, cols)), shape=(n + 2, n + 2))
-        dist, pred = dijkstra(graph, directed=True, indices=n, return_predecessors=True)
-        if not math.isfinite(dist[n + 1]):
-            return None
-        route = [n + 1]
-        while route[-1] != n:
-            route.append(int(pred[route[-1]]))
-        return route[-2:0:-1]
+        for d in discs:
+            pts, ring_edges = self._ring(d, doors)
+            if not len(pts):
+                continue
+            a = ring_edges[:, 0] + n
+            b = np.where(ring_edges[:, 1] >= 0, ring_edges[:, 1], n - 1 - ring_edges[:, 1])
+            nodes.append(pts)
+            edges.append(np.stack([a, b], axis=1))
+            n += len(pts)
+        all_nodes = np.vstack(nodes)
+        all_edges = np.vstack(edges)
+        if len(discs) and len(all_edges) > len(edges[0]):
+            ring_part = all_edges[len(edges[0]):]
+            others = [d for d in discs]
+            ok = self._free_segments(all_nodes[ring_part[:, 0]], all_nodes[ring_part[:, 1]], tuple(others))
+            all_edges = np.vstack([edges[0], ring_part[ok]])
+        lengths = np.hypot(*(all_nodes[all_edges[:, 0]] - all_nodes[all_edges[:, 1]]).T)
+        return all_nodes, all_edges, lengths
 
-    def _shortcut(self, pts: list[Point], ignore: tuple[str, ...]) -> list[Point]:
+    def _links(self, p: Point, nodes: np.ndarray, discs: tuple[Disc, ...], k: int = 16) -> tuple[np.ndarray, np.ndarray]:
+        """Nodes visible from ``p`` among its ``k`` nearest and every milestone within 3 m
+        that is not an OMPL sample (corners, doors, places, rings), with distances."""
+        d = np.hypot(nodes[:, 0] - p[0], nodes[:, 1] - p[1])
+        first = int(self.roadmap.corner_nodes[0]) if len(self.roadmap.corner_nodes) else len(self.roadmap.nodes)
+        near = np.argpartition(d, min(k, len(d) - 1))[:k]
+        special = first + np.flatnonzero(d[first:] <= 3.0)
+        cand = np.unique(np.concatenate([near, special]))
+        ok = self._free_segments(np.repeat([p], len(cand), axis=0), nodes[cand], discs)
+        return cand[ok], d[cand[ok]]
+
+    def _tree(self, s: Point, layer: Layer) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Distances and predecessors from ``s`` over ``layer``'s graph (cached), and its nodes."""
+        key = (s, layer)
+        if key in self._trees:
+            self._trees.move_to_end(key)
+            return self._trees[key]
+        nodes, edges, lengths = self._graph(layer)
+        n = len(nodes)
+        si, sd = self._links(s, nodes, layer[1])
+        rows = np.concatenate([edges[:, 0], edges[:, 1], np.full(len(si), n)])
+        cols = np.concatenate([edges[:, 1], edges[:, 0], si])
+        graph = csr_matrix((np.concatenate([lengths, lengths, sd + 1e-9]), (rows, cols)), shape=(n + 1, n + 1))
+        dist, pred = dijkstra(graph, directed=True, indices=n, return_predecessors=True)
+        self.searches += 1
+        self._trees[key] = (dist, pred, nodes)
+        if len(self._trees) > 512:
+            self._trees.popitem(last=False)
+        return self._trees[key]
+
+    def _shortcut(self, pts: list[Point], discs: tuple[Disc, ...]) -> list[Point]:
         """The shortest chain through ``pts`` whose links are all collision-free."""
         n = len(pts)
         if n <= 2:
@@ -157,7 +267,7 @@ class BasePlanner:
         P = np.asarray(pts)
         ii, jj = np.triu_indices(n, 1)
         free = np.zeros((n, n), dtype=bool)
-        free[ii, jj] = self.scene.segments_free(P[ii], P[jj], ignore=ignore)
+        free[ii, jj] = self._free_segments(P[ii], P[jj], discs)
         free[np.arange(n - 1), np.arange(1, n)] = True  # route links are valid by construction
         seg = np.hypot(*(P[None, :, :] - P[:, None, :]).transpose(2, 0, 1))
         best = np.full(n, math.inf)
@@ -172,36 +282,70 @@ class BasePlanner:
             out.append(int(back[out[-1]]))
         return [pts[k] for k in reversed(out)]
 
+    def snap(self, p: Point, discs: tuple[Disc, ...] = ()) -> Point | None:
+        """The nearest free point to ``p`` (``p`` itself when free), within ``SNAP_REACH``."""
+        if self._free_points(np.array([p]), discs)[0]:
+            return p
+        radii = np.arange(1, int(SNAP_REACH / SNAP_STEP) + 1) * SNAP_STEP
+        ang = 2 * math.pi * np.arange(32) / 32
+        pts = np.stack([p[0] + np.outer(radii, np.cos(ang)).ravel(), p[1] + np.outer(radii, np.sin(ang)).ravel()], 1)
+        ok = np.flatnonzero(self._free_points(pts, discs))
+        if not len(ok):
+            return None
+        return (round(float(pts[ok[0], 0]), 4), round(float(pts[ok[0], 1]), 4))
+
+    def _query(self, s: Point, g: Point, layer: Layer) -> tuple[Point, ...] | None:
+        discs = layer[1]
+        if not self._free_points(np.array([g]), discs)[0]:
+            return None
+        s0 = s
+        snapped = self.snap(s, discs)
+        if snapped is None:
+            return None
+        s = snapped
+        head = (s0,) if s != s0 else ()
+        if math.hypot(g[0] - s[0], g[1] - s[1]) < 1e-6 or self._free_segments(np.array([s]), np.array([g]), discs)[0]:
+            return (*head, s, g)
+        dist, pred, nodes = self._tree(s, layer)
+        gi, gd = self._links(g, nodes, discs)
+        if not len(gi):
+            return None
+        total = dist[gi] + gd
+        b = int(np.argmin(total))
+        if not math.isfinite(total[b]):
+            return None
+        route = [int(gi[b])]
+        n = len(nodes)
+        while route[-1] != n:
+            route.append(int(pred[route[-1]]))
+        pts = [s] + [(float(x), float(y)) for x, y in nodes[route[-2::-1]]] + [g]
+        return (*head, *self._shortcut(pts, discs))
+
     def plan(self, start: Point, goal: Point) -> tuple[Point, ...] | None:
         """A collision-free polyline from ``start`` to ``goal``, or None when there is none."""
         s = (round(float(start[0]), 4), round(float(start[1]), 4))
         g = (round(float(goal[0]), 4), round(float(goal[1]), 4))
-        key = (s, g, self.scene.version)
+        doors = self._doors()
+        ignore = self.scene.blocking_discs([s, g])
+        discs = tuple(self.scene.discs(ignore))
+        path = self._cached((s, g, doors, ()))
+        if path is None or not discs:
+            return path
+        pts = np.asarray(path)
+        if self._free_segments(pts[:-1], pts[1:], discs).all():
+            return path
+        return self._cached((s, g, doors, discs))
+
+    def _cached(self, key: tuple[Point, Point, tuple[str, ...], tuple[Disc, ...]]) -> tuple[Point, ...] | None:
         if key in self._cache:
             self._cache.move_to_end(key)
             return self._cache[key]
-        result = self._plan(s, g)
+        s, g, doors, discs = key
+        result = self._query(s, g, (doors, discs))
         self._cache[key] = result
         if len(self._cache) > self._cache_size:
             self._cache.popitem(last=False)
         return result
-
-    def _plan(self, s: Point, g: Point) -> tuple[Point, ...] | None:
-        ignore = self.scene.blocking_discs([s, g])
-        if not (self.scene.free(*s, ignore=ignore) and self.scene.free(*g, ignore=ignore)):
-            return None
-        if math.hypot(g[0] - s[0], g[1] - s[1]) < 1e-6:
-            return (s, g)
-        direct, src, dst = self._links(s, g, ignore)
-        if direct:
-            return (s, g)
-        if not len(src[0]) or not len(dst[0]):
-            return None
-        route = self._search(src, dst, ignore)
-        if route is None:
-            return None
-        pts = [s] + [(float(x), float(y)) for x, y in self.roadmap.nodes[route]] + [g]
-        return tuple(self._shortcut(pts, ignore))
 
 
 class MotionEstimator:
