@@ -229,7 +229,8 @@ class BasePlanner:
         lengths = np.hypot(*(all_nodes[all_edges[:, 0]] - all_nodes[all_edges[:, 1]]).T)
         return all_nodes, all_edges, lengths
 
-    def _links(self, p: Point, nodes: np.ndarray, discs: tuple[Disc, ...], k: int = 16) -> tuple[np.ndarray, np.ndarray]:
+    def _links(self, p: Point, nodes: np.ndarray, discs: tuple[Disc, ...],
+               k: int = 16) -> tuple[np.ndarray, np.ndarray]:
         """Nodes visible from ``p`` among its ``k`` nearest and every milestone within 3 m
         that is not an OMPL sample (corners, doors, places, rings), with distances."""
         d = np.hypot(nodes[:, 0] - p[0], nodes[:, 1] - p[1])

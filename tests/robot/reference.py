@@ -36,18 +36,20 @@ class GridReference:
             free &= np.hypot(px - d.x, py - d.y) >= d.r + r
         self.free = free.reshape(self.nx, self.ny)
         idx = np.arange(self.nx * self.ny).reshape(self.nx, self.ny)
+
+        def cells(ox: int, oy: int, dx: int, dy: int) -> np.ndarray:
+            """Cells at offset ``(ox, oy)`` from every cell that has a neighbour at ``(dx, dy)``."""
+            i0, j0 = max(0, -dx) + ox, max(0, -dy) + oy
+            return idx[i0 : self.nx - max(0, dx) + ox, j0 : self.ny - max(0, dy) + oy].ravel()
+
         rows, cols, w = [], [], []
         for dx, dy in MOVES:
-            a = idx[max(0, -dx): self.nx - max(0, dx), max(0, -dy): self.ny - max(0, dy)]
-            b = idx[max(0, dx): self.nx - max(0, -dx) + (0 if dx <= 0 else 0), max(0, dy): self.ny + min(0, dy) if dy < 0 else self.ny][: a.shape[0], : a.shape[1]]
-            b = idx[max(0, -dx) + dx: self.nx - max(0, dx) + dx, max(0, -dy) + dy: self.ny - max(0, dy) + dy]
-            ok = free[a.ravel()] & free[b.ravel()]
-            if abs(dx) + abs(dy) == 3:  # a knight's move: the cells it passes must be free too
-                mid1 = idx[max(0, -dx) + (dx // 2 if abs(dx) == 2 else 0): self.nx - max(0, dx) + (dx // 2 if abs(dx) == 2 else 0),
-                           max(0, -dy) + (dy // 2 if abs(dy) == 2 else 0): self.ny - max(0, dy) + (dy // 2 if abs(dy) == 2 else 0)]
-                ok &= free[mid1.ravel()]
-            rows.append(a.ravel()[ok])
-            cols.append(b.ravel()[ok])
+            a, b = cells(0, 0, dx, dy), cells(dx, dy, dx, dy)
+            ok = free[a] & free[b]
+            if abs(dx) + abs(dy) == 3:  # a knight's move: the cell it passes over must be free too
+                ok &= free[cells(int(dx / 2) if abs(dx) == 2 else 0, int(dy / 2) if abs(dy) == 2 else 0, dx, dy)]
+            rows.append(a[ok])
+            cols.append(b[ok])
             w.append(np.full(int(ok.sum()), cell * float(np.hypot(dx, dy))))
         n = self.nx * self.ny
         self.graph = coo_matrix((np.concatenate(w), (np.concatenate(rows), np.concatenate(cols))),
