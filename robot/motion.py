@@ -349,11 +349,17 @@ class BasePlanner:
         return result
 
 
+APPROACH = 0.9  # metres from a person's centre when the robot goes "to" them
+APPROACH_DIRECTIONS = 16
+
+
 class MotionEstimator:
     """:class:`tasker.world.MotionModel` for the base: OMPL-roadmap paths, profile-timed.
 
     An unreachable goal (walled off, behind a closed door, in collision) gives
-    :data:`tasker.world.UNREACHABLE`: infinite time, never zero.
+    :data:`tasker.world.UNREACHABLE`: infinite time, never zero.  A goal at a person's
+    position means "go to that person": the estimate is for :meth:`approach`'s pose, the
+    very pose the ``navigate`` skill drives to, so estimate and motion agree.
     """
 
     def __init__(self, planner: BasePlanner, limits: DriveLimits, open_planner: BasePlanner | None = None) -> None:
@@ -362,6 +368,9 @@ class MotionEstimator:
         self.open_planner = open_planner
 
     def estimate(self, start: Pose, goal: Pose) -> MotionEstimate:
+        person = self.planner.scene.person_at(goal[0], goal[1])
+        if person is not None:
+            return self.approach(start, person)[1]
         return self._estimate(self.planner, start, goal)
 
     def estimate_ignoring_doors(self, start: Pose, goal: Pose) -> MotionEstimate:
@@ -372,6 +381,41 @@ class MotionEstimator:
         """
         return self._estimate(self.open_planner or self.planner, start, goal)
 
+    def approach(self, start: Pose, person: str) -> tuple[Pose | None, MotionEstimate]:
+        """The cheapest reachable pose ``APPROACH`` metres from ``person``, facing them.
+
+        Candidates lie in ``APPROACH_DIRECTIONS`` directions around the person; ties go to
+        the first direction (east, then counter-clockwise), so the choice is deterministic.
+        ``(None, UNREACHABLE)`` when no candidate is reachable.
+        """
+        scene = self.planner.scene
+        d = scene.people[person]
+        best: tuple[Pose, MotionEstimate] | None = None
+        for k in range(APPROACH_DIRECTIONS):
+            a = 2 * math.pi * k / APPROACH_DIRECTIONS
+            gx, gy = d.x + APPROACH * math.cos(a), d.y + APPROACH * math.sin(a)
+            if not scene.free(gx, gy, ignore=(person,)):
+                continue
+            goal = (gx, gy, math.atan2(d.y - gy, d.x - gx))
+            est = self._estimate(self.planner, start, goal)
+            if est.reachable and (best is None or est.time_s < best[1].time_s):
+                best = (goal, est)
+        return best if best is not None else (None, UNREACHABLE)
+
+    def table(self, poses: list[Pose] | tuple[Pose, ...]) -> np.ndarray:
+        """Seconds from every pose to every other: an ``(n, n)`` matrix, ``inf`` if unreachable.
+
+        One shortest-path search per source and scene state (the planner caches the
+        search tree), so a table costs ``n`` searches plus ``n²`` cheap goal links.
+        """
+        n = len(poses)
+        out = np.zeros((n, n))
+        for i, a in enumerate(poses):
+            for j, b in enumerate(poses):
+                if i != j:
+                    out[i, j] = self.estimate(a, b).time_s
+        return out
+
     def _estimate(self, planner: BasePlanner, start: Pose, goal: Pose) -> MotionEstimate:
         path = planner.plan((start[0], start[1]), (goal[0], goal[1]))
         if path is None:
@@ -380,6 +424,74 @@ class MotionEstimator:
         time_s = self.limits.travel_time(pts, start[2], goal[2])
         end = (float(goal[0]), float(goal[1]), float(goal[2]))
         return MotionEstimate(True, time_s, path_length(pts), end, tuple(pts))
+
+
+@dataclass(frozen=True, slots=True)
+class TravelMatrix:
+    """Travel between given places or points of a world: ``time_s[i, j]`` and
+    ``distance_m[i, j]`` from ``labels[i]`` to ``labels[j]`` (``inf`` when unreachable)."""
+
+    world: str
+    seed: int
+    labels: tuple[str, ...]
+    poses: tuple[Pose, ...]
+    time_s: np.ndarray
+    distance_m: np.ndarray
+
+    def __post_init__(self) -> None:
+        n = len(self.labels)
+        if len(self.poses) != n or self.time_s.shape != (n, n) or self.distance_m.shape != (n, n):
+            raise ValueError(f"TravelMatrix: {n} labels need {n} poses and ({n}, {n}) matrices")
+
+    def to_json(self) -> dict[str, object]:
+        """Plain JSON: unreachable entries are ``null``."""
+        def rows(m: np.ndarray) -> list[list[float | None]]:
+            return [[float(v) if math.isfinite(v) else None for v in row] for row in m]
+
+        return {"world": self.world, "seed": self.seed, "labels": list(self.labels),
+                "poses": [list(p) for p in self.poses], "time_s": rows(self.time_s),
+                "distance_m": rows(self.distance_m)}
+
+
+def travel_matrix(world: str | WorldSpec, targets: list[str | tuple[float, ...]] | tuple[str | tuple[float, ...], ...],
+                  seed: int = 1, people: bool = True) -> TravelMatrix:
+    """Travel times and distances between ``targets`` in ``world``, in one call.
+
+    A target is a place name, a person's name (the robot goes next to them, see
+    :meth:`MotionEstimator.approach`) or a point ``(x, y)`` / pose ``(x, y, yaw)``.
+    People stand where the world file puts them unless ``people`` is False.  An unknown
+    name raises :class:`tasker.errors.UnknownName` listing the known ones.
+    """
+    from robot.spec import load_world
+    from tasker.errors import UnknownName
+
+    spec = world if isinstance(world, WorldSpec) else load_world(world)
+    model = motion_model(spec, seed=seed, people=people)
+    labels: list[str] = []
+    poses: list[Pose] = []
+    for t in targets:
+        if isinstance(t, str):
+            if t in spec.places:
+                poses.append(spec.places[t])
+            elif t in spec.people:
+                poses.append(spec.people[t].pose)
+            else:
+                raise UnknownName(f"place or person of world {spec.name!r}", t, [*spec.places, *spec.people])
+            labels.append(t)
+        else:
+            v = [float(c) for c in t]
+            if len(v) not in (2, 3) or not all(math.isfinite(c) for c in v):
+                raise ValueError(f"travel_matrix: a point is (x, y) or (x, y, yaw) of finite numbers, got {t!r}")
+            poses.append((v[0], v[1], v[2] if len(v) == 3 else 0.0))
+            labels.append(",".join(f"{c:g}" for c in v))
+    n = len(poses)
+    times, dists = np.zeros((n, n)), np.zeros((n, n))
+    for i, a in enumerate(poses):
+        for j, b in enumerate(poses):
+            if i != j:
+                est = model.estimate(a, b)
+                times[i, j], dists[i, j] = est.time_s, est.distance_m
+    return TravelMatrix(spec.name, seed, tuple(labels), tuple(poses), times, dists)
 
 
 def motion_model(spec: WorldSpec, seed: int = 1, people: bool = True) -> MotionEstimator:
