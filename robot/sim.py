@@ -19,14 +19,16 @@ physical and reported as ``("posture", person, posture)``.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
+
+import numpy as np
 
 from robot.control import STOP
 from robot.mjworld import TIMESTEP, MjApartment
 from robot.motion import BasePlanner, DriveLimits, MotionEstimator, open_planner
 from robot.people import People
-from robot.scene import Scene
+from robot.scene import Scene, segments_clear
 from robot.skills import SKILLS, Skill
 from robot.spec import WorldSpec, load_world
 from robot.tiago import robot_dimensions
@@ -53,6 +55,7 @@ class Simulation:
         self.rate_hz = float(rate_hz)
         _, _, radius = robot_dimensions()
         self.scene = Scene(self.spec, radius)
+        self._walls = np.array([o.box for o in self.spec.obstacles if o.kind == "wall"], dtype=float).reshape(-1, 4)
         self.people = People(self.spec.people.values())
         self.planner = BasePlanner(self.spec, self.scene, seed=seed, milestones=milestones)
         self.limits = DriveLimits.of(self.spec.robot)
@@ -141,21 +144,41 @@ class Simulation:
         return WorldState(frozenset(facts | self.people.facts()), poses, self.objects(), self.time)
 
     def person_place(self, x: float, y: float) -> str:
-        """Where a person is, symbolically: the nearest place in the same room, not counting
-        the places of devices (people are not "at the stove"); the nearest such place
-        anywhere if their room has none."""
+        """Where a person is, symbolically: :meth:`place_of` among the places that are not
+        the places of devices (people are not "at the stove"), or among all places if none."""
         device_places = {d.place for d in self.spec.devices.values()}
         spots = {n: p for n, p in self.spec.places.items() if n not in device_places} or dict(self.spec.places)
-        room = next((b for _, b in sorted(self.spec.rooms.items()) if b[0] <= x <= b[2] and b[1] <= y <= b[3]), None)
-        if room is not None:
-            inside = {n: p for n, p in spots.items() if room[0] <= p[0] <= room[2] and room[1] <= p[1] <= room[3]}
-            spots = inside or spots
-        return min(spots, key=lambda n: (math.hypot(spots[n][0] - x, spots[n][1] - y), n))
+        return self.place_of(x, y, spots)
 
     def nearest_place(self, x: float, y: float) -> str:
-        """The named place closest to ``(x, y)`` (ties broken by name, so deterministic)."""
-        return min(self.spec.places, key=lambda n: (math.hypot(self.spec.places[n][0] - x,
-                                                               self.spec.places[n][1] - y), n))
+        """Where the robot (or anything) at ``(x, y)`` is: :meth:`place_of` among all places."""
+        return self.place_of(x, y, self.spec.places)
+
+    def room_of(self, x: float, y: float) -> str | None:
+        """The smallest room whose box holds ``(x, y)`` (ties by name), or None."""
+        rooms = [(b[2] - b[0]) * (b[3] - b[1]) for b in self.spec.rooms.values()]
+        inside = [(area, n) for area, (n, b) in zip(rooms, self.spec.rooms.items(), strict=True)
+                  if b[0] <= x <= b[2] and b[1] <= y <= b[3]]
+        return min(inside)[1] if inside else None
+
+    def place_of(self, x: float, y: float, spots: Mapping[str, Pose]) -> str:
+        """The nearest of ``spots`` that is not behind a wall (ties broken by name).
+
+        The nearest place of the room that holds ``(x, y)``; if that room has none, the
+        nearest place in sight (the straight line to it crosses no wall); else the nearest.
+        """
+        def nearest(names: Iterable[str]) -> str:
+            return min(names, key=lambda n: (math.hypot(spots[n][0] - x, spots[n][1] - y), n))
+
+        room = self.room_of(x, y)
+        if room is not None:
+            inside = [n for n in spots if self.room_of(spots[n][0], spots[n][1]) == room]
+            if inside:
+                return nearest(inside)
+        names = sorted(spots)
+        ends = np.array([spots[n][:2] for n in names], dtype=float)
+        seen = segments_clear(np.repeat([[x, y]], len(names), axis=0), ends, self._walls, 1e-6)
+        return nearest([n for n, ok in zip(names, seen, strict=True) if ok] or names)
 
     def apply(self, add: Iterable[Iterable[str]] = (), delete: Iterable[Iterable[str]] = ()) -> None:
         """Change the symbolic state: ``delete`` first, then ``add`` (lists of ground facts)."""
