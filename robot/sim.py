@@ -28,6 +28,7 @@ from robot.control import STOP
 from robot.mjworld import TIMESTEP, MjApartment
 from robot.motion import BasePlanner, DriveLimits, MotionEstimator, open_planner
 from robot.people import People
+from robot.recording import PersonState, Recorder
 from robot.scene import Scene, segments_clear
 from robot.skills import SKILLS, Skill
 from robot.spec import WorldSpec, load_world
@@ -76,8 +77,12 @@ class Simulation:
         self.skill: Skill | None = None
         self._owner: tuple[str, Stage] | None = None
         self._applied = False
-        self.trajectory: list[tuple[float, float, float, float]] = []
+        self.recording = Recorder(self.spec.name)
+        self.trajectory: list[tuple[float, float, float, float]] = []  # (t, x, y, yaw) at RECORD_HZ
+        self._ticks = 0
+        self.physics_ticks = 0  # control ticks that stepped MuJoCo (the rest: robot at rest, nothing to do)
         self._sync_people()
+        self._record()
 
     # ---- World -----------------------------------------------------------------------
     def robot_pose(self) -> Pose:
@@ -98,15 +103,30 @@ class Simulation:
             self.mj.set_person(p.name, p.x, p.y, p.yaw, p.posture)
 
     def _tick(self) -> None:
-        t = self.time + CONTROL_DT
+        self._ticks += 1
+        t = round(self._ticks * CONTROL_DT, 9)
         x, y, _ = self.mj.pose()
         self.people.step(t, CONTROL_DT, self.facts, (x, y))
         self._sync_people()
         cmd = self.skill.control(t, CONTROL_DT) if self.skill is not None else STOP
         self.mj.command(cmd.v, cmd.w)
-        self.mj.step(round(CONTROL_DT / TIMESTEP))
+        # People are mocap bodies that touch nothing, so with no command and the base at
+        # rest a physics step changes nothing worth 25 MuJoCo steps: skip it
+        if cmd != STOP or not self.mj.at_rest():
+            self.mj.step(round(CONTROL_DT / TIMESTEP))
+            self.physics_ticks += 1
         self.time = t
-        self.trajectory.append((t, *self.mj.pose()))
+        if self.recording.due(t):
+            self._record()
+
+    def _record(self) -> None:
+        pose = self.mj.pose()
+        self.recording.record(self.time, pose, [PersonState(p.name, p.x, p.y, p.yaw, p.posture) for p in self.people])
+        self.trajectory.append((self.time, *pose))
+
+    def write_trajectory(self, path: str | Path) -> Path:
+        """Write what was recorded (``trajectory.jsonl``, see :mod:`robot.recording`)."""
+        return self.recording.write(path)
 
     def advance(self, now: float) -> None:
         """Step control and physics in fixed ticks up to simulated time ``now``."""
@@ -210,6 +230,10 @@ class Simulation:
         if status.state is SkillState.SUCCEEDED and not self._applied:
             self._applied = True
             self.apply(stage.data.get("add", []), stage.data.get("delete", []))
+            if stage.skill == "manipulate":  # where movable objects were handled, for the pictures
+                x, y, _ = self.robot_pose()
+                for obj in dict.fromkeys(a for a in (*stage.args, stage.data.get("object")) if a in self.spec.objects):
+                    self.recording.mark(self.time, str(obj), stage.action, x, y)
         return status
 
     def stop(self, agent: str, stage: Stage, now: float) -> None:
