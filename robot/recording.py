@@ -76,6 +76,10 @@ class Recorder:
         """Is a sample due at simulated time ``t``?"""
         return t >= self._next / self.rate_hz - 1e-9
 
+    def next_time(self) -> float:
+        """When the next sample is due."""
+        return self._next / self.rate_hz
+
     def record(self, t: float, robot: Pose, people: Iterable[PersonState]) -> None:
         self.samples.append(Sample(t, robot, tuple(people)))
         self._next = int(round(t * self.rate_hz)) + 1

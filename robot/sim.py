@@ -27,7 +27,7 @@ import numpy as np
 from robot.control import STOP
 from robot.mjworld import TIMESTEP, MjApartment
 from robot.motion import BasePlanner, DriveLimits, MotionEstimator, open_planner
-from robot.people import People
+from robot.people import People, Person
 from robot.recording import PersonState, Recorder
 from robot.scene import Scene, segments_clear
 from robot.skills import SKILLS, Skill
@@ -80,6 +80,8 @@ class Simulation:
         self.recording = Recorder(self.spec.name)
         self.trajectory: list[tuple[float, float, float, float]] = []  # (t, x, y, yaw) at RECORD_HZ
         self._ticks = 0
+        self._last_cmd = STOP
+        self._synced: dict[str, tuple[float, float, float, str]] = {}
         self.physics_ticks = 0  # control ticks that stepped MuJoCo (the rest: robot at rest, nothing to do)
         self._sync_people()
         self._record()
@@ -99,8 +101,56 @@ class Simulation:
 
     def _sync_people(self) -> None:
         for p in self.people:
-            self.scene.set_person(p.name, p.x, p.y, p.posture)
-            self.mj.set_person(p.name, p.x, p.y, p.yaw, p.posture)
+            state = (p.x, p.y, p.yaw, p.posture)
+            if self._synced.get(p.name) != state:  # only who moved: the scene and MuJoCo follow
+                self._synced[p.name] = state
+                self.scene.set_person(p.name, p.x, p.y, p.posture)
+                self.mj.set_person(p.name, p.x, p.y, p.yaw, p.posture)
+
+    def _still_until(self, p: Person) -> float:
+        """Until when person ``p`` certainly stays as they are (``self.time``: they may move now)."""
+        events = p.spec.events
+        nxt = events[p._event][0] if p._event < len(events) else math.inf
+        if ("following", p.name) in self.facts:
+            return self.time
+        if p.posture == "fallen" or ("told_to_wait", p.name) in self.facts or not p.spec.walk:
+            return nxt
+        walk = p.spec.walk
+        if self.time < walk[0][0]:
+            return min(nxt, walk[0][0])
+        if self.time >= walk[-1][0] and math.hypot(p.x - walk[-1][1], p.y - walk[-1][2]) <= 1e-9:
+            return nxt
+        return self.time
+
+    def _fast_forward(self, now: float) -> bool:
+        """Skip the control ticks in which nothing can change: no command, the base at rest,
+        every person still, the running skill only waiting for its time.  Such ticks would
+        leave the state exactly as it is, so skipping them changes no result; samples due
+        meanwhile are recorded."""
+        if self._last_cmd != STOP or not self.mj.at_rest():
+            return False
+        horizon = min(now + 1e-9, self.skill.quiet_until() if self.skill is not None else math.inf)
+        for p in self.people:
+            horizon = min(horizon, self._still_until(p))
+            if horizon <= self.time:
+                return False
+        if not math.isfinite(horizon):
+            return False
+        # ticks k = 1..n with time (ticks + k) * CONTROL_DT strictly before the horizon
+        n = math.ceil((horizon - 1e-9) / CONTROL_DT - 1e-9) - 1 - self._ticks
+        if n < 2:
+            return False
+        for p in self.people:
+            if ("following", p.name) not in self.facts:
+                p._trail = []  # what Person.step does for someone not following
+        end = self._ticks + n
+        while self._ticks < end:
+            due = math.ceil(self.recording.next_time() / CONTROL_DT - 1e-6)
+            self._ticks = min(end, max(due, self._ticks + 1))
+            self.time = round(self._ticks * CONTROL_DT, 9)
+            if self.recording.due(self.time):
+                self._record()
+        return True
 
     def _tick(self) -> None:
         self._ticks += 1
@@ -109,6 +159,7 @@ class Simulation:
         self.people.step(t, CONTROL_DT, self.facts, (x, y))
         self._sync_people()
         cmd = self.skill.control(t, CONTROL_DT) if self.skill is not None else STOP
+        self._last_cmd = cmd
         self.mj.command(cmd.v, cmd.w)
         # People are mocap bodies that touch nothing, so with no command and the base at
         # rest a physics step changes nothing worth 25 MuJoCo steps: skip it
@@ -130,8 +181,10 @@ class Simulation:
 
     def advance(self, now: float) -> None:
         """Step control and physics in fixed ticks up to simulated time ``now``."""
+        self._sync_people()  # a posture set from outside since the last tick
         while self.time + CONTROL_DT <= now + 1e-9:
-            self._tick()
+            if not self._fast_forward(now):
+                self._tick()
 
     def set_door(self, name: str, is_open: bool) -> None:
         """Open or close a door: the scene (and so every cached estimate) and MuJoCo follow."""

@@ -53,6 +53,12 @@ class Skill:
         if self.result is RUNNING:
             self.result = failed("stopped")
 
+    def quiet_until(self) -> float:
+        """Until when :meth:`control` certainly returns STOP and changes nothing: a timed
+        skill until its end, a finished one forever.  The simulation skips physics and
+        control ticks up to then when nothing else moves."""
+        return self.started + self.stage.duration - 1e-6 if self.result is RUNNING else math.inf
+
 
 class Manipulate(Skill):
     """A timed manipulation; fails at once if its object is gone."""
@@ -159,6 +165,10 @@ class Navigate(Skill):
         if self.follower is not None:
             self.follower.brake()
         super().stop(now)
+
+    def quiet_until(self) -> float:
+        done = self.follower is None or self.follower.done
+        return math.inf if done and self.result is not RUNNING else -math.inf
 
     def braking(self) -> bool:
         return self.stopping and self.follower is not None and not self.follower.done

@@ -66,3 +66,19 @@ def test_bad_files_and_rates_are_refused(tmp_path) -> None:
     bad.write_text('{"format": "other"}\n')
     with pytest.raises(ValueError, match="x.jsonl:1: format"):
         read_trajectory(bad)
+
+
+def test_skipping_still_ticks_changes_nothing(paper, monkeypatch) -> None:
+    """The same drive and waits with and without skipping: identical samples and physics."""
+    def scenario(sim: Simulation) -> tuple[list[str], object]:
+        sim.advance(12.0)  # still: John waits until 10 s, then walks
+        end = _drive(sim, "bedroom", 80.0)
+        wait = Stage("wait", (), skill="wait", duration=7.0)
+        sim.begin("d1", wait, end)
+        sim.advance(end + 30.0)
+        return sim.recording.lines(), sim.mj.state().tolist()
+
+    fast = scenario(Simulation(paper))
+    monkeypatch.setattr(Simulation, "_fast_forward", lambda self, now: False)
+    slow = scenario(Simulation(paper))
+    assert fast == slow
