@@ -3,7 +3,7 @@
 Run ``python benchmarks/bench_robot.py``.  In one run it measures, in the paper's
 apartment, over random reachable pose pairs:
 
-* our :class:`robot.planner.MotionEstimator` (roadmap grown once, result cache off so
+* our :class:`robot.motion.MotionEstimator` (roadmap grown once, result cache off so
   every query is really planned) against a fresh OMPL ``RRTConnect`` + ``simplify``
   query on the same 2-D checker, printing the speed and path-length ratios;
 * the real-time factor of a navigation in MuJoCo (TIAGo, 50 Hz controller).
@@ -25,7 +25,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from robot.planner import BasePlanner, DriveLimits, MotionEstimator  # noqa: E402
+from robot.motion import BasePlanner, DriveLimits, MotionEstimator  # noqa: E402
 from robot.roadmap import ompl_setup, path_length  # noqa: E402
 from robot.scene import Scene  # noqa: E402
 from robot.sim import Simulation  # noqa: E402

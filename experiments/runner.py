@@ -4,6 +4,7 @@
 gets the TIAGo simulation (:class:`robot.sim.Simulation`, both the world and the core
 agent), the OMPL motion model, and the bundled PDDL task types; a synthetic one gets
 timed stages.  In ``out`` it writes ``trace.jsonl`` (reproducible byte for byte),
+``trajectory.jsonl`` (robot and people at a fixed rate, robot runs),
 ``run.json`` (the record: scenario, seed, settings, planner, host, date, version),
 ``metrics.json`` and the pictures.  If the run raises, the trace so far, ``run.json``
 (with ``status: "aborted"`` and the ``error``) and ``metrics.json`` are still written,
@@ -181,7 +182,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         except Exception as exc:  # metrics of a cut trace may not compute: say so, keep the rest
             metrics = {"error": f"metrics failed on the partial trace: {type(exc).__name__}: {exc}"}
     if out is not None:
-        _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures and error is None)
+        _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures and error is None, sim)
     result = RunResult(record, metrics, trace, trajectory)
     if error is not None:
         raise RunAborted(reason, result) from error
@@ -234,9 +235,12 @@ def _metrics(trace: Trace, calls: list[dict[str, Any]], wall: float) -> dict[str
 
 
 def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Trace,
-          trajectory: tuple[tuple[float, float, float, float], ...], world: Any, pictures: bool) -> None:
+          trajectory: tuple[tuple[float, float, float, float], ...], world: Any, pictures: bool,
+          sim: Any = None) -> None:
     out.mkdir(parents=True, exist_ok=True)
     trace.write(out / "trace.jsonl")
+    if sim is not None:  # poses and postures at a fixed rate (robot.recording)
+        sim.write_trajectory(out / "trajectory.jsonl")
     (out / "run.json").write_text(json.dumps(record, indent=2, sort_keys=True, default=str) + "\n")
     (out / "metrics.json").write_text(json.dumps(metrics_, indent=2, sort_keys=True) + "\n")
     if not pictures:
@@ -246,4 +250,5 @@ def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Tr
     plots.timeline(trace.events, out / "timeline.png")
     plots.gantt(trace.events, out / "gantt.png")
     if world is not None:
-        plots.world_path(world, list(trajectory), out / "world.png")
+        plots.world_path(world, list(trajectory), out / "world.png", events=trace.events,
+                         recording=getattr(sim, "recording", None))

@@ -64,7 +64,7 @@ def _world(args: argparse.Namespace) -> int:
 
 
 def _cost(args: argparse.Namespace) -> int:
-    from robot.planner import motion_model
+    from robot.motion import motion_model
 
     spec = load_world(args.world)
     start, goal = _pose(spec, args.start), _pose(spec, args.goal)

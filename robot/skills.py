@@ -31,7 +31,6 @@ from tasker.world import Pose
 if TYPE_CHECKING:
     from robot.sim import Simulation
 
-APPROACH = 0.9  # metres from a person's centre when navigating "to" them
 BLOCK_TIMEOUT = 5.0  # seconds a blocked path is retried before the skill fails
 CHECK_PERIOD = 0.2  # seconds between checks of the path ahead
 
@@ -53,6 +52,12 @@ class Skill:
     def stop(self, now: float) -> None:
         if self.result is RUNNING:
             self.result = failed("stopped")
+
+    def quiet_until(self) -> float:
+        """Until when :meth:`control` certainly returns STOP and changes nothing: a timed
+        skill until its end, a finished one forever.  The simulation skips physics and
+        control ticks up to then when nothing else moves."""
+        return self.started + self.stage.duration - 1e-6 if self.result is RUNNING else math.inf
 
 
 class Manipulate(Skill):
@@ -95,21 +100,11 @@ class Navigate(Skill):
         return f"navigate needs data['to'] = a place, a person or [x, y, yaw]; got {t!r}"
 
     def _approach(self, name: str) -> Pose | str:
-        """The reachable pose ``APPROACH`` metres from the person, facing them, cheapest first."""
+        """The pose next to the person that the estimates use too (``MotionEstimator.approach``)."""
         p = self.sim.people[name]
         self.person_at = (p.x, p.y)
-        rx, ry, ryaw = self.sim.robot_pose()
-        best: tuple[float, Pose] | None = None
-        for k in range(16):
-            a = 2 * math.pi * k / 16
-            gx, gy = p.x + APPROACH * math.cos(a), p.y + APPROACH * math.sin(a)
-            if not self.sim.scene.free(gx, gy, ignore=(name,)):
-                continue
-            goal = (gx, gy, math.atan2(p.y - gy, p.x - gx))
-            est = self.sim.motion.estimate((rx, ry, ryaw), goal)
-            if est.reachable and (best is None or est.time_s < best[0]):
-                best = (est.time_s, goal)
-        return best[1] if best else f"no reachable pose next to {name}"
+        goal, _ = self.sim.motion.approach(self.sim.robot_pose(), name)
+        return goal if goal is not None else f"no reachable pose next to {name}"
 
     def _replan(self) -> str | None:
         goal = self._goal()
@@ -170,6 +165,10 @@ class Navigate(Skill):
         if self.follower is not None:
             self.follower.brake()
         super().stop(now)
+
+    def quiet_until(self) -> float:
+        done = self.follower is None or self.follower.done
+        return math.inf if done and self.result is not RUNNING else -math.inf
 
     def braking(self) -> bool:
         return self.stopping and self.follower is not None and not self.follower.done
