@@ -29,7 +29,8 @@ from experiments.synthetic import SyntheticScenario
 from tasker.agent import Rates
 from tasker.loop import SimulationLoop
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
-from tasker.reader import Table, load as read_table
+from tasker.reader import Table
+from tasker.reader import load as read_table
 from tasker.stage import Purpose, Stage, StageKind, StagePlan
 from tasker.synthetic import SyntheticTask
 from tasker.task import ArgSpec, TaskContext
