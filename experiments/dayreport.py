@@ -115,8 +115,9 @@ def _mean(values: Sequence[float]) -> float | None:
 
 def _oscillation(starts: Mapping[str, list[float]]) -> float | None:
     """Earliest time a task got its third switch within the window, or None."""
-    hits = [ts[i + OSCILLATION_SWITCHES - 1] for ts in starts.values() for i in range(len(ts) - OSCILLATION_SWITCHES + 1)
-            if ts[i + OSCILLATION_SWITCHES - 1] - ts[i] <= OSCILLATION_WINDOW_S]
+    k = OSCILLATION_SWITCHES - 1
+    hits = [ts[i + k] for ts in starts.values() for i in range(len(ts) - k)
+            if ts[i + k] - ts[i] <= OSCILLATION_WINDOW_S]
     return min(hits) if hits else None
 
 

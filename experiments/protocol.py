@@ -38,6 +38,7 @@ from tasker.task import ArgSpec, TaskContext
 Pose = tuple[float, ...]
 KINDS = ("transport", "fall", "pick_place")
 SUSP, BLOCK = StageKind.SUSPENDABLE, StageKind.BLOCKING
+_RESUME_STAGES = ("go_back", "apologise", "pick_again")
 
 
 @dataclass(frozen=True)
@@ -215,6 +216,7 @@ class DayTask(SyntheticTask):
 
     def _build(self, ctx: TaskContext, start: Pose | None, resume: bool) -> list[Stage]:
         rest = list(ctx.remaining) if ctx.plan is not None else self._template(ctx.args)
+        rest = [st for st in rest if st.action not in _RESUME_STAGES]  # an unfinished resume is rebuilt below
         out: list[Stage] = []
         pose = start
         first = rest[0] if rest else None
@@ -230,8 +232,6 @@ class DayTask(SyntheticTask):
             if "speed" in st.data:
                 origin = st.data["from"]
                 d = _dist(pose if origin is None else origin, st.data["site"]) / st.data["speed"]
-                if st.action == "go_back":
-                    continue  # a go_back left over from an earlier resume is rebuilt above
                 st = Stage(st.action, kind=st.kind, duration=d, skill="timed", data=st.data)
                 pose = st.data["site"]
             out.append(st)
