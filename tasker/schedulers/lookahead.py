@@ -17,11 +17,12 @@ Each decision solves a single-machine sequencing problem over the executing task
            + lateness_weight * cps_j * max(0, C_j - deadline_j)  (deadlines)
            + hazard_weight * max(0, C_j - deadline_j - budget_j) (hazard budgets, per task type)
 
-* the **search** is depth-first branch and bound over orders, children tried best
-  first (so the first leaf is the greedy order), pruned by the lower bound
-  ``C_j >= t + min_i d(i, j)`` for every job not yet placed.  It is exact when it ends
-  within ``node_budget`` expanded nodes, and anytime otherwise: the best order found
-  so far.  The budget counts nodes, never wall time, so traces are reproducible.
+* the **search** starts from a greedy order improved by insertion moves, then runs a
+  depth-first branch and bound over orders, children tried best first, pruned by the
+  lower bound ``C_j >= t + min_i d(i, j)`` for every job not yet placed.  It is exact
+  when it ends within ``node_budget`` (moves evaluated + nodes expanded), and anytime
+  otherwise: the best order found so far.  The budget counts work, never wall time, so
+  traces are reproducible.
 
 The executing task keeps the robot unless the best order that starts with another
 task beats the best order that continues it by the factor ``hysteresis``.
@@ -77,18 +78,65 @@ class Problem:
         return total
 
 
+def _greedy(p: Problem, allowed_first: list[int]) -> list[int]:
+    """Each step, the job whose completion now costs least above its earliest possible one."""
+    order: list[int] = []
+    left = set(range(p.n))
+    t, prev = p.now, -1
+    while left:
+        pool = allowed_first if prev < 0 else sorted(left)
+        best = min(pool, key=lambda j: (p.cost(j, t + (p.first[j] if prev < 0 else p.after[prev][j]))
+                                        - p.cost(j, t + p.dmin[j]), j))
+        t += p.first[best] if prev < 0 else p.after[prev][best]
+        order.append(best)
+        left.discard(best)
+        prev = best
+    return order
+
+
+def _improve(p: Problem, order: list[int], allowed_first: set[int], budget: int) -> tuple[list[int], float, int]:
+    """Insertion local search (move one job elsewhere; first improvement) within ``budget`` evaluations."""
+    best = p.evaluate(order)
+    used = 0
+    improved = True
+    while improved:
+        improved = False
+        for i in range(p.n):
+            for k in range(p.n):
+                if i == k:
+                    continue
+                cand = order[:i] + order[i + 1:]
+                cand.insert(k, order[i])
+                if cand[0] not in allowed_first:
+                    continue
+                if used >= budget:
+                    return order, best, used
+                used += 1
+                v = p.evaluate(cand)
+                if v < best - 1e-9 * max(1.0, abs(best)):
+                    order, best, improved = cand, v, True
+                    break
+            if improved:
+                break
+    return order, best, used
+
+
 def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
           exclude_first: int | None = None) -> tuple[list[int], float, int, bool]:
-    """Best order (branch and bound): ``(order, objective, nodes expanded, exact)``.
+    """Best order: ``(order, objective, nodes expanded, exact)``.
 
-    ``fixed_first`` forces the first job; ``exclude_first`` forbids one as first.
+    A greedy order, improved by insertion moves with up to half the budget, is the
+    incumbent of a depth-first branch and bound that uses the rest; ``exact`` is true
+    when that search ended on its own.  Every evaluated move and every expanded node
+    counts against ``node_budget``.  ``fixed_first`` forces the first job;
+    ``exclude_first`` forbids one as first.
     """
     n = p.n
-    if n == 0:
-        return [], 0.0, 0, True
-    best_order: list[int] = []
-    best = math.inf
-    nodes = 0
+    allowed = [j for j in range(n) if (fixed_first is None or j == fixed_first) and j != exclude_first]
+    if n == 0 or not allowed:
+        return [], (0.0 if n == 0 else math.inf), 0, True
+    best_order, best, nodes = _improve(p, _greedy(p, allowed), set(allowed), node_budget // 2)
+    nodes += n
     exhausted = False
     order: list[int] = []
     placed = [False] * n
@@ -103,10 +151,8 @@ def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
                 best, best_order = acc, list(order)
             return
         children = []
-        for j in range(n):
+        for j in (allowed if prev < 0 else range(n)):
             if placed[j]:
-                continue
-            if prev < 0 and ((fixed_first is not None and j != fixed_first) or j == exclude_first):
                 continue
             c = t + (p.first[j] if prev < 0 else p.after[prev][j])
             children.append((p.cost(j, c) - p.cost(j, t + p.dmin[j]), c, j))
@@ -114,8 +160,7 @@ def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
         for _, c, j in children:
             if nodes >= node_budget:
                 exhausted = True
-                if best_order:
-                    return
+                return
             nodes += 1
             acc_j = acc + p.cost(j, c)
             placed[j] = True
@@ -124,6 +169,8 @@ def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
                 dfs(j, c, acc_j)
             order.pop()
             placed[j] = False
+            if exhausted:
+                return
 
     dfs(-1, p.now, 0.0)
     return best_order, best, nodes, not exhausted
