@@ -3,8 +3,9 @@
 :func:`day_metrics` reads one day's trace (never the model) and returns the TaBSA-like
 metrics — tasks completed per type, completion minus deadline, falls that died,
 interruptions per type and per task, oscillation, how the day ended — plus ours:
-suspensions (interruptions that needed an ``exeSusp``), time spent suspending, and
-switches.  Abandonment and travel distance need the robot's path (robot backend) and
+suspensions (interruptions that needed an ``exeSusp``), time spent suspending,
+switches, and for whole-queue schedulers the longest queue ordered and the decisions
+whose search hit its budget.  Abandonment and travel distance need the robot's path (robot backend) and
 are not computed here.
 
 :func:`run_days` runs N days x schedulers in local processes and :func:`table` writes the
@@ -57,6 +58,7 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
     suspensions = 0
     suspension_time = 0.0
     entered: dict[str, float] = {}
+    longest_order = anytime = 0
     for e in events:
         ev = e["event"]
         if ev == "request":
@@ -74,6 +76,9 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
                 suspension_time += e["t"] - entered.pop(a, e["t"])
         elif ev == "plan" and e.get("purpose") == "genSusp" and e.get("stages"):
             suspensions += 1
+        elif ev == "decision" and "order" in e:  # whole-queue decisions (lookahead)
+            longest_order = max(longest_order, len(e["order"]))
+            anytime += e.get("rule") == "anytime"
     types = sorted(set(kind.values()))
     per_type: dict[str, dict[str, Any]] = {}
     dead: list[float] = []
@@ -106,6 +111,7 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
         "interruptions": sum(interruptions.values()), "suspensions": suspensions,
         "suspension_time_s": suspension_time, "switches": sum(len(v) for v in starts.values()),
         "oscillation_t": oscillation, "ending": ending, "per_type": per_type,
+        "longest_order": longest_order, "anytime_decisions": anytime,
     }
 
 
@@ -190,6 +196,9 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
         ("suspensions with exeSusp (ours)", "suspensions", lambda r: r["suspensions"]),
         ("time suspending (s, ours)", "susp_time", lambda r: r["suspension_time_s"]),
         ("switches (ours)", "switches", lambda r: r["switches"]),
+        ("longest queue ordered (lookahead)", "longest", lambda r: r["longest_order"] or None),
+        ("decisions not proven optimal (lookahead)", "anytime", lambda r: r["anytime_decisions"] if r["longest_order"]
+         else None),
     ]
     return rows
 
