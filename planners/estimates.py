@@ -26,8 +26,8 @@ open and nobody in the way (``estimate_ignoring_doors`` of ``robot``'s estimator
 invalidates a cached plan, and the cached plan is a function of its key alone: the same
 state gives the same estimate whatever ran before (byte-reproducible traces).  The
 plan is then re-timed with the live motion model; docs/planners.md says why that is a
-fair estimate.  A leg the live model finds unreachable is planned again on the live
-travel table (as ``upTsk`` would); still unreachable or unsolvable means ``inf``.
+fair estimate.  A leg the live model finds unreachable, or an unsolvable problem, means
+``inf`` (no other route exists: a path planner's reachability is transitive).
 A planner time-out falls back to the template walk and says so in
 :attr:`Estimate.note`.  No wall-clock value enters an estimate.
 """
@@ -77,7 +77,7 @@ class Estimate:
     """``cTime`` (s, ``inf`` when the task cannot be completed), ``endPose`` and where they came from.
 
     ``steps`` are the ground actions timed (for tests and tools); ``note`` says why a
-    fallback was taken (a planner time-out, a live re-plan).
+    fallback was taken (a planner time-out) or why the estimate is ``inf``.
     """
 
     c_time: float
@@ -96,20 +96,24 @@ class Estimate:
 
 
 def walk(stages: Sequence[Stage], start: Pose | None, world: WorldState | None, motion: Any,
-         elapsed: float = 0.0) -> tuple[float, Pose | None]:
+         elapsed: float = 0.0, through_door: Callable[[Stage], bool] | None = None) -> tuple[float, Pose | None]:
     """Seconds to run ``stages`` from ``start`` and the pose at the end; ``(inf, None)`` if a leg
     is unreachable.
 
     A ``navigate`` stage whose target has a pose in ``world`` is timed by ``motion`` from
-    the pose reached so far; any other stage takes its duration.  ``elapsed`` seconds of
-    the first stage have already run (a navigate leg is re-timed from ``start`` instead).
+    the pose reached so far (with ``estimate_ignoring_doors`` when ``through_door`` says
+    the leg crosses a door the plan opens, as :func:`~planners.problem.travel_table`
+    does); any other stage takes its duration.  ``elapsed`` seconds of the first stage
+    have already run (a navigate leg is re-timed from ``start`` instead).
     """
     pose = start
     total = 0.0
+    ignoring = getattr(motion, "estimate_ignoring_doors", None)
     for k, s in enumerate(stages):
         target = world.poses.get(str(s.data.get("to"))) if (world is not None and s.skill == NAVIGATE) else None
         if target is not None and pose is not None and motion is not None:
-            est = motion.estimate(pose, target)
+            door = ignoring is not None and through_door is not None and through_door(s)
+            est = ignoring(pose, target) if (door and ignoring is not None) else motion.estimate(pose, target)
             if not est.reachable:
                 return math.inf, None
             total += float(est.time_s)
@@ -165,11 +169,10 @@ class _Cached:
 
 @dataclass(slots=True)
 class EstimatorStats:
-    """Counters (no clock): planner calls, cache hits, live re-plans, time-outs."""
+    """Counters (no clock): planner calls, cache hits, time-outs."""
 
     solves: int = 0
     hits: int = 0
-    live_replans: int = 0
     timeouts: int = 0
 
 
@@ -261,19 +264,7 @@ class Estimator:
         if status is not PlanStatus.SOLVED:
             return Estimate(math.inf, None, Source.UNSOLVABLE, note=note or f"no plan reaches {goal}")
         stages = task.builder.from_steps(steps, {}, ctx.args)
-        est = self._timed(stages, start, world, ctx.motion, Source.PLAN, steps=steps)
-        if est.source is not Source.UNSOLVABLE:
-            return est
-        # a leg of the reference plan is unreachable now (a closed door, someone in the way):
-        # plan on the live travel table, as upTsk would
-        self.stats.live_replans += 1
-        live = travel_table(hworld, ctx.motion, task.spec.travel_s)
-        steps, status, note = self._plan(ctx, hworld, goal, extra, travel=live)
-        if status is not PlanStatus.SOLVED:
-            return Estimate(math.inf, None, Source.UNSOLVABLE, note=note or "unreachable on live travel times")
-        stages = task.builder.from_steps(steps, {}, ctx.args)
-        return self._timed(stages, start, world, ctx.motion, Source.PLAN, steps=steps,
-                           note="re-planned on live travel times")
+        return self._timed(stages, start, world, ctx.motion, Source.PLAN, steps=steps)
 
     def _template(self, ctx: TaskContext, start: Pose | None, note: str) -> Estimate:
         world = ctx.world
@@ -282,15 +273,31 @@ class Estimator:
         stages = task.builder.from_templates(task.spec.static_update, Bindings(ctx.args, world), {}, ctx.suspended)
         return self._timed(stages, start, world, ctx.motion, Source.TEMPLATE, note=note)
 
-    @staticmethod
-    def _timed(stages: Sequence[Stage], start: Pose | None, world: WorldState, motion: Any, source: Source,
+    def _timed(self, stages: Sequence[Stage], start: Pose | None, world: WorldState, motion: Any, source: Source,
                *, elapsed: float = 0.0, steps: tuple[PlanStep, ...] | None = None, note: str = "") -> Estimate:
-        c_time, end = walk(stages, start, world, motion, elapsed)
+        c_time, end = walk(stages, start, world, motion, elapsed, self._door_check(world))
         if steps is None:
             steps = tuple((s.action, *s.args) for s in stages)
         if not math.isfinite(c_time):
             return Estimate(math.inf, None, Source.UNSOLVABLE, steps, note or "a leg is unreachable")
         return Estimate(c_time, end, source, steps, note)
+
+    def _door_check(self, world: WorldState) -> Callable[[Stage], bool] | None:
+        """Does a stage travel between places joined by a ``door_between`` fact (a door the plan opens)?"""
+        pairs = {(f[2], f[3]) for f in world.matching("door_between") if len(f) == 4}
+        if not pairs:
+            return None
+        task = self.task
+
+        def check(stage: Stage) -> bool:
+            spec = task.spec.actions.get(stage.action)
+            model = task.domain.actions.get(stage.action)
+            if spec is None or spec.travel is None or model is None:
+                return False
+            bind = {f"?{p}": a for p, a in zip(model.params, stage.args, strict=False)}
+            return (bind.get(spec.travel[0]), bind.get(spec.travel[1])) in pairs
+
+        return check
 
     def _plan(self, ctx: TaskContext, world: WorldState, goal: list[Literal], extra: list[Literal],
               travel: Travel | None = None) -> tuple[tuple[PlanStep, ...], PlanStatus, str]:

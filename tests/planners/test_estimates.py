@@ -256,3 +256,29 @@ def test_without_world_the_declared_template_time(task: PddlTaskType) -> None:
     ctx = replace(make_ctx(task), world=None)
     est = estimator_for(task).estimate(ctx)
     assert est.source is Source.DECLARED and est.c_time == task._declared_template_time() > 0
+
+
+class _ClosedDoors:
+    """Straight lines, but the bedroom is behind a closed door unless doors are ignored."""
+
+    def __init__(self, bedroom: Pose) -> None:
+        self.closed = StraightLineMotion(blocked=frozenset({bedroom}))
+        self.open = StraightLineMotion()
+        self.ignoring = 0
+
+    def estimate(self, start: Pose, goal: Pose) -> object:
+        return self.closed.estimate(start, goal)
+
+    def estimate_ignoring_doors(self, start: Pose, goal: Pose) -> object:
+        self.ignoring += 1
+        return self.open.estimate(start, goal)
+
+
+def test_a_leg_through_a_door_the_plan_opens_is_timed_with_the_door_open(tasks: dict[str, PddlTaskType]) -> None:
+    task = tasks["carry_object"]
+    ctx = make_ctx(task)
+    motion = _ClosedDoors(ctx.world.poses["bedroom"])
+    est = Estimator(task).estimate(make_ctx(task, motion=motion))
+    assert est.source is Source.PLAN and math.isfinite(est.c_time), est.note
+    assert est.c_time == pytest.approx(executed(task, ctx))  # the same legs as with no door at all
+    assert motion.ignoring > 0
