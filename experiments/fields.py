@@ -43,6 +43,13 @@ class Fields:
             raise self.error(key, f"expected a positive number, got {value!r}")
         return value
 
+    def seed(self, key: str, default: int) -> int:
+        """A seed: an integer ``0 <= seed < 2**32`` (what NumPy, OMPL and MuJoCo accept)."""
+        value = self.get(key, int, default)
+        if not 0 <= value < 2**32:
+            raise self.error(key, f"expected a seed 0 <= seed < 2**32, got {value}")
+        return int(value)
+
     def sub(self, key: str, default: Any = ...) -> Fields:
         return Fields(self.source, self.path(key), self.get(key, dict, default))
 

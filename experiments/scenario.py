@@ -126,7 +126,7 @@ def load(path: str | Path) -> RobotScenario:
         task_exe_rate=s.get("task_exe_rate", float, 10.0, positive=True),
         sp_up_rate=s.get("sp_up_rate", float, 1.0, positive=True),
         update=_strategy(s, "update"), suspension=_strategy(s, "suspension"), strategies=strategies,
-        seed=top.get("seed", int, 1), horizon=s.get("horizon", float, 1800.0, positive=True), people=people,
+        seed=top.seed("seed", 1), horizon=s.get("horizon", float, 1800.0, positive=True), people=people,
     )
     s.done()
     top.done()
@@ -180,3 +180,4 @@ def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, 
         people[name] = e
     return dataclasses.replace(scenario, actions=tuple(sorted(actions, key=lambda a: a.t)), people=people,
                                seed=seed, name=f"{scenario.name}~{seed}")
+

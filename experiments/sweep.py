@@ -110,6 +110,7 @@ class Job:
     source: str
     seed: int
     strategy: Strategy
+    task_paths: tuple[str, ...] = ()  # absolute task folders (--path), so a Dask worker elsewhere loads the same
 
     @property
     def key(self) -> JobKey:
@@ -125,6 +126,7 @@ class SweepSpec:
     strategies: tuple[Strategy, ...]
     name: str = "sweep"
     sources: Mapping[str, str] = field(default_factory=dict)
+    task_paths: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if not self.scenarios:
@@ -140,7 +142,7 @@ class SweepSpec:
 
     def jobs(self) -> list[Job]:
         """Every job, scenario-major then seed then strategy (so paired runs finish close together)."""
-        return [Job(sc, self.sources.get(sc, sc), seed, st)
+        return [Job(sc, self.sources.get(sc, sc), seed, st, self.task_paths)
                 for sc in self.scenarios for seed in self.seeds for st in self.strategies]
 
     def to_json(self) -> dict[str, Any]:
@@ -245,6 +247,10 @@ def load_spec(path: str | Path) -> SweepSpec:
         seeds = tuple(seeds_raw)
     else:
         raise err("seeds", f"expected a count or a non-empty list of integers, got {seeds_raw!r}")
+    if not (0 <= min(seeds) and max(seeds) < 2**32):
+        bad = next(s for s in seeds if not 0 <= s < 2**32)
+        raise err("seed_start" if isinstance(seeds_raw, int) else f"seeds[{seeds.index(bad)}]",
+                  f"seeds must be 0 <= seed < 2**32, got {bad}")
 
     strategies_raw = raw["strategies"]
     if not isinstance(strategies_raw, list) or not strategies_raw:
@@ -277,7 +283,8 @@ def run_job(job: Job) -> tuple[dict[str, Any], dict[str, Any]]:
     from experiments.runner import run_scenario  # imported in the worker, never shared across processes
 
     result = run_scenario(job.source, seed=job.seed, update=job.strategy.update,
-                          suspension=job.strategy.suspension, scheduler=job.strategy.scheduler, randomize=True)
+                          suspension=job.strategy.suspension, scheduler=job.strategy.scheduler, randomize=True,
+                          task_paths=job.task_paths)
     return dict(result.record), dict(result.metrics)
 
 

@@ -125,7 +125,7 @@ def load(path: str | Path) -> SyntheticScenario:
                     settings.get("task_exe_rate", float, 10.0, positive=True),
                     settings.get("sp_up_rate", float, 1.0, positive=True)),
         jitter=settings.get("jitter", float, 0.0),
-        seed=top.get("seed", int, 0),
+        seed=top.seed("seed", 0),
         horizon=settings.get("horizon", float, 24 * 3600.0, positive=True),
     )
     settings.done()
