@@ -51,12 +51,11 @@ def content_key(kind: str, parts: Iterable[str | bytes]) -> str:
     return h.hexdigest()
 
 
-def folder_parts(folder: Path) -> list[str | bytes]:
-    """Every file of a task folder that a check reads (name and bytes), in a fixed order."""
+def file_parts(files: Iterable[Path]) -> list[str | bytes]:
+    """The names and bytes of the files a check reads (a missing one counts as absent)."""
     parts: list[str | bytes] = []
-    for p in sorted(folder.iterdir()):
-        if p.is_file() and p.suffix in (".toml", ".pddl", ".py"):
-            parts += [p.name, p.read_bytes()]
+    for p in files:
+        parts += [p.name, p.read_bytes() if p.is_file() else b"\0absent"]
     return parts
 
 

@@ -114,7 +114,9 @@ def load_task(folder: str | Path, *, use_cache: bool = True) -> PddlTaskType:
     dm = DomainModel(load_domain(spec.domain_file))
     _cross_check(spec, dm)
     task = PddlTaskType(spec, dm, hooks=_load_hooks(spec))
-    key = cache.content_key("task-folder", cache.folder_parts(folder))
+    # what the checks read: task.toml, the domain and task.py (not, e.g., a problem.pddl lying beside them)
+    key = cache.content_key("task-folder", cache.file_parts([folder / "task.toml", spec.domain_file,
+                                                              folder / "task.py"]))
     if not (use_cache and cache.passed("task-folder", key)):
         _check_example(task)
         cache.record("task-folder", key, {"folder": str(folder.resolve()), "name": spec.name})
