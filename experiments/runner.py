@@ -51,8 +51,10 @@ class RunResult:
 
 def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None = None,
                 suspension: str | None = None, scheduler: str | None = None,
-                trace: Trace | None = None) -> tuple[SimulationLoop, Any]:
-    """The loop and the simulation for a robot scenario, with every request and event scheduled."""
+                trace: Trace | None = None, task_paths: tuple[str, ...] = ()) -> tuple[SimulationLoop, Any]:
+    """The loop and the simulation for a robot scenario, with every request and event scheduled.
+
+    ``task_paths`` are task folders loaded besides the bundled ones and ``$TASKER_TASKS``."""
     from planners.bundled import task_types
     from robot.sim import Simulation
     from robot.spec import load_world
@@ -72,7 +74,7 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
             people[name] = dataclasses.replace(people[name], **changes)
         spec = dataclasses.replace(spec, people=people)
     sim = Simulation(spec, seed=seed)
-    store = TaskStore(task_types())
+    store = TaskStore(task_types(task_paths))
     default = Strategy(update or scn.update, suspension or scn.suspension)
     per_type = {t: Strategy(update or s.get("update", default.update), suspension or s.get("suspension",
                                                                                            default.suspension))
@@ -121,8 +123,10 @@ def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: TimedAction
 def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | None = None,
                  update: str | None = None, suspension: str | None = None, scheduler: str | None = None,
                  mode: str | None = None, out: Path | None = None, randomize: bool = False,
-                 progress: bool = False, pictures: bool = True) -> RunResult:
-    """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced."""
+                 progress: bool = False, pictures: bool = True, task_paths: tuple[str, ...] = ()) -> RunResult:
+    """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced.
+
+    ``task_paths``: task folders to load besides the bundled ones (``tasker run --path``)."""
     if isinstance(source, scenarios.RobotScenario):
         kind, scn_path = "robot", Path(source.source)
     else:
@@ -143,7 +147,8 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
             scn = scenarios.randomize(scn, run_seed)
         if mode is not None:
             scn = dataclasses.replace(scn, mode=mode)
-        loop, sim = build_robot(scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler)
+        loop, sim = build_robot(scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler,
+                                task_paths=task_paths)
         spec_json = {"kind": "robot", **scn.to_json()}
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")

@@ -121,6 +121,7 @@ class Job:
     source: str
     seed: int
     strategy: Strategy
+    task_paths: tuple[str, ...] = ()  # absolute task folders (--path), so a Dask worker elsewhere loads the same
 
     @property
     def key(self) -> JobKey:
@@ -136,6 +137,7 @@ class SweepSpec:
     strategies: tuple[Strategy, ...]
     name: str = "sweep"
     sources: Mapping[str, str] = field(default_factory=dict)
+    task_paths: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if not self.scenarios:
@@ -154,7 +156,7 @@ class SweepSpec:
 
     def jobs(self) -> list[Job]:
         """Every job, scenario-major then seed then strategy (so paired runs finish close together)."""
-        return [Job(sc, self.sources.get(sc, sc), seed, st)
+        return [Job(sc, self.sources.get(sc, sc), seed, st, self.task_paths)
                 for sc in self.scenarios for seed in self.seeds for st in self.strategies]
 
     def to_json(self) -> dict[str, Any]:
@@ -298,7 +300,8 @@ def run_job(job: Job) -> tuple[dict[str, Any], dict[str, Any]]:
     from experiments.runner import run_scenario  # imported in the worker, never shared across processes
 
     result = run_scenario(job.source, seed=job.seed, update=job.strategy.update,
-                          suspension=job.strategy.suspension, scheduler=job.strategy.scheduler, randomize=True)
+                          suspension=job.strategy.suspension, scheduler=job.strategy.scheduler, randomize=True,
+                          task_paths=job.task_paths)
     return dict(result.record), dict(result.metrics)
 
 
