@@ -132,7 +132,8 @@ class Checker:
             self.attempt(p, "synthetic scenario", lambda: synthetic.load(p))
             return
         loaded: list[Any] = []
-        if not self.attempt(p, "robot scenario", lambda: loaded.append(scenarios.load(p))):
+        paths = [*self.paths, *also]
+        if not self.attempt(p, "robot scenario", lambda: loaded.append(scenarios.load(p, task_paths=paths))):
             return
         scn = loaded[0]
         world: list[Any] = []

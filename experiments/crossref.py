@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 from experiments import fields
 from experiments.actions import TimedAction, located
+from tasker.cliargs import TASKS_HINT
 from tasker.errors import TaskerError
 from tasker.reader import Table, check_name, suggest
 
@@ -142,7 +143,7 @@ class _Checker:
         fields.scheduler_options(s, self.scn.scheduler, names)
         st = s.table("strategies", {})
         for task in self.scn.strategies:
-            check_name(st, task, task, names, "task type")
+            check_name(st, task, task, names, "task type", TASKS_HINT)
 
     def scenario_objects(self) -> None:
         ot = self.top.table("objects", {})
@@ -240,7 +241,7 @@ class _Checker:
             if a.t > self.scn.horizon:
                 self.warn(f, "t", f"t={a.t:g} is after the horizon ({self.scn.horizon:g} s): it never happens")
             if a.kind == "request":
-                check_name(f, "task", a.fields["task"], names, "task type")
+                check_name(f, "task", a.fields["task"], names, "task type", TASKS_HINT)
                 task = self.tasks[a.fields["task"]]
                 checked = self.validate(f, task, a.fields["args"])
                 self.args(f, task, a.fields["args"], checked)

@@ -10,6 +10,7 @@ from __future__ import annotations
 from typing import Any
 
 from tasker import schedulers
+from tasker.cliargs import TASKS_HINT
 from tasker.reader import InputError, Table
 
 MODES = ("IT", "CT")
@@ -41,7 +42,7 @@ def scheduler_options(s: Table, name: str, task_names: list[str] | None = None) 
             for t in named:
                 if t not in task_names:
                     raise opts.error(key, f"no task type {t!r}{_suggest(t, task_names)} "
-                                          f"(known: {', '.join(sorted(task_names))})")
+                                          f"(known: {', '.join(sorted(task_names))}); {TASKS_HINT}")
     try:
         schedulers.create(name, **options)
     except Exception as exc:  # the scheduler's own check, e.g. hysteresis out of range

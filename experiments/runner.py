@@ -141,7 +141,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         spec_json: dict[str, Any] = {"kind": "synthetic", "name": syn.name, "source": str(scn_path)}
         sim = None
     elif kind == "robot":
-        scn = source if isinstance(source, scenarios.RobotScenario) else scenarios.load(scn_path)
+        scn = source if isinstance(source, scenarios.RobotScenario) else scenarios.load(scn_path, task_paths=task_paths)
         run_seed = scn.seed if seed is None else seed
         if randomize:
             scn = scenarios.randomize(scn, run_seed)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import random
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -90,7 +91,7 @@ def kind_of(path: Path) -> str:
     return str(top.string("kind", "synthetic", choices=("robot", "synthetic")))
 
 
-def load(path: str | Path, *, check: bool = True) -> RobotScenario:
+def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()) -> RobotScenario:
     """Read and check a robot scenario (``kind = "robot"``).
 
     With ``check`` (the default) every cross-reference is checked against the world and
@@ -165,8 +166,9 @@ def load(path: str | Path, *, check: bool = True) -> RobotScenario:
         fields.scheduler_options(s, sched)
         return scenario
     from experiments import crossref
+    from planners.bundled import task_types
 
-    return crossref.check_robot(scenario, top)
+    return crossref.check_robot(scenario, top, task_types(list(task_paths)))
 
 
 def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, pose_jitter: float = 0.5

@@ -600,10 +600,12 @@ def precheck(jobs: Iterable[Job]) -> None:
     from experiments import scenario as scenarios
     from experiments import synthetic
 
+    jobs = list(jobs)
+    paths = {j.source: j.task_paths for j in jobs}
     for source in sorted({j.source for j in jobs}):
         path = scenarios.resolve(source)
         if scenarios.kind_of(path) == "robot":
-            scenarios.load(path)
+            scenarios.load(path, task_paths=paths.get(source, ()))
         else:
             synthetic.load(path)
 

@@ -309,11 +309,12 @@ def check_numbers(t: Table, key: str | int, value: Any, n: int, shape: str) -> t
     return tuple(float(v) for v in value)
 
 
-def check_name(t: Table, key: str | int, value: str, known: Iterable[str], what: str) -> None:
-    """``value`` must be one of ``known`` (e.g. a person of the world)."""
+def check_name(t: Table, key: str | int, value: str, known: Iterable[str], what: str, hint: str = "") -> None:
+    """``value`` must be one of ``known`` (e.g. a person of the world); ``hint`` says how to add one."""
     known = sorted(set(known))
     if value not in known:
-        raise t.error(key, f"no {what} {value!r}{suggest(value, known)} (known: {', '.join(known) or 'none'})")
+        raise t.error(key, f"no {what} {value!r}{suggest(value, known)} (known: {', '.join(known) or 'none'})"
+                           + (f"; {hint}" if hint else ""))
 
 
 def _check_finite(t: Table, key: str, value: Any) -> None:

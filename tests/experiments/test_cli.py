@@ -207,17 +207,19 @@ def test_check_lists_every_problem(tmp_path: Path, capsys: pytest.CaptureFixture
     toml.write_text(toml.read_text().replace('skill = "manipulate"', 'skill = "teleport"', 1))
     (tmp_path / "tasks" / "one" / "domain.pddl").write_text("(define (domain one) (:action")
     scn = tmp_path / "s.toml"
-    scn.write_text('kind = "robot"\nworld = "flat"\n[[requests]]\nt = 0\ntask = "fetch"\nargs = {}\n'
-                   '[people.bob]\npose = [1, 1, 0]\n')
+    scn.write_text('kind = "robot"\nworld = "flat"\n[[requests]]\nt = 0\ntask = "fetch"\nargs = {}\n')
+    scn2 = tmp_path / "s2.toml"  # one problem a file: a scenario's reading stops at its first fault
+    scn2.write_text('kind = "robot"\nworld = "flat"\n[[requests]]\nt = 0\ntask = "human_fell"\n'
+                    'args = { person = "anna" }\n[people.bob]\npose = [1, 1, 0]\n')
     capsys.readouterr()
-    assert main(["check", str(tmp_path / "tasks"), str(scn), str(ROOT / "robot" / "worlds"),
+    assert main(["check", str(tmp_path / "tasks"), str(scn), str(scn2), str(ROOT / "robot" / "worlds"),
                  str(ROOT / "experiments" / "sweeps"), str(tmp_path / "nothing")]) == 1
     out = capsys.readouterr().out
     problems = [line for line in out.splitlines() if line.startswith("error")]
     assert any("one/domain.pddl" in p for p in problems)
     assert any("teleport" in p for p in problems)
     assert any("people.bob" in p for p in problems)
-    assert any("unknown task type 'fetch'" in p and "--path DIR" in p for p in problems)
+    assert any("task type 'fetch'" in p and "--path DIR" in p for p in problems)
     assert any("nothing: no such file" in p for p in problems)
     assert "ok     " + str(ROOT / "robot" / "worlds" / "flat.toml") in out
     assert f"{len(problems)} problems" in out
