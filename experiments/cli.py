@@ -17,7 +17,8 @@ from collections.abc import Sequence
 from tasker import __version__
 from tasker.errors import TaskerError
 
-SUBCOMMAND_MODULES = ("experiments.run_cli", "experiments.sweep_cli", "planners.cli", "robot.cli")
+SUBCOMMAND_MODULES = ("experiments.run_cli", "experiments.sweep_cli", "planners.cli", "robot.cli",
+                      "experiments.explain")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -10,6 +10,7 @@ timed stages.  In ``out`` it writes ``trace.jsonl`` (reproducible byte for byte)
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import datetime as _dt
 import json
@@ -143,7 +144,8 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         spec_json = {"kind": "robot", **scn.to_json()}
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")
-    _run(loop, progress)
+    with _journal(kind) as journal:  # the PDDL of every planning call, for problems/
+        _run(loop, progress)
     wall = time.perf_counter() - t0
     trace = loop.trace
     world_spec = None
@@ -165,8 +167,16 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
     }
     metrics = _metrics(trace, calls, wall)
     if out is not None:
-        _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures)
+        _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures, journal)
     return RunResult(record, metrics, trace, trajectory)
+
+
+def _journal(kind: str) -> contextlib.AbstractContextManager[list[Any]]:
+    if kind != "robot":
+        return contextlib.nullcontext([])
+    from planners.pddl_task import planning_journal
+
+    return planning_journal()  # type: ignore[return-value]
 
 
 def _run(loop: SimulationLoop, progress: bool) -> None:
@@ -215,11 +225,15 @@ def _metrics(trace: Trace, calls: list[dict[str, Any]], wall: float) -> dict[str
 
 
 def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Trace,
-          trajectory: tuple[tuple[float, float, float, float], ...], world: Any, pictures: bool) -> None:
+          trajectory: tuple[tuple[float, float, float, float], ...], world: Any, pictures: bool,
+          journal: Any = ()) -> None:
+    from experiments.explain import write_problems
+
     out.mkdir(parents=True, exist_ok=True)
     trace.write(out / "trace.jsonl")
     (out / "run.json").write_text(json.dumps(record, indent=2, sort_keys=True, default=str) + "\n")
     (out / "metrics.json").write_text(json.dumps(metrics_, indent=2, sort_keys=True) + "\n")
+    write_problems(out / "problems", journal)
     if not pictures:
         return
     from experiments import plots
