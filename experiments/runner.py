@@ -176,7 +176,7 @@ def _journal(kind: str) -> contextlib.AbstractContextManager[list[Any]]:
         return contextlib.nullcontext([])
     from planners.pddl_task import planning_journal
 
-    return planning_journal()  # type: ignore[return-value]
+    return planning_journal()
 
 
 def _run(loop: SimulationLoop, progress: bool) -> None:
