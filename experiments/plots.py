@@ -216,7 +216,7 @@ def timeline_figure(events: Sequence[Event], *, title: str | None = None) -> Fig
         _plot_keys(mid, costs, RATES)
         top.set_ylabel("cost")
         mid.set_ylabel("rate [cost/s]")
-        panels = (top, mid)
+        panels: tuple[Axes, ...] = (top, mid)
     else:  # priority class or a baseline: no costs to draw, but when it decided and switched
         top, bottom = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [1.2, 1.6]})
         _decision_rug(top, events)
