@@ -236,9 +236,10 @@ def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Tr
     write_problems(out / "problems", journal)
     if not pictures:
         return
-    from experiments import plots
+    from experiments import plots, report_html
 
     plots.timeline(trace.events, out / "timeline.png")
     plots.gantt(trace.events, out / "gantt.png")
+    report_html.write_run(out, trace.events, record=record, metrics=metrics_, world=world, trajectory=trajectory)
     if world is not None:
         plots.world_path(world, list(trajectory), out / "world.png")
