@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 import plotly.graph_objects as go
+import plotly.io as pio
 from plotly.offline import get_plotlyjs
 from plotly.subplots import make_subplots
 
@@ -78,8 +79,10 @@ def page(title: str, sections: Iterable[str]) -> str:
         f"<h1>{html.escape(title)}</h1>", *sections, "</body></html>", ""])
 
 
-def figure_div(fig: go.Figure, div_id: str) -> str:
-    return str(fig.to_html(full_html=False, include_plotlyjs=False, div_id=div_id, config=_CONFIG))
+def figure_div(fig: go.Figure | dict[str, Any], div_id: str) -> str:
+    """A figure (or a figure dict, already valid: not validated again) as a ``<div>`` and its script."""
+    return str(pio.to_html(fig, full_html=False, include_plotlyjs=False, div_id=div_id, config=_CONFIG,
+                           validate=not isinstance(fig, dict)))
 
 
 def table(header: Sequence[str], rows: Iterable[Sequence[Any]], numeric: Sequence[bool] = ()) -> str:
@@ -129,12 +132,22 @@ def _roles_bars(fig: go.Figure, events: Sequence[Event], hazards: Sequence[tuple
     fig.update_yaxes(categoryorder="array", categoryarray=cats[::-1], row=row, col=1)
 
 
-def _mark_commands(fig: go.Figure, events: Sequence[Event]) -> None:
+def _mark_commands(events: Sequence[Event], panels: int = 1) -> list[dict[str, Any]]:
+    """Vertical lines on every panel: ``susp`` red dashed, ``start`` green dotted, a switch decided
+    by priority class (or a baseline) purple.  Built as plain shapes, set once (fast)."""
+    lines = []
     for e in events:
         if e["event"] == "command" and e["flag"] in ("susp", "start"):
             susp = e["flag"] == "susp"
-            fig.add_vline(x=float(e["t"]), line_width=1, line_dash="dash" if susp else "dot",
-                          line_color="#c0392b" if susp else "#2e8b57", opacity=0.6)
+            lines.append((float(e["t"]), "#c0392b" if susp else "#2e8b57", "dash" if susp else "dot"))
+        elif e["event"] == "decision" and e.get("rule") != "cost" and e.get("switch"):
+            lines.append((float(e["t"]), "#8e44ad", "solid"))
+    shapes = []
+    for i in range(1, panels + 1):
+        axis = "" if i == 1 else str(i)
+        shapes += [{"type": "line", "x0": t, "x1": t, "y0": 0, "y1": 1, "xref": f"x{axis}", "yref": f"y{axis} domain",
+                    "line": {"color": colour, "dash": dash, "width": 1}, "opacity": 0.6} for t, colour, dash in lines]
+    return shapes
 
 
 def timeline_figure(events: Sequence[Event], hazards: Sequence[tuple[str, str, float, float]] = ()) -> go.Figure:
@@ -164,12 +177,9 @@ def timeline_figure(events: Sequence[Event], hazards: Sequence[tuple[str, str, f
                     "color": "#8e44ad"},
             text=[f"{e.get('rule')}: dac={e.get('dac')}, exeDA={e.get('exeDA')}, switch={e.get('switch')}"
                   for e in decisions], hovertemplate="%{text} at %{x:.1f} s<extra></extra>"), row=1, col=1)
-        for e in decisions:
-            if e.get("switch") and costs:
-                fig.add_vline(x=float(e["t"]), line_color="#8e44ad", line_width=1, opacity=0.6)
     _roles_bars(fig, events, hazards, 3, t_end)
-    _mark_commands(fig, events)
-    fig.update_layout(barmode="overlay", height=720, template="plotly_white", hovermode="closest",
+    fig.update_layout(shapes=_mark_commands(events, panels=3), barmode="overlay", height=720,
+                      template="plotly_white", hovermode="closest",
                       legend={"groupclick": "toggleitem"}, margin={"t": 40, "r": 10})
     fig.update_xaxes(range=[0, t_end * 1.01])
     fig.update_xaxes(title_text="time [s] (red dashed: susp, green dotted: start, purple: decision by priority)",
@@ -252,8 +262,8 @@ def gantt_figure(events: Sequence[Event]) -> go.Figure:
                                  mode="text", textposition="middle right", textfont={"size": 10,
                                                                                      "color": [n[3] for n in names]},
                                  name="stage names", hoverinfo="skip"))
-    _mark_commands(fig, events)
-    fig.update_layout(barmode="overlay", height=140 + 34 * max(y, 2.0), template="plotly_white",
+    fig.update_layout(shapes=_mark_commands(events), barmode="overlay", height=140 + 34 * max(y, 2.0),
+                      template="plotly_white",
                       margin={"t": 30, "r": 10}, legend={"groupclick": "toggleitem"},
                       xaxis_title="time [s] (hover a stage for its arguments)")
     fig.update_yaxes(tickvals=[t[0] for t in ticks], ticktext=[t[1] for t in ticks], autorange="reversed",
@@ -338,9 +348,10 @@ _FILL = {"wall": "#444", "furniture": "#c8b48a", "door": "#7a4f2a"}
 
 
 def world_figure(world: Any, robot: Sequence[Sample], people: Mapping[str, Sequence[tuple[float, float, float, str]]],
-                 events: Sequence[Event], hazards: Sequence[tuple[str, str, float, float]]) -> go.Figure:
+                 events: Sequence[Event], hazards: Sequence[tuple[str, str, float, float]]) -> dict[str, Any]:
     """The world from above, a time slider over the trajectory: the robot, its path so far,
-    people, the hazards on and the agent executing at that moment."""
+    people, the hazards on and the agent executing at that moment.  A figure dict: its
+    frames are built as plain data (validating hundreds of frames would cost seconds)."""
     robot = _thin(robot, MAX_POINTS)
     people = {n: _thin(track, MAX_POINTS) for n, track in people.items()} or _people_from_trace(world, events)
     fig = go.Figure()
@@ -367,16 +378,13 @@ def world_figure(world: Any, robot: Sequence[Sample], people: Mapping[str, Seque
     times = [round(t_end * i / (n - 1), 3) for i in range(n)]
     suspended = _suspension_spans(events, t_end)
     roles = [(float(e["t"]), e.get("exeDA")) for e in events if e["event"] == "roles"]
-    frames = []
-    for t in times:
-        frames.append(go.Frame(name=f"{t:g}", data=_world_state(t, robot, people), traces=[2, 3, 4],
-                               layout={"title": {"text": _world_title(t, hazards, suspended, roles, t_end)}}))
+    frames = [{"name": f"{t:g}", "data": _world_state(t, robot, people), "traces": [2, 3, 4],
+               "layout": {"title": {"text": _world_title(t, hazards, suspended, roles, t_end)}}} for t in times]
     for trace in _world_state(times[0], robot, people):
-        fig.add_trace(trace)
+        fig.add_trace(go.Scatter(**{k: v for k, v in trace.items() if k != "type"}))
     (x0, y0), (x1, y1) = world.bounds
     steps = [{"method": "animate", "label": f"{t:.0f}", "args": [[f"{t:g}"], {"mode": "immediate",
              "frame": {"duration": 0, "redraw": True}, "transition": {"duration": 0}}]} for t in times]
-    fig.frames = frames
     fig.update_layout(
         shapes=shapes, annotations=annotations, template="plotly_white", height=680,
         margin={"t": 60, "r": 10, "b": 130},
@@ -391,7 +399,9 @@ def world_figure(world: Any, robot: Sequence[Sample], people: Mapping[str, Seque
                                                    "transition": {"duration": 0}}]},
                                   {"label": "❚❚ pause", "method": "animate",
                                    "args": [[None], {"mode": "immediate", "frame": {"duration": 0}}]}]}])
-    return fig
+    out: dict[str, Any] = fig.to_dict()
+    out["frames"] = frames
+    return out
 
 
 def _people_from_trace(world: Any, events: Sequence[Event]) -> dict[str, list[tuple[float, float, float, str]]]:
@@ -407,22 +417,23 @@ def _people_from_trace(world: Any, events: Sequence[Event]) -> dict[str, list[tu
 
 
 def _world_state(t: float, robot: Sequence[Sample], people: Mapping[str, Sequence[tuple[float, float, float, str]]]
-                 ) -> list[go.Scatter]:
-    """Traces 2–4 of the world figure at time ``t``: path so far, robot, people."""
+                 ) -> list[dict[str, Any]]:
+    """Traces 2–4 of the world figure at time ``t`` (plain dicts): path so far, robot, people."""
     done = [s for s in robot if s[0] <= t] or list(robot[:1])
     r = _at(robot, t)
     heading = ([r[1], r[1] + 0.45 * math.cos(r[3])], [r[2], r[2] + 0.45 * math.sin(r[3])]) if r else ([], [])
     now = {name: _at(track, t) for name, track in people.items()}
     return [
-        go.Scatter(x=[s[1] for s in done] + [None] + heading[0], y=[s[2] for s in done] + [None] + heading[1],
-                   mode="lines", name="path so far", line={"color": "#1f5fbf", "width": 2.5}, hoverinfo="skip"),
-        go.Scatter(x=[r[1]] if r else [], y=[r[2]] if r else [], mode="markers", name="robot",
-                   marker={"symbol": "pentagon", "size": 16, "color": "#1f5fbf"},
-                   hovertemplate="robot %{x:.2f}, %{y:.2f}<extra></extra>"),
-        go.Scatter(x=[p[1] for p in now.values() if p], y=[p[2] for p in now.values() if p],
-                   text=[f"{n} ({p[3]})" if p[3] else n for n, p in now.items() if p], mode="markers+text",
-                   textposition="top center", name="people", marker={"size": 13, "color": "#c0392b"},
-                   hoverinfo="text"),
+        {"type": "scatter", "x": [s[1] for s in done] + [None] + heading[0],
+         "y": [s[2] for s in done] + [None] + heading[1], "mode": "lines", "name": "path so far",
+         "line": {"color": "#1f5fbf", "width": 2.5}, "hoverinfo": "skip"},
+        {"type": "scatter", "x": [r[1]] if r else [], "y": [r[2]] if r else [], "mode": "markers", "name": "robot",
+         "marker": {"symbol": "pentagon", "size": 16, "color": "#1f5fbf"},
+         "hovertemplate": "robot %{x:.2f}, %{y:.2f}<extra></extra>"},
+        {"type": "scatter", "x": [p[1] for p in now.values() if p], "y": [p[2] for p in now.values() if p],
+         "text": [f"{n} ({p[3]})" if p[3] else n for n, p in now.items() if p], "mode": "markers+text",
+         "textposition": "top center", "name": "people", "marker": {"size": 13, "color": "#c0392b"},
+         "hoverinfo": "text"},
     ]
 
 

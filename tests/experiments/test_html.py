@@ -62,7 +62,7 @@ def test_timeline_separates_costs_rates_roles_and_hazards(events: list[dict[str,
     assert by_axis["y3"] >= {"exeDA", "idleDA", "hazard on"}
     bar = next(t for t in fig.data if t.name == "hazard on")
     assert list(bar.base) == [3.0] and list(bar.x) == [6.0] and list(bar.y) == ["d1 hazard: device_on cooker"]
-    susp = [s for s in fig.layout.shapes if s.line.dash == "dash"]
+    susp = [s for s in fig.layout.shapes if s.line.dash == "dash"]  # susp commands
     n_susp = sum(1 for e in events if e["event"] == "command" and e["flag"] == "susp")
     assert n_susp and len(susp) == 3 * n_susp  # one line per panel
 
@@ -96,13 +96,15 @@ def test_world_slider_follows_the_trajectory(events: list[dict[str, Any]]) -> No
     people = {"peter": [(0.0, 8.0, 5.0, "standing"), (30.0, 8.0, 5.0, "fallen")]}
     trace = [*events, {"t": 10.0, **HAZARD, "status": "on"}]
     fig = report_html.world_figure(world, robot, people, trace, report_html.hazards_of(trace, None))
-    assert len(fig.frames) == len(fig.layout.sliders[0].steps) >= 2
-    last = fig.frames[-1]
-    robot_trace = last.data[1]
-    assert robot_trace.name == "robot" and robot_trace.x[0] == pytest.approx(1.0 + 0.1 * 59)
-    assert "peter (fallen)" in last.data[2].text
-    assert "device_on cooker (d1)" in last.layout.title.text
-    assert "hazards on: none" in fig.frames[0].layout.title.text
+    frames = fig["frames"]
+    assert len(frames) == len(fig["layout"]["sliders"][0]["steps"]) >= 2
+    last = frames[-1]
+    robot_trace = last["data"][1]
+    assert robot_trace["name"] == "robot" and robot_trace["x"][0] == pytest.approx(1.0 + 0.1 * 59)
+    assert "peter (fallen)" in last["data"][2]["text"]
+    assert "device_on cooker (d1)" in last["layout"]["title"]["text"]
+    assert "hazards on: none" in frames[0]["layout"]["title"]["text"]
+    assert [t["name"] for t in fig["data"]][2:] == [t["name"] for t in last["data"]]  # frames update traces 2-4
 
 
 @pytest.mark.parametrize("kind", ["jsonl", "csv"])
