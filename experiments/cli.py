@@ -28,6 +28,7 @@ SUBCOMMAND_MODULES = (
     "experiments.check_cli",  # check
     "planners.cli",           # plan, domains, fsm, new
     "robot.cli",              # world, cost
+    "experiments.explain",    # explain
     # Add a subcommand here: a module with ``register(subparsers)`` (e.g. explain, an HTML report).
 )
 """Modules that add subcommands, in the order ``tasker --help`` lists them."""

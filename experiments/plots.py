@@ -1,8 +1,10 @@
 """Plots of a run, drawn from its saved trace (and, for paths, its saved trajectory).
 
-* :func:`timeline` is the paper's Fig. 11: Alg. 2's costs over time above the
-  harmoniser's roles (``exeDA``/``irrDA``/``idleDA``) as coloured bands per agent.
-* :func:`gantt` shows every agent's FSM leaf state over time, with stage actions.
+* :func:`timeline` is the paper's Fig. 11: Alg. 2's costs over time, its cost rates on
+  an axis of their own, above the harmoniser's roles (``exeDA``/``irrDA``/``idleDA``)
+  as coloured bands per agent, with hazards marked.
+* :func:`gantt` shows every agent's FSM leaf state over time, with stage names in
+  lanes that never overlap.
 * :func:`world_path` draws the robot's path over a world with :mod:`robot.picture`.
 
 Plots read events only (STYLE principle 10), draw on bare :class:`Figure` objects
@@ -26,8 +28,13 @@ from tasker.trace import number
 
 Event = Mapping[str, Any]
 
-COST_KEYS = ("cost_dac", "cost_exeDA", "cc_dac", "cc_exeDA", "ccps_dac", "ccps_exeDA", "c_switch", "c_wait")
-"""The Alg. 2 parameters of Fig. 11, in its legend order."""
+COSTS = ("cost_dac", "cost_exeDA", "cc_dac", "cc_exeDA", "c_switch", "c_wait")
+"""Alg. 2's costs of Fig. 11 (discomfort accumulated by completion; they add up)."""
+RATES = ("cps_dac", "cps_exeDA", "ccps_dac", "ccps_exeDA")
+"""Alg. 2's cost rates (cost per second): a scale of their own, so they get their own axis."""
+COST_KEYS = COSTS + RATES
+"""Every Alg. 2 parameter the timeline draws."""
+HAZARD_COLOUR = "#c0392b"
 
 ROLE_COLOURS = {"exeDA": "#2e8b57", "irrDA": "#e67e22", "idleDA": "#b0b0b0"}
 STATES = ("initComm", "compSP", "upTsk", "exeTsk", "genSusp", "exeSusp", "wait")
@@ -60,8 +67,9 @@ def _agents(events: Sequence[Event]) -> dict[str, str]:
 
 
 def _note(ax: Axes, text: str) -> None:
+    """A grey note in an empty panel; the x axis is kept (panels share it: clearing it here
+    would take the time axis away from the panels below)."""
     ax.text(0.5, 0.5, text, ha="center", va="center", transform=ax.transAxes, fontsize=11, color="#666")
-    ax.set_xticks([])
     ax.set_yticks([])
 
 
@@ -126,43 +134,121 @@ def _with_gaps(costs: list[Event]) -> tuple[list[float], list[Event | None]]:
     return out_t, out_e
 
 
+def hazard_spans(events: Sequence[Event], t_end: float) -> list[tuple[str, str, float, float]]:
+    """(agent, hazard label, start, end) from ``hazard`` events (``status`` on/off); a hazard
+    still on at the end of the trace lasts until ``t_end``."""
+    spans: list[tuple[str, str, float, float]] = []
+    on: dict[tuple[str, str], float] = {}
+    for e in events:
+        if e["event"] != "hazard":
+            continue
+        label = " ".join([str(e.get("hazard", "?")), *(str(a) for a in e.get("args") or [])])
+        key = (str(e.get("agent", "?")), label)
+        if e.get("status") == "on":
+            on.setdefault(key, float(e["t"]))
+        elif key in on:
+            spans.append((*key, on.pop(key), float(e["t"])))
+    spans += [(*key, t0, t_end) for key, t0 in on.items()]
+    return sorted(spans, key=lambda s: (s[2], s[0], s[1]))
+
+
+def _mark_other_decisions(axes: Sequence[Axes], events: Sequence[Event]) -> None:
+    """Decisions without costs (priority class, baselines) that switched: a purple line on each panel."""
+    for e in events:
+        if e["event"] == "decision" and e.get("rule") != "cost" and e.get("switch"):
+            for ax in axes:
+                ax.axvline(float(e["t"]), color="#8e44ad", lw=0.8, alpha=0.6)
+
+
+def _decision_rug(ax: Axes, events: Sequence[Event]) -> None:
+    """Without cost decisions: every decision as a tick on a row per rule, switches as diamonds."""
+    decisions = [e for e in events if e["event"] == "decision"]
+    if not decisions:
+        _note(ax, "no decisions")
+        return
+    rules = sorted({str(e.get("rule") or e.get("algorithm", "?")) for e in decisions})
+    row = {r: i for i, r in enumerate(rules)}
+    ys = [row[str(e.get("rule") or e.get("algorithm", "?"))] for e in decisions]
+    ax.plot([float(e["t"]) for e in decisions], ys, "|", color="#8e44ad", ms=8, label="decision")
+    sw = [(float(e["t"]), y) for e, y in zip(decisions, ys, strict=True) if e.get("switch")]
+    if sw:
+        ax.plot(*zip(*sw, strict=True), "D", color="#c0392b", ms=5, label="switch")
+    ax.set_yticks(range(len(rules)), rules, fontsize=8)
+    ax.set_ylim(len(rules) - 0.5, -0.5)
+    ax.set_ylabel("decisions")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.005, 1.0))
+
+
+def _plot_keys(ax: Axes, costs: list[Event], keys: Sequence[str]) -> None:
+    ts, points = _with_gaps(costs)
+    for key in keys:
+        if not any(key in e for e in costs):
+            continue
+        style = "--" if key.startswith("cc") else "-"  # cc_* often equals cost_*: keep both visible
+        (line,) = ax.plot(ts, [_value(e, key) if e else math.nan for e in points], marker=".", ls=style, ms=2.5,
+                          lw=1.2 if style == "-" else 1.0, label=key)
+        inf = [float(e["t"]) for e in costs if _is_inf(e, key)]
+        if inf:  # infinite costs (no way to do the task from there): triangles along the top edge
+            ax.plot(inf, [0.98] * len(inf), "^", ms=3, color=line.get_color(), transform=ax.get_xaxis_transform())
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.005, 1.0))
+
+
 def timeline(events: Sequence[Event], out_png: str | Path, *, title: str | None = None) -> Path:
-    """Fig. 11: Alg. 2's cost parameters over time, the roles below; returns the PNG path."""
+    """Fig. 11: Alg. 2's costs, its cost rates (own axis), and the roles below; returns the PNG path.
+
+    Switches decided by priority class (or by a baseline) are purple lines; ``susp`` commands
+    red dashed, ``start`` green dotted; hazards (``hazard`` events) a red strip under their
+    agent.  Without cost decisions the top panel shows when each rule decided.
+    """
+    return _save(timeline_figure(events, title=title), out_png)
+
+
+def timeline_figure(events: Sequence[Event], *, title: str | None = None) -> Figure:
+    """The figure :func:`timeline` saves (for tests and other outputs)."""
     events = list(events)
-    fig = Figure(figsize=(11, 6), layout="constrained")
-    top, bottom = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.4]})
+    t_end = _end_time(events)
     costs = [e for e in events if e["event"] == "decision" and e.get("rule") == "cost"]
+    fig = Figure(figsize=(11, 7 if costs else 5), layout="constrained")
     if costs:
-        ts, points = _with_gaps(costs)
-        for key in COST_KEYS:
-            (line,) = top.plot(ts, [_value(e, key) if e else math.nan for e in points], ".-", ms=2.5, lw=1, label=key)
-            inf = [float(e["t"]) for e in costs if _is_inf(e, key)]
-            if inf:  # infinite costs (no way to do the task from there): triangles along the top edge
-                top.plot(inf, [0.98] * len(inf), "^", ms=3, color=line.get_color(), transform=top.get_xaxis_transform())
-        top.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.005, 1.0))
-        top.set_ylabel("Alg. 2 parameters")
-        _mark_commands(top, events)
-    else:
-        _note(top, "no decisions")
-    for e in events:  # decisions without costs (priority class, baselines): a tick on top
-        if e["event"] == "decision" and e.get("rule") != "cost" and costs:
-            top.axvline(float(e["t"]), color="#8e44ad", lw=0.6, alpha=0.5)
+        top, mid, bottom = fig.subplots(3, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.2, 1.6]})
+        _plot_keys(top, costs, COSTS)
+        _plot_keys(mid, costs, RATES)
+        top.set_ylabel("cost")
+        mid.set_ylabel("rate [cost/s]")
+        panels: tuple[Axes, ...] = (top, mid)
+    else:  # priority class or a baseline: no costs to draw, but when it decided and switched
+        top, bottom = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [1.2, 1.6]})
+        _decision_rug(top, events)
+        panels = (top,)
+    _mark_other_decisions((*panels, bottom), events)
+    for ax in panels:
+        _mark_commands(ax, events)
     agents = list(_agents(events))
-    spans = _role_spans(events, _end_time(events))
+    spans = _role_spans(events, t_end)
+    hazards = hazard_spans(events, t_end)
     if spans:
         rows = {a: i for i, a in enumerate(agents + sorted({s[0] for s in spans} - set(agents)))}
         for agent, role, t0, t1 in spans:
             bottom.broken_barh([(t0, t1 - t0)], (rows[agent] - 0.4, 0.8), color=ROLE_COLOURS[role])
+        for agent, _, t0, t1 in hazards:
+            if agent in rows:
+                bottom.broken_barh([(t0, max(t1 - t0, 1e-3))], (rows[agent] + 0.28, 0.12), color=HAZARD_COLOUR)
         bottom.set_yticks(range(len(rows)), list(rows), fontsize=8)
         bottom.set_ylim(len(rows) - 0.5, -0.5)
-        bottom.legend(handles=[Patch(color=c, label=r) for r, c in ROLE_COLOURS.items()], fontsize=7,
-                      loc="upper left", bbox_to_anchor=(1.005, 1.0))
+        handles = [Patch(color=c, label=r) for r, c in ROLE_COLOURS.items()]
+        if hazards:
+            handles.append(Patch(color=HAZARD_COLOUR, label="hazard on"))
+        bottom.legend(handles=handles, fontsize=7, loc="upper left", bbox_to_anchor=(1.005, 1.0))
         _mark_commands(bottom, events)
-        bottom.set_xlabel("time [s]")
     else:
         _note(bottom, "no roles")
-    top.set_title(title or "Alg. 2 parameters and harmoniser roles (cf. Fig. 11)", fontsize=10)
-    return _save(fig, out_png)
+    bottom.set_xlabel("time [s]")
+    bottom.set_xlim(0.0, max(t_end, 1.0) * 1.01)
+    what = "Alg. 2 costs, cost rates" if costs else "decisions"
+    top.set_title(title or f"{what} and harmoniser roles (cf. Fig. 11); red dashed: susp, green dotted: start, "
+                           "purple: switch by priority class", fontsize=10)
+    return fig
 
 
 def _state_spans(events: Sequence[Event], t_end: float) -> dict[str, list[tuple[str, float, float]]]:
@@ -185,36 +271,83 @@ def _state_spans(events: Sequence[Event], t_end: float) -> dict[str, list[tuple[
     return spans
 
 
+LABEL_FONT = 7
+MAX_LANES = 6
+
+
+def _label_lanes(labels: Sequence[tuple[float, str]], seconds_per_point: float) -> list[int]:
+    """A lane (0 = nearest the bar) for each ``(t, label)`` so that no two labels in a lane
+    overlap; ``seconds_per_point`` converts text width to time.  Labels past
+    :data:`MAX_LANES` share the least crowded lane."""
+    ends: list[float] = []
+    out = []
+    for t, label in labels:
+        width = (len(label) * 0.6 + 1.0) * LABEL_FONT * seconds_per_point
+        lane = next((i for i, end in enumerate(ends) if end <= t), None)
+        if lane is None:
+            if len(ends) < MAX_LANES:
+                ends.append(-math.inf)
+                lane = len(ends) - 1
+            else:
+                lane = min(range(len(ends)), key=lambda i: ends[i])
+        ends[lane] = t + width
+        out.append(lane)
+    return out
+
+
 def gantt(events: Sequence[Event], out_png: str | Path, *, title: str | None = None) -> Path:
-    """Every agent's FSM state over time, one row per agent, stage actions annotated."""
+    """Every agent's FSM state over time, one row per agent, stage names in lanes above the bars
+    (never on top of each other; suspension stages in orange italics; x: stopped or failed)."""
+    return _save(gantt_figure(events, title=title), out_png)
+
+
+def gantt_figure(events: Sequence[Event], *, title: str | None = None) -> Figure:
+    """The figure :func:`gantt` saves."""
     events = list(events)
     kinds = _agents(events)
-    spans = _state_spans(events, _end_time(events))
-    fig = Figure(figsize=(10, 1.8 + 0.7 * max(1, len(spans))), layout="constrained")
+    t_end = max(_end_time(events), 1.0)
+    spans = _state_spans(events, t_end)
+    width_in = 11.0
+    seconds_per_point = t_end * 1.02 / ((width_in - 2.2) * 72)  # axes ≈ figure minus the row labels
+    stages = {a: [e for e in events if e["event"] == "stage" and e.get("agent") == a] for a in spans}
+    lanes = {a: _label_lanes([(float(e["t"]), e["action"]) for e in stages[a] if e["status"] == "begin"],
+                             seconds_per_point) for a in spans}
+    lane_h = 0.32
+    heights = {a: 1.0 + lane_h * (max(lanes[a], default=-1) + 1) for a in spans}
+    fig = Figure(figsize=(width_in, 1.6 + 0.45 * max(1.0, sum(heights.values()))), layout="constrained")
     ax = fig.subplots()
     if not spans:
         _note(ax, "no agents")
-        return _save(fig, out_png)
-    rows = {a: i for i, a in enumerate(spans)}
+        ax.set_xticks([])
+        return fig
+    base: dict[str, float] = {}
+    y = 0.0
+    for agent in spans:  # each row: its label lanes, then the bar
+        y += heights[agent]
+        base[agent] = y - 0.5
     for agent, stretch in spans.items():
         for state, t0, t1 in stretch:
-            colour = STATE_COLOURS.get(state, "#555")
-            ax.broken_barh([(t0, max(t1 - t0, 1e-3))], (rows[agent] - 0.35, 0.7), color=colour)
-    for e in events:
-        if e["event"] == "stage" and e["status"] == "begin" and e["agent"] in rows:
+            ax.broken_barh([(t0, max(t1 - t0, 1e-3))], (base[agent] - 0.3, 0.6), color=STATE_COLOURS.get(state, "#555"))
+        begins = [e for e in stages[agent] if e["status"] == "begin"]
+        for e, lane in zip(begins, lanes[agent], strict=True):
             susp = e.get("fsm") == "exeSusp"  # suspension stages in the exeSusp colour
-            ax.annotate(e["action"], (float(e["t"]), rows[e["agent"]] - 0.38), fontsize=6, rotation=30, va="bottom",
-                        color=STATE_COLOURS["exeSusp"] if susp else "#222", style="italic" if susp else "normal")
-        elif e["event"] == "stage" and e["status"] in ("stopped", "failed") and e["agent"] in rows:
-            ax.plot(float(e["t"]), rows[e["agent"]], "x", color="#000", ms=5)
-    ax.set_yticks(range(len(rows)), [f"{a} {kinds.get(a, '?')}" for a in rows], fontsize=8)
-    ax.set_ylim(len(rows) - 0.2, -0.9)
+            t = float(e["t"])
+            top = base[agent] - 0.32 - lane_h * lane
+            ax.plot([t, t], [base[agent] - 0.3, top], color="#999", lw=0.5)
+            ax.text(t, top, e["action"], fontsize=LABEL_FONT, va="bottom", ha="left",
+                    color=STATE_COLOURS["exeSusp"] if susp else "#222", style="italic" if susp else "normal")
+        for e in stages[agent]:
+            if e["status"] in ("stopped", "failed"):
+                ax.plot(float(e["t"]), base[agent], "x", color="#000", ms=6)
+    ax.set_yticks([base[a] for a in spans], [f"{a} {kinds.get(a, '?')}" for a in spans], fontsize=8)
+    ax.set_ylim(y + 0.1, -0.1)
+    ax.set_xlim(0.0, t_end * 1.02)
     ax.set_xlabel("time [s]")
     fig.legend(handles=[Patch(color=STATE_COLOURS[s], label=s) for s in STATES], fontsize=7, ncol=7,
                loc="outside lower center")
     ax.set_title(title or "dynamic agents' FSM states (stage names at their start; x: stopped or failed)",
                  fontsize=10)
-    return _save(fig, out_png)
+    return fig
 
 
 TASK_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22")

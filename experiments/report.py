@@ -33,6 +33,9 @@ from experiments.sweep import Strategy
 HIGHER_IS_BETTER = re.compile(r"(?<!un)finished|completed|success|throughput|reward|real_time_factor")
 """Metric names for which a larger value is better (otherwise smaller is)."""
 
+HOST_DEPENDENT = re.compile(r"wall_time|real_time_factor|cache_hits|planner_time")
+"""Metric names that measure the machine a run ran on, not the strategy: reported, never given a verdict."""
+
 HEADLINE = (
     "totals.duration_s.mean", "totals.makespan_s", "people.people_waiting_s", "people.people_following_s",
     "safety.cooker_unattended_s", "safety.violations_at_switch", "safety.hazards_active_at_switch",
@@ -94,6 +97,8 @@ class Paired:
 
     @property
     def better(self) -> str:
+        if host_dependent(self.metric):
+            return "–"  # a property of the host, not of the strategy
         return "higher" if higher_is_better(self.metric) else "lower"
 
 
@@ -105,6 +110,7 @@ class ReportFiles:
     summary_csv: Path
     paired_csv: Path
     plots: tuple[Path, ...]
+    html: Path | None = None
 
 
 def estimate(values: Sequence[float], confidence: float = 0.95) -> Estimate:
@@ -124,6 +130,11 @@ def estimate(values: Sequence[float], confidence: float = 0.95) -> Estimate:
 
 def higher_is_better(metric: str) -> bool:
     return HIGHER_IS_BETTER.search(metric.lower()) is not None
+
+
+def host_dependent(metric: str) -> bool:
+    """True for metrics of the host (wall time, real-time factor, …): no verdict, no wins or losses."""
+    return HOST_DEPENDENT.search(metric.lower()) is not None
 
 
 def headline(metrics: Iterable[str]) -> list[str]:
@@ -274,7 +285,9 @@ def markdown(rows: Sequence[RunRow], summaries: Sequence[MetricSummary], pairs: 
         out += ["## Planned vs static, paired by (scenario, seed)", "",
                 "Difference planned − static over the pairs where both ran; *wins/ties/losses* count the "
                 "pairs where planned is better / equal / worse (*better* says which direction is better); "
-                "the verdict reads the 95 % confidence interval of the difference.", ""]
+                "the verdict reads the 95 % confidence interval of the difference. Host-dependent metrics "
+                "(wall time, real-time factor, planner time, cache hits) measure the machine, not the strategy: "
+                "their difference is reported without a verdict.", ""]
         shown = set(headline({p.metric for p in pairs}))
         for dim, p_label, s_label in sorted({(p.dimension, p.planned, p.static) for p in pairs}):
             mine = [p for p in pairs if (p.dimension, p.planned, p.static) == (dim, p_label, s_label)
@@ -283,15 +296,14 @@ def markdown(rows: Sequence[RunRow], summaries: Sequence[MetricSummary], pairs: 
             out += [f"### {dim}: `{p_label}` vs `{s_label}`", ""]
             pooled = sorted((p for p in mine if p.scenario == ALL), key=lambda p: order[p.metric])
             out += _table(["metric", "better", "planned − static", "wins/ties/losses", "verdict"],
-                          [[p.metric, p.better, _cell(p.diff), f"{p.wins}/{p.ties}/{p.losses}", _verdict(p)]
-                           for p in pooled])
+                          [[p.metric, p.better, _cell(p.diff), _counts(p), _verdict(p)] for p in pooled])
             out.append("")
             per = {(p.scenario, p.metric): p for p in mine if p.scenario != ALL}
             if per:
                 metrics = [p.metric for p in pooled]
                 out += ["Per scenario (wins/ties/losses, verdict):", ""]
                 out += _table(["scenario", *metrics],
-                              [[sc, *(f"{q.wins}/{q.ties}/{q.losses} {_verdict(q, short=True)}"
+                              [[sc, *(f"{_counts(q)} {_verdict(q, short=True)}".strip()
                                       if (q := per.get((sc, m))) else "–" for m in metrics)]
                                for sc in sorted({sc for sc, _ in per})])
                 out.append("")
@@ -305,7 +317,13 @@ def markdown(rows: Sequence[RunRow], summaries: Sequence[MetricSummary], pairs: 
     return "\n".join(out)
 
 
+def _counts(p: Paired) -> str:
+    return "–" if host_dependent(p.metric) else f"{p.wins}/{p.ties}/{p.losses}"
+
+
 def _verdict(p: Paired, short: bool = False) -> str:
+    if host_dependent(p.metric):
+        return "" if short else "host-dependent: no verdict"
     if p.wins == p.losses == 0:
         return "=" if short else "identical"
     if p.diff.n < 2 or math.isnan(p.diff.half):
@@ -329,10 +347,10 @@ def write_csv(summaries: Sequence[MetricSummary], pairs: Sequence[Paired], out: 
     with paired_path.open("w", newline="", encoding="utf-8") as f:
         w = csv.writer(f)
         w.writerow(["dimension", "planned", "static", "scenario", "metric", "better", "n", "mean_diff",
-                    "ci_low", "ci_high", "wins", "ties", "losses"])
+                    "ci_low", "ci_high", "wins", "ties", "losses", "host_dependent"])
         for p in pairs:
             w.writerow([p.dimension, p.planned, p.static, p.scenario, p.metric, p.better, p.diff.n, p.diff.mean,
-                        p.diff.low, p.diff.high, p.wins, p.ties, p.losses])
+                        p.diff.low, p.diff.high, p.wins, p.ties, p.losses, int(host_dependent(p.metric))])
     return summary_path, paired_path
 
 
@@ -356,7 +374,8 @@ def plot(summaries: Sequence[MetricSummary], pairs: Sequence[Paired], out: Path)
     cells = {(s.scenario, s.strategy, s.metric): s.estimate for s in summaries}
     width = 0.8 / max(1, len(strategies))
     for metric in headline({s.metric for s in summaries}):
-        fig, ax = plt.subplots(figsize=(max(5.5, 1.5 + 0.7 * len(groups) * len(strategies)), 3.8))
+        fig, ax = plt.subplots(figsize=(max(5.5, 1.5 + 0.7 * len(groups) * len(strategies)),
+                                        4.0 + 0.2 * math.ceil(len(strategies) / 2)), layout="constrained")
         for i, st in enumerate(strategies):
             est = [cells.get((g, st, metric)) for g in groups]
             means = [e.mean if e else math.nan for e in est]
@@ -365,9 +384,9 @@ def plot(summaries: Sequence[MetricSummary], pairs: Sequence[Paired], out: Path)
             ax.bar(xs, means, width, yerr=errs, capsize=3, label=st)
         ax.set_xticks(range(len(groups)), ["all scenarios" if g == ALL else Path(g).stem for g in groups])
         ax.set_ylabel("mean, 95 % CI")
-        ax.set_title(metric, fontsize="medium")
-        ax.legend(fontsize="x-small")
-        fig.tight_layout()
+        ax.set_title(metric + (" (host-dependent: no verdict)" if host_dependent(metric) else ""), fontsize="medium")
+        # below the axes, never over a bar
+        fig.legend(fontsize="x-small", loc="outside lower center", ncol=min(2, len(strategies)))
         path = out / f"{_slug(metric)}.png"
         fig.savefig(path, dpi=100)
         plt.close(fig)
@@ -375,10 +394,11 @@ def plot(summaries: Sequence[MetricSummary], pairs: Sequence[Paired], out: Path)
     for dim, p_label, s_label in sorted({(p.dimension, p.planned, p.static) for p in pairs}):
         shown = headline({p.metric for p in pairs})
         mine = sorted((p for p in pairs if (p.dimension, p.planned, p.static) == (dim, p_label, s_label)
-                       and p.scenario == ALL and p.metric in shown), key=lambda p: shown.index(p.metric))
+                       and p.scenario == ALL and p.metric in shown and not host_dependent(p.metric)),
+                      key=lambda p: shown.index(p.metric))
         if not mine:
             continue
-        fig, ax = plt.subplots(figsize=(6.4, 0.9 + 0.35 * len(mine)))
+        fig, ax = plt.subplots(figsize=(6.4, 1.4 + 0.35 * len(mine)), layout="constrained")
         ys = range(len(mine))
         ax.barh(ys, [p.wins for p in mine], color="tab:green", label="planned better")
         ax.barh(ys, [p.ties for p in mine], left=[p.wins for p in mine], color="tab:gray", label="tie")
@@ -387,8 +407,7 @@ def plot(summaries: Sequence[MetricSummary], pairs: Sequence[Paired], out: Path)
         ax.set_yticks(list(ys), [p.metric for p in mine])
         ax.set_xlabel("(scenario, seed) pairs")
         ax.set_title(f"{dim}: planned vs static", fontsize="medium")
-        ax.legend(fontsize="x-small", loc="lower right")
-        fig.tight_layout()
+        fig.legend(fontsize="x-small", loc="outside lower center", ncol=3)  # never over a bar
         path = out / f"paired_{_slug(dim)}_{_slug(p_label)}.png"
         fig.savefig(path, dpi=100)
         plt.close(fig)
@@ -412,8 +431,14 @@ def build_report(db_path: str | Path, out: str | Path, *, plots: bool = True) ->
     summaries = summarise(rows)
     pairs = paired(rows)
     md = out_dir / "report.md"
-    md.write_text(markdown(rows, summaries, pairs, title=f"Sweep report: {Path(db_path).name}") + "\n",
-                  encoding="utf-8")
+    text = markdown(rows, summaries, pairs, title=f"Sweep report: {Path(db_path).name}")
+    md.write_text(text + "\n", encoding="utf-8")
     summary_csv, paired_csv = write_csv(summaries, pairs, out_dir)
     files = plot(summaries, pairs, out_dir / "plots") if plots and summaries else []
-    return ReportFiles(md, summary_csv, paired_csv, tuple(files))
+    page = None
+    if plots:
+        from experiments.report_html import sweep_page
+
+        page = out_dir / "report.html"
+        page.write_text(sweep_page(text, summaries, pairs), encoding="utf-8")
+    return ReportFiles(md, summary_csv, paired_csv, tuple(files), page)

@@ -13,6 +13,7 @@ then :class:`tasker.errors.RunAborted` is raised carrying the partial :class:`Ru
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import datetime as _dt
 import json
@@ -153,10 +154,11 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")
     error: Exception | None = None
-    try:
-        _run(loop, progress)
-    except Exception as exc:  # the trace so far, run.json and metrics.json are still written, then it propagates
-        error = exc
+    with _journal(kind) as journal:  # the PDDL of every planning call, for problems/
+        try:
+            _run(loop, progress)
+        except Exception as exc:  # the trace so far, run.json and metrics.json are still written, then it propagates
+            error = exc
     wall = time.perf_counter() - t0
     trace = loop.trace
     world_spec = None
@@ -187,11 +189,19 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         except Exception as exc:  # metrics of a cut trace may not compute: say so, keep the rest
             metrics = {"error": f"metrics failed on the partial trace: {type(exc).__name__}: {exc}"}
     if out is not None:
-        _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures and error is None, sim)
+        _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures and error is None, sim, journal)
     result = RunResult(record, metrics, trace, trajectory)
     if error is not None:
         raise RunAborted(reason, result) from error
     return result
+
+
+def _journal(kind: str) -> contextlib.AbstractContextManager[list[Any]]:
+    if kind != "robot":
+        return contextlib.nullcontext([])
+    from planners.pddl_task import planning_journal
+
+    return planning_journal()
 
 
 def _run(loop: SimulationLoop, progress: bool) -> None:
@@ -241,19 +251,23 @@ def _metrics(trace: Trace, calls: list[dict[str, Any]], wall: float) -> dict[str
 
 def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Trace,
           trajectory: tuple[tuple[float, float, float, float], ...], world: Any, pictures: bool,
-          sim: Any = None) -> None:
+          sim: Any = None, journal: Any = ()) -> None:
+    from experiments.explain import write_problems
+
     out.mkdir(parents=True, exist_ok=True)
     trace.write(out / "trace.jsonl")
     if sim is not None:  # poses and postures at a fixed rate (robot.recording)
         sim.write_trajectory(out / "trajectory.jsonl")
     (out / "run.json").write_text(json.dumps(record, indent=2, sort_keys=True, default=str) + "\n")
     (out / "metrics.json").write_text(json.dumps(metrics_, indent=2, sort_keys=True) + "\n")
+    write_problems(out / "problems", journal)
     if not pictures:
         return
-    from experiments import plots
+    from experiments import plots, report_html
 
     plots.timeline(trace.events, out / "timeline.png")
     plots.gantt(trace.events, out / "gantt.png")
+    report_html.write_run(out, trace.events, record=record, metrics=metrics_, world=world, trajectory=trajectory)
     if world is not None:
         plots.world_path(world, list(trajectory), out / "world.png", events=trace.events,
                          recording=getattr(sim, "recording", None))

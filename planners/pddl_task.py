@@ -20,13 +20,16 @@ suspension or a planner time-out falls back to the static strategy, said in the 
 
 from __future__ import annotations
 
+import contextlib
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextvars import ContextVar
+from dataclasses import dataclass
 from typing import Any
 
 from planners.estimates import estimator_for
 from planners.planner import PddlText, Planner
-from planners.problem import DomainModel, holds, render_problem, travel_table
+from planners.problem import DomainModel, PortablePddl, holds, portable, render_problem, travel_table
 from planners.results import PlanResult, PlanStatus
 from planners.stages import Bindings, StageBuilder
 from planners.taskspec import Branch, Literal, TaskSpec
@@ -40,6 +43,40 @@ INTERRUPTION_KEY = "interruption_s"
 """``ctx.memory`` key: expected length of an interruption (s); unknown means long."""
 
 _shared_planner: Planner | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class PlanningRecord:
+    """One planned upTsk/genSusp of a run: the PDDL it planned from (renamed so that any reader
+    takes it, :func:`planners.problem.portable`), and how it ended.  ``status`` is a
+    :class:`PlanStatus` value or ``"holds"`` (the goal held: nothing was planned); ``plan``
+    is in the task's own names."""
+
+    t: float
+    agent: str
+    task_type: str
+    purpose: str
+    label: str
+    pddl: PortablePddl
+    status: str
+    plan: tuple[tuple[str, ...], ...] | None = None
+    cost: float | None = None
+    message: str = ""
+
+
+_journal: ContextVar[list[PlanningRecord] | None] = ContextVar("tasker_planning_journal", default=None)
+
+
+@contextlib.contextmanager
+def planning_journal() -> Iterator[list[PlanningRecord]]:
+    """Record every planned upTsk/genSusp made inside the block (this thread/context only);
+    the PDDL stays out of the trace: the runner writes it to the run's ``problems/``."""
+    records: list[PlanningRecord] = []
+    token = _journal.set(records)
+    try:
+        yield records
+    finally:
+        _journal.reset(token)
 
 
 def default_planner() -> Planner:
@@ -215,9 +252,11 @@ class PddlTaskType(TaskType):
         """A planned StagePlan, or the failed PlanResult for the caller to handle."""
         text, init, travel = self.problem_text(ctx, world, goal, extra)
         if holds(init, goal):
+            self._record(ctx, purpose, label, text, None)
             note = "goal already holds" + (f" ({label})" if label else "")
             return StagePlan((), purpose, strategy="planned", sim_time=self.spec.static_time_s, note=note)
         result = self.planner.solve(text, timeout=self.timeout)
+        self._record(ctx, purpose, label, text, result)
         if not result.solved:
             return result
         assert result.plan is not None
@@ -226,6 +265,15 @@ class PddlTaskType(TaskType):
                          note=label or None,
                          info={"planner": result.planner, "cost": result.cost, "cached": result.cached,
                                "planner_time_s": result.wall_time_s})
+
+    def _record(self, ctx: TaskContext, purpose: Purpose, label: str, text: PddlText,
+                result: PlanResult | None) -> None:
+        journal = _journal.get()
+        if journal is not None:
+            journal.append(PlanningRecord(
+                ctx.now, ctx.agent, self.name, purpose.value, label, portable(self.domain, text.domain, text.problem),
+                result.status.value if result else "holds", result.plan if result else (),
+                result.cost if result else 0.0, result.message if result else "goal already holds"))
 
     @staticmethod
     def _fallback(plan: StagePlan, why: str) -> StagePlan:

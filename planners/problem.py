@@ -9,6 +9,7 @@ the domain knows, the facts over them, travel times between places, and the goal
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
@@ -204,3 +205,75 @@ def render_problem(
 def holds(facts: frozenset[Fact] | set[Fact], literals: Iterable[Sequence[str]]) -> bool:
     """True if every literal holds among ``facts`` (``["not", ...]`` means absent)."""
     return all((tuple(lit[1:]) not in facts) if lit[0] == "not" else (tuple(lit) in facts) for lit in literals)
+
+
+# ------------------------------------------------------------------ PDDL any reader accepts
+
+_OBJECTS_SECTION = re.compile(r"\(:objects(.*?)\)", re.S)
+
+
+@dataclass(frozen=True, slots=True)
+class PortablePddl:
+    """A domain and problem renamed so that a default ``PDDLReader`` reads them.
+
+    PDDL keeps types, predicates, actions and objects in separate namespaces (an object
+    ``robot`` of type ``robot``, an action ``place`` beside a type ``place``);
+    unified-planning refuses a name used twice.  ``renamed`` maps each original name to
+    the one written; :meth:`original` maps a written plan step back.
+    """
+
+    domain: str
+    problem: str
+    renamed: Mapping[str, str]
+
+    def written(self, step: Sequence[str]) -> tuple[str, ...]:
+        return tuple(self.renamed.get(s, s) for s in step)
+
+    def original(self, step: Sequence[str]) -> tuple[str, ...]:
+        back = {v: k for k, v in self.renamed.items()}
+        return tuple(back.get(s, s) for s in step)
+
+
+def portable(domain: DomainModel, domain_text: str, problem_text: str) -> PortablePddl:
+    """Rename actions and problem objects whose names a domain's types, predicates or
+    functions already use (``robot`` → ``robot-obj``, action ``place`` → ``place-action``)."""
+    domain_names = set(domain.types) | set(domain.predicates) | set(domain.functions)
+    section = _OBJECTS_SECTION.search(problem_text)
+    objects = set(_names(section.group(1))) if section else set()
+    taken = domain_names | set(domain.actions) | objects
+    renamed: dict[str, str] = {}
+
+    def fresh(name: str, suffix: str) -> str:
+        new, i = f"{name}-{suffix}", 1
+        while new in taken:
+            i += 1
+            new = f"{name}-{suffix}{i}"
+        taken.add(new)
+        return new
+
+    for action in sorted(domain.actions):
+        if action in domain_names:
+            renamed[action] = fresh(action, "action")
+    for obj in sorted(objects):
+        if obj in domain_names or obj in domain.actions:
+            renamed[obj] = fresh(obj, "obj")
+    for action in (a for a in renamed if a in domain.actions):
+        domain_text = re.sub(rf"(\(:action\s+){re.escape(action)}(?=[\s)])", rf"\g<1>{renamed[action]}",
+                             domain_text)
+    head_end = problem_text.find("(:objects")
+    head, body = (problem_text[:head_end], problem_text[head_end:]) if head_end >= 0 else ("", problem_text)
+    for obj in (o for o in renamed if o in objects):
+        # every use of the object after the header, but not a type after " - " in :objects
+        body = re.sub(rf"(?<![\w?-])(?<!- ){re.escape(obj)}(?![\w-])", renamed[obj], body)
+    problem_text = head + body
+    if renamed:
+        note = "; renamed for unified-planning's PDDLReader: " + ", ".join(
+            f"{k} -> {v}" for k, v in sorted(renamed.items())) + "\n"
+        problem_text = note + problem_text
+    return PortablePddl(domain_text, problem_text, renamed)
+
+
+def _names(objects_section: str) -> list[str]:
+    """Object names of a ``:objects`` section (the words that are not types after ``-``)."""
+    words = objects_section.split()
+    return [w for i, w in enumerate(words) if w != "-" and (i == 0 or words[i - 1] != "-")]

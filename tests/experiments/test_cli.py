@@ -83,6 +83,8 @@ BAD: list[tuple[list[str], str]] = [
     (["cost", "flat", "living"], "PLACE"),
     (["cost", "flat", "living", "kitchn"], "did you mean 'kitchen'"),
     (["cost", "flat", "living", "kitchen", "--seed", "-1"], "--seed"),
+    (["explain", "{missing}", "--agent", "d1"], "no such run folder"),
+    (["explain", "{tmp}"], "--agent"),
 ]
 
 

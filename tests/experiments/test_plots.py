@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from experiments import plots, synthetic
 
@@ -102,3 +103,56 @@ def test_world_path_with_trace_and_recording(tmp_path: Path) -> None:
               {"t": 19.0, "event": "end", "agent": "d1", "reason": "finished"}]
     traj = [(s.t, *s.robot) for s in rec.samples]
     assert is_png(plots.world_path("paper", traj, tmp_path / "w.png", events=events, recording=rec), 10_000)
+
+
+def _lines(ax: Any) -> set[str]:
+    return {str(line.get_label()) for line in ax.get_lines() if not str(line.get_label()).startswith("_")}
+
+
+def test_timeline_puts_rates_on_their_own_axis(events: list[dict[str, Any]]) -> None:
+    fig = plots.timeline_figure(events)
+    costs, rates, roles = fig.axes[:3]
+    assert _lines(costs) and _lines(costs) <= set(plots.COSTS)
+    assert _lines(rates) and _lines(rates) <= set(plots.RATES)
+    assert roles.get_xlabel() == "time [s]"
+
+
+def test_timeline_keeps_its_time_axis_with_only_priority_decisions(tmp_path: Path) -> None:
+    trace = TINY + [
+        {"t": float(t), "event": "decision", "algorithm": "priority", "dac": "d2", "exeDA": "d1",
+         "rule": "priority", "switch": t == 3}
+        for t in range(1, 6)
+    ] + [{"t": 1.0, "event": "roles", "exeDA": "d1", "irrDA": None, "idleDA": ["d2"]}]
+    fig = plots.timeline_figure(trace)
+    FigureCanvasAgg(fig).draw()  # tick labels exist only once drawn
+    bottom = fig.axes[1]
+    labels = [t.get_text() for t in bottom.get_xticklabels() if t.get_visible() and t.get_text()]
+    assert bottom.get_xlabel() == "time [s]" and len(labels) >= 3, labels
+    assert _lines(fig.axes[0]) == {"decision", "switch"}
+
+
+def test_hazard_spans_pair_on_and_off() -> None:
+    hz = {"event": "hazard", "agent": "d1", "hazard": "device_on", "args": ["cooker"], "budget_s": 30.0}
+    trace = [{"t": 1.0, **hz, "status": "on"}, {"t": 4.0, **hz, "status": "off"}, {"t": 6.0, **hz, "status": "on"}]
+    assert plots.hazard_spans(trace, 9.0) == [("d1", "device_on cooker", 1.0, 4.0),
+                                              ("d1", "device_on cooker", 6.0, 9.0)]
+
+
+def test_gantt_stage_names_do_not_overlap(tmp_path: Path) -> None:
+    trace: list[dict[str, Any]] = [{"t": 0.0, "event": "request", "agent": "d1", "task_type": "cook", "args": {},
+                                    "requester": "x"},
+                                   {"t": 0.1, "event": "transition", "agent": "d1", "from": "initComm", "to": "exeTsk"}]
+    for i, name in enumerate(["navigate", "pick_pan", "navigate", "turn_on", "put_on_cooker", "cook_food"]):
+        trace.append({"t": 1.0 + 2.0 * i, "event": "stage", "agent": "d1", "fsm": "exeTsk", "index": i,
+                      "action": name, "args": [], "kind": "suspendable", "status": "begin"})
+    trace.append({"t": 300.0, "event": "transition", "agent": "d1", "from": "exeTsk", "to": "end"})
+    fig = plots.gantt_figure(trace)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    boxes = [t.get_window_extent(renderer) for t in fig.axes[0].texts]
+    assert len(boxes) == 6
+    for i, a in enumerate(boxes):
+        for b in boxes[i + 1:]:
+            assert not a.overlaps(b), (a, b)
+    assert is_png(plots.gantt(trace, tmp_path / "g.png"))

@@ -128,3 +128,29 @@ def test_report_files(tmp_path: Path, rows: list[RunRow]) -> None:
 def test_report_of_a_missing_database_is_an_error(tmp_path: Path) -> None:
     with pytest.raises(StoreError, match="no such results database"):
         build_report(tmp_path / "missing.db", tmp_path / "out")
+
+
+def test_host_dependent_metrics_are_reported_without_a_verdict(tmp_path: Path, rows: list[RunRow]) -> None:
+    timed = [RunRow(r.scenario, r.seed, r.strategy, r.status, r.record,
+                    {**r.metrics, "wall_time_s": 2.0 + r.seed if r.strategy == PLANNED else 1.0 + r.seed,
+                     "real_time_factor": 30.0})
+             for r in rows]
+    pairs = {(p.scenario, p.metric): p for p in paired(timed)}
+    wall = pairs[(ALL, "wall_time_s")]
+    assert wall.diff.mean == pytest.approx(1.0) and report.host_dependent("wall_time_s")
+    assert report._verdict(wall) == "host-dependent: no verdict" and wall.better == "–"
+    md = report.markdown(timed, summarise(timed), list(pairs.values()))
+    assert "| wall_time_s | – | 1 ± 0 (10) | – | host-dependent: no verdict |" in md
+    assert "static better" not in [line for line in md.splitlines() if "wall_time_s" in line][-1]
+    db = tmp_path / "r.db"
+    with ResultStore(db) as store:
+        for row in timed:
+            store.add(row)
+    files = build_report(db, tmp_path / "out")
+    with files.paired_csv.open() as f:
+        flags = {r["metric"]: r["host_dependent"] for r in csv.DictReader(f)}
+    assert flags["wall_time_s"] == "1" and flags["real_time_factor"] == "1" and flags["totals.failed"] == "0"
+    assert files.html is not None
+    page = files.html.read_text()
+    assert "<table>" in page and "host-dependent: no verdict" in page and 'id="metric-0"' in page
+    assert "<script src" not in page
