@@ -117,6 +117,8 @@ class DynamicAgent:
         self._ready_at = 0.0  # end of a planning hook's simulated time
         self._next_sp = 0.0
         self._params: ScheduleParams | None = None
+        self._params_at: float | None = None  # when _params was computed (None: not since the last change)
+        self._fresh: tuple[float, ScheduleParams | None] | None = None  # fresh_params' answer at one moment
         self.planner_calls: list[dict[str, Any]] = []
 
     # -- the harmoniser's side ----------------------------------------------------------
@@ -131,6 +133,7 @@ class DynamicAgent:
         """A requester changed the task's arguments (R2); parameters are recomputed at once."""
         changed = {k: v for k, v in args.items() if self.ctx.args.get(k) != v}
         self.ctx.args = dict(args)
+        self._params_at = self._fresh = None
         self._trace.emit(now, "change", agent=self.id, args=changed, requester=requester)
         if self._waker is not None:
             self._waker(self)
@@ -155,14 +158,23 @@ class DynamicAgent:
     def fresh_params(self, now: float) -> ScheduleParams | None:
         """``compute_params`` at ``now``, without publishing: for a decision made from one moment.
 
+        Parameters already computed at ``now`` (by the agent's own timer, or by an
+        earlier call) are of this moment and are returned as they are: nothing the
+        hook reads changes between them, since the agent is not stepped in between.
         Returns None when the task type reports no parameters; raises
         :class:`~tasker.errors.AgentEnded` (after ending the agent) if the hook raises.
         """
         if self.state is S.END:
             raise AgentEnded(self.id, self.end_reason or "ended")
+        if self._params_at == now:
+            return self._params
+        if self._fresh is not None and self._fresh[0] == now:
+            return self._fresh[1]
         try:
             self._refresh(now)
-            return self.task.compute_params(self.ctx)
+            params = self.task.compute_params(self.ctx)
+            self._fresh = (now, params)
+            return params
         except _UNCONTAINED:
             raise
         except Exception as exc:
@@ -191,6 +203,7 @@ class DynamicAgent:
         if self.state is S.END:
             self.next_wake = math.inf
             return
+        self._params_at = self._fresh = None  # stepping may change what the parameters depend on
         try:
             self._refresh(now)
             self._read_inbox()
@@ -243,6 +256,7 @@ class DynamicAgent:
             self._end(now, why, cause="self", event="term")
             return
         self._params = self.task.compute_params(self.ctx)
+        self._params_at = now
         self._publish()
         self.next_wake = _next_tick_of(now, self.rates.rep_rate)
 
@@ -338,6 +352,7 @@ class DynamicAgent:
                     return
         if in_task and now >= self._next_sp:
             self._params = self.task.compute_params(self.ctx)
+            self._params_at = now
             self._publish()
             self._next_sp = _next_tick_of(now, self.rates.sp_up_rate)
         if runner.running:

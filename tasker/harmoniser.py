@@ -251,15 +251,14 @@ class TaskHarmoniser:
             self._trace.emit(now, "decision", algorithm=name, rule="error", switch=False,
                              error=f"the scheduler chose {choice!r}, which is not idle; idle: {list(self._idle)}")
             return
-        record = dict(decision.record) if decision.record is not None else None
+        record = decision.record
         if choice is not None and record is None:  # every choice leaves a decision, whatever the scheduler
             record = {"algorithm": name, "dac": choice, "exeDA": exe.id if exe is not None else None,
                       "rule": "no exeDA" if exe is None else "choice", "switch": True}
         if choice is not None and exe is not None and record is not None:
             held = self._held(choice, exe.id, now)
             if held is not None:
-                record["switch"] = False
-                record["held"] = held
+                record = {**record, "switch": False, "held": held}
                 choice = None
         if record is not None:
             self._trace.emit(now, "decision", **record)

@@ -14,7 +14,7 @@ The paper's algorithm has two classes, ``humanFell`` above ``guideHuman``:
 
   and the switch is made when ``c_switch < hysteresis * c_wait`` (the paper: 1.0;
   the original ROS code used 0.9); both agents' ``cost``, ``cps`` and ``cTime`` are
-  computed afresh at the decision's moment (``ScheduleView.at_now``), and so are
+  computed afresh at the decision's moment (``ScheduleView.params_now``), and so are
   the ``reqSP`` answers, so the comparison never mixes reports of different ticks;
 * a non-finite ``c_switch`` or ``c_wait`` (an infeasible task reports ``cost = inf``)
   never switches: the comparison is recorded with ``undecided: "non-finite"``; a
@@ -40,7 +40,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from tasker.errors import ConfigError
-from tasker.messages import SP_COMPLETION, CompletionCost, SPRequest
+from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, ScheduleParams, SPRequest
 from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, ScheduleView
 
 DEFAULT_CLASSES: tuple[tuple[str, ...], ...] = (("human_fell",), ("guide_human",))
@@ -85,7 +85,7 @@ class Alg2(Scheduler):
         best: Candidate | None = None
         best_key: tuple[int, float, int] | None = None
         for c in view.candidates:  # one pass: lowest (class, cost, request order), lines 3-4
-            key = self.queue_key(c)
+            key = (self._rank.get(c.task_type, self._lowest), self.cost_params(c, self.name).cost, c.order)
             if best_key is None or key < best_key:
                 best, best_key = c, key
         if best is None or best_key is None:
@@ -109,8 +109,8 @@ class Alg2(Scheduler):
 
     def _compare(self, view: ScheduleView, dac: Candidate, exe: Candidate) -> Decision:
         """Lines 20-33 with parameters of one moment: both agents compute them at ``view.now``."""
-        p_dac = self.cost_params(view.at_now(dac), self.name)
-        p_exe = self.cost_params(view.at_now(exe), self.name)
+        p_dac = self._cost(view.params_now(dac), dac)
+        p_exe = self._cost(view.params_now(exe), exe)
         a_dac = self._completion(view, dac, p_exe.end_pose)
         a_exe = self._completion(view, exe, p_dac.end_pose)
         c_switch = p_dac.cost + a_exe.cc + _mul(p_exe.cps, p_dac.c_time)
@@ -131,6 +131,12 @@ class Alg2(Scheduler):
             record["undecided"] = "non-finite"
         record["switch"] = switch
         return Decision(dac.id if switch else None, record)
+
+    def _cost(self, params: ScheduleParams, c: Candidate) -> CostParams:
+        if not isinstance(params, CostParams):
+            raise ConfigError(f"scheduler {self.name!r} needs CostParams from task type {c.task_type!r} "
+                              f"(agent {c.id}), got {type(params).__name__}")
+        return params
 
     @staticmethod
     def _completion(view: ScheduleView, c: Candidate, pose: Any) -> CompletionCost:

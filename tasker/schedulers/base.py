@@ -44,8 +44,8 @@ class ScheduleView:
     req_sp: Callable[[str, SPRequest], Any]
     fresh: Callable[[str], ScheduleParams | None] | None = None
 
-    def at_now(self, c: Candidate) -> Candidate:
-        """``c`` with parameters computed by its agent at :attr:`now` (``compute_params``).
+    def params_now(self, c: Candidate) -> ScheduleParams:
+        """``c``'s parameters computed by its agent at :attr:`now` (``compute_params``).
 
         Reports arrive at each agent's own rate, so two candidates' reports may be
         from different ticks; a scheduler that compares two agents asks both for
@@ -53,9 +53,9 @@ class ScheduleView:
         the task type has none, the reported parameters are returned.
         """
         if self.fresh is None:
-            return c
+            return c.params
         params = self.fresh(c.id)
-        return c if params is None else Candidate(c.id, c.task_type, params, c.request_time, c.order)
+        return c.params if params is None else params
 
 
 @dataclass(frozen=True, slots=True)

@@ -235,3 +235,15 @@ def test_ic_term_during_a_suspendable_stage_stops_it_once_then_suspends() -> Non
         ("walk", "begin"), ("walk", "stopped"), ("park", "begin"), ("park", "done")]
     assert core.stops == Counter({("d1", "walk"): 1})
     assert tr.of("end", agent="d1")[0]["cause"] == "self"
+
+
+def test_a_run_with_contained_errors_is_reproducible() -> None:
+    def run() -> str:
+        tasks = [SyntheticTask("skill", [st("drive", 3, raise_in="poll")]), HookRaises("hook", [st("second", 1)]),
+                 SyntheticTask("fine", [st("a", 2)])]
+        loop = make_loop(tasks, scheduler="alg2", core=FaultyCore())
+        for i, name in enumerate(["skill", "hook", "fine"]):
+            loop.request(0.5 * i, name)
+        return loop.run().dumps()
+
+    assert run() == run()
