@@ -37,9 +37,8 @@ def test_a_day_is_reproducible_per_seed(tabsa: protocol.Protocol) -> None:
     assert t1 == t2  # byte for byte
 
 
-@pytest.mark.parametrize("name", ["alg2", "simple", "simple2", "distance", "lookahead", "edf", "fifo"])
+@pytest.mark.parametrize("name", schedulers.names())
 def test_every_scheduler_runs_every_task_type(tabsa: protocol.Protocol, name: str) -> None:
-    assert name in schedulers.names()
     trace = protocol.build_day(tabsa, 2, name, dayreport.scheduler_options(tabsa, name)).run()
     finished = {e["task_type"] for e in trace.of("end", cause="finished")}
     assert finished == {"transport", "fall", "pick_place"}

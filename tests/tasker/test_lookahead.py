@@ -125,3 +125,34 @@ def test_decisions_are_deterministic() -> None:
 def test_bad_options_are_config_errors(options: dict[str, object]) -> None:
     with pytest.raises(ConfigError, match="lookahead"):
         schedulers.create("lookahead", **options)
+
+
+# -- the TaBSA baselines (re-implemented from their description) ---------------------------------------
+
+def test_simple_is_longest_first_with_a_hesitance_margin() -> None:
+    exe = cand("d1", 0, c_time=40)
+    assert schedulers.create("simple", hesitance=0.5).schedule(view(exe, [cand("d2", 1, c_time=50)])).irr_da is None
+    assert schedulers.create("simple", hesitance=0.5).schedule(view(exe, [cand("d2", 1, c_time=70)])).irr_da == "d2"
+    assert schedulers.create("simple").schedule(view(None, [cand("d2", 1, c_time=5),
+                                                            cand("d3", 2, c_time=9)])).irr_da == "d3"
+
+
+def test_simple2_is_shortest_first() -> None:
+    s = schedulers.create("simple2")
+    assert s.schedule(view(cand("d1", 0, c_time=40), [cand("d2", 1, c_time=10)])).irr_da == "d2"
+    assert s.schedule(view(None, [cand("d2", 1, c_time=5), cand("d3", 2, c_time=9)])).irr_da == "d2"
+
+
+def test_distance_prefers_little_travel_per_second_of_work_and_priority_first() -> None:
+    s = schedulers.create("distance")
+    s.schedule(view(cand("d1", 0, c_time=10, x=0.0), []))  # the robot will be at x = 0
+    near, far = cand("d2", 1, c_time=10, x=1.0), cand("d3", 2, c_time=10, x=8.0)
+    assert s.schedule(view(None, [far, near])).irr_da == "d2"
+    hi = Candidate("d4", "t", CostParams("t", cost=1, cps=1, c_time=10, end_pose=(9.0, 0.0), priority=3), 3.0, 3)
+    assert s.schedule(view(None, [near, hi])).irr_da == "d4"
+
+
+@pytest.mark.parametrize("name", ["simple", "simple2"])
+def test_a_negative_hesitance_is_a_config_error(name: str) -> None:
+    with pytest.raises(ConfigError, match="hesitance"):
+        schedulers.create(name, hesitance=-0.1)
