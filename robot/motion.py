@@ -128,22 +128,33 @@ class BasePlanner:
         self._rings: OrderedDict[tuple[Disc, tuple[str, ...]], tuple[np.ndarray, np.ndarray]] = OrderedDict()
         self._trees: OrderedDict[tuple[object, ...], tuple[np.ndarray, np.ndarray, np.ndarray]] = OrderedDict()
         self.searches = 0  # Dijkstra runs so far (benchmarks and tests read it)
+        self._boxes_key: tuple[str, ...] | None = None
+        self._all_boxes = np.zeros((0, 4))
 
     # ---- the scene, by layer -----------------------------------------------------------
     def _doors(self) -> tuple[str, ...]:
         return tuple(n for n, o in sorted(self.scene.door_open.items()) if not o)
 
+    def _boxes(self) -> np.ndarray:
+        """Walls, furniture and closed doors as one array (cached per set of closed doors)."""
+        doors = self._doors()
+        if self._boxes_key != doors:
+            self._boxes_key = doors
+            self._all_boxes = np.vstack([self.scene.static, self.scene.closed_doors()])
+        return self._all_boxes
+
     def _free_segments(self, a: np.ndarray, b: np.ndarray, discs: tuple[Disc, ...]) -> np.ndarray:
-        """Which segments are clear of walls, furniture, closed doors and ``discs``."""
-        scene = self.scene
-        ok = scene.segments_free(a, b, dynamic=False)
-        ok &= segments_clear(np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2),
-                             scene.closed_doors(), scene.radius)
+        """Which segments are clear of the bounds, walls, furniture, closed doors and ``discs``."""
+        scene, r = self.scene, self.scene.radius
+        a, b = np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2)
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        ok = (lo[:, 0] >= scene.xmin + r) & (hi[:, 0] <= scene.xmax - r) & (lo[:, 1] >= scene.ymin + r)
+        ok &= hi[:, 1] <= scene.ymax - r
+        ok &= segments_clear(a, b, self._boxes(), r)
         if discs and ok.any():
-            a2, b2 = np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2)
             px, py = np.array([d.x for d in discs]), np.array([d.y for d in discs])
-            rr = np.array([d.r for d in discs]) + scene.radius
-            ok &= (point_segment_distance(px, py, a2, b2) >= rr[None, :]).all(axis=1)
+            rr = np.array([d.r for d in discs]) + r
+            ok &= (point_segment_distance(px, py, a, b) >= rr[None, :]).all(axis=1)
         return ok
 
     def _free_points(self, pts: np.ndarray, discs: tuple[Disc, ...]) -> np.ndarray:
@@ -229,17 +240,23 @@ class BasePlanner:
         lengths = np.hypot(*(all_nodes[all_edges[:, 0]] - all_nodes[all_edges[:, 1]]).T)
         return all_nodes, all_edges, lengths
 
-    def _links(self, p: Point, nodes: np.ndarray, discs: tuple[Disc, ...],
-               k: int = 16) -> tuple[np.ndarray, np.ndarray]:
-        """Nodes visible from ``p`` among its ``k`` nearest and every milestone within 3 m
-        that is not an OMPL sample (corners, doors, places, rings), with distances."""
+    def _links(self, p: Point, nodes: np.ndarray, discs: tuple[Disc, ...], k: int = 16,
+               also: Point | None = None) -> tuple[np.ndarray, np.ndarray, bool]:
+        """Nodes visible from ``p`` among its ``k`` nearest and the nearest 24 milestones within
+        3 m that are not OMPL samples (corners, doors, places, rings), with distances; and
+        whether ``p`` sees ``also`` directly (one vectorised test for all)."""
         d = np.hypot(nodes[:, 0] - p[0], nodes[:, 1] - p[1])
         first = int(self.roadmap.corner_nodes[0]) if len(self.roadmap.corner_nodes) else len(self.roadmap.nodes)
         near = np.argpartition(d, min(k, len(d) - 1))[:k]
         special = first + np.flatnonzero(d[first:] <= 3.0)
+        if len(special) > 24:
+            special = special[np.argsort(d[special], kind="stable")[:24]]
         cand = np.unique(np.concatenate([near, special]))
-        ok = self._free_segments(np.repeat([p], len(cand), axis=0), nodes[cand], discs)
-        return cand[ok], d[cand[ok]]
+        ends = nodes[cand] if also is None else np.vstack([nodes[cand], [also]])
+        ok = self._free_segments(np.repeat([p], len(ends), axis=0), ends, discs)
+        direct = bool(ok[-1]) if also is not None else False
+        ok = ok[: len(cand)]
+        return cand[ok], d[cand[ok]], direct
 
     def _tree(self, s: Point, layer: Layer) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Distances and predecessors from ``s`` over ``layer``'s graph (cached), and its nodes."""
@@ -249,7 +266,7 @@ class BasePlanner:
             return self._trees[key]
         nodes, edges, lengths = self._graph(layer)
         n = len(nodes)
-        si, sd = self._links(s, nodes, layer[1])
+        si, sd, _ = self._links(s, nodes, layer[1])
         rows = np.concatenate([edges[:, 0], edges[:, 1], np.full(len(si), n)])
         cols = np.concatenate([edges[:, 1], edges[:, 0], si])
         graph = csr_matrix((np.concatenate([lengths, lengths, sd + 1e-9]), (rows, cols)), shape=(n + 1, n + 1))
@@ -305,10 +322,12 @@ class BasePlanner:
             return None
         s = snapped
         head = (s0,) if s != s0 else ()
-        if math.hypot(g[0] - s[0], g[1] - s[1]) < 1e-6 or self._free_segments(np.array([s]), np.array([g]), discs)[0]:
+        if math.hypot(g[0] - s[0], g[1] - s[1]) < 1e-6:
             return (*head, s, g)
         dist, pred, nodes = self._tree(s, layer)
-        gi, gd = self._links(g, nodes, discs)
+        gi, gd, direct = self._links(g, nodes, discs, also=s)
+        if direct:
+            return (*head, s, g)
         if not len(gi):
             return None
         total = dist[gi] + gd

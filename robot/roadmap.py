@@ -53,8 +53,9 @@ class RoadmapStats:
     dropped_edges: int
 
 
-def ompl_setup(scene: Scene, resolution: float) -> Any:
-    """An OMPL ``SimpleSetup`` for the base in R² over ``scene``'s static layer (walls, furniture).
+def ompl_setup(scene: Scene, resolution: float, dynamic: bool = False) -> Any:
+    """An OMPL ``SimpleSetup`` for the base in R² over ``scene``'s static layer (walls, furniture),
+    or, with ``dynamic``, over the whole scene (closed doors and people too).
 
     ``resolution`` is OMPL's validity-checking resolution, a fraction of the space's extent.
     """
@@ -69,7 +70,10 @@ def ompl_setup(scene: Scene, resolution: float) -> Any:
     bounds.setHigh(1, scene.ymax)
     space.setBounds(bounds)
     setup = og.SimpleSetup(space)
-    setup.setStateValidityChecker(lambda s: scene.static_free(s[0], s[1]))
+    if dynamic:
+        setup.setStateValidityChecker(lambda s: scene.free(s[0], s[1]))
+    else:
+        setup.setStateValidityChecker(lambda s: scene.static_free(s[0], s[1]))
     setup.getSpaceInformation().setStateValidityCheckingResolution(resolution)
     return setup
 

@@ -19,17 +19,39 @@ On success the simulation applies ``data["add"]`` and ``data["delete"]``.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from collections.abc import Mapping
+from typing import Protocol
 
 import numpy as np
 
 from robot.control import STOP, Command, PathFollower
+from robot.motion import BasePlanner, DriveLimits, MotionEstimator
+from robot.people import People
+from robot.scene import Scene
+from robot.spec import WorldSpec
 from tasker.protocols import RUNNING, SUCCEEDED, SkillStatus, failed
 from tasker.stage import Stage
 from tasker.world import Pose
 
-if TYPE_CHECKING:
-    from robot.sim import Simulation
+
+class SkillHost(Protocol):
+    """What a skill may see of the world it runs in (:class:`robot.sim.Simulation` is one).
+
+    The narrow meeting point of skills and simulation: skills read poses, people, the
+    collision scene and the motion planner through it, and never step or change the
+    world themselves (the simulation calls :meth:`Skill.control` and applies results).
+    """
+
+    spec: WorldSpec
+    people: People
+    scene: Scene
+    planner: BasePlanner
+    motion: MotionEstimator
+    limits: DriveLimits
+
+    def robot_pose(self) -> Pose: ...
+
+    def objects(self) -> Mapping[str, str]: ...
 
 BLOCK_TIMEOUT = 5.0  # seconds a blocked path is retried before the skill fails
 CHECK_PERIOD = 0.2  # seconds between checks of the path ahead
@@ -38,7 +60,7 @@ CHECK_PERIOD = 0.2  # seconds between checks of the path ahead
 class Skill:
     """A running skill: timed by default; subclasses override :meth:`control`/:meth:`status`."""
 
-    def __init__(self, sim: Simulation, stage: Stage, now: float) -> None:
+    def __init__(self, sim: SkillHost, stage: Stage, now: float) -> None:
         self.sim = sim
         self.stage = stage
         self.started = now
@@ -63,7 +85,7 @@ class Skill:
 class Manipulate(Skill):
     """A timed manipulation; fails at once if its object is gone."""
 
-    def __init__(self, sim: Simulation, stage: Stage, now: float) -> None:
+    def __init__(self, sim: SkillHost, stage: Stage, now: float) -> None:
         super().__init__(sim, stage, now)
         obj = stage.data.get("object")
         if obj is not None and obj not in sim.objects():
@@ -73,7 +95,7 @@ class Manipulate(Skill):
 class Navigate(Skill):
     """Drive the base along a planned path to a place, a person or a pose."""
 
-    def __init__(self, sim: Simulation, stage: Stage, now: float) -> None:
+    def __init__(self, sim: SkillHost, stage: Stage, now: float) -> None:
         super().__init__(sim, stage, now)
         self.target = stage.data.get("to")
         self.follower: PathFollower | None = None
