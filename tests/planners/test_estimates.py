@@ -282,3 +282,17 @@ def test_a_leg_through_a_door_the_plan_opens_is_timed_with_the_door_open(tasks: 
     assert est.source is Source.PLAN and math.isfinite(est.c_time), est.note
     assert est.c_time == pytest.approx(executed(task, ctx))  # the same legs as with no door at all
     assert motion.ignoring > 0
+
+
+def test_paper_scenario_trace_does_not_depend_on_what_earlier_runs_cached() -> None:
+    """The estimator's cache lives as long as the task type: a second run in the same process
+    (warm caches) must write the same trace, byte for byte, as the first."""
+    import json
+
+    from experiments import scenario as scenarios
+    from experiments.runner import run_scenario
+
+    scn = replace(scenarios.load(scenarios.resolve("paper")), horizon=40.0)  # Alice greeted, decisions on
+    runs = [run_scenario(scn, pictures=False).trace.events for _ in range(2)]
+    assert any(e["event"] == "decision" and e.get("rule") == "cost" for e in runs[0])
+    assert [json.dumps(e, sort_keys=True) for e in runs[0]] == [json.dumps(e, sort_keys=True) for e in runs[1]]
