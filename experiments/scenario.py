@@ -22,6 +22,7 @@ from experiments.actions import TimedAction, read_actions
 from experiments.fields import Fields as _Fields
 from experiments.fields import ScenarioError
 from tasker import schedulers
+from tasker.task import POLICIES
 
 SCENARIOS = Path(__file__).resolve().parent / "scenarios"
 
@@ -47,6 +48,8 @@ class RobotScenario:
     seed: int = 1
     horizon: float = 1800.0
     people: dict[str, dict[str, Any]] = field(default_factory=dict)
+    objects: dict[str, dict[str, Any]] = field(default_factory=dict)
+    policy: str = "strict"
 
     def to_json(self) -> dict[str, Any]:
         out = dataclasses.asdict(self)
@@ -118,6 +121,18 @@ def load(path: str | Path) -> RobotScenario:
                              for i, w in enumerate(pf.get("walk", list))]
         pf.done()
         people[name] = entry
+    objects_f = top.sub("objects", {})
+    objects: dict[str, dict[str, Any]] = {}
+    for name in list(objects_f.table):
+        of = objects_f.sub(name)
+        obj: dict[str, Any] = {"type": of.get("type", str), "place": of.get("place", str)}
+        facts = of.get("facts", list, [])
+        if not all(isinstance(f, list) and f and all(isinstance(x, str) and x for x in f) for f in facts):
+            raise of.error("facts", f"expected a list of facts such as [[\"on_counter\", \"{name}\"]], got {facts!r}")
+        obj["facts"] = [list(f) for f in facts]
+        of.done()
+        objects[name] = obj
+    objects_f.done()
     scenario = RobotScenario(
         name=top.get("name", str, p.stem), source=source, world=world, actions=actions,
         scheduler=scheduler, scheduler_options=s.get("scheduler_options", dict, {}),
@@ -127,6 +142,7 @@ def load(path: str | Path) -> RobotScenario:
         sp_up_rate=s.get("sp_up_rate", float, 1.0, positive=True),
         update=_strategy(s, "update"), suspension=_strategy(s, "suspension"), strategies=strategies,
         seed=top.get("seed", int, 1), horizon=s.get("horizon", float, 1800.0, positive=True), people=people,
+        objects=objects, policy=_choice(s, "policy", POLICIES, "strict"),
     )
     s.done()
     top.done()

@@ -19,7 +19,9 @@ from planners.pddl_task import PddlTaskType
 from planners.problem import DomainModel
 from planners.results import PlanStatus
 from planners.stages import Bindings
-from planners.taskspec import TaskSpec, read_task_toml
+from planners.taskspec import TaskSpec, meaning_of, read_task_toml
+from tasker import reader
+from tasker.meaning import Binding
 
 HOOK_NAMES = ("extra_facts", "suspension_goal", "check_args", "check_terminate")
 """Functions a ``task.py`` may define (see ``docs/domains.md``)."""
@@ -83,6 +85,48 @@ def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
                                             f"argument(s), got {len(t.args)}")
 
 
+def _check_pattern(spec: TaskSpec, dm: DomainModel, where: str, lit: tuple[str, ...], variables: bool) -> None:
+    """A declared pattern names a predicate of the domain with its arity, and only request
+    arguments it has (``$robot`` too) or, where allowed, ``?variables``."""
+    atom = lit[1:] if lit[0] == "not" else lit
+    if atom[0] not in dm.predicates:
+        raise spec.error(where, f"unknown predicate {atom[0]!r}{reader.suggest(atom[0], dm.predicates)} "
+                                f"(the domain declares {', '.join(sorted(dm.predicates))})")
+    arity = len(dm.predicates[atom[0]])
+    if len(atom) - 1 != arity:
+        raise spec.error(where, f"{atom[0]!r} takes {arity} argument(s), got {len(atom) - 1}: {list(lit)}")
+    args = [a.name for a in spec.args] + ["robot"]
+    for tok in atom[1:]:
+        if tok.startswith("$") and tok[1:] not in args:
+            raise spec.error(where, f"unknown request argument {tok!r}"
+                                    f"{reader.suggest(tok, ['$' + a for a in args])} "
+                                    f"(this task's: {', '.join('$' + a for a in args)})")
+        if tok.startswith("?") and not variables:
+            raise spec.error(where, f"{tok}: a ?variable is not allowed here")
+
+
+def _check_meaning(spec: TaskSpec, dm: DomainModel) -> tuple[Binding, ...]:
+    """Hazards, people's roles and bindings against the domain; bindings get their object types."""
+    for k, h in enumerate(spec.hazards):
+        _check_pattern(spec, dm, f"hazards[{k}].fact", h.fact, variables=True)
+    if spec.people is not None:
+        args = [a.name for a in spec.args]
+        if spec.people.person not in args:
+            raise spec.error("people.person", f"no request argument {spec.people.person!r}"
+                                              f"{reader.suggest(spec.people.person, args)} (this task's: "
+                                              f"{', '.join(args) or 'none'})")
+        for role, lits in spec.people.roles.items():
+            for lit in lits:
+                _check_pattern(spec, dm, f"people.{role}", lit, variables=True)
+    out = []
+    for k, b in enumerate(spec.bindings):
+        _check_pattern(spec, dm, f"bindings[{k}].fact", b.fact, variables=True)
+        wanted = dm.predicates[b.fact[0]][b.fact.index(b.object) - 1]
+        types = tuple(sorted(t for t, chain in dm.types.items() if wanted in chain)) if wanted else ()
+        out.append(b.resolve(types))
+    return tuple(out)
+
+
 def _check_example(task: PddlTaskType) -> None:
     from planners.examples import example_context
 
@@ -104,7 +148,9 @@ def load_task(folder: str | Path) -> PddlTaskType:
     spec = read_task_toml(folder / "task.toml")
     dm = DomainModel(load_domain(spec.domain_file))
     _cross_check(spec, dm)
+    bindings = _check_meaning(spec, dm)
     task = PddlTaskType(spec, dm, hooks=_load_hooks(spec))
+    task.meaning = meaning_of(spec, bindings)
     _check_example(task)
     return task
 

@@ -81,6 +81,7 @@ class SimulationLoop:
         self._tokens: dict[str, int] = {}
         self._started = False
         self.all_agents: list[DynamicAgent] = []  # every agent created, ended ones included
+        self.observers: list[Callable[[float], None]] = []  # called after each tick, e.g. tasker.meaning.Monitor
 
     # -- time ---------------------------------------------------------------------------------
 
@@ -213,4 +214,6 @@ class SimulationLoop:
                     timer = True
                     self._push(tick + max(1, round(1.0 / (harm.s_freq * self.resolution))), _TIMER, None)
             harm.step(now, timer)
+            for observe in self.observers:
+                observe(now)
         return self.trace

@@ -34,8 +34,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tasker.errors import BadRequest, ConfigError
+from tasker.meaning import NO_MEANING, Meaning
 from tasker.messages import CompletionCost, CostParams, ScheduleParams, SPRequest
 from tasker.stage import Purpose, Stage, StagePlan
+
+POLICIES = ("strict", "conditional")
+"""Suspension policies (:attr:`Strategy.policy`)."""
 
 _ARG_TYPES: dict[str, type] = {"str": str, "float": float, "int": int, "bool": bool, "pose": tuple}
 
@@ -158,12 +162,15 @@ class TaskType:
 
     Subclasses set :attr:`name`, :attr:`arg_specs` and :attr:`description`, and
     override hooks.  One instance serves every agent of the type, so per-agent state
-    belongs in ``ctx.memory``, never on ``self``.
+    belongs in ``ctx.memory``, never on ``self``.  :attr:`meaning` declares what the
+    task means for safety and people (hazards, roles, physical bindings; see
+    :mod:`tasker.meaning`): the trace and the metrics read it, never the task's name.
     """
 
     name: str = ""
     description: str = ""
     arg_specs: tuple[ArgSpec, ...] = ()
+    meaning: Meaning = NO_MEANING
 
     # -- framework-owned ------------------------------------------------------------
 
