@@ -2,7 +2,8 @@
 
 It is read strictly with :mod:`tasker.reader`: every fault (an unknown key or table
 such as ``kindd`` or ``[shedule]`` included) is a :class:`~planners.checks.DefinitionError`
-naming ``task.toml``, the line, the field and what was expected, with a "did you mean".  The format is documented, with an example, in ``docs/domains.md``.
+naming ``task.toml``, the line, the field and what was expected, with a "did you mean".
+The format is documented, with an example, in ``docs/domains.md``.
 Literals are lists of strings, like the world's facts: ``["at", "$person", "$destination"]``,
 negated as ``["not", "following", "$person"]``; ``$name`` is a request argument,
 ``$robot`` the robot, ``$at:name`` the place where ``name`` is; ``?param`` (in
@@ -150,7 +151,8 @@ class _Reader:
         value = t.raw(key, [] if default is None else default)
         self.note(t, key)
         if not isinstance(value, list):
-            raise self.fail(t, key, f"expected a list of literals such as [[\"at\", \"$x\", \"$place\"]], got {value!r}")
+            raise self.fail(t, key, 'expected a list of literals such as [["at", "$x", "$place"]], '
+                                    f"got {value!r}")
         out: list[Literal] = []
         for lit in value:
             out.append(self.literal(t, key, lit))

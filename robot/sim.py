@@ -146,8 +146,9 @@ class Simulation:
 
     def _binding(self, fact: Fact) -> tuple[Binding, str] | None:
         """The binding that covers a ground fact, with the physical thing it is about."""
-        kinds = {"device": self.device_state, "door": self.door_open, "held": self.spec.objects,
-                 "following": self.people.by_name, "waiting": self.people.by_name}
+        kinds: dict[str, set[str]] = {"device": set(self.device_state), "door": set(self.door_open),
+                                      "held": set(self.spec.objects), "following": set(self.people.by_name),
+                                      "waiting": set(self.people.by_name)}
         for b in self.bindings:
             obj = b.object_of(fact)
             if obj is not None and obj in kinds[b.kind] and (not b.types or self._type(obj) in b.types):
@@ -220,7 +221,7 @@ class Simulation:
             place = next((f[2] for f in facts if f[0] == "at" and len(f) == 3 and f[1] == name), None)
             if name in self.held:
                 poses[name] = poses["robot"]
-            elif place in self.spec.places:
+            elif place is not None and place in self.spec.places:
                 poses[name] = self.spec.places[place]
         return WorldState(frozenset(facts | self.people.facts()), poses, self.objects(), self.time)
 

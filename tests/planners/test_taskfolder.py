@@ -30,7 +30,8 @@ def _edit(path: Path, old: str, new: str) -> None:
 TOML_CASES = [
     ('skill = "say"\nkind = "blocking"\ntext = "Hello {h}', 'skill = "talk"\nkind = "blocking"\ntext = "Hello {h}',
      "actions.greet.skill: expected one of ['navigate', 'say', 'manipulate', 'wait'], got 'talk'"),
-    ('[actions.say_goodbye]\nskill = "say"\n', '[actions.say_goodbye]\nskill = "say"\nkind = "sometimes"\n', "actions.say_goodbye.kind: expected one of"),
+    ('[actions.say_goodbye]\nskill = "say"\n', '[actions.say_goodbye]\nskill = "say"\nkind = "sometimes"\n',
+     "actions.say_goodbye.kind: expected one of"),
     ('["not", "told_to_wait", "$person"]]', '["not", "told_to", "$person"]]', "unknown predicate 'told_to'"),
     ('goal = [["at", "$person", "$destination"]', 'goal = [["at", "$person"]', "takes 2 argument(s)"),
     ('{ action = "say_goodbye", args = ["$robot", "$person", "$destination"] }',
@@ -83,7 +84,8 @@ def test_strict_reader_names_the_line(tmp_path: Path) -> None:
     assert "valid keys: duration, kind, skill, text, to, travel" in str(info.value)
 
 
-def test_a_bad_task_toml_is_one_line_and_exit_2_from_the_cli(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_bad_task_toml_is_one_line_and_exit_2_from_the_cli(tmp_path: Path,
+                                                             capsys: pytest.CaptureFixture[str]) -> None:
     from experiments.cli import main
 
     folder = _copy(tmp_path)
