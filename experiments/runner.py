@@ -84,7 +84,8 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
         strategy=default, strategies=per_type, core=sim, world=sim, motion=sim.motion, horizon=scn.horizon,
     )
     monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning,
-                      lambda: sim.snapshot().facts, task_types=store.names())
+                      lambda: sim.snapshot().facts, task_types=store.names(),
+                      version=lambda: (sim.time, sim.version))
     loop.observers.append(monitor.observe)
     requester = Requester(store, loop.harmoniser, "scenario")
     for a in scn.actions:

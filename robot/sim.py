@@ -147,7 +147,7 @@ class Simulation:
     def _binding(self, fact: Fact) -> tuple[Binding, str] | None:
         """The binding that covers a ground fact, with the physical thing it is about."""
         kinds: dict[str, set[str]] = {"device": set(self.device_state), "door": set(self.door_open),
-                                      "held": set(self.spec.objects), "following": set(self.people.by_name),
+                                      "held": set(self.spec.objects), "follower": set(self.people.by_name),
                                       "waiting": set(self.people.by_name)}
         for b in self.bindings:
             obj = b.object_of(fact)
@@ -169,7 +169,7 @@ class Simulation:
             self.set_door(obj, value)
         elif b.kind == "held":
             (self.held.add if value else self.held.discard)(obj)
-        elif b.kind == "following":
+        elif b.kind == "follower":
             self.people[obj].following = value
         else:
             self.people[obj].waiting = value
@@ -185,7 +185,7 @@ class Simulation:
                 things = [n for n, v in self.door_open.items() if v]
             elif b.kind == "held":
                 things = sorted(self.held)
-            elif b.kind == "following":
+            elif b.kind == "follower":
                 things = [p.name for p in self.people if p.following]
             else:
                 things = [p.name for p in self.people if p.waiting]

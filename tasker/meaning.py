@@ -29,7 +29,7 @@ ROLES = ("waiting", "following", "told_to_wait", "needs_help", "helped")
 """People's roles a task may declare: the person waits for the robot, follows it, has been
 told to wait, needs help; ``helped`` marks the moment help was given (time-to-help)."""
 
-BINDING_KINDS = ("device", "door", "held", "following", "waiting")
+BINDING_KINDS = ("device", "door", "held", "follower", "waiting")
 """Physical state a fact may be bound to: a device's state, a door's open/closed, an object
 held by the robot, a person following the robot, a person standing still waiting."""
 
@@ -198,14 +198,17 @@ class Monitor:
     start, so a pattern without ``$args`` that already holds (a door open in the world
     file) belongs to nobody (``agent: null``) rather than to the next agent requested.
     Call :meth:`observe` after each tick; it re-evaluates only when the facts or the
-    set of live agents changed.  Edges are written in a fixed order (agent, hazard or
+    set of live agents changed, and asks for the facts only when ``version`` (e.g. the
+    world's clock and change counter) moved.  Edges are written in a fixed order (agent, hazard or
     role, arguments), so the trace stays deterministic.
     """
 
     def __init__(self, trace: Any, agents: Callable[[], Sequence[Any]], meaning_of: Callable[[str], Meaning],
                  facts: Callable[[], frozenset[Fact] | None], robot: Callable[[], str] = lambda: "robot",
-                 task_types: Sequence[str] = ()) -> None:
+                 task_types: Sequence[str] = (), version: Callable[[], Any] | None = None) -> None:
         self.trace = trace
+        self._version = version
+        self._seen: Any = None
         self.task_types = tuple(task_types)
         self._agents = agents
         self._meaning_of = meaning_of
@@ -223,12 +226,17 @@ class Monitor:
             self._done_in_tick.append(str(e.get("agent")))
 
     def observe(self, now: float) -> None:
-        facts = self._facts()
         made_by, self._done_in_tick = self._done_in_tick, []
-        if facts is None:
-            return
         agents = list(self._agents())
         alive = tuple((a.id, bool(a.ended)) for a in agents)
+        if self._version is not None:  # the world says whether its facts can have changed
+            seen = (self._version(), alive)
+            if seen == self._seen:
+                return
+            self._seen = seen
+        facts = self._facts()
+        if facts is None:
+            return
         if self._last is not None and self._last == (facts, alive):
             return
         self._last = (facts, alive)

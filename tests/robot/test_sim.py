@@ -73,7 +73,7 @@ def test_person_asked_to_follow_ends_near_the_destination(paper) -> None:
     sim = Simulation(paper)
     status, now = run(sim, nav("john", add=[["met", "robot", "john"]]), 0.0)
     assert status.state is SkillState.SUCCEEDED and sim.snapshot().holds("met", "robot", "john")
-    sim.bind([Binding("following", ("following", "?h"), "?h", ("person",))])
+    sim.bind([Binding("follower", ("following", "?h"), "?h", ("person",))])
     sim.apply(add=[["following", "john"]])
     status, now = run(sim, nav("john_destination"), now)
     assert status.state is SkillState.SUCCEEDED
