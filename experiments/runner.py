@@ -73,9 +73,9 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
     store = TaskStore(task_types())
     types = [store.get(n) for n in store.names()]
     sim.bind(b for t in types for b in t.meaning.bindings)  # the world reads the folders' bindings
-    default = Strategy(update or scn.update, suspension or scn.suspension)
-    per_type = {t: Strategy(update or s.get("update", default.update), suspension or s.get("suspension",
-                                                                                           default.suspension))
+    default = Strategy(update or scn.update, suspension or scn.suspension, scn.policy)
+    per_type = {t: Strategy(update or s.get("update", default.update),
+                            suspension or s.get("suspension", default.suspension), scn.policy)
                 for t, s in scn.strategies.items()}
     options = scn.scheduler_options if scheduler in (None, scn.scheduler) else {}
     loop = SimulationLoop(
@@ -187,6 +187,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
                      # synthetic task types have only static strategies: say what was used
                      "update": "static" if kind == "synthetic" else (update or loop.strategy.update),
                      "suspension": "static" if kind == "synthetic" else (suspension or loop.strategy.suspension),
+                     "policy": loop.strategy.policy,
                      "randomized": randomize},
         "planner": _planner_config() if kind == "robot" else None,
         "host": platform.node(), "platform": platform.platform(), "python": sys.version.split()[0],

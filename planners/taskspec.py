@@ -23,7 +23,7 @@ from tasker import reader
 from tasker.errors import ConfigError
 from tasker.meaning import BINDING_KINDS, ROLES, Binding, Hazard, Meaning, People
 from tasker.stage import StageKind
-from tasker.task import ArgSpec
+from tasker.task import POLICIES, ArgSpec
 
 SKILLS = ("navigate", "say", "manipulate", "wait")
 """Skills the core agent offers (the contract with ``robot/``)."""
@@ -55,14 +55,20 @@ class StageTemplate:
 
 @dataclass(frozen=True, slots=True)
 class Branch:
-    """One branch of a decision list: ``when`` all literals hold (and the interruption is
-    at least ``min_interruption_s`` long), use ``goal`` (planned) or ``stages`` (static)."""
+    """One branch of the suspension decision list (eq. 47), shared by both strategies.
+
+    It applies when every ``when`` literal holds (``?vars`` are bound by the first match,
+    in sorted order, and may be used in ``goal`` and ``stages``); ``planned`` plans to
+    ``goal``, ``static`` runs ``stages`` — the load check proves the stages reach the goal.
+    A ``policy = "conditional"`` branch trades safety for time: it is eligible only under
+    that policy and when the expected interruption is at most ``max_interruption_s``."""
 
     when: tuple[Literal, ...] = ()
-    min_interruption_s: float = 0.0
     goal: tuple[Literal, ...] = ()
     stages: tuple[StageTemplate, ...] = ()
     label: str = ""
+    policy: str = "strict"
+    max_interruption_s: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,7 +96,6 @@ class TaskSpec:
     suspension: tuple[Branch, ...]
     actions: Mapping[str, ActionSpec]
     static_update: tuple[StageTemplate, ...]
-    static_suspension: tuple[Branch, ...]
     cps: float
     travel_s: float
     planning_time_s: float
@@ -184,23 +189,28 @@ class _Reader:
             out.append(StageTemplate(action, tuple(args), sus))
         return tuple(out)
 
-    def branches(self, t: reader.Table, key: str, static: bool) -> tuple[Branch, ...]:
+    def branches(self, t: reader.Table, key: str) -> tuple[Branch, ...]:
         if key not in t:
             out = [Branch()]
         else:
             out = []
             for b in t.tables(key):
-                when = self.literals(b, "when")
-                mi = b.number("min_interruption_s", 0.0, min=0)
-                goal = () if static else self.literals(b, "goal")
-                stages = self.templates(b, "stages") if static else ()
-                out.append(Branch(when, float(mi), goal, stages, b.string("label", "", empty=True)))
+                policy = b.string("policy", "strict", choices=POLICIES)
+                limit = b.number("max_interruption_s", None, min=0)
+                if (policy == "conditional") != (limit is not None):
+                    raise self.fail(b, "max_interruption_s" if limit is not None else "policy",
+                                    'a branch that trades safety for time has policy = "conditional" and '
+                                    "max_interruption_s (the longest interruption it accepts), and only such a branch")
+                out.append(Branch(self.literals(b, "when"), self.literals(b, "goal"), self.templates(b, "stages"),
+                                  b.string("label", "", empty=True), policy,
+                                  None if limit is None else float(limit)))
+                self.note(b)
                 b.done()
             if not out:
                 raise self.fail(t, key, "needs at least one branch (the default case, with no 'when')")
         last = out[-1]
-        if last.when or last.min_interruption_s:
-            raise self.fail(t, key, "the last branch must have no 'when' (the default case)")
+        if last.when or last.policy != "strict":
+            raise self.fail(t, key, "the last branch must have no 'when' and the strict policy (the default case)")
         return tuple(out)
 
 
@@ -346,7 +356,9 @@ def read_task_toml(path: Path) -> TaskSpec:
         actions_t.done()
         static = top.table("static")
         static_update = r.templates(static, "update")
-        static_suspension = r.branches(static, "suspension", static=True)
+        if "suspension" in static:
+            raise r.fail(static, "suspension", "[[static.suspension]] is gone: each [[suspension]] branch now has "
+                                               "both `goal` (planned) and `stages` (static), see docs/domains.md")
         static.done()
         schedule = top.table("schedule", {})
         cps = schedule.number("cps", 1.0, min=0)
@@ -355,8 +367,7 @@ def read_task_toml(path: Path) -> TaskSpec:
         spec = TaskSpec(
             folder=path.parent, name=name, description=description, domain_file=path.parent / domain,
             args=_args(r, top), goal=goal, facts=facts, suspended_facts=suspended_facts,
-            suspension=r.branches(top, "suspension", static=False), actions=actions,
-            static_update=static_update, static_suspension=static_suspension,
+            suspension=r.branches(top, "suspension"), actions=actions, static_update=static_update,
             cps=float(cps), travel_s=float(travel_s), planning_time_s=float(planning_time_s),
             static_time_s=float(static_time_s), timeout_s=float(timeout_s), example=_example(r, top),
             hazards=_hazards(r, top), people=_people(r, top), bindings=_bindings(r, top), lines=r.lines,
