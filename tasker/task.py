@@ -93,15 +93,22 @@ class Strategy:
 
     Each is ``"planned"`` (call a planner on the world as it is) or ``"static"``
     (the task's template ``exeTsk``, Alg. 3, and decision-tree ``exeSusp``, eq. 47).
+    Both pursue the same suspension goal.  ``policy`` is a separate factor applied to
+    both: ``"strict"`` always reaches the safe state; ``"conditional"`` also allows the
+    branches a task declares as trading safety for time (e.g. leave the cooker on for a
+    short interruption).
     """
 
     update: str = "planned"
     suspension: str = "planned"
+    policy: str = "strict"
 
     def __post_init__(self) -> None:
         for name in ("update", "suspension"):
             if getattr(self, name) not in ("planned", "static"):
                 raise ConfigError(f"Strategy.{name} must be 'planned' or 'static', got {getattr(self, name)!r}")
+        if self.policy not in POLICIES:
+            raise ConfigError(f"Strategy.policy must be one of {list(POLICIES)}, got {self.policy!r}")
 
 
 @dataclass(slots=True)
