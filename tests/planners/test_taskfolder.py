@@ -43,11 +43,18 @@ TOML_CASES = [
     ('travel = ["?from", "?to"]', 'travel = ["?from", "?nowhere"]', "?nowhere is not a parameter"),
     ('[[suspension]]\nlabel = "save"\ngoal = []', '[[suspension]]\nlabel = "save"\nwhen = [["greeted", "$person"]]\n'
      'goal = []', "the last branch must have no 'when'"),
+    ('when = [["greeted", "$person"]]\ngoal = [["told_to_wait", "$person"]]',
+     'when = [["greeted", "$person"]]\ngoal = [["told_to_wait", "?who"]]', "suspension[1]: ?who is not bound"),
     ('name = "guide_human"', 'name = "guide human"', "'name' must be an identifier"),
     # the strict reader: unknown keys and tables are errors with the line and a did-you-mean
     ('[actions.say_goodbye]\nskill = "say"\n', '[actions.say_goodbye]\nskill = "say"\nkindd = "blocking"\n',
      "actions.say_goodbye.kindd: unknown key 'kindd'; did you mean 'kind'?"),
     ('[schedule]', '[shedule]', "shedule: unknown key 'shedule'; did you mean 'schedule'?"),
+    # static and planned pursue the same goal: the branch's stages must reach it
+    ('stages = [{ action = "ask_to_wait", args = ["$robot", "$person", "$at:robot"] }]', 'stages = []',
+     "suspension[0]: static and planned must pursue the same goal"),
+    ('label = "save"\ngoal = []', 'label = "save"\npolicy = "conditional"\ngoal = []', "suspension[2].policy: a branch"),
+    ('[static]', '[[static.suspension]]\nstages = []\n\n[static]', "[[static.suspension]] is gone"),
     ('budget_s = 0', 'budget = 0', "hazards[0].budget_s: missing (required)"),
     ('fact = ["following", "$person"]\nbudget_s', 'fact = ["folowing", "$person"]\nbudget_s',
      "hazards[0].fact: unknown predicate 'folowing'; did you mean 'following'?"),
