@@ -2,7 +2,9 @@
 
 :func:`check` walks a trace of the paper scenario (``tasker run paper``) and returns
 one :class:`Step` per step of Appendix B, each with the time it happened and the
-events that show it, or why it was not found.  ``docs/paper.md`` explains each
+events that show it, or why it was not found.  What a person does (follows the robot,
+is told to wait) is read from the trace's ``role`` events, which the task folders
+declare, never from action names.  ``docs/paper.md`` explains each
 step; the end-to-end test asserts they all hold, in order.
 """
 
@@ -38,6 +40,13 @@ def _switch(events: Sequence[Event], after: float, dac: str, exe: str, rule: str
     return d, _first(events, d["t"], event="command", agent=dac, flag="start")
 
 
+def _role_at(events: Sequence[Event], t: float, agent: str, role: str) -> bool:
+    """Whether ``agent``'s person had ``role`` at time ``t`` (the last role edge before it)."""
+    edges = [e for e in events if e["event"] == "role" and e["t"] <= t and e.get("agent") == agent
+             and e.get("role") == role]
+    return bool(edges) and edges[-1].get("status") == "on"
+
+
 def check(events: Sequence[Event]) -> list[Step]:
     """The steps of Appendix B in order; each later step is searched after the one before."""
     steps: list[Step] = []
@@ -62,19 +71,16 @@ def check(events: Sequence[Event]) -> list[Step]:
     t = s["t"] if s else t
 
     d, s = _switch(events, t, "d3", "d1", "priority class")
-    guiding = None
-    told = None
+    following = told = None
     if d is not None:
-        guiding = next((e for e in reversed([e for e in events if e["t"] <= d["t"]]) if e["event"] == "stage"
-                        and e.get("agent") == "d1"), None)
-        told = next((e for e in events if e["event"] == "stage" and e["t"] >= d["t"] and e.get("agent") == "d1"
-                     and e.get("fsm") == "exeSusp" and e.get("action") == "ask_to_wait" and e.get("status") == "done"),
-                    None)
-    ok = s is not None and guiding is not None and guiding.get("action") == "guide" and told is not None
+        # read from the trace's role edges, which the task folder declares: no task or action names here
+        following = _role_at(events, d["t"], "d1", "following")
+        told = next((e for e in events if e["event"] == "role" and e["t"] >= d["t"] and e.get("agent") == "d1"
+                     and e.get("role") == "told_to_wait" and e.get("status") == "on"), None)
+    ok = s is not None and following is True and told is not None
     steps.append(Step("Peter fell (d3) preempts guide John at once while John is guided; John is asked to wait",
                       ok, s["t"] if s else None,
-                      f"d1 was in stage {guiding.get('action') if guiding else None}; ask_to_wait done at "
-                      f"{told['t'] if told else None}"))
+                      f"John following d1 at the decision: {following}; told to wait at {told['t'] if told else None}"))
     t = s["t"] if s else t
 
     d, s = _switch(events, t, "d4", "d3", "cost")

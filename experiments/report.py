@@ -38,7 +38,7 @@ HOST_DEPENDENT = re.compile(r"wall_time|real_time_factor|cache_hits|planner_time
 
 HEADLINE = (
     "totals.duration_s.mean", "totals.makespan_s", "people.people_waiting_s", "people.people_following_s",
-    "safety.cooker_unattended_s", "safety.violations_at_switch", "safety.hazards_active_at_switch",
+    "safety.unattended_s", "safety.budget_overruns", "safety.violations_at_switch", "safety.hazards_active_at_switch",
     "totals.suspension_s.mean", "totals.resumption_s.mean", "switching.switches", "totals.failed",
     "totals.unfinished", "totals.plans", "totals.static_fallbacks", "planner_wall_time_s", "wall_time_s",
 )

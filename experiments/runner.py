@@ -34,6 +34,7 @@ from tasker.agent import Rates
 from tasker.errors import RunAborted
 from tasker.harmoniser import Mode
 from tasker.loop import SimulationLoop
+from tasker.meaning import Monitor
 from tasker.requester import Requester
 from tasker.store import TaskStore
 from tasker.task import Strategy
@@ -74,11 +75,14 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
                 changes["walk"] = tuple(tuple(w) for w in entry["walk"])
             people[name] = dataclasses.replace(people[name], **changes)
         spec = dataclasses.replace(spec, people=people)
+    spec = _with_objects(scn, spec)
     sim = Simulation(spec, seed=seed)
     store = TaskStore(task_types(task_paths))
-    default = Strategy(update or scn.update, suspension or scn.suspension)
-    per_type = {t: Strategy(update or s.get("update", default.update), suspension or s.get("suspension",
-                                                                                           default.suspension))
+    types = [store.get(n) for n in store.names()]
+    sim.bind(b for t in types for b in t.meaning.bindings)  # the world reads the folders' bindings
+    default = Strategy(update or scn.update, suspension or scn.suspension, scn.policy)
+    per_type = {t: Strategy(update or s.get("update", default.update),
+                            suspension or s.get("suspension", default.suspension), scn.policy)
                 for t, s in scn.strategies.items()}
     options = scn.scheduler_options if scheduler in (None, scn.scheduler) else {}
     loop = SimulationLoop(
@@ -86,12 +90,38 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
         mode=Mode(scn.mode), s_freq=scn.s_freq, rates=Rates(scn.rep_rate, scn.task_exe_rate, scn.sp_up_rate),
         strategy=default, strategies=per_type, core=sim, world=sim, motion=sim.motion, horizon=scn.horizon,
     )
+    monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning,
+                      lambda: sim.snapshot().facts, task_types=store.names(),
+                      version=lambda: (sim.time, sim.version))
+    loop.observers.append(monitor.observe)
     requester = Requester(store, loop.harmoniser, "scenario")
     for a in scn.actions:
         loop.at(a.t, _action(loop, sim, requester, a, scn))
         if a.kind == "request":
             store.validate(a.fields["task"], a.fields["args"])  # bad requests fail before the run
     return loop, sim
+
+
+def _with_objects(scn: scenarios.RobotScenario, spec: Any) -> Any:
+    """The world with the scenario's ``[objects]``: each gets its type, ``("at", name, place)``
+    and its facts (its pose is its place's, see :meth:`robot.sim.Simulation.snapshot`)."""
+    if not scn.objects:
+        return spec
+    objects = dict(spec.objects)
+    facts = list(spec.facts)
+    for name, o in sorted(scn.objects.items()):
+        if o["place"] not in spec.places:
+            raise scenarios.ScenarioError(f"{scn.source}: objects.{name}.place: no place {o['place']!r} in world "
+                                          f"{scn.world!r}; known: {sorted(spec.places)}")
+        taken = set(spec.places) | set(spec.people) | set(spec.devices) | set(spec.doors) | {"robot"}
+        if name in taken:
+            raise scenarios.ScenarioError(f"{scn.source}: objects.{name}: the world already has something "
+                                          f"called {name!r}")
+        objects[name] = o["type"]
+        facts = [f for f in facts if not (f[0] == "at" and len(f) == 3 and f[1] == name)]
+        facts.append(("at", name, o["place"]))
+        facts += [tuple(f) for f in o.get("facts", [])]
+    return dataclasses.replace(spec, objects=objects, facts=tuple(dict.fromkeys(facts)))
 
 
 def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: TimedAction,
@@ -172,6 +202,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
                      # synthetic task types have only static strategies: say what was used
                      "update": "static" if kind == "synthetic" else (update or loop.strategy.update),
                      "suspension": "static" if kind == "synthetic" else (suspension or loop.strategy.suspension),
+                     "policy": loop.strategy.policy,
                      "randomized": randomize},
         "planner": _planner_config() if kind == "robot" else None,
         "host": platform.node(), "platform": platform.platform(), "python": sys.version.split()[0],

@@ -82,6 +82,7 @@ class SimulationLoop:
         self._started = False
         self.aborted: str | None = None  # why the run was aborted, if it was
         self.all_agents: list[DynamicAgent] = []  # every agent created, ended ones included
+        self.observers: list[Callable[[float], None]] = []  # called after each tick, e.g. tasker.meaning.Monitor
 
     # -- time ---------------------------------------------------------------------------------
 
@@ -257,4 +258,6 @@ class SimulationLoop:
                     timer = True
                     self._push(tick + max(1, round(1.0 / (harm.s_freq * self.resolution))), _TIMER, None)
             harm.step(now, timer)
+            for observe in self.observers:
+                observe(now)
         return self.trace

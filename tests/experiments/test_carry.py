@@ -14,5 +14,5 @@ def test_carry_opens_the_door_and_planned_suspension_closes_it() -> None:
         assert "open_door" in [s["action"] for s in up["stages"]]  # the door is closed at first
     susp = planned.trace.of("plan", agent="d1", purpose="genSusp")[0]
     assert susp["strategy"] == "planned" and "close_door" in [s["action"] for s in susp["stages"]]
-    assert planned.metrics["safety"]["doors_open_at_switch"] == 0
-    assert static.metrics["safety"]["doors_open_at_switch"] == 1  # eq. 47's tree only puts the vase down
+    assert planned.metrics["safety"]["hazards"]["door_open"]["at_switch"] == 0
+    assert static.metrics["safety"]["hazards"]["door_open"]["at_switch"] == 1  # eq. 47's tree only puts the vase down
