@@ -77,9 +77,19 @@ class Bindings:
     def literals(self, lits: Sequence[Literal]) -> list[Literal]:
         return [tuple(self.token(t) for t in lit) for lit in lits]
 
+    def _distance(self, env: Mapping[str, str]) -> float:
+        """How far the things ``env`` names are from the robot (straight line; 0 without poses)."""
+        if self.world is None:
+            return 0.0
+        robot = self.world.poses.get(robot_name(self.world))
+        if robot is None:
+            return 0.0
+        return sum(math.dist(robot[:2], self.world.poses[v][:2]) for v in env.values() if v in self.world.poses)
+
     def match(self, when: Sequence[Literal], facts: frozenset[tuple[str, ...]]) -> Bindings | None:
-        """These bindings extended by the first assignment of ``when``'s ``?vars`` (facts in
-        sorted order) under which every literal holds; None if none does.  A negated literal
+        """These bindings extended by the first assignment of ``when``'s ``?vars`` under which
+        every literal holds — candidates nearest the robot first (straight line), then by
+        name — or None if none does.  A negated literal
         holds when no fact matches it."""
         def solve(k: int, env: dict[str, str]) -> dict[str, str] | None:
             if k == len(when):
@@ -97,6 +107,7 @@ class Bindings:
                     found.append(new)
             if negated:
                 return solve(k + 1, env) if not found else None
+            found.sort(key=lambda e: (self._distance(e), sorted(e.items())))
             for new in found:
                 done = solve(k + 1, new)
                 if done is not None:
