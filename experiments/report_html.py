@@ -350,7 +350,8 @@ _FILL = {"wall": "#444", "furniture": "#c8b48a", "door": "#7a4f2a"}
 def world_figure(world: Any, robot: Sequence[Sample], people: Mapping[str, Sequence[tuple[float, float, float, str]]],
                  events: Sequence[Event], hazards: Sequence[tuple[str, str, float, float]]) -> dict[str, Any]:
     """The world from above, a time slider over the trajectory: the robot, its path so far,
-    people, the hazards on and the agent executing at that moment.  A figure dict: its
+    people, the hazards on and the agent executing at that moment; red crosses where the robot
+    was at each ``susp`` command.  A figure dict: its
     frames are built as plain data (validating hundreds of frames would cost seconds)."""
     robot = _thin(robot, MAX_POINTS)
     people = {n: _thin(track, MAX_POINTS) for n, track in people.items()} or _people_from_trace(world, events)
@@ -373,12 +374,18 @@ def world_figure(world: Any, robot: Sequence[Sample], people: Mapping[str, Seque
                              textfont={"size": 9, "color": "#2a7a2a"}, hoverinfo="text"))
     fig.add_trace(go.Scatter(x=[s[1] for s in robot], y=[s[2] for s in robot], mode="lines", name="robot path",
                              line={"color": "#1f5fbf", "width": 1}, opacity=0.25, hoverinfo="skip"))
+    susp_at = [(float(e["t"]), e["agent"], _at(robot, float(e["t"]))) for e in events
+               if e["event"] == "command" and e["flag"] == "susp"]
+    fig.add_trace(go.Scatter(x=[p[1] for _, _, p in susp_at if p], y=[p[2] for _, _, p in susp_at if p],
+                             text=[f"susp {a} at {t:.1f} s" for t, a, p in susp_at if p], mode="markers",
+                             marker={"symbol": "x-thin-open", "size": 14, "color": "#c0392b", "line": {"width": 3}},
+                             name="robot at susp", hoverinfo="text"))
     t_end = max(robot[-1][0] if robot else 0.0, _end_time(events))
     n = min(MAX_FRAMES, max(2, len(robot)))
     times = [round(t_end * i / (n - 1), 3) for i in range(n)]
     suspended = _suspension_spans(events, t_end)
     roles = [(float(e["t"]), e.get("exeDA")) for e in events if e["event"] == "roles"]
-    frames = [{"name": f"{t:g}", "data": _world_state(t, robot, people), "traces": [2, 3, 4],
+    frames = [{"name": f"{t:g}", "data": _world_state(t, robot, people), "traces": [3, 4, 5],
                "layout": {"title": {"text": _world_title(t, hazards, suspended, roles, t_end)}}} for t in times]
     for trace in _world_state(times[0], robot, people):
         fig.add_trace(go.Scatter(**{k: v for k, v in trace.items() if k != "type"}))
@@ -418,7 +425,7 @@ def _people_from_trace(world: Any, events: Sequence[Event]) -> dict[str, list[tu
 
 def _world_state(t: float, robot: Sequence[Sample], people: Mapping[str, Sequence[tuple[float, float, float, str]]]
                  ) -> list[dict[str, Any]]:
-    """Traces 2–4 of the world figure at time ``t`` (plain dicts): path so far, robot, people."""
+    """Traces 3–5 of the world figure at time ``t`` (plain dicts): path so far, robot, people."""
     done = [s for s in robot if s[0] <= t] or list(robot[:1])
     r = _at(robot, t)
     heading = ([r[1], r[1] + 0.45 * math.cos(r[3])], [r[2], r[2] + 0.45 * math.sin(r[3])]) if r else ([], [])

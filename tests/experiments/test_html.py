@@ -104,7 +104,10 @@ def test_world_slider_follows_the_trajectory(events: list[dict[str, Any]]) -> No
     assert "peter (fallen)" in last["data"][2]["text"]
     assert "device_on cooker (d1)" in last["layout"]["title"]["text"]
     assert "hazards on: none" in frames[0]["layout"]["title"]["text"]
-    assert [t["name"] for t in fig["data"]][2:] == [t["name"] for t in last["data"]]  # frames update traces 2-4
+    assert [t["name"] for t in fig["data"]][3:] == [t["name"] for t in last["data"]]  # frames update traces 3-5
+    susp = next(t for t in fig["data"] if t["name"] == "robot at susp")
+    n_susp = sum(1 for e in events if e["event"] == "command" and e["flag"] == "susp")
+    assert len(susp["x"]) == n_susp and list(susp["text"])[0].startswith("susp d")
 
 
 @pytest.mark.parametrize("kind", ["jsonl", "csv"])
