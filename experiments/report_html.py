@@ -282,7 +282,8 @@ def read_trajectory(run_dir: Path) -> tuple[list[Sample], dict[str, list[tuple[f
 
     Rows are read tolerantly: ``t`` and the robot as ``x``/``y``/``yaw`` or ``robot``
     (``[x, y, yaw]`` or ``{"x", "y", "yaw"}``/``{"pose"}``); people under ``people`` as
-    ``name -> [x, y, ...]`` or ``{"pose"|"x","y", "posture"}``."""
+    ``name -> [x, y, yaw, posture]`` or ``{"pose"|"x","y", "posture"}``; rows without ``t``
+    (a header) and ``mark`` rows are skipped (``tasker-trajectory/1`` of ``robot.recording``)."""
     jsonl, csv_path = run_dir / "trajectory.jsonl", run_dir / "trajectory.csv"
     rows: list[Mapping[str, Any]] = []
     try:
@@ -296,6 +297,8 @@ def read_trajectory(run_dir: Path) -> tuple[list[Sample], dict[str, list[tuple[f
         robot: list[Sample] = []
         people: dict[str, list[tuple[float, float, float, str]]] = {}
         for r in rows:
+            if "t" not in r or "mark" in r:  # a header line (format, fields) or an event mark
+                continue
             t = float(r["t"])
             pose = _pose(r.get("robot", r))
             if pose is not None:
@@ -303,11 +306,12 @@ def read_trajectory(run_dir: Path) -> tuple[list[Sample], dict[str, list[tuple[f
             for name, p in (r.get("people") or {}).items():
                 pp = _pose(p)
                 if pp is not None:
-                    posture = str(p.get("posture", "")) if isinstance(p, Mapping) else ""
+                    posture = str(p.get("posture", "")) if isinstance(p, Mapping) else (
+                        p[3] if isinstance(p, list | tuple) and len(p) > 3 and isinstance(p[3], str) else "")
                     people.setdefault(name, []).append((t, pp[0], pp[1], posture))
     except (ValueError, KeyError, TypeError, AttributeError):
         return None  # a format this page does not know: fall back to the run's own trajectory
-    return robot, people
+    return (robot, people) if robot else None
 
 
 def _pose(v: Any) -> tuple[float, float, float] | None:

@@ -110,6 +110,18 @@ def test_world_slider_follows_the_trajectory(events: list[dict[str, Any]]) -> No
     assert len(susp["x"]) == n_susp and list(susp["text"])[0].startswith("susp d")
 
 
+def test_recorded_trajectory_of_the_robot_recorder_is_read(tmp_path: Path) -> None:
+    lines = [{"format": "tasker-trajectory/1", "world": "paper", "rate_hz": 10.0,
+              "fields": {"robot": ["x", "y", "yaw"], "people": ["x", "y", "yaw", "posture"]}},
+             {"t": 0.0, "robot": [1.0, 2.0, 0.5], "people": {"peter": [3.0, 4.0, 0.0, "standing"]}},
+             {"t": 0.1, "mark": "manipulated", "object": "pan", "action": "pick_pan", "at": [1.0, 2.0]},
+             {"t": 0.1, "robot": [1.5, 2.0, 0.5], "people": {"peter": [3.0, 4.0, 0.0, "fallen"]}}]
+    (tmp_path / "trajectory.jsonl").write_text("".join(json.dumps(r) + "\n" for r in lines))
+    assert report_html.read_trajectory(tmp_path) == (
+        [(0.0, 1.0, 2.0, 0.5), (0.1, 1.5, 2.0, 0.5)],
+        {"peter": [(0.0, 3.0, 4.0, "standing"), (0.1, 3.0, 4.0, "fallen")]})
+
+
 @pytest.mark.parametrize("kind", ["jsonl", "csv"])
 def test_recorded_trajectory_files_are_read(kind: str, tmp_path: Path) -> None:
     if kind == "jsonl":
