@@ -2,7 +2,9 @@
 changes, mode switches and world events, each at a time.
 
 Shared by the synthetic and the robot scenario loaders, so both check the same
-fields the same way; errors name the file and the field.
+fields the same way, with :mod:`tasker.reader`: errors name the file, the line and
+the field.  Cross-references to the world and the task store (who is a person, what
+a task type takes) are checked by :mod:`experiments.crossref`.
 """
 
 from __future__ import annotations
@@ -11,24 +13,32 @@ from collections.abc import Collection
 from dataclasses import dataclass, field
 from typing import Any
 
-from experiments.fields import Fields, ScenarioError
+from experiments.fields import MODES, ScenarioError
+from tasker.reader import Table, check_name, suggest
+
+__all__ = ["TABLES", "WORLD_EVENT_KINDS", "ScenarioError", "TimedAction", "located", "read_actions"]
 
 WORLD_EVENT_KINDS = ("posture", "door", "add", "delete")
 
-_TABLES = (("requests", "request"), ("terminations", "terminate"), ("changes", "change"),
-           ("mode_changes", "mode"), ("world_events", "world"))
+TABLES = (("requests", "request"), ("terminations", "terminate"), ("changes", "change"),
+          ("mode_changes", "mode"), ("world_events", "world"))
+"""The array-of-tables keys of a scenario file and the kind of action each holds."""
 
 
 @dataclass(frozen=True)
 class TimedAction:
-    """One thing that happens at time ``t``: ``kind`` is request, terminate, change, mode or world."""
+    """One thing that happens at time ``t``: ``kind`` is request, terminate, change, mode or world.
+
+    ``origin`` is where it was written (``("requests", 2)``), for error messages.
+    """
 
     t: float
     kind: str
     fields: dict[str, Any] = field(default_factory=dict)
+    origin: tuple[str, int] = field(default=("", -1), compare=False, repr=False)
 
 
-def read_actions(top: Fields, *, task_names: Collection[str] | None = None,
+def read_actions(top: Table, *, task_names: Collection[str] | None = None,
                  world_events: bool = False) -> tuple[TimedAction, ...]:
     """Every timed action of a scenario file, sorted by time (stable).
 
@@ -36,64 +46,74 @@ def read_actions(top: Fields, *, task_names: Collection[str] | None = None,
     ``world_events`` allows the ``[[world_events]]`` table (robot scenarios).
     """
     out: list[TimedAction] = []
-    for key, kind in _TABLES:
+    for key, kind in TABLES:
         if kind == "world" and not world_events:
             continue
-        for i, item in enumerate(top.get(key, list, [])):
-            f = Fields(top.source, f"{key}[{i}]", item)
-            t = f.get("t", float)
-            if t < 0:
-                raise f.error("t", f"expected >= 0, got {t}")
-            out.append(TimedAction(t, kind, _read(f, kind, task_names)))
+        for i, f in enumerate(top.tables(key, [])):
+            t = float(f.number("t", min=0))
+            out.append(TimedAction(t, kind, _read(f, kind, task_names), (key, i)))
             f.done()
     actions = tuple(sorted(out, key=lambda a: a.t))
     if not any(a.kind == "request" for a in actions):
-        raise top.error("requests", "a scenario needs at least one request")
-    _check_agents(top.source, actions)
+        raise top.error("requests", "a scenario needs at least one request ([[requests]] with t and task)")
+    _check_agents(top, actions)
     return actions
 
 
-def _read(f: Fields, kind: str, task_names: Collection[str] | None) -> dict[str, Any]:
+def located(top: Table, a: TimedAction) -> Table:
+    """The table an action was read from (for errors that name its file, line and field)."""
+    key, i = a.origin
+    return top.tables(key)[i]
+
+
+def _args(f: Table, key: str, required: bool) -> dict[str, Any]:
+    args = f.table(key) if required else f.table(key, {})
+    return dict(args.items())
+
+
+def _read(f: Table, kind: str, task_names: Collection[str] | None) -> dict[str, Any]:
     if kind == "request":
-        task = f.get("task", str)
-        if task_names is not None and task not in task_names:
-            raise f.error("task", f"unknown task type {task!r}; defined: {sorted(task_names)}")
-        return {"task": task, "args": f.get("args", dict, {})}
+        task = f.string("task")
+        if task_names is not None:
+            check_name(f, "task", task, task_names, "task type")
+        return {"task": task, "args": _args(f, "args", False)}
     if kind == "terminate":
-        return {"agent": f.get("agent", str), "reason": f.get("reason", str, "terminated by the requester")}
+        return {"agent": f.string("agent"), "reason": f.string("reason", "terminated by the requester")}
     if kind == "change":
-        return {"agent": f.get("agent", str), "args": f.get("args", dict)}
+        return {"agent": f.string("agent"), "args": _args(f, "args", True)}
     if kind == "mode":
-        mode = f.get("mode", str)
-        if mode not in ("IT", "CT"):
-            raise f.error("mode", f"expected 'IT' or 'CT', got {mode!r}")
-        return {"mode": mode}
-    given = [k for k in WORLD_EVENT_KINDS if k in f.table]
+        return {"mode": f.string("mode", choices=MODES)}
+    given = [k for k in WORLD_EVENT_KINDS if k in f]
     if len(given) != 1:
-        raise f.error("", f"a world event has exactly one of {list(WORLD_EVENT_KINDS)}, got {given}")
+        others = [k for k in f.keys() if k not in ("t", "note")]
+        hint = suggest(others[0], WORLD_EVENT_KINDS) if others and not given else ""
+        raise f.error(None, f"a world event has exactly one of {list(WORLD_EVENT_KINDS)}, got "
+                            f"{given or others or 'none'}{hint}")
     what = given[0]
-    value = f.get(what, list)
-    if what == "posture" and (len(value) != 2 or not all(isinstance(v, str) for v in value)):
+    value = f.array(what)
+    if what == "posture" and (len(value) != 2 or not all(isinstance(v, str) and v for v in value)):
         raise f.error(what, f"expected [person, posture], got {value!r}")
     if what == "door" and (len(value) != 2 or not isinstance(value[0], str) or not isinstance(value[1], bool)):
         raise f.error(what, f"expected [door, true|false], got {value!r}")
-    if what in ("add", "delete") and not all(isinstance(x, list) and all(isinstance(a, str) for a in x)
-                                             for x in value):
-        raise f.error(what, f"expected a list of facts (lists of strings), got {value!r}")
-    return {"what": what, "value": value, "note": f.get("note", str, "")}
+    if what in ("add", "delete") and not (value and all(
+            isinstance(x, list) and x and all(isinstance(a, str) and a for a in x) for x in value)):
+        raise f.error(what, f"expected a non-empty list of facts (lists of non-empty strings), got {value!r}")
+    return {"what": what, "value": value, "note": f.string("note", "", empty=True)}
 
 
-def _check_agents(source: str, actions: tuple[TimedAction, ...]) -> None:
+def _check_agents(top: Table, actions: tuple[TimedAction, ...]) -> None:
     """Agents are ``d1``, ``d2``, … in request order; one can only be changed once requested."""
     request_times = [a.t for a in actions if a.kind == "request"]
+    agents = [f"d{k}" for k in range(1, len(request_times) + 1)]
     for a in actions:
         if a.kind not in ("terminate", "change"):
             continue
         agent = a.fields["agent"]
+        f = located(top, a)
         k = int(agent[1:]) if agent[:1] == "d" and agent[1:].isdigit() else 0
-        key = "terminations" if a.kind == "terminate" else "changes"
-        if not 1 <= k <= len(request_times) or request_times[k - 1] > a.t:
-            raise ScenarioError(
-                f"{source}: {key}: agent {agent!r} at t={a.t}: agents are d1..d{len(request_times)} "
-                "in request order, and must be requested before they are changed or terminated"
-            )
+        if not 1 <= k <= len(request_times):
+            raise f.error("agent", f"no agent {agent!r}{suggest(agent, agents)}: agents are d1..d{len(agents)} "
+                                   "in request order")
+        if request_times[k - 1] > a.t:
+            raise f.error("agent", f"agent {agent!r} at t={a.t:g} is requested only at t={request_times[k - 1]:g}: "
+                                   "a task must be requested before it is changed or terminated")

@@ -233,12 +233,20 @@ def write(ex: Explanation, out: Path) -> list[Path]:
 # ----------------------------------------------------------------------------------------- command
 
 
+EXAMPLES = """\
+examples:
+  tasker explain out/paper --agent d3                 # d3's last problem, plan and what moved it
+  tasker explain out/paper --agent d1 --at 60         # the problem d1 planned from at t = 60 s
+  tasker explain out/run --agent d2 --out /tmp/d2     # domain.pddl, problem.pddl, plan, explain.txt"""
+
+
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("explain", help="the PDDL an agent planned from, its plan and what moved it",
                        description="Print (or write with --out) the domain and problem an agent of a run planned "
                                    "from at a time (default: its last planning call), the plan, and the decisions, "
                                    "commands and transitions of the trace that moved it. The PDDL is read by any "
-                                   "planner and by unified-planning's PDDLReader.")
+                                   "planner and by unified-planning's PDDLReader.",
+                       epilog=EXAMPLES)
     _arguments(p)
     p.set_defaults(func=_command)
 

@@ -1,52 +1,60 @@
-"""Reading one table of a scenario file, with errors that name the file and the field."""
+"""What every scenario reader shares: the error class and the ``[settings]`` fields.
+
+Files are read with the strict reader :mod:`tasker.reader` (every fault names the file,
+the line, the field, what was expected and "did you mean"); this module holds only
+what the robot and the synthetic scenario readers have in common.
+"""
 
 from __future__ import annotations
 
 from typing import Any
 
-from tasker.errors import TaskerError
+from tasker import schedulers
+from tasker.cliargs import TASKS_HINT
+from tasker.reader import InputError, Table
+
+MODES = ("IT", "CT")
+STRATEGIES = ("planned", "static")
+POLICIES = ("strict", "conditional")
 
 
-class ScenarioError(TaskerError, ValueError):
-    """A scenario file is malformed; the message names the file and the field."""
+class ScenarioError(InputError):
+    """A scenario file is malformed; the message names the file, the line and the field."""
 
 
-class Fields:
-    """Reads one table of a scenario file, naming ``file: path.to.field`` in every error."""
+def scheduler(s: Table) -> str:
+    """``settings.scheduler``: a registered scheduler name."""
+    return str(s.string("scheduler", "alg2", choices=schedulers.names()))
 
-    def __init__(self, source: str, where: str, table: Any) -> None:
-        if not isinstance(table, dict):
-            raise ScenarioError(f"{source}: {where or 'top level'}: expected a table, got {type(table).__name__}")
-        self.source, self.where, self.table = source, where, table
-        self.used: set[str] = set()
 
-    def path(self, key: str) -> str:
-        return f"{self.where}.{key}" if self.where else key
+def scheduler_options(s: Table, name: str, task_names: list[str] | None = None) -> dict[str, Any]:
+    """``settings.scheduler_options``: checked by building the scheduler; task types named in
+    ``classes`` (alg2) or ``priorities`` (priority) must be known when ``task_names`` is given."""
+    opts = s.table("scheduler_options", {})
+    options = dict(opts.items())
+    if task_names is not None:
+        for key, value in options.items():
+            named: list[str] = []
+            if key == "classes" and isinstance(value, list):
+                named = [t for c in value if isinstance(c, list) for t in c if isinstance(t, str)]
+            elif key == "priorities" and isinstance(value, dict):
+                named = [t for t in value if isinstance(t, str)]
+            for t in named:
+                if t not in task_names:
+                    raise opts.error(key, f"no task type {t!r}{_suggest(t, task_names)} "
+                                          f"(known: {', '.join(sorted(task_names))}); {TASKS_HINT}")
+    try:
+        schedulers.create(name, **options)
+    except Exception as exc:  # the scheduler's own check, e.g. hysteresis out of range
+        raise s.error("scheduler_options", f"{exc}") from None
+    return options
 
-    def error(self, key: str, msg: str) -> ScenarioError:
-        return ScenarioError(f"{self.source}: {self.path(key)}: {msg}")
 
-    def get(self, key: str, kind: type[Any] | tuple[type[Any], ...], default: Any = ..., *,
-            positive: bool = False) -> Any:
-        self.used.add(key)
-        if key not in self.table:
-            if default is ...:
-                raise self.error(key, "missing (required)")
-            return default
-        value = self.table[key]
-        if kind is float and isinstance(value, int) and not isinstance(value, bool):
-            value = float(value)
-        if isinstance(value, bool) and kind is not bool or not isinstance(value, kind):
-            names = kind.__name__ if isinstance(kind, type) else " or ".join(k.__name__ for k in kind)
-            raise self.error(key, f"expected {names}, got {value!r}")
-        if positive and value <= 0:
-            raise self.error(key, f"expected a positive number, got {value!r}")
-        return value
+def rate(s: Table, key: str, default: float) -> float:
+    return float(s.number(key, default, positive=True))
 
-    def sub(self, key: str, default: Any = ...) -> Fields:
-        return Fields(self.source, self.path(key), self.get(key, dict, default))
 
-    def done(self) -> None:
-        extra = sorted(set(self.table) - self.used)
-        if extra:
-            raise self.error(extra[0], f"unknown field; expected one of {sorted(self.used)}")
+def _suggest(name: str, known: list[str]) -> str:
+    from tasker.reader import suggest
+
+    return suggest(name, known)

@@ -350,31 +350,99 @@ def gantt_figure(events: Sequence[Event], *, title: str | None = None) -> Figure
     return fig
 
 
+TASK_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22")
+IDLE_COLOUR = "#9a9a9a"
+
+
+def _executing(events: Sequence[Event]) -> list[tuple[float, str | None]]:
+    """(time, exeDA) at every change of the harmoniser's executing agent."""
+    out: list[tuple[float, str | None]] = []
+    for e in events:
+        if e["event"] == "roles" and (not out or out[-1][1] != e.get("exeDA")):
+            out.append((float(e["t"]), e.get("exeDA")))
+    return out
+
+
+def _pose_at(samples: Sequence[tuple[float, ...]], t: float) -> tuple[float, float] | None:
+    """The robot's position at ``t``: the last sample at or before it."""
+    best = None
+    for s in samples:
+        if s[0] > t + 1e-9:
+            break
+        best = (s[1], s[2])
+    return best if best is not None else ((samples[0][1], samples[0][2]) if samples else None)
+
+
 def world_path(world_name_or_path: Any, trajectory: Iterable[Sequence[float]], out_png: str | Path,
                people: Mapping[str, tuple[tuple[float, float, float], str]] | None = None,
-               *, title: str | None = None) -> Path:
+               *, title: str | None = None, events: Sequence[Event] | None = None,
+               recording: Any = None) -> Path:
     """The world seen from above with the robot's path (``trajectory``: (t, x, y, yaw) samples).
 
     ``world_name_or_path`` may also be a loaded :class:`robot.spec.WorldSpec` (a run's
-    world with the scenario's changes to people).
-
-    Drawn by :func:`robot.picture.draw_world`; the robot is shown at its last pose, or
-    at the world's initial pose if the trajectory is empty.  ``people`` maps a name to
-    (pose, posture) as in ``draw_world``.
+    world with the scenario's changes to people).  With the run's trace ``events`` the
+    path is coloured by the task executing (the harmoniser's ``exeDA``, grey when none),
+    with a dot and the time every 30 s, an ``x`` where a task was told to suspend
+    (``command`` with ``flag = "susp"``) and a marker where each task ended.  With the
+    run's ``recording`` (:class:`robot.recording.Recorder`) people are drawn as they were
+    at the end, and a square marks where the robot handled an object.  ``people`` (name →
+    (pose, posture)) overrides where people are drawn.
     """
     from robot.picture import draw_world
     from robot.spec import load_world
 
     spec = world_name_or_path if hasattr(world_name_or_path, "places") else load_world(world_name_or_path)
     samples = [tuple(float(v) for v in s) for s in trajectory]
-    path = [(s[1], s[2]) for s in samples]
     robot = (samples[-1][1], samples[-1][2], samples[-1][3]) if samples else None
+    if people is None and recording is not None and recording.samples:
+        people = {p.name: ((p.x, p.y, p.yaw), p.posture) for p in recording.samples[-1].people}
     if title is None:
         title = f"{spec.name}: robot path, {samples[-1][0] - samples[0][0]:.1f} s" if samples else \
             f"{spec.name}: no trajectory"
+    evs = list(events or [])
+    agents = _agents(evs)
+    colour = {a: TASK_COLOURS[k % len(TASK_COLOURS)] for k, a in enumerate(agents)}
+
+    def decorate(ax: Axes) -> None:
+        changes = _executing(evs) or [(0.0, None)]
+        handles: dict[str, Any] = {}
+        for k, (t0, agent) in enumerate(changes):
+            t1 = changes[k + 1][0] if k + 1 < len(changes) else math.inf
+            seg = [(s[1], s[2]) for s in samples if t0 - 1e-9 <= s[0] <= t1 + 1e-9]
+            if len(seg) < 2:
+                continue
+            c = colour.get(agent, IDLE_COLOUR) if agent else IDLE_COLOUR
+            label = f"{agent} {agents.get(agent, '')}" if agent else "no task"
+            (line,) = ax.plot(*zip(*seg, strict=True), "-", color=c, lw=1.8, label=label)
+            handles.setdefault(label, line)
+        for s in samples[:: max(1, int(round(30.0 / max(samples[1][0] - samples[0][0], 1e-9))))]\
+                if len(samples) > 1 else []:
+            ax.plot(s[1], s[2], ".", color="#333", ms=3)
+            ax.text(s[1] + 0.08, s[2] + 0.08, f"{s[0]:.0f}s", fontsize=5, color="#333")
+        for e in evs:
+            at = _pose_at(samples, float(e["t"]))
+            if at is None:
+                continue
+            if e["event"] == "command" and e.get("flag") == "susp":
+                h = ax.plot(*at, "x", color=colour.get(e["agent"], "k"), ms=9, mew=2.2)[0]
+                ax.text(at[0] + 0.1, at[1] - 0.25, f"susp {e['agent']} {float(e['t']):.0f}s", fontsize=6)
+                handles.setdefault("suspension", h)
+            elif e["event"] == "end":
+                h = ax.plot(*at, "o", mfc="none", color=colour.get(e["agent"], "k"), ms=10, mew=1.5)[0]
+                ax.text(at[0] + 0.1, at[1] + 0.15, f"{e['agent']} {e.get('reason', 'end')} {float(e['t']):.0f}s",
+                        fontsize=6)
+                handles.setdefault("task ends", h)
+        for m in getattr(recording, "marks", []):
+            h = ax.plot(m.x, m.y, "s", color="#6a3d9a", ms=6)[0]
+            ax.text(m.x + 0.12, m.y - 0.3, f"{m.action} {m.item} {m.t:.0f}s", fontsize=5, color="#6a3d9a")
+            handles.setdefault("object handled", h)
+        if handles:
+            ax.legend(list(handles.values()), list(handles), fontsize=6, loc="upper right", framealpha=0.8)
+
     out = Path(out_png)
     out.parent.mkdir(parents=True, exist_ok=True)
-    return draw_world(spec, out, robot=robot, paths=[path] if path else [], people=people, title=title)
+    return draw_world(spec, out, robot=robot, people=people, title=title, decorate=decorate,
+                      show_walks=recording is None)
 
 
 def all_plots(events: Sequence[Event], out_dir: str | Path) -> list[Path]:

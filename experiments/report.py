@@ -20,6 +20,7 @@ from __future__ import annotations
 import csv
 import math
 import re
+import warnings
 from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -414,16 +415,19 @@ def plot(summaries: Sequence[MetricSummary], pairs: Sequence[Paired], out: Path)
     return files
 
 
+class EmptyDatabase(UserWarning):
+    """The results database holds no runs (the sweep has not run, or ran nothing)."""
+
+
 def build_report(db_path: str | Path, out: str | Path, *, plots: bool = True) -> ReportFiles:
     """Read the results database and write ``report.md``, ``summary.csv``, ``paired.csv`` and ``plots/``."""
+    with ResultStore(db_path, readonly=True) as store:  # a report never writes to the database
+        rows = store.rows()
+    if not rows:
+        warnings.warn(EmptyDatabase(f"{db_path}: the results database holds no runs yet; the report is empty"),
+                      stacklevel=2)
     out_dir = Path(out)
     out_dir.mkdir(parents=True, exist_ok=True)
-    if not Path(db_path).is_file():
-        from experiments.store import StoreError
-
-        raise StoreError(f"{db_path}: no such results database")
-    with ResultStore(db_path) as store:
-        rows = store.rows()
     summaries = summarise(rows)
     pairs = paired(rows)
     md = out_dir / "report.md"

@@ -4,8 +4,11 @@
 gets the TIAGo simulation (:class:`robot.sim.Simulation`, both the world and the core
 agent), the OMPL motion model, and the bundled PDDL task types; a synthetic one gets
 timed stages.  In ``out`` it writes ``trace.jsonl`` (reproducible byte for byte),
+``trajectory.jsonl`` (robot and people at a fixed rate, robot runs),
 ``run.json`` (the record: scenario, seed, settings, planner, host, date, version),
-``metrics.json`` and the pictures.
+``metrics.json`` and the pictures.  If the run raises, the trace so far, ``run.json``
+(with ``status: "aborted"`` and the ``error``) and ``metrics.json`` are still written,
+then :class:`tasker.errors.RunAborted` is raised carrying the partial :class:`RunResult`.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from experiments import synthetic
 from experiments.actions import TimedAction
 from tasker import schedulers
 from tasker.agent import Rates
+from tasker.errors import RunAborted
 from tasker.harmoniser import Mode
 from tasker.loop import SimulationLoop
 from tasker.requester import Requester
@@ -48,8 +52,10 @@ class RunResult:
 
 def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None = None,
                 suspension: str | None = None, scheduler: str | None = None,
-                trace: Trace | None = None) -> tuple[SimulationLoop, Any]:
-    """The loop and the simulation for a robot scenario, with every request and event scheduled."""
+                trace: Trace | None = None, task_paths: tuple[str, ...] = ()) -> tuple[SimulationLoop, Any]:
+    """The loop and the simulation for a robot scenario, with every request and event scheduled.
+
+    ``task_paths`` are task folders loaded besides the bundled ones and ``$TASKER_TASKS``."""
     from planners.bundled import task_types
     from robot.sim import Simulation
     from robot.spec import load_world
@@ -69,7 +75,7 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
             people[name] = dataclasses.replace(people[name], **changes)
         spec = dataclasses.replace(spec, people=people)
     sim = Simulation(spec, seed=seed)
-    store = TaskStore(task_types())
+    store = TaskStore(task_types(task_paths))
     default = Strategy(update or scn.update, suspension or scn.suspension)
     per_type = {t: Strategy(update or s.get("update", default.update), suspension or s.get("suspension",
                                                                                            default.suspension))
@@ -118,8 +124,10 @@ def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: TimedAction
 def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | None = None,
                  update: str | None = None, suspension: str | None = None, scheduler: str | None = None,
                  mode: str | None = None, out: Path | None = None, randomize: bool = False,
-                 progress: bool = False, pictures: bool = True) -> RunResult:
-    """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced."""
+                 progress: bool = False, pictures: bool = True, task_paths: tuple[str, ...] = ()) -> RunResult:
+    """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced.
+
+    ``task_paths``: task folders to load besides the bundled ones (``tasker run --path``)."""
     if isinstance(source, scenarios.RobotScenario):
         kind, scn_path = "robot", Path(source.source)
     else:
@@ -134,18 +142,23 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         spec_json: dict[str, Any] = {"kind": "synthetic", "name": syn.name, "source": str(scn_path)}
         sim = None
     elif kind == "robot":
-        scn = source if isinstance(source, scenarios.RobotScenario) else scenarios.load(scn_path)
+        scn = source if isinstance(source, scenarios.RobotScenario) else scenarios.load(scn_path, task_paths=task_paths)
         run_seed = scn.seed if seed is None else seed
         if randomize:
             scn = scenarios.randomize(scn, run_seed)
         if mode is not None:
             scn = dataclasses.replace(scn, mode=mode)
-        loop, sim = build_robot(scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler)
+        loop, sim = build_robot(scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler,
+                                task_paths=task_paths)
         spec_json = {"kind": "robot", **scn.to_json()}
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")
+    error: Exception | None = None
     with _journal(kind) as journal:  # the PDDL of every planning call, for problems/
-        _run(loop, progress)
+        try:
+            _run(loop, progress)
+        except Exception as exc:  # the trace so far, run.json and metrics.json are still written, then it propagates
+            error = exc
     wall = time.perf_counter() - t0
     trace = loop.trace
     world_spec = None
@@ -165,10 +178,22 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         "date": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "tasker_version": tasker.__version__,
         "wall_time_s": round(wall, 3),
     }
-    metrics = _metrics(trace, calls, wall)
+    reason = ""
+    if error is None:
+        metrics = _metrics(trace, calls, wall)
+    else:
+        reason = error.reason if isinstance(error, RunAborted) else f"{type(error).__name__}: {error}"
+        record["status"], record["error"] = "aborted", reason
+        try:
+            metrics = _metrics(trace, calls, wall)
+        except Exception as exc:  # metrics of a cut trace may not compute: say so, keep the rest
+            metrics = {"error": f"metrics failed on the partial trace: {type(exc).__name__}: {exc}"}
     if out is not None:
-        _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures, journal)
-    return RunResult(record, metrics, trace, trajectory)
+        _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures and error is None, sim, journal)
+    result = RunResult(record, metrics, trace, trajectory)
+    if error is not None:
+        raise RunAborted(reason, result) from error
+    return result
 
 
 def _journal(kind: str) -> contextlib.AbstractContextManager[list[Any]]:
@@ -226,11 +251,13 @@ def _metrics(trace: Trace, calls: list[dict[str, Any]], wall: float) -> dict[str
 
 def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Trace,
           trajectory: tuple[tuple[float, float, float, float], ...], world: Any, pictures: bool,
-          journal: Any = ()) -> None:
+          sim: Any = None, journal: Any = ()) -> None:
     from experiments.explain import write_problems
 
     out.mkdir(parents=True, exist_ok=True)
     trace.write(out / "trace.jsonl")
+    if sim is not None:  # poses and postures at a fixed rate (robot.recording)
+        sim.write_trajectory(out / "trajectory.jsonl")
     (out / "run.json").write_text(json.dumps(record, indent=2, sort_keys=True, default=str) + "\n")
     (out / "metrics.json").write_text(json.dumps(metrics_, indent=2, sort_keys=True) + "\n")
     write_problems(out / "problems", journal)
@@ -242,4 +269,5 @@ def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Tr
     plots.gantt(trace.events, out / "gantt.png")
     report_html.write_run(out, trace.events, record=record, metrics=metrics_, world=world, trajectory=trajectory)
     if world is not None:
-        plots.world_path(world, list(trajectory), out / "world.png")
+        plots.world_path(world, list(trajectory), out / "world.png", events=trace.events,
+                         recording=getattr(sim, "recording", None))

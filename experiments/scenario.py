@@ -1,7 +1,9 @@
 """Robot scenarios: a world, task requests over time, changes during the run, settings.
 
-A scenario file (TOML) says everything a run needs; every field is checked when the
-file is loaded and an error names the file and the field.  ``kind = "synthetic"``
+A scenario file (TOML) says everything a run needs.  It is read with the strict reader
+:mod:`tasker.reader` and every field is checked when the file is loaded, with its
+cross-references against the world and the task store (:mod:`experiments.crossref`):
+an error names the file, the line, the field, what was expected and "did you mean".  ``kind = "synthetic"``
 files are read by :mod:`experiments.synthetic` instead.  The format is documented in
 ``docs/scenarios.md``; shipped scenarios live in ``experiments/scenarios/``.
 
@@ -13,22 +15,29 @@ from __future__ import annotations
 
 import dataclasses
 import random
-import tomllib
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from experiments.actions import TimedAction, read_actions
-from experiments.fields import Fields as _Fields
-from experiments.fields import ScenarioError
-from tasker import schedulers
+from experiments import fields
+from experiments.actions import TABLES, TimedAction, read_actions
+from experiments.fields import MODES, POLICIES, STRATEGIES, ScenarioError
+from tasker import reader
+
+__all__ = ["RobotScenario", "ScenarioError", "load", "randomize", "resolve", "kind_of", "SCENARIOS"]
 
 SCENARIOS = Path(__file__).resolve().parent / "scenarios"
 
 
 @dataclass(frozen=True)
 class RobotScenario:
-    """A checked robot scenario."""
+    """A checked robot scenario.
+
+    ``objects`` are the scenario's own things (``[objects.NAME]``):
+    ``{name: {"type", "place", "facts"}}``; ``warnings`` what the loader accepted but
+    doubts (a request after the horizon, two identical requests that overlap).
+    """
 
     name: str
     source: str
@@ -47,112 +56,119 @@ class RobotScenario:
     seed: int = 1
     horizon: float = 1800.0
     people: dict[str, dict[str, Any]] = field(default_factory=dict)
+    objects: dict[str, dict[str, Any]] = field(default_factory=dict)
+    policy: str = "strict"
+    warnings: tuple[str, ...] = field(default=(), compare=False)
 
     def to_json(self) -> dict[str, Any]:
         out = dataclasses.asdict(self)
         out["actions"] = [{"t": a.t, "kind": a.kind, **a.fields} for a in self.actions]
+        out.pop("warnings", None)
         return out
 
 
+SCENARIO_KEYS = ("kind", "name", "world", "seed", "settings", "people", "objects", *(k for k, _ in TABLES))
+
+
 def resolve(name_or_path: str | Path) -> Path:
-    """A shipped scenario name (``paper``) or a path."""
+    """A shipped scenario name (``paper``) or a path, as an absolute path."""
     p = Path(name_or_path)
     if p.suffix in (".toml", ".json") or p.exists():
         if not p.is_file():
-            raise ScenarioError(f"{p}: no such scenario file")
-        return p
+            raise ScenarioError(str(p), "no such scenario file" if not p.exists() else "is not a file")
+        return p.resolve()
     shipped = SCENARIOS / f"{name_or_path}.toml"
     if shipped.is_file():
         return shipped
     known = sorted(q.stem for q in SCENARIOS.glob("*.toml"))
-    raise ScenarioError(f"unknown scenario {str(name_or_path)!r}: not a file, and not a shipped one "
-                        f"({', '.join(known)})")
+    raise ScenarioError(str(name_or_path), f"no such scenario: not a file, and not a shipped one"
+                                           f"{reader.suggest(str(name_or_path), known)} (shipped: {', '.join(known)})")
 
 
 def kind_of(path: Path) -> str:
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(f"{path}: not valid TOML: {exc}") from None
-    return str(raw.get("kind", "synthetic"))
+    """``robot`` or ``synthetic`` (the default), read strictly."""
+    top = reader.load(path, ScenarioError)
+    return str(top.string("kind", "synthetic", choices=("robot", "synthetic")))
 
 
-def load(path: str | Path) -> RobotScenario:
-    """Read and check a robot scenario (``kind = "robot"``)."""
+def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()) -> RobotScenario:
+    """Read and check a robot scenario (``kind = "robot"``).
+
+    With ``check`` (the default) every cross-reference is checked against the world and
+    the task store too (:mod:`experiments.crossref`); doubtful but valid inputs are
+    :class:`~tasker.reader.InputWarning` warnings, kept on ``RobotScenario.warnings``.
+    """
     p = resolve(path)
     source = str(p)
-    try:
-        raw = tomllib.loads(p.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(f"{source}: not valid TOML: {exc}") from None
-    top = _Fields(source, "", raw)
-    if top.get("kind", str) != "robot":
-        raise top.error("kind", "this loader reads kind = 'robot'")
-    world = top.get("world", str)
-    world_path = p.parent / world
-    if world_path.suffix == ".toml":
-        if not world_path.is_file():
-            raise top.error("world", f"no world file {world_path}")
-        world = str(world_path)
-    s = top.sub("settings", {})
-    scheduler = s.get("scheduler", str, "alg2")
-    if scheduler not in schedulers.names():
-        raise s.error("scheduler", f"unknown scheduler {scheduler!r}; known: {schedulers.names()}")
-    strategies_f = s.sub("strategies", {})
+    top = reader.load(p, ScenarioError)
+    top.string("kind", choices=("robot",))
+    world = top.string("world")
+    world_file = p.parent / world
+    if world_file.suffix == ".toml" or "/" in world:
+        if not world_file.is_file():
+            raise top.error("world", f"no world file {world_file} (a shipped world name or a .toml file "
+                                     "relative to the scenario)")
+        world = str(world_file.resolve())
+    else:
+        from robot.spec import shipped_worlds
+
+        reader.check_name(top, "world", world, shipped_worlds(), "shipped world")
+    s = top.table("settings", {})
+    sched = fields.scheduler(s)
     strategies: dict[str, dict[str, str]] = {}
-    for task in list(strategies_f.table):
-        t = strategies_f.sub(task)
-        strategies[task] = {k: _strategy(t, k) for k in ("update", "suspension") if k in t.table}
+    for task, t in s.named("strategies"):
+        strategies[task] = {k: str(t.string(k, choices=STRATEGIES)) for k in ("update", "suspension") if k in t}
         t.done()
-    strategies_f.done()
     actions = read_actions(top, world_events=True)
-    people_f = top.sub("people", {})
     people: dict[str, dict[str, Any]] = {}
-    for name in list(people_f.table):
-        pf = people_f.sub(name)
+    for name, pf in top.named("people"):
         entry: dict[str, Any] = {}
-        if "pose" in pf.table:
-            entry["pose"] = _numbers(pf, "pose", 3)
-        if "walk" in pf.table:
-            entry["walk"] = [tuple(_numbers(_Fields(source, f"{pf.path('walk')}[{i}]", {"w": w}), "w", 3))
-                             for i, w in enumerate(pf.get("walk", list))]
+        if "pose" in pf:
+            entry["pose"] = list(pf.numbers("pose", 3, "[x, y, yaw]"))
+        if "walk" in pf:
+            walk_t = pf.at("walk", {})
+            walk: list[tuple[float, ...]] = []
+            for i, w in enumerate(pf.array("walk")):
+                wp = reader.check_numbers(walk_t, i, w, 3, "[t, x, y]")
+                if wp[0] < 0:
+                    raise walk_t.error(i, f"expected a time >= 0, got {wp[0]!r}")
+                if walk and wp[0] <= walk[-1][0]:
+                    raise walk_t.error(i, f"waypoint times must increase: {wp[0]!r} after {walk[-1][0]!r}")
+                walk.append(wp)
+            entry["walk"] = walk
         pf.done()
         people[name] = entry
+    objects: dict[str, dict[str, Any]] = {}
+    for name, of in top.named("objects"):
+        facts_t = of.at("facts", {})
+        facts = []
+        for i, fact in enumerate(of.array("facts", [])):
+            if not isinstance(fact, list) or not fact or not all(isinstance(a, str) and a for a in fact):
+                raise facts_t.error(i, f"expected a fact: a list of non-empty strings, got {fact!r}")
+            facts.append([str(a) for a in fact])
+        objects[name] = {"type": of.string("type"), "place": of.string("place"), "facts": facts}
+        of.done()
     scenario = RobotScenario(
-        name=top.get("name", str, p.stem), source=source, world=world, actions=actions,
-        scheduler=scheduler, scheduler_options=s.get("scheduler_options", dict, {}),
-        mode=_choice(s, "mode", ("IT", "CT"), "IT"),
-        s_freq=s.get("s_freq", float, 1.0, positive=True), rep_rate=s.get("rep_rate", float, 1.0, positive=True),
-        task_exe_rate=s.get("task_exe_rate", float, 10.0, positive=True),
-        sp_up_rate=s.get("sp_up_rate", float, 1.0, positive=True),
-        update=_strategy(s, "update"), suspension=_strategy(s, "suspension"), strategies=strategies,
-        seed=top.get("seed", int, 1), horizon=s.get("horizon", float, 1800.0, positive=True), people=people,
+        name=str(top.string("name", p.stem)), source=source, world=world, actions=actions,
+        scheduler=sched, scheduler_options=dict(s.table("scheduler_options", {}).items()),
+        mode=str(s.string("mode", "IT", choices=MODES)),
+        s_freq=fields.rate(s, "s_freq", 1.0), rep_rate=fields.rate(s, "rep_rate", 1.0),
+        task_exe_rate=fields.rate(s, "task_exe_rate", 10.0), sp_up_rate=fields.rate(s, "sp_up_rate", 1.0),
+        update=str(s.string("update", "planned", choices=STRATEGIES)),
+        suspension=str(s.string("suspension", "planned", choices=STRATEGIES)), strategies=strategies,
+        seed=int(top.number("seed", 1, integer=True, min=0, max=reader.MAX_SEED)),
+        horizon=float(s.number("horizon", 1800.0, positive=True)),
+        people=people, objects=objects, policy=str(s.string("policy", "strict", choices=POLICIES)),
     )
     s.done()
-    top.done()
-    try:
-        schedulers.create(scenario.scheduler, **scenario.scheduler_options)
-    except Exception as exc:
-        raise ScenarioError(f"{source}: settings.scheduler_options: {exc}") from None
-    return scenario
+    top.done(SCENARIO_KEYS)
+    if not check:
+        fields.scheduler_options(s, sched)
+        return scenario
+    from experiments import crossref
+    from planners.bundled import task_types
 
-
-def _choice(f: _Fields, key: str, choices: tuple[str, ...], default: str) -> str:
-    value = f.get(key, str, default)
-    if value not in choices:
-        raise f.error(key, f"expected one of {list(choices)}, got {value!r}")
-    return str(value)
-
-
-def _strategy(f: _Fields, key: str) -> str:
-    return _choice(f, key, ("planned", "static"), "planned")
-
-
-def _numbers(f: _Fields, key: str, n: int) -> list[float]:
-    value = f.get(key, list)
-    if len(value) != n or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in value):
-        raise f.error(key, f"expected {n} numbers, got {value!r}")
-    return [float(v) for v in value]
+    return crossref.check_robot(scenario, top, task_types(list(task_paths)))
 
 
 def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, pose_jitter: float = 0.5
@@ -166,7 +182,7 @@ def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, 
     times = sorted({a.t for a in scenario.actions})
     drawn = sorted(t if t == 0 else max(0.0, t * (1 + rng.uniform(-time_jitter, time_jitter))) for t in times)
     new_t = dict(zip(times, drawn, strict=True))
-    actions = [TimedAction(round(new_t[a.t], 3), a.kind, dict(a.fields)) for a in scenario.actions]
+    actions = [TimedAction(round(new_t[a.t], 3), a.kind, dict(a.fields), a.origin) for a in scenario.actions]
     people: dict[str, dict[str, Any]] = {}
     for name, entry in sorted(scenario.people.items()):
         e = dict(entry)

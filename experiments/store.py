@@ -7,7 +7,11 @@ synchronisation, so a sweep that is killed loses nothing it had finished, and a
 resumed sweep runs only the keys the table does not hold yet.
 
 Only the process that drives a sweep writes to the database (workers return their
-results to it); any number of readers (``tasker report``) may read meanwhile.
+results to it); any number of readers (``tasker report``) may read meanwhile, and a
+reader (``ResultStore(path, readonly=True)``) never writes: not even the schema.  A
+file that is not a results database (another program's SQLite file, a foreign or newer
+schema) is refused before anything is written to it, and a corrupt row is a
+:class:`StoreError` naming the row and the column.
 """
 
 from __future__ import annotations
@@ -58,8 +62,16 @@ JobKey = tuple[str, int, str]
 """``(scenario, seed, strategy)``: what identifies one run of a sweep."""
 
 
+_COLUMNS = {
+    "meta": ("key", "value"),
+    "runs": ("id", "scenario", "seed", "strategy", "status", "error", "record", "metrics", "wall", "worker",
+             "finished"),
+    "sweeps": ("id", "started", "spec", "setup"),
+}
+
+
 class StoreError(TaskerError, RuntimeError):
-    """The results database cannot be opened or does not have the expected schema."""
+    """The results database cannot be opened, does not have the expected schema, or holds a corrupt row."""
 
 
 class Status(StrEnum):
@@ -120,23 +132,67 @@ class ResultStore:
     Use as a context manager, or call :meth:`close`.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, *, readonly: bool = False) -> None:
         self.path = Path(path)
-        if self.path.parent and not self.path.parent.exists():
+        self.readonly = readonly
+        if readonly:
+            if not self.path.is_file():
+                raise StoreError(f"{self.path}: no such results database")
+            try:
+                # mode=ro: a reader never creates, migrates or journals anything.  Without a live
+                # writer (no -wal file: a sweep removes it when it closes) the file is opened
+                # immutable, else SQLite would leave -wal and -shm files beside it.
+                live = Path(f"{self.path}-wal").exists()
+                flags = "mode=ro" if live else "mode=ro&immutable=1"
+                self._db = sqlite3.connect(f"{self.path.resolve().as_uri()}?{flags}", uri=True, timeout=30.0,
+                                           isolation_level=None)
+                self._check_schema(must_exist=True)
+            except sqlite3.DatabaseError as exc:
+                raise StoreError(f"{self.path}: not a results database: {exc}") from None
+            return
+        if self.path.is_dir():
+            raise StoreError(f"{self.path}: is a directory, expected a results database file")
+        try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise StoreError(f"{self.path}: cannot create its folder: {exc.strerror or exc}") from None
         try:
             # isolation_level=None: we issue BEGIN/COMMIT ourselves, one transaction per run
             self._db = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
+            fresh = self._check_schema(must_exist=False)
             self._db.execute("PRAGMA journal_mode=WAL")
             self._db.execute("PRAGMA synchronous=FULL")
-            self._db.executescript(_SCHEMA)
-            version = self._db.execute("SELECT value FROM meta WHERE key='schema_version'").fetchone()
+            if fresh:
+                with self._transaction() as db:
+                    for statement in _SCHEMA.split(";"):
+                        if statement.strip():
+                            db.execute(statement)
+                    db.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),))
         except sqlite3.DatabaseError as exc:
             raise StoreError(f"{self.path}: not a results database: {exc}") from None
-        if version is None:
-            self._db.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),))
-        elif int(version[0]) != SCHEMA_VERSION:
-            raise StoreError(f"{self.path}: schema version {version[0]}, this tasker reads {SCHEMA_VERSION}")
+
+    def _check_schema(self, *, must_exist: bool) -> bool:
+        """Is this an empty database (``True``), ours (``False``), or neither (:class:`StoreError`)?"""
+        tables = {r[0] for r in self._db.execute("SELECT name FROM sqlite_master WHERE type='table'")}
+        if not tables:
+            if must_exist:
+                raise StoreError(f"{self.path}: an empty SQLite file, not a results database "
+                                 "(no sweep has written to it)")
+            return True
+        missing = sorted(set(_COLUMNS) - tables)
+        if missing:
+            raise StoreError(f"{self.path}: not a tasker results database: it has tables {sorted(tables)}, "
+                             f"expected {sorted(_COLUMNS)} (missing {missing}); refusing to touch it")
+        for table, expected in _COLUMNS.items():
+            cols = tuple(r[1] for r in self._db.execute(f"PRAGMA table_info({table})"))
+            if cols != expected:
+                raise StoreError(f"{self.path}: table {table!r} has columns {list(cols)}, expected {list(expected)}: "
+                                 "a foreign or damaged schema")
+        version = self._db.execute("SELECT value FROM meta WHERE key='schema_version'").fetchone()
+        if version is None or str(version[0]) != str(SCHEMA_VERSION):
+            found = "none" if version is None else repr(version[0])
+            raise StoreError(f"{self.path}: schema version {found}, this tasker reads {SCHEMA_VERSION}")
+        return False
 
     def __enter__(self) -> ResultStore:
         return self
@@ -157,12 +213,17 @@ class ResultStore:
             raise
         self._db.execute("COMMIT")
 
+    def _writable(self) -> None:
+        if self.readonly:
+            raise StoreError(f"{self.path}: opened read-only")
+
     def add(self, row: RunRow) -> bool:
         """Store one finished run in its own transaction.
 
         Returns ``False`` (and changes nothing) if a run with the same key is already
         stored: the first result of a key is the one kept.
         """
+        self._writable()
         try:
             with self._transaction() as db:
                 db.execute(
@@ -182,34 +243,75 @@ class ResultStore:
         if status is not None:
             sql += " WHERE status = ?"
             args = (status.value,)
-        return {(s, int(n), k) for s, n, k in self._db.execute(sql, args)}
+        try:
+            return {(str(s), int(n), str(k)) for s, n, k in self._db.execute(sql, args)}
+        except (sqlite3.DatabaseError, TypeError, ValueError) as exc:
+            raise StoreError(f"{self.path}: cannot read the run keys: {exc}") from None
 
     def forget(self, keys: Iterable[JobKey]) -> int:
         """Delete the runs with these keys (to run them again); returns how many were deleted."""
+        self._writable()
         with self._transaction() as db:
             return sum(db.execute("DELETE FROM runs WHERE scenario=? AND seed=? AND strategy=?", k).rowcount
                        for k in keys)
 
     def rows(self, status: Status | None = None) -> list[RunRow]:
         """The stored runs in key order (of one status, if given)."""
-        sql = ("SELECT scenario, seed, strategy, status, error, record, metrics, wall, worker, finished FROM runs"
+        sql = ("SELECT id, scenario, seed, strategy, status, error, record, metrics, wall, worker, finished FROM runs"
                + (" WHERE status = ?" if status is not None else "") + " ORDER BY scenario, seed, strategy")
         args = (status.value,) if status is not None else ()
-        return [
-            RunRow(s, int(n), k, Status(st), json.loads(rec), json.loads(met), err, wall, worker, fin)
-            for s, n, k, st, err, rec, met, wall, worker, fin in self._db.execute(sql, args)
-        ]
+        try:
+            return [self._row(*r) for r in self._db.execute(sql, args)]
+        except sqlite3.DatabaseError as exc:
+            raise StoreError(f"{self.path}: cannot read the runs: {exc}") from None
+
+    def _row(self, rid: int, s: Any, n: Any, k: Any, st: Any, err: Any, rec: Any, met: Any, wall: Any,
+             worker: Any, fin: Any) -> RunRow:
+        """One stored row, checked: a corrupt one names its id and column."""
+        def bad(column: str, what: str) -> StoreError:
+            return StoreError(f"{self.path}: runs row id={rid}: {column}: {what}")
+
+        for column, value in (("scenario", s), ("strategy", k), ("finished", fin)):
+            if not isinstance(value, str):
+                raise bad(column, f"expected text, got {value!r}")
+        if isinstance(n, bool) or not isinstance(n, int):
+            raise bad("seed", f"expected an integer, got {n!r}")
+        try:
+            status = Status(st)
+        except ValueError:
+            raise bad("status", f"expected one of {[x.value for x in Status]}, got {st!r}") from None
+        decoded = []
+        for column, text in (("record", rec), ("metrics", met)):
+            try:
+                value = json.loads(text)
+            except (TypeError, ValueError) as exc:
+                raise bad(column, f"not JSON ({exc})") from None
+            if not isinstance(value, dict):
+                raise bad(column, f"expected a JSON object, got {type(value).__name__}")
+            decoded.append(value)
+        if wall is not None and (isinstance(wall, bool) or not isinstance(wall, int | float)):
+            raise bad("wall", f"expected a number, got {wall!r}")
+        try:
+            return RunRow(s, n, k, status, decoded[0], decoded[1], err, wall, worker, fin)
+        except ValueError as exc:
+            raise bad("error", str(exc)) from None
 
     def count(self) -> int:
         return int(self._db.execute("SELECT COUNT(*) FROM runs").fetchone()[0])
 
     def log_sweep(self, spec: Mapping[str, Any], setup: Mapping[str, Any]) -> None:
         """Record that a sweep (or a resumption of one) started: its spec and how it runs."""
+        self._writable()
         with self._transaction() as db:
             db.execute("INSERT INTO sweeps (started, spec, setup) VALUES (?, ?, ?)",
                        (_now(), _dumps(spec), _dumps(setup)))
 
     def sweeps(self) -> list[dict[str, Any]]:
         """Every logged sweep start, oldest first: ``started``, ``spec``, ``setup``."""
-        return [{"started": st, "spec": json.loads(sp), "setup": json.loads(se)}
-                for st, sp, se in self._db.execute("SELECT started, spec, setup FROM sweeps ORDER BY id")]
+        out = []
+        for sid, st, sp, se in self._db.execute("SELECT id, started, spec, setup FROM sweeps ORDER BY id"):
+            try:
+                out.append({"started": st, "spec": json.loads(sp), "setup": json.loads(se)})
+            except (TypeError, ValueError) as exc:
+                raise StoreError(f"{self.path}: sweeps row id={sid}: not JSON ({exc})") from None
+        return out

@@ -16,6 +16,9 @@ different randomised variant of the scenario.  See ``docs/sweeps.md``.
 
 from __future__ import annotations
 
+import ctypes
+import dataclasses
+import fcntl
 import itertools
 import logging
 import multiprocessing
@@ -25,13 +28,14 @@ import signal
 import socket
 import sys
 import tempfile
+import threading
 import time
-import tomllib
 import traceback
 from collections import deque
 from collections.abc import Callable, Generator, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, CancelledError, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -39,9 +43,16 @@ from typing import Any
 
 import tasker
 from experiments.store import JobKey, ResultStore, RunRow, Status
+from tasker import reader
 from tasker.errors import TaskerError
+from tasker.reader import InputError
 
 STRATEGY_VALUES = ("static", "planned")
+
+_PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+
+MAX_JOBS = 100_000
+"""A spec that expands to more jobs than this is refused (a typo such as ``seeds = 10000000``)."""
 
 log = logging.getLogger(__name__)
 
@@ -49,8 +60,8 @@ RunFn = Callable[["Job"], tuple[Mapping[str, Any], Mapping[str, Any]]]
 """Runs one job and returns ``(record, metrics)``; must be a picklable top-level function."""
 
 
-class SpecError(TaskerError, ValueError):
-    """A sweep spec is malformed; the message names the file and the field."""
+class SpecError(InputError):
+    """A sweep spec is malformed; the message names the file, the line and the field."""
 
 
 class SweepError(TaskerError, RuntimeError):
@@ -110,6 +121,7 @@ class Job:
     source: str
     seed: int
     strategy: Strategy
+    task_paths: tuple[str, ...] = ()  # absolute task folders (--path), so a Dask worker elsewhere loads the same
 
     @property
     def key(self) -> JobKey:
@@ -125,6 +137,7 @@ class SweepSpec:
     strategies: tuple[Strategy, ...]
     name: str = "sweep"
     sources: Mapping[str, str] = field(default_factory=dict)
+    task_paths: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if not self.scenarios:
@@ -137,10 +150,13 @@ class SweepSpec:
                             ("strategies", [s.label for s in self.strategies])):
             if len(set(items)) != len(items):
                 raise ValueError(f"{what}: duplicates in {list(items)}")
+        n = len(self.scenarios) * len(self.seeds) * len(self.strategies)
+        if n > MAX_JOBS:
+            raise ValueError(f"the spec expands to {n} jobs, more than the {MAX_JOBS} a sweep may have")
 
     def jobs(self) -> list[Job]:
         """Every job, scenario-major then seed then strategy (so paired runs finish close together)."""
-        return [Job(sc, self.sources.get(sc, sc), seed, st)
+        return [Job(sc, self.sources.get(sc, sc), seed, st, self.task_paths)
                 for sc in self.scenarios for seed in self.seeds for st in self.strategies]
 
     def to_json(self) -> dict[str, Any]:
@@ -182,91 +198,98 @@ def _looks_like_path(text: str) -> bool:
     return "/" in text or os.sep in text or text.endswith((".toml", ".json"))
 
 
-def load_spec(path: str | Path) -> SweepSpec:
-    """Read and check a sweep spec (TOML).  Relative scenario paths are relative to the spec file.
+SPEC_KEYS = ("name", "scenarios", "seeds", "seed_start", "strategies")
 
-    Fields: ``name`` (optional), ``scenarios`` (list of files), ``seeds`` (a count, seeds
-    ``seed_start`` … ``seed_start + count - 1``, or a list), ``seed_start`` (optional, default 0),
-    ``strategies`` (list of ``"update=…,suspension=…[,scheduler=…]"`` strings or tables).
+
+def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
+    """Read and check a sweep spec (TOML) with :mod:`tasker.reader`.
+
+    Fields: ``name`` (optional), ``scenarios`` (list of files or shipped names), ``seeds``
+    (a count, seeds ``seed_start`` … ``seed_start + count - 1``, or a list), ``seed_start``
+    (optional, default 0), ``strategies`` (list of ``"update=…,suspension=…[,scheduler=…]"``
+    strings or tables).  Scenario paths are relative to the spec file and come back
+    absolute, so workers started anywhere (Dask) find them.  A spec that expands to more
+    than ``max_jobs`` (default :data:`MAX_JOBS`) jobs is refused.
     """
-    p = Path(path)
-    src = str(p)
-    try:
-        raw = tomllib.loads(p.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise SpecError(f"{src}: cannot read: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecError(f"{src}: not valid TOML: {exc}") from None
+    from experiments import scenario as scenarios
 
-    def err(key: str, msg: str) -> SpecError:
-        return SpecError(f"{src}: {key}: {msg}")
-
-    known = {"name", "scenarios", "seeds", "seed_start", "strategies"}
-    for key in raw:
-        if key not in known:
-            raise err(key, f"unknown field; expected one of {sorted(known)}")
-    for key in ("scenarios", "seeds", "strategies"):
-        if key not in raw:
-            raise err(key, "missing (required)")
-    name = raw.get("name", p.stem)
-    if not isinstance(name, str):
-        raise err("name", f"expected a string, got {name!r}")
-
-    scenarios = raw["scenarios"]
-    if not isinstance(scenarios, list) or not scenarios:
-        raise err("scenarios", f"expected a non-empty list of scenario files, got {scenarios!r}")
+    limit = MAX_JOBS if max_jobs is None else max_jobs
+    p = Path(path).resolve()
+    top = reader.load(p, SpecError)
+    name = str(top.string("name", p.stem))
+    scenario_list = top.array("scenarios", nonempty=True)
+    at = top.at("scenarios", {})
     sources: dict[str, str] = {}
-    for i, sc in enumerate(scenarios):
+    for i, sc in enumerate(scenario_list):
         if not isinstance(sc, str) or not sc:
-            raise err(f"scenarios[{i}]", f"expected a file name, got {sc!r}")
+            raise at.error(i, f"expected a scenario file or a shipped scenario name, got {sc!r}")
+        if sc in scenario_list[:i]:
+            raise at.error(i, f"{sc!r} is listed twice")
         if _looks_like_path(sc):
             file = Path(sc) if Path(sc).is_absolute() else p.parent / sc
             if not file.is_file():
-                raise err(f"scenarios[{i}]", f"no such file: {file}")
-            sources[sc] = str(file)
-    if len(set(scenarios)) != len(scenarios):
-        raise err("scenarios", f"duplicates in {scenarios}")
-
-    seeds_raw, start = raw["seeds"], raw.get("seed_start", 0)
-    if isinstance(start, bool) or not isinstance(start, int):
-        raise err("seed_start", f"expected an integer, got {start!r}")
+                raise at.error(i, f"no such file: {file} (scenario paths are relative to the spec file)")
+            sources[sc] = str(file.resolve())
+        else:
+            try:  # a shipped scenario's name is passed on as it is: every worker has the package
+                scenarios.resolve(sc)
+            except reader.InputError as exc:
+                raise at.error(i, exc.message) from None
+    start = int(top.number("seed_start", 0, integer=True, min=0, max=reader.MAX_SEED))
+    seeds_raw = top.raw("seeds")
     if isinstance(seeds_raw, int) and not isinstance(seeds_raw, bool):
         if seeds_raw < 1:
-            raise err("seeds", f"expected a positive count, got {seeds_raw}")
+            raise top.error("seeds", f"expected a positive count, got {seeds_raw}")
+        if seeds_raw > limit:
+            raise top.error("seeds", f"{seeds_raw} seeds is more than the {limit} jobs a sweep may have")
+        if start + seeds_raw - 1 > reader.MAX_SEED:
+            raise top.error("seeds", f"seeds {start}..{start + seeds_raw - 1} go past the largest seed, "
+                                     f"{reader.MAX_SEED}")
         seeds = tuple(range(start, start + seeds_raw))
     elif isinstance(seeds_raw, list) and seeds_raw:
+        st = top.at("seeds", {})
         for i, s in enumerate(seeds_raw):
-            if isinstance(s, bool) or not isinstance(s, int):
-                raise err(f"seeds[{i}]", f"expected an integer, got {s!r}")
-        if "seed_start" in raw:
-            raise err("seed_start", "only with a count of seeds, not a list")
-        if len(set(seeds_raw)) != len(seeds_raw):
-            raise err("seeds", f"duplicates in {seeds_raw}")
+            reader.check_number(st, i, s, integer=True, min=0, max=reader.MAX_SEED)
+        if "seed_start" in top:
+            raise top.error("seed_start", "only with a count of seeds, not a list")
+        dup = sorted({s for s in seeds_raw if seeds_raw.count(s) > 1})
+        if dup:
+            raise top.error("seeds", f"duplicates {dup} in the list of seeds")
         seeds = tuple(seeds_raw)
     else:
-        raise err("seeds", f"expected a count or a non-empty list of integers, got {seeds_raw!r}")
-
-    strategies_raw = raw["strategies"]
-    if not isinstance(strategies_raw, list) or not strategies_raw:
-        raise err("strategies", f"expected a non-empty list, got {strategies_raw!r}")
+        raise top.error("seeds", f"expected a count or a non-empty list of integers, got {seeds_raw!r}")
     strategies = []
-    for i, st in enumerate(strategies_raw):
+    strategies_t = top.at("strategies", {})
+    for i, st in enumerate(top.array("strategies", nonempty=True)):
         try:
             if isinstance(st, str):
                 strategies.append(Strategy.parse(st))
             elif isinstance(st, dict):
-                extra = set(st) - {"update", "suspension", "scheduler"}
-                if extra:
-                    raise ValueError(f"unknown field {sorted(extra)[0]!r}; expected update, suspension, scheduler")
-                strategies.append(Strategy(**st))
+                t = strategies_t.at(i, st)
+                strategies.append(Strategy(**{k: t.string(k, choices=STRATEGY_VALUES if k != "scheduler" else None)
+                                              for k in ("update", "suspension", "scheduler") if k in t}))
+                t.done(("update", "suspension", "scheduler"))
             else:
-                raise ValueError(f"expected a string or a table, got {st!r}")
+                raise ValueError(f"expected a string such as 'update=planned,suspension=static' or a table, "
+                                 f"got {st!r}")
         except (ValueError, TypeError) as exc:
-            raise err(f"strategies[{i}]", str(exc)) from None
+            if isinstance(exc, reader.InputError):
+                raise
+            raise strategies_t.error(i, str(exc)) from None
+        if strategies[-1].scheduler is not None:
+            from tasker import schedulers
+
+            reader.check_name(strategies_t, i, strategies[-1].scheduler, schedulers.names(), "scheduler")
     labels = [s.label for s in strategies]
-    if len(set(labels)) != len(labels):
-        raise err("strategies", f"duplicates in {labels}")
-    return SweepSpec(tuple(scenarios), seeds, tuple(strategies), name=name, sources=sources)
+    dup_labels = sorted({x for x in labels if labels.count(x) > 1})
+    if dup_labels:
+        raise top.error("strategies", f"duplicates {dup_labels}")
+    top.done(SPEC_KEYS)
+    n = len(scenario_list) * len(seeds) * len(strategies)
+    if n > limit:
+        raise top.error("seeds", f"the spec expands to {len(scenario_list)} scenarios x {len(seeds)} seeds x "
+                                 f"{len(strategies)} strategies = {n} jobs, more than the {limit} a sweep may have")
+    return SweepSpec(tuple(scenario_list), seeds, tuple(strategies), name=name, sources=sources)
 
 
 # ----------------------------------------------------------------------------------------- running
@@ -277,7 +300,8 @@ def run_job(job: Job) -> tuple[dict[str, Any], dict[str, Any]]:
     from experiments.runner import run_scenario  # imported in the worker, never shared across processes
 
     result = run_scenario(job.source, seed=job.seed, update=job.strategy.update,
-                          suspension=job.strategy.suspension, scheduler=job.strategy.scheduler, randomize=True)
+                          suspension=job.strategy.suspension, scheduler=job.strategy.scheduler, randomize=True,
+                          task_paths=job.task_paths)
     return dict(result.record), dict(result.metrics)
 
 
@@ -301,6 +325,47 @@ def _failed(job: Job, error: str, wall: float = 0.0, worker: str = "") -> Outcom
 
 def _exception_message(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {exc}"
+
+
+def _alive(pid: int) -> bool:
+    """Is ``pid`` running (a zombie, killed but not yet reaped by its parent, is not)?"""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):  # no /proc (not Linux): the signal test alone
+        return True
+
+
+def die_with_parent(driver: int) -> None:
+    """Make this worker process die when its parent does — even when the driver is killed with ``kill -9``.
+
+    On Linux the kernel sends SIGKILL when the parent dies (``prctl(PR_SET_PDEATHSIG)``);
+    everywhere a daemon thread also polls the parent and the driver (``driver`` is its
+    pid) twice a second and exits when either is gone.  Used as the worker initializer,
+    so an orphaned worker never goes on running (or holding memory) after its sweep.
+    """
+    parent = os.getppid()
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError):  # no libc prctl: the watchdog alone
+            pass
+    if not _alive(driver) or (parent == 1 and driver != 1):  # the parent died before prctl took effect
+        os._exit(1)
+
+    def watch() -> None:
+        while True:
+            if os.getppid() != parent or not _alive(driver):
+                os._exit(1)
+            time.sleep(0.5)
+
+    threading.Thread(target=watch, name="tasker-sweep-watchdog", daemon=True).start()
 
 
 def _mp_context() -> multiprocessing.context.BaseContext:
@@ -334,8 +399,9 @@ def _died(exitcode: int | None) -> str:
             "(a crash in native code, os._exit, or the OOM killer)")
 
 
-def _alone_child(conn: Any, run_fn: RunFn, job: Job) -> None:
+def _alone_child(conn: Any, run_fn: RunFn, job: Job, driver: int) -> None:
     """The body of the process that runs one job alone: send its outcome back, or die trying."""
+    die_with_parent(driver)
     out = execute(run_fn, job)
     try:
         conn.send(out)
@@ -349,7 +415,8 @@ def _alone(run_fn: RunFn, job: Job, ctx: Any) -> Outcome:  # a multiprocessing c
     """Run one job alone in a fresh worker process; if the process dies, an ``error`` outcome that says so."""
     start = time.perf_counter()
     receiver, sender = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_alone_child, args=(sender, run_fn, job), name=f"tasker-sweep-alone-{job.seed}")
+    proc = ctx.Process(target=_alone_child, args=(sender, run_fn, job, os.getpid()),
+                       name=f"tasker-sweep-alone-{job.seed}")
     proc.start()
     sender.close()  # so that receiving ends (EOFError) when the process dies without sending
     out: Outcome | None = None
@@ -377,7 +444,8 @@ def _pool_pass(run_fn: RunFn, queue: deque[Job], workers: int, ctx: multiprocess
     the jobs that had not started back at the front of ``queue``.
     """
     pending: dict[Future[Outcome], tuple[Job, Path]] = {}
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=die_with_parent,
+                             initargs=(os.getpid(),)) as pool:
         try:
             broken = False
             while not broken:
@@ -485,6 +553,63 @@ def _dask(run_fn: RunFn, jobs: Sequence[Job], address: str) -> Iterator[Outcome]
             client.cancel([f for f in futures if not f.done()])
 
 
+@contextmanager
+def lease(db_path: str | Path) -> Iterator[None]:
+    """Hold the sweep lease of a results database: one driver at a time, or a clear :class:`SweepError`.
+
+    An exclusive ``flock`` on ``<db>.lock``, which says who holds it.  The kernel drops
+    the lock when the holder dies, even by ``kill -9``, so a stale lease never blocks a
+    resumption.  Readers (``tasker report``) take no lease.
+    """
+    lock = Path(f"{db_path}.lock")
+    try:
+        lock.parent.mkdir(parents=True, exist_ok=True)
+        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+    except OSError as exc:
+        raise SweepError(f"{db_path}: cannot take the sweep lease ({lock}: {exc.strerror or exc})") from None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        holder = os.pread(fd, 512, 0).decode("utf-8", "replace").strip() or "another process"
+        os.close(fd)
+        raise SweepError(f"{db_path}: another sweep is running on this database ({holder}); two drivers would "
+                         "run the same jobs. Wait for it to end (then run again to resume), or use another "
+                         "database") from None
+    try:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"pid {os.getpid()} on {socket.gethostname()}, since "
+                      f"{datetime.now(UTC).isoformat(timespec='seconds')}".encode(), 0)
+        yield
+    finally:
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        os.close(fd)
+
+
+def absolute_source(source: str) -> str:
+    """A job's scenario as an absolute path (a shipped scenario name stays a name): workers may run elsewhere."""
+    p = Path(source)
+    if p.is_absolute():
+        return source
+    if p.exists() or _looks_like_path(source):
+        return str(p.resolve())
+    return source
+
+
+def precheck(jobs: Iterable[Job]) -> None:
+    """Load every distinct scenario of ``jobs`` once, so a bad one fails before any job runs."""
+    from experiments import scenario as scenarios
+    from experiments import synthetic
+
+    jobs = list(jobs)
+    paths = {j.source: j.task_paths for j in jobs}
+    for source in sorted({j.source for j in jobs}):
+        path = scenarios.resolve(source)
+        if scenarios.kind_of(path) == "robot":
+            scenarios.load(path, task_paths=paths.get(source, ()))
+        else:
+            synthetic.load(path)
+
+
 def _setup(workers: int, address: str | None) -> dict[str, Any]:
     return {"backend": "dask" if address else "local", "workers": None if address else workers,
             "scheduler_address": address,
@@ -515,7 +640,8 @@ def run_sweep(
     ``max_jobs`` stops after starting that many jobs (the rest stay missing, for a later
     resumption).  Results are written by this process only, one transaction per run.
     """
-    jobs = spec.jobs() if isinstance(spec, SweepSpec) else list(spec)
+    jobs = [dataclasses.replace(j, source=absolute_source(j.source))
+            for j in (spec.jobs() if isinstance(spec, SweepSpec) else list(spec))]
     keys = [j.key for j in jobs]
     if len(set(keys)) != len(keys):
         raise SweepError("two jobs have the same key (scenario, seed, strategy)")
@@ -524,7 +650,9 @@ def run_sweep(
     n_workers = workers or os.cpu_count() or 1
     start = time.perf_counter()
     backend = "dask" if scheduler_address else "local"
-    with ResultStore(db_path) as store:
+    if run_fn is run_job:
+        precheck(jobs)
+    with lease(db_path), ResultStore(db_path) as store:
         if retry_errors:
             store.forget(set(keys) & store.keys(Status.ERROR))
         stored = store.keys()

@@ -2,26 +2,27 @@
 
 A synthetic scenario file (TOML or JSON) defines task types as stage templates,
 the requests with their times, changes during the run, and the harmonisation
-settings.  Every field is checked when the file is loaded; an error names the file
-and the field.  See ``docs/scenarios.md`` for the format.
+settings.  Every field is checked when the file is loaded, with :mod:`tasker.reader`;
+an error names the file, the line and the field.  See ``docs/scenarios.md`` for the format.
 """
 
 from __future__ import annotations
 
-import json
-import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from experiments.actions import TimedAction, read_actions
-from experiments.fields import Fields as _Fields
-from experiments.fields import ScenarioError
-from tasker import schedulers
+from experiments import fields
+from experiments.actions import TABLES, TimedAction, located, read_actions
+from experiments.crossref import validate_request
+from experiments.fields import MODES, ScenarioError
+from tasker import reader, schedulers
 from tasker.agent import Rates
+from tasker.errors import TaskerError
 from tasker.harmoniser import Mode
 from tasker.loop import SimulationLoop
+from tasker.reader import Table, check_name
 from tasker.stage import Stage, StageKind
 from tasker.store import TaskStore
 from tasker.synthetic import SyntheticTask, TimedExecutor
@@ -48,89 +49,92 @@ class SyntheticScenario:
     horizon: float = 24 * 3600.0
 
 
-def _stage(f: _Fields) -> Stage:
-    kind = f.get("kind", str, "suspendable")
-    if kind not in ("suspendable", "blocking"):
-        raise f.error("kind", f"expected 'suspendable' or 'blocking', got {kind!r}")
-    duration = f.get("duration", float)
-    if duration < 0:
-        raise f.error("duration", f"expected >= 0, got {duration}")
+SYNTHETIC_KEYS = ("kind", "name", "seed", "settings", "tasks", *(k for k, _ in TABLES if k != "world_events"))
+
+
+def _stage(f: Table) -> Stage:
+    kind = f.string("kind", "suspendable", choices=("suspendable", "blocking"))
+    duration = float(f.number("duration", min=0))
     data: dict[str, Any] = {}
-    site = f.get("site", list, None)
-    if site is not None:
-        data["site"] = tuple(site)
-    fail = f.get("fail", str, None)
+    if "site" in f:
+        data["site"] = _site(f)
+    fail = f.string("fail", None)
     if fail:
         data["fail"] = fail
-    stage = Stage(f.get("action", str), kind=StageKind(kind), duration=duration, skill="timed", data=data)
+    stage = Stage(f.string("action"), kind=StageKind(kind), duration=duration, skill="timed", data=data)
     f.done()
     return stage
 
 
-def _stages(f: _Fields, key: str) -> list[Stage]:
-    items = f.get(key, list)
+def _site(f: Table) -> tuple[float, ...]:
+    """``site``: ``[x, y]`` or ``[x, y, yaw]``."""
+    value = f.raw("site")
+    n = len(value) if isinstance(value, list) and len(value) in (2, 3) else 2
+    return tuple(f.numbers("site", n, "[x, y] or [x, y, yaw]"))
+
+
+def _stages(f: Table, key: str) -> list[Stage]:
+    items = f.tables(key)
     if not items:
         raise f.error(key, "expected at least one stage")
-    return [_stage(_Fields(f.source, f"{f.path(key)}[{i}]", s)) for i, s in enumerate(items)]
+    return [_stage(t) for t in items]
 
 
 def load(path: str | Path) -> SyntheticScenario:
     """Read and check a synthetic scenario file (``.toml`` or ``.json``)."""
     p = Path(path)
-    source = str(p)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ScenarioError(f"{source}: cannot read: {exc.strerror}") from None
-    try:
-        raw = json.loads(text) if p.suffix == ".json" else tomllib.loads(text)
-    except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise ScenarioError(f"{source}: not valid {'JSON' if p.suffix == '.json' else 'TOML'}: {exc}") from None
-    top = _Fields(source, "", raw)
-    kind = top.get("kind", str, "synthetic")
-    if kind != "synthetic":
-        raise top.error("kind", f"this loader reads kind = 'synthetic', got {kind!r}")
-    settings = top.sub("settings", {})
-    tasks_f = top.sub("tasks")
+    top = reader.load(p, ScenarioError)
+    top.string("kind", "synthetic", choices=("synthetic",))
+    settings = top.table("settings", {})
+    tasks_f = top.table("tasks")
     tasks = []
-    for name in tasks_f.table:
-        t = tasks_f.sub(name)
-        susp_f = t.sub("suspension", {})
-        suspension = {action: _stages(susp_f, action) for action in list(susp_f.table)}
+    for name, t in [(n, tasks_f.at(n, v)) for n, v in tasks_f.items()]:
+        stages = _stages(t, "stages")
+        susp_f = t.table("suspension", {})
+        actions_of = sorted({st.action for st in stages})
+        for action in susp_f.keys():  # keyed by the action of the interrupted stage (eq. 47)
+            check_name(susp_f, action, action, actions_of, f"action in the stages of {name!r}")
+        suspension = {action: _stages(susp_f, action) for action in susp_f.keys()}
         tasks.append(SyntheticTask(
-            name, _stages(t, "stages"),
-            weight=t.get("weight", float, 1.0), speed=t.get("speed", float, 1.0, positive=True),
-            site=tuple(t.get("site", list)) if "site" in t.table else None,
+            name, stages,
+            weight=float(t.number("weight", 1.0, min=0)), speed=float(t.number("speed", 1.0, positive=True)),
+            site=_site(t) if "site" in t else None,
             suspension=suspension or None,
-            resume_prefix=_stages(t, "resume_prefix") if "resume_prefix" in t.table else (),
-            planning_time=t.get("planning_time", float, 0.0),
+            resume_prefix=_stages(t, "resume_prefix") if "resume_prefix" in t else (),
+            planning_time=float(t.number("planning_time", 0.0, min=0)),
         ))
         t.done()
+    if not tasks:
+        raise top.error("tasks", "expected at least one task type ([tasks.NAME])")
     actions = read_actions(top, task_names={t.name for t in tasks})
-    mode = settings.get("mode", str, "IT")
-    if mode not in ("IT", "CT"):
-        raise settings.error("mode", f"expected 'IT' or 'CT', got {mode!r}")
-    scheduler = settings.get("scheduler", str, "alg2")
-    if scheduler not in schedulers.names():
-        raise settings.error("scheduler", f"unknown scheduler {scheduler!r}; known: {schedulers.names()}")
+    sched = fields.scheduler(settings)
     scenario = SyntheticScenario(
-        name=top.get("name", str, p.stem),
+        name=str(top.string("name", p.stem)),
         tasks=tuple(tasks),
         actions=actions,
-        scheduler=scheduler,
-        scheduler_options=settings.get("scheduler_options", dict, {}),
-        mode=mode,
-        s_freq=settings.get("s_freq", float, 1.0, positive=True),
-        rates=Rates(settings.get("rep_rate", float, 1.0, positive=True),
-                    settings.get("task_exe_rate", float, 10.0, positive=True),
-                    settings.get("sp_up_rate", float, 1.0, positive=True)),
-        jitter=settings.get("jitter", float, 0.0),
-        seed=top.get("seed", int, 0),
-        horizon=settings.get("horizon", float, 24 * 3600.0, positive=True),
+        scheduler=sched,
+        scheduler_options=fields.scheduler_options(settings, sched, [t.name for t in tasks]),
+        mode=str(settings.string("mode", "IT", choices=MODES)),
+        s_freq=fields.rate(settings, "s_freq", 1.0),
+        rates=Rates(fields.rate(settings, "rep_rate", 1.0), fields.rate(settings, "task_exe_rate", 10.0),
+                    fields.rate(settings, "sp_up_rate", 1.0)),
+        jitter=float(settings.number("jitter", 0.0, min=0, max=1)),
+        seed=int(top.number("seed", 0, integer=True, min=0, max=reader.MAX_SEED)),
+        horizon=float(settings.number("horizon", 24 * 3600.0, positive=True)),
     )
     settings.done()
-    top.done()
-    build(scenario, seed=scenario.seed)  # checks request arguments and scheduler options now, before any run
+    top.done(SYNTHETIC_KEYS)
+    for a in actions:
+        if a.t > scenario.horizon:
+            located(top, a).warn("t", f"t={a.t:g} is after the horizon ({scenario.horizon:g} s): it never happens")
+    by_name = {t.name: t for t in tasks}
+    for a in actions:
+        if a.kind == "request":
+            validate_request(located(top, a), by_name[a.fields["task"]], a.fields["args"])
+    try:
+        build(scenario, seed=scenario.seed)  # the rest (changes, the scheduler) now, before any run
+    except TaskerError as exc:
+        raise ScenarioError(str(p), f"{exc}") from None
     return scenario
 
 

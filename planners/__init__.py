@@ -1,30 +1,40 @@
 """Planning for tasker: unified-planning + Fast Downward, task folders, and their checks.
 
 * :class:`Planner` — solve with any UP one-shot engine by name, cached (:mod:`planners.planner`);
-* ``tasker-fd`` — the fast optimal Fast Downward engine, registered with UP's factory
-  when this package is imported (:mod:`planners.engine`);
+* ``tasker-fd`` — the fast optimal Fast Downward engine (:mod:`planners.engine`), registered
+  with UP's factory by :func:`register_engine` (a :class:`Planner` does it when it needs UP's
+  factory, and so does asking this package for any engine-related name);
 * :func:`load_task_folder` — task folders (``domain.pddl`` + ``task.toml`` [+ ``task.py``])
   to :class:`~tasker.task.TaskType` instances, checked before any run.
 
-Importing the package also silences UP's credits banner (``credits_stream = None``).
+The names below are imported lazily (PEP 562): ``import planners.fd`` must not pay for
+unified-planning's engine framework (ConfigSpace, scipy.stats: about 0.9 s), which the
+command line's path to Fast Downward never needs.
 """
 
 from __future__ import annotations
 
-from unified_planning.environment import get_environment
+import importlib
+from typing import Any
 
-from planners.checks import DefinitionError, PddlError, load_domain, load_problem
-from planners.engine import ENGINE_NAME, TaskerFastDownward, register_engine
-from planners.loader import load_task, load_task_folder, store_loader
-from planners.pddl_task import PddlTaskType
-from planners.planner import DEFAULT_PLANNER, PddlText, Planner, oneshot_planners
-from planners.results import PlanResult, PlanStatus
+_EXPORTS = {
+    "DEFAULT_PLANNER": "planners.planner", "ENGINE_NAME": "planners.engine", "DefinitionError": "planners.checks",
+    "PddlError": "planners.checks", "PddlTaskType": "planners.pddl_task", "PddlText": "planners.planner",
+    "PlanResult": "planners.results", "PlanStatus": "planners.results", "Planner": "planners.planner",
+    "TaskerFastDownward": "planners.engine", "load_domain": "planners.checks", "load_problem": "planners.checks",
+    "load_task": "planners.loader", "load_task_folder": "planners.loader", "oneshot_planners": "planners.planner",
+    "register_engine": "planners.engine", "store_loader": "planners.loader",
+}
 
-get_environment().credits_stream = None
-register_engine()
+__all__ = sorted(_EXPORTS)
 
-__all__ = [
-    "DEFAULT_PLANNER", "ENGINE_NAME", "DefinitionError", "PddlError", "PddlTaskType", "PddlText", "PlanResult",
-    "PlanStatus", "Planner", "TaskerFastDownward", "load_domain", "load_problem", "load_task", "load_task_folder",
-    "oneshot_planners", "register_engine", "store_loader",
-]
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'planners' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    if module == "planners.engine":
+        importlib.import_module(module).register_engine()
+    globals()[name] = value
+    return value

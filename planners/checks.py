@@ -26,7 +26,7 @@ from unified_planning.io import PDDLReader
 from unified_planning.io.pddl_reader import PDDLGrammar
 from unified_planning.io.utils import parse_string
 
-from planners.engine import TaskerFastDownward
+from planners.kind import supported_kind
 from tasker.errors import TaskerError
 
 SUPPORTED_REQUIREMENTS = frozenset({
@@ -130,7 +130,7 @@ def check_requirements(domain_text: str, file: str | Path) -> None:
 
 def check_kind(problem: up.model.Problem, file: str | Path) -> None:
     """Refuse a problem whose UP problem kind needs features the planner lacks."""
-    supported = set(TaskerFastDownward.supported_kind().features)
+    supported = set(supported_kind().features)
     extra = sorted(set(problem.kind.features) - supported - _TOLERATED_FEATURES)
     if extra:
         raise PddlError(file, f"unsupported PDDL features for a classical planner: {', '.join(extra)}")

@@ -1,48 +1,56 @@
-"""``tasker plan``, ``tasker domains`` and ``tasker fsm``: the planning side of the command line.
+"""``tasker plan``, ``domains``, ``fsm`` and ``new``: the planning side of the command line.
 
 :func:`register` adds the subcommands to an ``argparse`` sub-parser set; each sets
-``func`` to a handler ``(args) -> int`` returning the exit status: 0 success, 1 no plan
-(unsolvable or time-out), 2 bad input, with the message on stderr and never a traceback.
+``func`` to a handler ``(args) -> int`` returning the exit status (0 success, 1 no
+plan, 2 bad input; :mod:`tasker.cliargs`).  Handlers raise on bad input and the caller
+(:func:`tasker.cliargs.run_handler`) prints one line, never a traceback.
+
+Heavy modules are imported inside the handlers.  ``tasker plan`` with the default
+engine goes to Fast Downward without unified-planning's engine framework, and skips
+UP's PDDL reader when the same domain and problem passed its checks before
+(:mod:`planners.cache`).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
+import re
+import shutil
 import sys
-from collections.abc import Callable
-from typing import Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-from planners.checks import DefinitionError, load_problem
-from planners.engine import ENGINE_NAME
-from planners.examples import StraightLineMotion, example_context
-from planners.pddl_task import PddlTaskType
-from planners.planner import DEFAULT_PLANNER, PddlText, Planner
-from planners.results import PlanResult, PlanStatus
-from tasker.errors import TaskerError
-from tasker.stage import Purpose, Stage, StagePlan
-from tasker.task import Strategy, TaskType
+from tasker.cliargs import EXIT_FAILED, EXIT_OK, UsageError, non_negative_int, note, positive_seconds
 
-Handler = Callable[[argparse.Namespace], int]
+if TYPE_CHECKING:
+    from planners.pddl_task import PddlTaskType
+    from planners.results import PlanResult
+    from tasker.stage import Purpose, Stage, StagePlan
+    from tasker.task import TaskType
+
+ENV_VAR = "TASKER_TASKS"  # as planners.bundled.ENV_VAR, which would import the loader (and UP's reader)
+
+TEMPLATE = Path(__file__).resolve().parent / "template"
+"""The folder ``tasker new`` copies: ``domain.pddl``, ``task.toml``, ``scenario.toml``."""
+
+_DOMAIN_NAME = re.compile(r"\(\s*domain\s+([^\s()]+)\s*\)", re.IGNORECASE)
 
 
-def _guard(handler: Handler) -> Handler:
-    """Run a handler; turn every error into a one-line message and exit status 2."""
+def _path_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--path", action="append", default=[], metavar="DIR",
+                   help="also load task types from this task folder or folder of task folders (repeatable; "
+                        "also $TASKER_TASKS)")
 
-    def run(args: argparse.Namespace) -> int:
-        try:
-            return handler(args)
-        except TaskerError as exc:
-            print(f"error: {exc}", file=sys.stderr)
-        except OSError as exc:
-            print(f"error: {exc}", file=sys.stderr)
-        except Exception as exc:  # noqa: BLE001 - a command line never shows a traceback
-            print(f"error: internal: {type(exc).__name__}: {exc}", file=sys.stderr)
-        return 2
 
-    run.__name__ = handler.__name__
-    run.__doc__ = handler.__doc__
-    return run
+def _paths(args: argparse.Namespace) -> list[str]:
+    out = []
+    for p in getattr(args, "path", []) or []:
+        if not Path(p).expanduser().is_dir():
+            raise UsageError("--path", f"{p}: no such folder")
+        out.append(str(Path(p).expanduser().resolve()))
+    return out
 
 
 def _task_types(extra: list[str]) -> list[TaskType]:
@@ -60,12 +68,44 @@ def _find_task(name: str, extra: list[str]) -> TaskType:
     return types[name]
 
 
-def _stages_for(domain_name: str, result: PlanResult, extra: list[str]) -> tuple[Stage, ...]:
+def _task_folders(extra: list[str]) -> list[Path]:
+    """Every task folder tasker would load (bundled, ``$TASKER_TASKS``, ``--path``), without loading any."""
+    from domains import BUNDLED
+
+    roots = [BUNDLED, *(Path(p) for p in os.environ.get(ENV_VAR, "").split(os.pathsep) if p),
+             *(Path(p) for p in extra)]
+    out: list[Path] = []
+    for r in roots:
+        if (r / "task.toml").is_file():
+            out.append(r)
+        elif r.is_dir():
+            out += [q for q in sorted(r.iterdir()) if (q / "task.toml").is_file()]
+    return out
+
+
+def _task_for_domain(domain_text: str, extra: list[str]) -> PddlTaskType | None:
+    """The registered task whose domain has this domain's name; only that folder is loaded."""
+    m = _DOMAIN_NAME.search(domain_text)
+    if not m:
+        return None
+    for folder in _task_folders(extra):
+        dm = _DOMAIN_NAME.search((folder / "domain.pddl").read_text(encoding="utf-8", errors="replace")) \
+            if (folder / "domain.pddl").is_file() else None
+        if dm and dm.group(1).lower() == m.group(1).lower():
+            from planners.loader import load_task
+
+            return load_task(folder)
+    return None
+
+
+def _stages_for(domain_text: str, result: PlanResult, extra: list[str]) -> tuple[Stage, ...]:
     """Stages of a plan: the task type's skills when the domain is a registered task's."""
+    from tasker.errors import TaskerError
+    from tasker.stage import Stage
+
     assert result.plan is not None
     try:
-        task = next((t for t in _task_types(extra) if isinstance(t, PddlTaskType)
-                     and t.domain.name == domain_name), None)
+        task = _task_for_domain(domain_text, extra)
     except TaskerError:
         task = None
     if task is not None:
@@ -73,45 +113,77 @@ def _stages_for(domain_name: str, result: PlanResult, extra: list[str]) -> tuple
     return tuple(Stage(s[0], tuple(s[1:])) for s in result.plan)
 
 
-@_guard
+def _read_arg(path: str, argument: str) -> str:
+    p = Path(path)
+    if not p.is_file():
+        raise UsageError(argument, f"{path}: no such file")
+    try:
+        return p.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UsageError(argument, f"{path}: cannot read: {exc}") from None
+
+
 def plan_command(args: argparse.Namespace) -> int:
     """Solve DOMAIN + PROBLEM; print the plan, its cost and its stages (or JSON)."""
-    domain, text, model = load_problem(args.domain, args.problem)
+    from planners import cache
+    from planners.planner import ENGINE_NAME, PddlText, Planner
+    from planners.results import PlanStatus
+
+    domain_text, problem_text = _read_arg(args.domain, "DOMAIN"), _read_arg(args.problem, "PROBLEM")
+    extra = _paths(args)
     planner = Planner(args.planner, timeout=args.timeout, cache_size=0)
-    result = planner.solve(PddlText(domain.text, text) if planner.name == ENGINE_NAME else model)
-    if result.status is PlanStatus.ERROR and result.message.startswith("translator"):
+    key = cache.content_key("pddl-problem", [domain_text, problem_text])
+    model = None
+    if planner.name != ENGINE_NAME or not cache.passed("pddl-problem", key):
+        from planners.checks import load_problem
+
+        _, _, model = load_problem(args.domain, args.problem)
+        cache.record("pddl-problem", key, {"domain": str(args.domain), "problem": str(args.problem)})
+    result = planner.solve(PddlText(domain_text, problem_text) if planner.name == ENGINE_NAME else model)
+    if result.status is PlanStatus.ERROR and planner.name == ENGINE_NAME and result.message.startswith("translator"):
         # FD's own PDDL reader is stricter than UP's (e.g. an empty ``(:goal ())``): let UP write it.
+        if model is None:
+            from planners.checks import load_problem
+
+            _, _, model = load_problem(args.domain, args.problem)
         result = planner.solve(model)
     if result.status is PlanStatus.ERROR:
-        print(f"error: planner {result.planner} failed on {args.problem}: {result.message}", file=sys.stderr)
-        return 2
+        raise UsageError("PROBLEM", f"planner {result.planner} failed on {args.problem}: {result.message}")
     if args.json:
         print(json.dumps(result.to_json()))
     elif result.solved:
-        assert result.plan is not None
+        assert result.plan is not None and result.cost is not None
         print(f"plan ({len(result.plan)} steps, cost {result.cost:g}, {result.planner}, "
               f"{result.wall_time_s * 1000:.0f} ms):")
         for k, step in enumerate(result.plan, 1):
             print(f"  {k:3d}. ({' '.join(step)})")
-        print("stages:")
-        for k, s in enumerate(_stages_for(domain.name, result, []), 1):
-            print(f"  {k:3d}. {s.label} [{s.kind.value}, skill={s.skill or '-'}, {s.duration:g} s]")
+        if not getattr(args, "quiet", False):
+            print("stages:")
+            for k, s in enumerate(_stages_for(domain_text, result, extra), 1):
+                print(f"  {k:3d}. {s.label} [{s.kind.value}, skill={s.skill or '-'}, {s.duration:g} s]")
     else:
         print(f"{result.status.value}: {result.message or 'no plan'} ({result.planner})")
-    return 0 if result.solved else 1
+    return EXIT_OK if result.solved else EXIT_FAILED
 
 
-@_guard
 def domains_command(args: argparse.Namespace) -> int:
     """List the registered task types."""
-    for t in _task_types(args.path):
+    for t in _task_types(_paths(args)):
         arg_list = ", ".join(a.name + ("" if a.required else "?") for a in t.arg_specs)
         print(f"{t.name}({arg_list}): {t.description}")
-    return 0
+    return EXIT_OK
 
 
 def example_plan(task: TaskType, purpose: Purpose, strategy: str, after: int | None) -> StagePlan:
-    """``exeTsk`` of the task's example, or ``exeSusp`` after ``after`` stages of it ran."""
+    """``exeTsk`` of the task's example, or ``exeSusp`` after ``after`` stages of it ran.
+
+    ``after`` must lie in ``0 … len(exeTsk)`` (``None``: half way)."""
+    from planners.checks import DefinitionError
+    from planners.examples import StraightLineMotion, example_context
+    from planners.pddl_task import PddlTaskType
+    from tasker.stage import Purpose
+    from tasker.task import Strategy
+
     if not isinstance(task, PddlTaskType):
         raise DefinitionError(task.name, "fsm needs a task type built from a task folder")
     ctx = example_context(task, strategy=Strategy(strategy, strategy), motion=StraightLineMotion())
@@ -120,7 +192,10 @@ def example_plan(task: TaskType, purpose: Purpose, strategy: str, after: int | N
     exe = task.update_task(ctx)
     if purpose is Purpose.UP_TSK:
         return exe
-    k = len(exe.stages) // 2 if after is None else max(0, min(after, len(exe.stages)))
+    n = len(exe.stages)
+    if after is not None and not 0 <= after <= n:
+        raise UsageError("--after", f"expected 0 <= K <= {n} (the example's exeTsk has {n} stages), got {after}")
+    k = n // 2 if after is None else after
     for s in exe.stages[:k]:
         ctx.world = ctx.world.updated([tuple(f) for f in s.data.get("add", ())],
                                       [tuple(f) for f in s.data.get("delete", ())])
@@ -129,49 +204,142 @@ def example_plan(task: TaskType, purpose: Purpose, strategy: str, after: int | N
     return task.generate_suspension(ctx)
 
 
-@_guard
 def fsm_command(args: argparse.Namespace) -> int:
     """Print a task's exeTsk or exeSusp FSM for its example world."""
-    task = _find_task(args.task_type, args.path)
+    from tasker.stage import Purpose
+
+    task = _find_task(args.task_type, _paths(args))
     plan = example_plan(task, Purpose(args.purpose), args.strategy, args.after)
     print(plan.to_dot() if args.format == "dot" else plan.to_mermaid(), end="")
     if plan.note:
         print(f"%% note: {plan.note}" if args.format == "mermaid" else f"// note: {plan.note}")
-    return 0
+    return EXIT_OK
+
+
+def scaffold(name: str, folder: Path) -> list[Path]:
+    """Write a task folder for ``name`` from :data:`TEMPLATE` into ``folder``; return the files.
+
+    Besides the template's files it writes ``problem.pddl``, the ``[example]``'s problem,
+    for ``tasker plan``.  The folder must not exist or be empty."""
+    if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
+        raise UsageError("TASK", f"expected a lower-case identifier such as fetch_cup, got {name!r}")
+    if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
+        raise UsageError("DIR", f"{folder} exists and is not empty; choose a new folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UsageError("DIR", f"cannot create {folder}: {exc.strerror or exc}") from None
+    written = []
+    for src in sorted(TEMPLATE.iterdir()):
+        if src.is_file() and src.suffix in (".pddl", ".toml"):
+            dst = folder / src.name
+            dst.write_text(src.read_text(encoding="utf-8").replace("__TASK__", name).replace("__DIR__", str(folder)),
+                           encoding="utf-8")
+            written.append(dst)
+    written.append(_write_example_problem(folder))
+    return written
+
+
+def _write_example_problem(folder: Path) -> Path:
+    from planners.examples import example_context
+    from planners.loader import load_task
+    from planners.stages import Bindings
+
+    task = load_task(folder)  # the scaffold is checked like any task folder: it loads and plans
+    ctx = example_context(task)
+    assert ctx is not None
+    b = Bindings(ctx.args, ctx.world)
+    text, _, _ = task.problem_text(ctx, ctx.world, b.literals(task.spec.goal), b.literals(task.spec.facts))
+    out = folder / "problem.pddl"
+    out.write_text(f"; the [example] of task.toml as a PDDL problem (written by 'tasker new')\n{text.problem}",
+                   encoding="utf-8")
+    return out
+
+
+def new_command(args: argparse.Namespace) -> int:
+    """Scaffold a task folder that loads, plans and runs at once."""
+    folder = Path(args.dir if args.dir else args.task)
+    existed = folder.exists()
+    try:
+        files = scaffold(args.task, folder)
+    except BaseException:
+        if not existed and folder.is_dir():
+            shutil.rmtree(folder)  # leave nothing half-written behind
+        raise
+    print(f"wrote task folder {folder}/: " + ", ".join(p.name for p in files))
+    note(args, "next:\n"
+               f"  tasker check {folder}                                   # all the load-time checks\n"
+               f"  tasker plan {folder}/domain.pddl {folder}/problem.pddl   # solve its example\n"
+               f"  tasker fsm {args.task} --path {folder}                  # its exeTsk FSM\n"
+               f"  tasker run {folder}/scenario.toml --path {folder}       # run it on TIAGo in the flat world")
+    return EXIT_OK
 
 
 def register(subparsers: Any) -> None:
-    """Add ``plan``, ``domains`` and ``fsm`` to an argparse sub-parser set."""
-    p = subparsers.add_parser("plan", help="solve a PDDL domain + problem")
+    """Add ``plan``, ``domains``, ``fsm`` and ``new`` to an argparse sub-parser set."""
+    from planners.planner import DEFAULT_PLANNER
+
+    p = subparsers.add_parser(
+        "plan", help="solve a PDDL domain + problem with Fast Downward (or any UP one-shot engine)",
+        description="Check a PDDL domain and problem, solve them and print the plan, its cost and, when the domain "
+                    "is a registered task's, the stages it becomes. No plan exits 1.",
+        epilog="examples:\n"
+               "  tasker plan domains/cook/domain.pddl problem.pddl\n"
+               "  tasker plan domain.pddl problem.pddl --json --timeout 5\n"
+               "  tasker plan domain.pddl problem.pddl --planner fast-downward-opt   # any UP one-shot engine")
     p.add_argument("domain", metavar="DOMAIN", help="domain.pddl")
     p.add_argument("problem", metavar="PROBLEM", help="problem.pddl")
-    p.add_argument("--planner", default=DEFAULT_PLANNER, help=f"UP one-shot engine (default {DEFAULT_PLANNER})")
-    p.add_argument("--timeout", type=float, default=60.0, metavar="S", help="seconds (default 60)")
+    p.add_argument("--planner", default=DEFAULT_PLANNER,
+                   help=f"a unified-planning one-shot engine by name (default {DEFAULT_PLANNER}: Fast Downward "
+                        "A* + LM-cut in-process; e.g. fast-downward, fast-downward-opt)")
+    p.add_argument("--timeout", type=positive_seconds, default=60.0, metavar="S", help="seconds (default 60)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
+    _path_option(p)
     p.set_defaults(func=plan_command)
 
-    d = subparsers.add_parser("domains", help="list registered task types")
-    d.add_argument("--path", action="append", default=[], help="also load task folders from here")
+    d = subparsers.add_parser(
+        "domains", help="list the registered task types",
+        description="List every task type tasker loads: the bundled ones, those in $TASKER_TASKS and --path. "
+                    "Each is checked as it loads (an error names the file and line).",
+        epilog="examples:\n  tasker domains\n  tasker domains --path ~/my_tasks")
+    _path_option(d)
     d.set_defaults(func=domains_command)
 
-    f = subparsers.add_parser("fsm", help="print a task's exeTsk/exeSusp FSM for its example world")
+    f = subparsers.add_parser(
+        "fsm", help="print a task's exeTsk/exeSusp FSM for its example world",
+        description="Plan the task's [example] request and print the FSM of its stages (exeTsk, purpose upTsk), "
+                    "or the suspension FSM (exeSusp, purpose genSusp) after K stages ran, as Mermaid or Graphviz.",
+        epilog="examples:\n"
+               "  tasker fsm guide_human\n"
+               "  tasker fsm cook --purpose genSusp --after 3 --format dot | dot -Tpng > cook.png\n"
+               "  tasker fsm my_task --path ~/my_tasks --strategy static")
     f.add_argument("task_type", metavar="TASK_TYPE")
-    f.add_argument("--purpose", choices=[p.value for p in Purpose], default=Purpose.UP_TSK.value)
+    f.add_argument("--purpose", choices=["upTsk", "genSusp"], default="upTsk")
     f.add_argument("--format", choices=["mermaid", "dot"], default="mermaid")
     f.add_argument("--strategy", choices=["planned", "static"], default="planned")
-    f.add_argument("--after", type=int, default=None, metavar="K",
-                   help="genSusp: interrupt after K stages of exeTsk (default: half way)")
-    f.add_argument("--path", action="append", default=[], help="also load task folders from here")
+    f.add_argument("--after", type=non_negative_int, default=None, metavar="K",
+                   help="genSusp: interrupt after K stages of exeTsk, 0 <= K <= its length (default: half way)")
+    _path_option(f)
     f.set_defaults(func=fsm_command)
+
+    n = subparsers.add_parser(
+        "new", help="write a new task folder that loads, plans and runs at once",
+        description="Scaffold a task folder: domain.pddl, a task.toml with every key present and commented and an "
+                    "[example], the example's problem.pddl, and a scenario.toml that runs the task on TIAGo.",
+        epilog="examples:\n"
+               "  tasker new fetch_cup                # into ./fetch_cup\n"
+               "  tasker new fetch_cup ~/my_tasks/fetch_cup && tasker check ~/my_tasks/fetch_cup")
+    n.add_argument("task", metavar="TASK", help="the task type's name (a lower-case identifier)")
+    n.add_argument("dir", metavar="DIR", nargs="?", default=None, help="folder to create (default: ./TASK)")
+    n.set_defaults(func=new_command)
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Stand-alone entry (the lead wires :func:`register` into ``tasker``)."""
-    parser = argparse.ArgumentParser(prog="tasker")
-    register(parser.add_subparsers(dest="command", required=True))
-    args = parser.parse_args(argv)
-    return int(args.func(args))
+    """Stand-alone entry: these subcommands without the rest of ``tasker``."""
+    from tasker.cliargs import standalone
+
+    return standalone(register, argv)
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    sys.exit(main())

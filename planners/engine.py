@@ -13,27 +13,27 @@ a drop-in for ``fast-downward-opt`` at a fraction of its start-up cost.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
-from typing import IO, Any
+from typing import IO
 
 import unified_planning as up
-from unified_planning.engines import Engine, OptimalityGuarantee, PlanGenerationResult
+from unified_planning.engines import Engine, LogLevel, LogMessage, OptimalityGuarantee, PlanGenerationResult
 from unified_planning.engines import PlanGenerationResultStatus as UPStatus
 from unified_planning.engines.mixins import OneshotPlannerMixin
 from unified_planning.environment import get_environment
 from unified_planning.io import PDDLWriter
 from unified_planning.model import ProblemKind
 
-from planners.fd import OPTIMAL_SEARCH, FDExit, run_fast_downward
-
-ENGINE_NAME = "tasker-fd"
-"""The name under which :class:`TaskerFastDownward` is registered in UP's factory."""
+from planners.fd import OPTIMAL_SEARCH, run_fast_downward
+from planners.kind import supported_kind
+from planners.planner import ENGINE_NAME
+from planners.results import PlanStatus, from_fd_outcome
 
 _UP_STATUS = {
-    FDExit.UNSOLVABLE: UPStatus.UNSOLVABLE_PROVEN,
-    FDExit.TIMEOUT: UPStatus.TIMEOUT,
-    FDExit.MEMOUT: UPStatus.MEMOUT,
-    FDExit.ERROR: UPStatus.INTERNAL_ERROR,
+    PlanStatus.UNSOLVABLE: UPStatus.UNSOLVABLE_PROVEN,
+    PlanStatus.TIMEOUT: UPStatus.TIMEOUT,
+    PlanStatus.ERROR: UPStatus.INTERNAL_ERROR,
 }
 
 
@@ -42,10 +42,16 @@ class TaskerFastDownward(Engine, OneshotPlannerMixin):
 
     ``search`` is a Fast Downward search string (default ``astar(lmcut())``); with a
     non-optimal search the engine reports ``SOLVED_SATISFICING``.  ``timeout`` given
-    to the constructor is the default for :meth:`solve` calls that pass none.
+    to the constructor is the default for :meth:`solve` calls that pass none.  Any
+    other parameter (``OneshotPlanner(name="tasker-fd", params={...})``) is refused, as
+    ``TypeError`` naming it: a misspelt option must not be ignored.
     """
 
-    def __init__(self, search: str = OPTIMAL_SEARCH, timeout: float | None = None, **kwargs: Any) -> None:
+    def __init__(self, search: str = OPTIMAL_SEARCH, timeout: float | None = None) -> None:
+        if not isinstance(search, str) or not search.strip():
+            raise ValueError(f"tasker-fd: search must be a Fast Downward search string, got {search!r}")
+        if timeout is not None and not timeout > 0:
+            raise ValueError(f"tasker-fd: timeout must be a positive number of seconds, got {timeout!r}")
         Engine.__init__(self)
         OneshotPlannerMixin.__init__(self)
         self._search = search
@@ -57,21 +63,7 @@ class TaskerFastDownward(Engine, OneshotPlannerMixin):
 
     @staticmethod
     def supported_kind() -> ProblemKind:
-        kind = ProblemKind(version=2)
-        kind.set_problem_class("ACTION_BASED")
-        kind.set_typing("FLAT_TYPING")
-        kind.set_typing("HIERARCHICAL_TYPING")
-        for c in ("NEGATIVE_CONDITIONS", "DISJUNCTIVE_CONDITIONS", "EXISTENTIAL_CONDITIONS",
-                  "UNIVERSAL_CONDITIONS", "EQUALITIES"):
-            kind.set_conditions_kind(c)
-        for e in ("CONDITIONAL_EFFECTS", "STATIC_FLUENTS_IN_BOOLEAN_ASSIGNMENTS",
-                  "FLUENTS_IN_BOOLEAN_ASSIGNMENTS", "FORALL_EFFECTS"):
-            kind.set_effects_kind(e)
-        kind.set_quality_metrics("ACTIONS_COST")
-        kind.set_quality_metrics("PLAN_LENGTH")
-        kind.set_actions_cost_kind("STATIC_FLUENTS_IN_ACTIONS_COST")
-        kind.set_actions_cost_kind("INT_NUMBERS_IN_ACTIONS_COST")
-        return kind
+        return supported_kind()
 
     @staticmethod
     def supports(problem_kind: ProblemKind) -> bool:
@@ -89,37 +81,43 @@ class TaskerFastDownward(Engine, OneshotPlannerMixin):
         output_stream: IO[str] | None = None,
     ) -> PlanGenerationResult:
         assert isinstance(problem, up.model.Problem)
+        start = time.perf_counter()
         writer = PDDLWriter(problem)
         outcome = run_fast_downward(
             writer.get_domain(), writer.get_problem(), search=self._search,
             timeout=timeout if timeout is not None else self._timeout,
         )
+        result = from_fd_outcome(outcome, self.name, time.perf_counter() - start)
         metrics = {
             "engine_internal_time": str(outcome.translate_s + outcome.search_s),
             "translate_time": str(outcome.translate_s),
             "search_time": str(outcome.search_s),
         }
-        if outcome.exit is not FDExit.SOLVED:
-            if output_stream is not None and outcome.message:
-                output_stream.write(outcome.message + "\n")
-            return PlanGenerationResult(_UP_STATUS[outcome.exit], None, self.name, metrics)
-        assert outcome.plan is not None
+        if result.status is not PlanStatus.SOLVED:
+            if output_stream is not None and result.message:
+                output_stream.write(result.message + "\n")
+            logs = [LogMessage(LogLevel.ERROR if result.status is PlanStatus.ERROR else LogLevel.INFO, result.message)]
+            return PlanGenerationResult(_UP_STATUS[result.status], None, self.name, metrics, logs)
+        assert result.plan is not None and result.cost is not None
         em = problem.environment.expression_manager
         actions = [
             up.plans.ActionInstance(
                 writer.get_item_named(step[0]), [em.ObjectExp(writer.get_item_named(a)) for a in step[1:]]
             )
-            for step in outcome.plan
+            for step in result.plan
         ]
-        if outcome.cost is not None:
-            metrics["cost"] = str(outcome.cost)
+        metrics["cost"] = str(result.cost)
         optimal = self._search == OPTIMAL_SEARCH and bool(problem.quality_metrics)
         status = UPStatus.SOLVED_OPTIMALLY if optimal else UPStatus.SOLVED_SATISFICING
-        return PlanGenerationResult(status, up.plans.SequentialPlan(actions), self.name, metrics)
+        logs = [LogMessage(LogLevel.INFO, f"{len(result.plan)} steps, cost {result.cost:g}, search {self._search}")]
+        return PlanGenerationResult(status, up.plans.SequentialPlan(actions), self.name, metrics, logs)
 
 
 def register_engine(name: str = ENGINE_NAME) -> None:
-    """Add the engine to UP's factory (idempotent), through UP's documented ``add_engine``."""
-    factory = get_environment().factory
+    """Add the engine to UP's factory (idempotent), through UP's documented ``add_engine``;
+    also silence UP's credits banner, which would otherwise go to stdout."""
+    env = get_environment()
+    env.credits_stream = None
+    factory = env.factory
     if name not in factory.engines:
         factory.add_engine(name, __name__, TaskerFastDownward.__name__)

@@ -18,6 +18,7 @@ the :class:`~planners.planner.Planner` facade are built on it.
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import io
 import os
 import subprocess
@@ -28,9 +29,16 @@ from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
 
-import up_fast_downward
 
-DOWNWARD_BIN = Path(up_fast_downward.__file__).parent / "downward" / "builds" / "release" / "bin" / "downward"
+def _downward_bin() -> Path:
+    # Located, not imported: importing ``up_fast_downward`` pulls in UP's engine framework (about 1 s).
+    spec = importlib.util.find_spec("up_fast_downward")
+    if spec is None or not spec.submodule_search_locations:
+        raise ImportError("up-fast-downward is not installed; it ships the Fast Downward search binary")
+    return Path(next(iter(spec.submodule_search_locations))) / "downward" / "builds" / "release" / "bin" / "downward"
+
+
+DOWNWARD_BIN = _downward_bin()
 """The search binary that ships inside the ``up-fast-downward`` wheel."""
 
 OPTIMAL_SEARCH = "astar(lmcut())"

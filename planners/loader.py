@@ -4,7 +4,12 @@ A task folder holds ``task.toml``, ``domain.pddl`` and optionally ``task.py``.  
 checks the PDDL (syntax, predicates, arity, types, requirements), that ``task.toml``
 and the domain agree (every action has a skill, literals use declared predicates with
 the right arity, static templates name real actions with the right arity), and, when
-the folder ships an ``[example]`` world, that the problem built from it is valid PDDL.
+the folder ships an ``[example]`` world, that the problem built from it is valid PDDL
+and that Fast Downward solves it.
+
+The example check (a UP parse of the problem and a planner call) is the costly part;
+once it passed for a folder's exact content it is recorded in the check cache
+(:mod:`planners.cache`) and not repeated in later processes.
 """
 
 from __future__ import annotations
@@ -14,6 +19,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from planners import cache
 from planners.checks import DefinitionError, load_domain, load_problem_text
 from planners.pddl_task import PddlTaskType
 from planners.problem import DomainModel
@@ -98,25 +104,33 @@ def _check_example(task: PddlTaskType) -> None:
         raise DefinitionError(task.spec.domain_file, f"the planner fails on the {where}: {result.message}")
 
 
-def load_task(folder: str | Path) -> PddlTaskType:
-    """Load one task folder; raise :class:`~planners.checks.DefinitionError` naming the faulty file."""
+def load_task(folder: str | Path, *, use_cache: bool = True) -> PddlTaskType:
+    """Load one task folder; raise :class:`~planners.checks.DefinitionError` naming the faulty file.
+
+    ``use_cache=False`` solves the example even when the folder's content passed before
+    (``tasker check`` does, so that it reports what the planner says today)."""
     folder = Path(folder)
     spec = read_task_toml(folder / "task.toml")
     dm = DomainModel(load_domain(spec.domain_file))
     _cross_check(spec, dm)
     task = PddlTaskType(spec, dm, hooks=_load_hooks(spec))
-    _check_example(task)
+    # what the checks read: task.toml, the domain and task.py (not, e.g., a problem.pddl lying beside them)
+    key = cache.content_key("task-folder", cache.file_parts([folder / "task.toml", spec.domain_file,
+                                                              folder / "task.py"]))
+    if not (use_cache and cache.passed("task-folder", key)):
+        _check_example(task)
+        cache.record("task-folder", key, {"folder": str(folder.resolve()), "name": spec.name})
     return task
 
 
-def load_task_folder(path: str | Path) -> list[PddlTaskType]:
+def load_task_folder(path: str | Path, *, use_cache: bool = True) -> list[PddlTaskType]:
     """Task types from ``path``: a task folder, or a folder of task folders (sorted by name)."""
     path = Path(path)
     if (path / "task.toml").is_file():
-        return [load_task(path)]
+        return [load_task(path, use_cache=use_cache)]
     if not path.is_dir():
         raise DefinitionError(path, "not a task folder (no task.toml) nor a folder of task folders")
-    tasks = [load_task(p) for p in sorted(path.iterdir()) if (p / "task.toml").is_file()]
+    tasks = [load_task(p, use_cache=use_cache) for p in sorted(path.iterdir()) if (p / "task.toml").is_file()]
     if not tasks:
         raise DefinitionError(path, "holds no task folder (a subfolder with a task.toml)")
     names = [t.name for t in tasks]
@@ -124,7 +138,6 @@ def load_task_folder(path: str | Path) -> list[PddlTaskType]:
     if dup:
         raise DefinitionError(path, f"duplicate task name(s) {dup}")
     return tasks
-
 
 
 def store_loader(folder: str | Path) -> list[PddlTaskType]:

@@ -9,8 +9,9 @@ Hooks, and what they do here:
   whose ``when`` holds in the state at interruption gives the goal, planned from that
   state; ``static``: the decision list ``[[static.suspension]]`` (eq. 47).
 * ``compute_params`` / ``request_sp`` — ``cost = cps * (age + cTime)``: the discomfort
-  accumulated by completion, with ``cTime`` walked over the remaining stages (or the
-  static template) with ``ctx.motion``; unreachable means ``inf``.
+  accumulated by completion, with ``cTime`` and ``endPose`` from the plan upTsk would make
+  from the state asked about (:mod:`planners.estimates`), timed with ``ctx.motion``;
+  unreachable or unsolvable means ``inf``.
 
 An unsolvable task raises :class:`~tasker.errors.PlanningFailed`; an unsolvable
 suspension or a planner time-out falls back to the static strategy, said in the note.
@@ -26,10 +27,11 @@ from contextvars import ContextVar
 from dataclasses import dataclass
 from typing import Any
 
+from planners.estimates import estimator_for
 from planners.planner import PddlText, Planner
 from planners.problem import DomainModel, PortablePddl, holds, portable, render_problem, travel_table
 from planners.results import PlanResult, PlanStatus
-from planners.stages import Bindings, StageBuilder, robot_name
+from planners.stages import Bindings, StageBuilder
 from planners.taskspec import Branch, Literal, TaskSpec
 from tasker.errors import PlanningFailed, UnknownName
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
@@ -144,11 +146,13 @@ class PddlTaskType(TaskType):
                               f"{why.get(outcome.status, 'planner error')} for {goal}")
 
     def compute_params(self, ctx: TaskContext) -> CostParams:
+        """``cost = cps * (age + cTime)``; cTime and endPose from :meth:`estimate` of the state now."""
         c_time, end = self.estimate(ctx, None)
         cost = self.spec.cps * (ctx.age + c_time) if math.isfinite(c_time) else math.inf
         return CostParams(self.name, cost=cost, cps=self.spec.cps, c_time=c_time, end_pose=end)
 
     def request_sp(self, ctx: TaskContext, request: SPRequest) -> CompletionCost:
+        """Alg. 2's ``cc``: :meth:`estimate` with the robot moved to the request's start pose."""
         if request.sp_id != SP_COMPLETION:
             raise UnknownName("schedule parameter", request.sp_id, [SP_COMPLETION])
         pose = next((request.args[k] for k in ("pose", "start_pose", "end_pose") if request.args.get(k)), None)
@@ -288,29 +292,10 @@ class PddlTaskType(TaskType):
         return total
 
     def estimate(self, ctx: TaskContext, start: Pose | None) -> tuple[float, Pose | None]:
-        """Seconds to complete the task from ``start`` (the robot's pose if None) and the end pose."""
-        world = ctx.world if isinstance(ctx.world, WorldState) else None
-        stages: tuple[Stage, ...]
-        if ctx.plan is not None and ctx.plan.purpose is Purpose.UP_TSK:
-            stages = ctx.remaining
-        elif world is not None:
-            try:  # no travel table: the walk below asks the motion model for each leg only
-                stages = self._template_stages(ctx, world, {})
-            except PlanningFailed:
-                return math.inf, None
-        else:
-            return self._declared_template_time(), None
-        pose = start if start is not None else (world.poses.get(robot_name(world)) if world else None)
-        total = 0.0
-        for s in stages:
-            target = world.poses.get(str(s.data.get("to"))) if (world and s.skill == "navigate") else None
-            if target is not None and pose is not None and ctx.motion is not None:
-                est = ctx.motion.estimate(pose, target)
-                if not est.reachable:
-                    return math.inf, None
-                total += est.time_s
-                pose = est.end_pose or target
-            else:
-                total += s.duration
-                pose = target or pose
-        return total, pose
+        """Seconds to complete the task from ``start`` (the robot's pose if None) and the end pose.
+
+        From a plan of the state asked about (:mod:`planners.estimates`), never from the
+        stale remainder of a plan made before a suspension; ``inf`` when it cannot be done.
+        """
+        est = estimator_for(self).estimate(ctx, start)
+        return est.c_time, est.end_pose

@@ -7,31 +7,35 @@
 building a UP model at all.  Results are cached on the PDDL text (domain + problem),
 so a repeated identical problem is answered from memory; time-outs and errors are
 never cached.
+
+With the default engine nothing of unified-planning is imported (the command line's
+path to Fast Downward stays fast); another engine imports UP's factory when first used,
+and its warnings and credits are kept off the terminal (they go to the result's message).
 """
 
 from __future__ import annotations
 
+import math
 import threading
 import time
+import warnings
 import weakref
 from collections import OrderedDict
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
 
-import unified_planning as up
-from unified_planning.environment import get_environment
-from unified_planning.io import PDDLReader, PDDLWriter
-from unified_planning.shortcuts import OneshotPlanner, PlanValidator
-
-from planners.engine import ENGINE_NAME, register_engine
-from planners.fd import OPTIMAL_SEARCH, FDExit, run_fast_downward
-from planners.results import PlanResult, PlanStatus
+from planners.fd import OPTIMAL_SEARCH, run_fast_downward
+from planners.results import PlanResult, PlanStatus, from_fd_outcome
 from tasker.errors import UnknownName
+
+if TYPE_CHECKING:
+    import unified_planning as up
+
+ENGINE_NAME = "tasker-fd"
+"""The name of the in-process Fast Downward engine (:mod:`planners.engine` registers it)."""
 
 DEFAULT_PLANNER = ENGINE_NAME
 """The engine a :class:`Planner` uses unless told otherwise."""
-
-_FD_STATUS = {FDExit.UNSOLVABLE: PlanStatus.UNSOLVABLE, FDExit.TIMEOUT: PlanStatus.TIMEOUT,
-              FDExit.MEMOUT: PlanStatus.ERROR, FDExit.ERROR: PlanStatus.ERROR}
 
 
 @dataclass(frozen=True, slots=True)
@@ -44,6 +48,10 @@ class PddlText:
 
 def oneshot_planners() -> list[str]:
     """Names of the one-shot planning engines installed in UP's factory."""
+    from unified_planning.environment import get_environment
+
+    from planners.engine import register_engine
+
     register_engine()
     factory = get_environment().factory
     return sorted(n for n in factory.engines if _is_oneshot(factory.engine(n)))
@@ -56,7 +64,7 @@ def _is_oneshot(cls: type) -> bool:
         return False
 
 
-def plan_steps(plan: up.plans.SequentialPlan) -> tuple[tuple[str, ...], ...]:
+def plan_steps(plan: Any) -> tuple[tuple[str, ...], ...]:
     """A UP sequential plan as tuples of strings: ``("action", "arg", ...)``."""
     return tuple((a.action.name, *(str(p) for p in a.actual_parameters)) for a in plan.actions)
 
@@ -72,9 +80,12 @@ class Planner:
 
     def __init__(self, name: str = DEFAULT_PLANNER, *, timeout: float | None = 30.0, cache_size: int = 512,
                  search: str = OPTIMAL_SEARCH) -> None:
-        known = oneshot_planners()
-        if name not in known:
-            raise UnknownName("planner", name, known)
+        if name != ENGINE_NAME:  # tasker-fd needs no factory: keep UP's engines unimported
+            known = oneshot_planners()
+            if name not in known:
+                raise UnknownName("planner", name, known)
+        if timeout is not None and not (math.isfinite(timeout) and timeout > 0):
+            raise ValueError(f"timeout must be a finite positive number of seconds, got {timeout}")
         if cache_size < 0:
             raise ValueError(f"cache_size must be >= 0, got {cache_size}")
         self.name = name
@@ -82,7 +93,7 @@ class Planner:
         self.search = search
         self.cache_size = cache_size
         self._cache: OrderedDict[tuple[str, str, str], PlanResult] = OrderedDict()
-        self._keys: dict[int, tuple[weakref.ref[up.model.Problem], int, PddlText]] = {}
+        self._keys: dict[int, tuple[weakref.ref[Any], int, PddlText]] = {}
         self._lock = threading.Lock()
         self.hits = 0
         self.misses = 0
@@ -106,7 +117,7 @@ class Planner:
         if self.name == ENGINE_NAME:
             result = self._solve_fd(text, timeout, start)
         else:
-            model = problem if isinstance(problem, up.model.Problem) else self._parse(text)
+            model = self._parse(text) if isinstance(problem, PddlText) else problem
             result = self._solve_up(model, timeout, start)
         if self.cache_size and result.status in (PlanStatus.SOLVED, PlanStatus.UNSOLVABLE):
             with self._lock:
@@ -129,6 +140,8 @@ class Planner:
             known = self._keys.get(id(problem))
         if known is not None and known[0]() is problem and known[1] == h:
             return known[2]
+        from unified_planning.io import PDDLWriter
+
         writer = PDDLWriter(problem)
         text = PddlText(writer.get_domain(), writer.get_problem())
         with self._lock:
@@ -139,31 +152,41 @@ class Planner:
 
     @staticmethod
     def _parse(text: PddlText) -> up.model.Problem:
+        from unified_planning.io import PDDLReader
+
         return PDDLReader().parse_problem_string(text.domain, text.problem)
 
     def _solve_fd(self, text: PddlText, timeout: float | None, start: float) -> PlanResult:
         out = run_fast_downward(text.domain, text.problem, search=self.search, timeout=timeout)
-        wall = time.perf_counter() - start
-        if out.exit is FDExit.SOLVED:
-            cost = out.cost if out.cost is not None else float(len(out.plan or ()))
-            return PlanResult(PlanStatus.SOLVED, out.plan, cost, self.name, wall)
-        return PlanResult(_FD_STATUS[out.exit], None, None, self.name, wall, message=out.message)
+        return from_fd_outcome(out, self.name, time.perf_counter() - start)
 
     def _solve_up(self, problem: up.model.Problem, timeout: float | None, start: float) -> PlanResult:
-        with OneshotPlanner(name=self.name) as engine:
-            engine.skip_checks = True  # problems are checked when loaded (planners.checks)
-            res = engine.solve(problem, timeout=timeout)
+        from unified_planning.shortcuts import OneshotPlanner
+
+        from planners.engine import register_engine
+
+        register_engine()  # also silences the credits banner
+        with warnings.catch_warnings(record=True) as caught:
+            # e.g. fast-downward-opt warns that it does not support the timeout; that is a message, not noise
+            warnings.simplefilter("always")
+            with OneshotPlanner(name=self.name) as engine:
+                engine.skip_checks = True  # problems are checked when loaded (planners.checks)
+                res = engine.solve(problem, timeout=timeout)
         wall = time.perf_counter() - start
+        notes = [str(w.message) for w in caught]
         status = PlanStatus.from_up(res.status)
         if status is not PlanStatus.SOLVED or res.plan is None:
-            msg = "; ".join(m.message for m in (res.log_messages or ()))[-300:]
+            msg = "; ".join([*(m.message for m in (res.log_messages or ())), *notes])[-300:]
             return PlanResult(status if status is not PlanStatus.SOLVED else PlanStatus.ERROR, None, None,
                               self.name, wall, message=msg or res.status.name)
-        return PlanResult(PlanStatus.SOLVED, plan_steps(res.plan), plan_cost(problem, res.plan), self.name, wall)
+        return PlanResult(PlanStatus.SOLVED, plan_steps(res.plan), plan_cost(problem, res.plan), self.name, wall,
+                          message="; ".join(notes)[-300:])
 
 
 def plan_cost(problem: up.model.Problem, plan: up.plans.SequentialPlan) -> float:
     """The plan's metric value as UP's validator computes it (its length without a metric)."""
+    from unified_planning.shortcuts import PlanValidator
+
     if not problem.quality_metrics:
         return float(len(plan.actions))
     with PlanValidator(name="sequential_plan_validator") as validator:

@@ -110,7 +110,8 @@ def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float)
 
     Without a motion model (or a pose) the declared ``travel_s`` is used, never zero.
     Pairs joined by a ``door_between`` fact are timed with the motion model's optional
-    ``estimate_ignoring_doors`` (``robot.planner.MotionEstimator`` has it).
+    ``estimate_ignoring_doors`` (``robot.motion.MotionEstimator`` has it).  A motion model
+    with a ``table(poses)`` method (the same class) gives the whole matrix in one pass.
     """
     places = sorted(n for n, t in world.objects.items() if t == PLACE_TYPE)
     # places joined by a door the domain models: the plan decides whether the door is open, so
@@ -118,9 +119,16 @@ def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float)
     through_door = {(f[2], f[3]) for f in world.matching("door_between") if len(f) == 4}
     ignoring_doors = getattr(motion, "estimate_ignoring_doors", None)
     out: dict[tuple[str, str], float] = {}
+    table = getattr(motion, "table", None)  # a whole matrix in one pass (robot.motion.MotionEstimator)
+    posed = [n for n in places if n in world.poses]
+    if table is not None and len(posed) > 1:
+        matrix = table([world.poses[n] for n in posed])
+        out = {(a, b): float(matrix[i][j]) for i, a in enumerate(posed) for j, b in enumerate(posed) if a != b}
     for a in places:
         for b in places:
             if a == b:
+                continue
+            if (a, b) in out and (a, b) not in through_door:
                 continue
             if motion is not None and a in world.poses and b in world.poses:
                 estimate = ignoring_doors if (a, b) in through_door and ignoring_doors else motion.estimate

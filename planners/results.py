@@ -1,12 +1,22 @@
-"""Typed results of a planner call: a status enum and a frozen :class:`PlanResult`."""
+"""Typed results of a planner call: a status enum and a frozen :class:`PlanResult`.
+
+:func:`from_fd_outcome` is the one place where a Fast Downward run becomes a result:
+the :class:`~planners.planner.Planner` facade returns it as is, and the registered
+``tasker-fd`` engine (:mod:`planners.engine`) converts it to UP's result type.  This
+module imports nothing of unified-planning at load time.
+"""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 from enum import StrEnum
+from typing import TYPE_CHECKING
 
-from unified_planning.engines import PlanGenerationResultStatus as UPStatus
+from planners.fd import FDExit, FDOutcome
+
+if TYPE_CHECKING:
+    from unified_planning.engines import PlanGenerationResultStatus as UPStatus
 
 
 class PlanStatus(StrEnum):
@@ -20,6 +30,8 @@ class PlanStatus(StrEnum):
     @classmethod
     def from_up(cls, status: UPStatus) -> PlanStatus:
         """Fold unified-planning's nine statuses into our four."""
+        from unified_planning.engines import PlanGenerationResultStatus as UPStatus
+
         if status in (UPStatus.SOLVED_SATISFICING, UPStatus.SOLVED_OPTIMALLY):
             return cls.SOLVED
         if status in (UPStatus.UNSOLVABLE_PROVEN, UPStatus.UNSOLVABLE_INCOMPLETELY):
@@ -80,4 +92,26 @@ class PlanResult:
             "planner": self.planner,
             "planner_time_s": round(self.wall_time_s, 6),
             "cached": self.cached,
+            "message": self.message,
         }
+
+
+_FD_STATUS = {FDExit.SOLVED: PlanStatus.SOLVED, FDExit.UNSOLVABLE: PlanStatus.UNSOLVABLE,
+              FDExit.TIMEOUT: PlanStatus.TIMEOUT, FDExit.MEMOUT: PlanStatus.ERROR, FDExit.ERROR: PlanStatus.ERROR}
+
+
+def from_fd_outcome(outcome: FDOutcome, planner: str, wall_time_s: float) -> PlanResult:
+    """The result of one Fast Downward run (the only map from FD's outcome to a status).
+
+    A solved run without a ``; cost`` line costs its length (FD writes the line for every
+    plan; this is the unit-cost meaning should a build omit it).  Running out of memory
+    is an ``ERROR`` whose message says so.
+    """
+    if outcome.exit is FDExit.SOLVED:
+        assert outcome.plan is not None
+        cost = outcome.cost if outcome.cost is not None else float(len(outcome.plan))
+        return PlanResult(PlanStatus.SOLVED, outcome.plan, cost, planner, wall_time_s)
+    message = outcome.message or f"Fast Downward ended with {outcome.exit.value} (exit code {outcome.code})"
+    if outcome.exit is FDExit.MEMOUT and "memory" not in message:
+        message = f"out of memory: {message}"
+    return PlanResult(_FD_STATUS[outcome.exit], None, None, planner, wall_time_s, message=message)

@@ -1,8 +1,9 @@
 """Command-line subcommands of ``tasker`` for worlds: ``world`` and ``cost``.
 
 ``register(subparsers)`` adds them to an :mod:`argparse` parser; each handler returns
-the exit status.  ``cost`` exits 0 when the goal is reachable, 1 when it is not and 2
-on bad input (message on stderr, never a traceback).
+the exit status.  ``cost`` answers the travel-time matrix of every given place or
+point in one process; it exits 0 when every pair is reachable, 1 when one is not and
+2 on bad input (:mod:`tasker.cliargs`; one line on stderr, never a traceback).
 """
 
 from __future__ import annotations
@@ -11,18 +12,22 @@ import argparse
 import json
 import math
 import sys
-from typing import Any
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-from robot.spec import WorldSpec, load_world
-from tasker.errors import TaskerError
-from tasker.world import Pose
+from tasker.cliargs import EXIT_FAILED, EXIT_OK, UsageError, did_you_mean, seed, show_progress, writable_file
+from tasker.world import MotionEstimate, MotionModel, Pose
+
+if TYPE_CHECKING:
+    from robot.spec import WorldSpec
 
 
-class BadInput(TaskerError, ValueError):
+class BadInput(UsageError):
     """A command-line argument that names no place and is no ``x,y[,yaw]``."""
 
 
-def _pose(spec: WorldSpec, text: str) -> Pose:
+def _pose(spec: WorldSpec, text: str, argument: str = "PLACE") -> Pose:
     if text in spec.places:
         return spec.places[text]
     parts = text.split(",")
@@ -31,17 +36,47 @@ def _pose(spec: WorldSpec, text: str) -> Pose:
     except ValueError:
         values = []
     if len(values) not in (2, 3) or not all(math.isfinite(v) for v in values):
-        raise BadInput(f"{text!r} is neither a place of {spec.name} ({', '.join(sorted(spec.places))}) "
-                       "nor x,y[,yaw]")
+        raise BadInput(argument, f"{text!r} is neither a place of {spec.name}{did_you_mean(text, spec.places)} "
+                                 f"({', '.join(sorted(spec.places))}) nor x,y[,yaw]")
     return (values[0], values[1], values[2] if len(values) == 3 else 0.0)
 
 
+def _load(world: str) -> WorldSpec:
+    from robot.spec import load_world, shipped_worlds
+
+    p = Path(world)
+    if p.suffix != ".toml" and not p.exists() and world not in shipped_worlds():
+        raise UsageError("WORLD", f"unknown world {world!r}{did_you_mean(world, shipped_worlds())}; shipped: "
+                                  f"{', '.join(shipped_worlds())}, or give a world file (.toml)")
+    if p.suffix == ".toml" and not p.is_file():
+        raise UsageError("WORLD", f"{world}: no such world file")
+    return load_world(world)
+
+
+def travel_matrix(model: MotionModel, poses: Sequence[Pose], progress: bool = False) -> list[list[MotionEstimate]]:
+    """Every ordered pair's estimate: ``m[i][j]`` from ``poses[i]`` to ``poses[j]``.
+
+    One function so that a faster batch query of the motion model can replace the
+    per-pair :meth:`~robot.planner.MotionEstimator.estimate` calls without touching callers.
+    """
+    pairs = [(i, j) for i in range(len(poses)) for j in range(len(poses))]
+    it: Any = pairs
+    if progress and len(pairs) > 16:
+        from tqdm import tqdm
+
+        it = tqdm(pairs, desc="travel times", unit="pair", leave=False, file=sys.stderr)
+    out: list[list[MotionEstimate]] = [[] for _ in poses]
+    for i, j in it:
+        out[i].append(model.estimate(poses[i], poses[j]))
+    return out
+
+
 def _world(args: argparse.Namespace) -> int:
-    spec = load_world(args.world)
+    spec = _load(args.world)
     if args.out:
         from robot.picture import draw_world
 
-        draw_world(spec, args.out)
+        draw_world(spec, writable_file(args.out, "--out"))
     if args.json:
         doc: dict[str, Any] = {
             "name": spec.name,
@@ -60,60 +95,71 @@ def _world(args: argparse.Namespace) -> int:
             print(f"  place  {n:18s} {p[0]:6.2f} {p[1]:6.2f} {p[2]:6.2f}")
         for n, per in spec.people.items():
             print(f"  person {n:18s} {per.pose[0]:6.2f} {per.pose[1]:6.2f}  {per.posture}")
-    return 0
+    return EXIT_OK
 
 
 def _cost(args: argparse.Namespace) -> int:
-    from robot.planner import motion_model
+    from robot.motion import motion_model
 
-    spec = load_world(args.world)
-    start, goal = _pose(spec, args.start), _pose(spec, args.goal)
-    est = motion_model(spec, seed=args.seed).estimate(start, goal)
+    if len(args.points) < 2:
+        raise UsageError("PLACE", f"expected at least two places or points, got {len(args.points)}")
+    spec = _load(args.world)
+    poses = [_pose(spec, t) for t in args.points]
+    m = travel_matrix(motion_model(spec, seed=args.seed), poses, progress=show_progress(args))
+    reachable = all(e.reachable for row in m for e in row)
     if args.json:
-        print(json.dumps({"reachable": est.reachable,
-                          "distance_m": est.distance_m if est.reachable else None,
-                          "time_s": est.time_s if est.reachable else None,
-                          "path": [list(p) for p in est.path]}))
-    elif est.reachable:
-        print(f"{args.start} -> {args.goal}: {est.distance_m:.2f} m, {est.time_s:.1f} s, {len(est.path)} waypoints")
+        print(json.dumps({
+            "world": spec.name, "seed": args.seed, "points": list(args.points), "poses": [list(p) for p in poses],
+            "reachable": [[e.reachable for e in row] for row in m],
+            "time_s": [[e.time_s if e.reachable else None for e in row] for row in m],
+            "distance_m": [[e.distance_m if e.reachable else None for e in row] for row in m],
+        }))
+    elif len(poses) == 2:
+        e = m[0][1]
+        what = f"{e.distance_m:.2f} m, {e.time_s:.1f} s, {len(e.path)} waypoints" if e.reachable else "unreachable"
+        print(f"{args.points[0]} -> {args.points[1]}: {what}")
     else:
-        print(f"{args.start} -> {args.goal}: unreachable")
-    return 0 if est.reachable else 1
-
-
-def _guarded(handler: Any) -> Any:
-    def run(args: argparse.Namespace) -> int:
-        try:
-            return int(handler(args))
-        except TaskerError as e:
-            print(f"error: {e}", file=sys.stderr)
-            return 2
-
-    return run
+        width = max(8, *(len(t) for t in args.points))
+        print("travel time (s), from row to column")
+        print(" " * width + "".join(f" {t[:width]:>{width}}" for t in args.points))
+        for name, row in zip(args.points, m, strict=True):
+            cells = "".join(f" {(f'{e.time_s:.1f}' if e.reachable else '-'):>{width}}" for e in row)
+            print(f"{name:<{width}}{cells}")
+    return EXIT_OK if reachable else EXIT_FAILED
 
 
 def register(subparsers: Any) -> None:
     """Add ``world`` and ``cost`` to ``subparsers`` (from ``ArgumentParser.add_subparsers``)."""
-    p = subparsers.add_parser("world", help="show a world: places, people; draw it")
-    p.add_argument("world", help="a shipped world name (paper, flat) or a .toml path")
+    p = subparsers.add_parser(
+        "world", help="show a world: places, people; draw it",
+        description="Load and check a world (a shipped name or a .toml file); print its places and people, "
+                    "as text or JSON, and draw it from above.",
+        epilog="examples:\n  tasker world paper\n  tasker world flat --json\n"
+               "  tasker world my_flat.toml --out flat.png")
+    p.add_argument("world", metavar="WORLD", help="a shipped world name (paper, flat) or a .toml path")
     p.add_argument("--out", metavar="PNG", help="write a top-down picture")
     p.add_argument("--json", action="store_true", help="print places, bounds and people as JSON")
-    p.set_defaults(func=_guarded(_world))
-    c = subparsers.add_parser("cost", help="travel time and path of the robot between two poses")
-    c.add_argument("world", help="a shipped world name (paper, flat) or a .toml path")
-    c.add_argument("start", metavar="FROM", help="a place name or x,y[,yaw]")
-    c.add_argument("goal", metavar="TO", help="a place name or x,y[,yaw]")
-    c.add_argument("--json", action="store_true", help="print the estimate as JSON")
-    c.add_argument("--seed", type=int, default=1, help="roadmap seed (default 1)")
-    c.set_defaults(func=_guarded(_cost))
+    p.set_defaults(func=_world)
+    c = subparsers.add_parser(
+        "cost", help="travel times of the robot between places (a matrix, one call)",
+        description="The robot's travel time and path length between every ordered pair of the given places or "
+                    "points, from OMPL paths over TIAGo's base in the world. Exits 1 when a pair is unreachable.",
+        epilog="examples:\n"
+               "  tasker cost paper kitchen bedroom\n"
+               "  tasker cost paper kitchen bedroom hall livingroom --json   # the 4 x 4 matrix\n"
+               "  tasker cost flat 5.0,2.0 2.5,1.8,0 --seed 7")
+    c.add_argument("world", metavar="WORLD", help="a shipped world name (paper, flat) or a .toml path")
+    c.add_argument("points", metavar="PLACE", nargs="+", help="two or more place names or x,y[,yaw] points")
+    c.add_argument("--json", action="store_true", help="print the matrices as JSON")
+    c.add_argument("--seed", type=seed, default=1, help="roadmap seed, 0 <= N < 2**32 (default 1)")
+    c.set_defaults(func=_cost)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the subcommands on their own (the ``tasker`` command wires them in normally)."""
-    parser = argparse.ArgumentParser(prog="tasker")
-    register(parser.add_subparsers(dest="command", required=True))
-    args = parser.parse_args(argv)
-    return int(args.func(args))
+    from tasker.cliargs import standalone
+
+    return standalone(register, argv)
 
 
 if __name__ == "__main__":

@@ -88,6 +88,11 @@ class MjApartment:
         v = self.data.qvel
         return float(math.hypot(v[0], v[1])), float(v[5])
 
+    def at_rest(self, tolerance: float = 1e-4) -> bool:
+        """Is the base still (planar speed below ``tolerance`` m/s, turn rate below ``tolerance`` rad/s)?"""
+        speed, turn = self.velocity()
+        return speed < tolerance and abs(turn) < tolerance
+
     def command(self, v: float, w: float) -> None:
         half = w * self.wheel_separation / 2
         self.data.ctrl[self._wheels[0]] = (v - half) / self.wheel_radius

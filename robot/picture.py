@@ -8,8 +8,9 @@ paper's Fig. 10 where it has one: the robot is a pentagon, people are circles
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 from robot.spec import WorldSpec
 from tasker.world import Pose
@@ -20,11 +21,13 @@ _FILL = {"wall": "#6b6259", "furniture": "#b08d62"}
 def draw_world(spec: WorldSpec, out: str | Path, *, robot: Pose | None = None,
                paths: Sequence[Sequence[tuple[float, float]]] = (),
                people: Mapping[str, tuple[Pose, str]] | None = None,
-               doors_open: Mapping[str, bool] | None = None, title: str | None = None) -> Path:
+               doors_open: Mapping[str, bool] | None = None, title: str | None = None,
+               decorate: Callable[[Any], None] | None = None, show_walks: bool = True) -> Path:
     """Write a PNG of ``spec`` to ``out`` and return its path.
 
     ``robot``, ``people`` (name → (pose, posture)) and ``doors_open`` default to the
-    world file's initial state; ``paths`` are polylines drawn over the plan.
+    world file's initial state; ``paths`` are polylines drawn over the plan;
+    ``decorate(ax)`` draws more on the matplotlib axes before the file is written.
     """
     import matplotlib
 
@@ -53,7 +56,7 @@ def draw_world(spec: WorldSpec, out: str | Path, *, robot: Pose | None = None,
             xs, ys = zip(*path, strict=False)
             ax.plot(xs, ys, "-", color="#1f5fbf", lw=1.5)
     for p in spec.people.values():
-        if p.walk:
+        if p.walk and show_walks:
             ax.plot([w[1] for w in p.walk], [w[2] for w in p.walk], ":", color="#c0392b", lw=1)
     now = people if people is not None else {n: (p.pose, p.posture) for n, p in spec.people.items()}
     for name, ((px, py, _), posture) in now.items():
@@ -62,6 +65,8 @@ def draw_world(spec: WorldSpec, out: str | Path, *, robot: Pose | None = None,
         ax.text(px, py + 0.32, f"{name} ({posture})", fontsize=7, ha="center")
     rx, ry, ryaw = robot if robot is not None else spec.robot.pose
     ax.add_patch(RegularPolygon((rx, ry), 5, radius=0.3, orientation=ryaw - math.pi / 2, color="#1f5fbf"))
+    if decorate is not None:
+        decorate(ax)
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
     ax.set_aspect("equal")
@@ -69,6 +74,6 @@ def draw_world(spec: WorldSpec, out: str | Path, *, robot: Pose | None = None,
     ax.tick_params(labelsize=7)
     fig.tight_layout()
     out = Path(out)
-    fig.savefig(out)
+    fig.savefig(out, metadata={"Software": "tasker"})
     plt.close(fig)
     return out

@@ -10,12 +10,19 @@ the build (no nanobind leaks at exit), and completed:
 
 * every edge is re-checked with the scene's exact segment test (OMPL checks motions
   by sampling at a resolution) and dropped if it grazes an obstacle;
-* nodes are added at the named places and through every door (centre and both sides),
-  the narrow passages uniform sampling finds last;
-* all-pairs shortest paths are computed once (scipy), so a query on an unobstructed
-  roadmap is a table look-up.
+* **corner milestones** are added around every convex corner of the walls and furniture,
+  on an arc just outside the robot's clearance, and joined to every corner milestone
+  they see: the visibility graph of the inflated obstacles, on which the shortest path
+  around any set of boxes lies (within the arc's chord error, < 2 %).  Every passage the
+  robot fits through — doorways included — is thereby in the roadmap, whatever the
+  random samples did;
+* nodes are added at the named places and through every door (centre and both sides);
+* OMPL's seed: OMPL ignores ``RNG.setSeed(0)``, so the seed given to OMPL is
+  ``seed + 1`` (:func:`ompl_seed`): seed 0 is a seed like any other, and the roadmap
+  never depends on what the process ran before.
 
-Roadmaps are cached in-process by (world, radius, seed, size).
+Shortest paths are searched per source and scene state by :mod:`robot.motion`
+(Dijkstra, scipy).  Roadmaps are cached in-process by (world, radius, seed, size).
 """
 
 from __future__ import annotations
@@ -26,7 +33,6 @@ from typing import Any
 
 import numpy as np
 from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import shortest_path
 
 from robot.scene import Scene
 from robot.spec import WorldSpec
@@ -47,8 +53,9 @@ class RoadmapStats:
     dropped_edges: int
 
 
-def ompl_setup(scene: Scene, resolution: float) -> Any:
-    """An OMPL ``SimpleSetup`` for the base in R² over ``scene``'s static layer (walls, furniture).
+def ompl_setup(scene: Scene, resolution: float, dynamic: bool = False) -> Any:
+    """An OMPL ``SimpleSetup`` for the base in R² over ``scene``'s static layer (walls, furniture),
+    or, with ``dynamic``, over the whole scene (closed doors and people too).
 
     ``resolution`` is OMPL's validity-checking resolution, a fraction of the space's extent.
     """
@@ -63,9 +70,19 @@ def ompl_setup(scene: Scene, resolution: float) -> Any:
     bounds.setHigh(1, scene.ymax)
     space.setBounds(bounds)
     setup = og.SimpleSetup(space)
-    setup.setStateValidityChecker(lambda s: scene.static_free(s[0], s[1]))
+    if dynamic:
+        setup.setStateValidityChecker(lambda s: scene.free(s[0], s[1]))
+    else:
+        setup.setStateValidityChecker(lambda s: scene.static_free(s[0], s[1]))
     setup.getSpaceInformation().setStateValidityCheckingResolution(resolution)
     return setup
+
+
+def ompl_seed(seed: int) -> int:
+    """The seed handed to OMPL for our ``seed``: OMPL ignores 0, so every seed is shifted by one."""
+    if seed < 0:
+        raise ValueError(f"roadmap seed must be >= 0, got {seed}")
+    return seed % (2**32 - 1) + 1
 
 
 def _grow_with_ompl(scene: Scene, seed: int, milestones: int) -> tuple[np.ndarray, list[tuple[int, int]]]:
@@ -75,7 +92,7 @@ def _grow_with_ompl(scene: Scene, seed: int, milestones: int) -> tuple[np.ndarra
     from ompl import util as ou
 
     ou.setLogLevel(ou.LOG_NONE)  # setSeed complains if RNGs already exist; the reseed still works
-    ou.RNG.setSeed(seed)
+    ou.RNG.setSeed(ompl_seed(seed))
     setup = ompl_setup(scene, 0.01)  # coarse: every edge is re-checked exactly afterwards
     si = setup.getSpaceInformation()
     prm = og.PRM(si)
@@ -92,6 +109,28 @@ def _grow_with_ompl(scene: Scene, seed: int, milestones: int) -> tuple[np.ndarra
     return verts.reshape(-1, 2), edges
 
 
+CORNER_ARC = 5  # milestones on the quarter arc around each convex corner
+
+
+def corner_points(scene: Scene, boxes: np.ndarray) -> np.ndarray:
+    """Milestones on a quarter arc outside each corner of ``boxes``, free of the static layer.
+
+    The arc's radius is the robot's radius divided by ``cos(half the arc step)``, so the
+    chord between two neighbouring milestones stays clear of the corner; the path along
+    the chords is at most ``1/cos(11.25°) - 1`` ≈ 2 % longer than along the arc.
+    """
+    step = (math.pi / 2) / (CORNER_ARC - 1)
+    radius = scene.radius / math.cos(step / 2) + 0.005
+    out = []
+    for x0, y0, x1, y1 in boxes:
+        for cx, cy, a0 in ((x1, y1, 0.0), (x0, y1, math.pi / 2), (x0, y0, math.pi), (x1, y0, 1.5 * math.pi)):
+            for k in range(CORNER_ARC):
+                a = a0 + k * step
+                out.append((cx + radius * math.cos(a), cy + radius * math.sin(a)))
+    pts = [p for p in out if scene.static_free(*p)]
+    return np.array(sorted(set((round(x, 6), round(y, 6)) for x, y in pts)), dtype=float).reshape(-1, 2)
+
+
 def _door_points(spec: WorldSpec) -> list[tuple[float, float]]:
     pts = []
     for d in spec.doors.values():
@@ -105,34 +144,42 @@ def _door_points(spec: WorldSpec) -> list[tuple[float, float]]:
 
 
 class Roadmap:
-    """The roadmap graph: nodes, edge lengths, and all-pairs distances and predecessors.
+    """The roadmap graph over the static layer: nodes ``(N, 2)``, undirected edges, lengths.
 
-    Build with :meth:`for_world`, which caches.  ``dist[i, j]`` is the roadmap
-    distance between nodes ``i`` and ``j`` (``inf`` if disconnected) and
-    :meth:`route` walks the predecessor table.
+    Build with :meth:`for_world`, which caches.  Node order: OMPL's milestones, the
+    corner milestones (:attr:`corner_nodes`), then door and place nodes.
     """
 
     def __init__(self, spec: WorldSpec, scene: Scene, seed: int = 1, milestones: int | None = None) -> None:
         (x0, y0), (x1, y1) = spec.bounds
         milestones = milestones or int(DEFAULT_DENSITY * (x1 - x0) * (y1 - y0))
         verts, edges = _grow_with_ompl(scene, seed, milestones)
+        corners = corner_points(scene, scene.static)
         extra = [p for p in _door_points(spec) + [(x, y) for x, y, _ in spec.places.values()]
                  if scene.static_free(*p)]
         ompl_n = len(verts)
-        self.nodes = np.vstack([verts, np.array(extra, dtype=float).reshape(-1, 2)])
+        self.corner_nodes = np.arange(ompl_n, ompl_n + len(corners))
+        self.nodes = np.vstack([verts, corners, np.array(extra, dtype=float).reshape(-1, 2)])
         edge_arr = np.array(edges, dtype=int).reshape(-1, 2)
-        new = self._connect_extra(scene, ompl_n)
-        edge_arr = np.vstack([edge_arr, new]) if len(new) else edge_arr
+        new = [self._connect_extra(scene, ompl_n), self._visibility(scene)]
+        edge_arr = np.vstack([edge_arr, *new])
         ok = scene.segments_free(self.nodes[edge_arr[:, 0]], self.nodes[edge_arr[:, 1]], dynamic=False)
-        self.edges = edge_arr[ok]
+        self.edges = np.unique(np.sort(edge_arr[ok], axis=1), axis=0)
         self.lengths = np.hypot(*(self.nodes[self.edges[:, 0]] - self.nodes[self.edges[:, 1]]).T)
         n = len(self.nodes)
         self.graph = csr_matrix((np.concatenate([self.lengths, self.lengths]),
                                  (np.concatenate([self.edges[:, 0], self.edges[:, 1]]),
                                   np.concatenate([self.edges[:, 1], self.edges[:, 0]]))), shape=(n, n))
-        self.dist, self.pred = shortest_path(self.graph, method="D", directed=False, return_predecessors=True)
         self.stats = RoadmapStats(n, len(self.edges), seed, "ompl.geometric.PRM", ompl_n,
                                   int((~ok).sum()))
+
+    def _visibility(self, scene: Scene) -> np.ndarray:
+        """Edges between every pair of corner and added nodes that see each other (static layer)."""
+        idx = np.arange(int(self.corner_nodes[0]) if len(self.corner_nodes) else len(self.nodes), len(self.nodes))
+        ii, jj = np.triu_indices(len(idx), 1)
+        a, b = idx[ii], idx[jj]
+        ok = scene.segments_free(self.nodes[a], self.nodes[b], dynamic=False)
+        return np.stack([a[ok], b[ok]], axis=1).reshape(-1, 2)
 
     def _connect_extra(self, scene: Scene, first: int, k: int = 14, reach: float = 2.0) -> np.ndarray:
         """Edges from each added node (door, place) to its nearest visible nodes."""
@@ -163,32 +210,27 @@ class Roadmap:
         idx = idx[np.argsort(d[idx])]
         return idx, d[idx]
 
-    def route(self, i: int, j: int, pred: np.ndarray | None = None) -> list[int]:
-        """Node indices from ``i`` to ``j`` along shortest paths (``pred`` rows are sources)."""
-        table = self.pred if pred is None else pred
-        out = [j]
-        while out[-1] != i:
-            p = int(table[i, out[-1]]) if table.ndim == 2 else int(table[out[-1]])
-            if p < 0:
-                return []
-            out.append(p)
-        return out[::-1]
+    def box_blocked(self, boxes: np.ndarray, radius: float) -> np.ndarray:
+        """Mask of edges that pass closer than ``radius`` to any of ``boxes`` (closed doors)."""
+        from robot.scene import segments_clear
 
-    def blocked_edges(self, scene: Scene, ignore: tuple[str, ...]) -> np.ndarray:
-        """Mask of edges that the dynamic layer (closed doors, people not ignored) blocks."""
+        a, b = self.nodes[self.edges[:, 0]], self.nodes[self.edges[:, 1]]
+        return ~segments_clear(a, b, np.asarray(boxes, dtype=float).reshape(-1, 4), radius)
+
+    def disc_blocked(self, x: float, y: float, clearance: float) -> np.ndarray:
+        """Mask of edges that pass closer than ``clearance`` to ``(x, y)`` (a person)."""
+        from robot.scene import point_segment_distance
+
         a, b = self.nodes[self.edges[:, 0]], self.nodes[self.edges[:, 1]]
         lo, hi = np.minimum(a, b), np.maximum(a, b)
-        r = scene.radius
-        boxes = [tuple(bx) for bx in scene.closed_doors()] + [
-            (d.x - d.r, d.y - d.r, d.x + d.r, d.y + d.r) for d in scene.discs(ignore)]
-        near = np.zeros(len(a), dtype=bool)
-        for x0, y0, x1, y1 in boxes:  # cheap bounding-box filter before the exact test
-            near |= (hi[:, 0] > x0 - r) & (lo[:, 0] < x1 + r) & (hi[:, 1] > y0 - r) & (lo[:, 1] < y1 + r)
-        blocked = np.zeros(len(a), dtype=bool)
-        if near.any():
-            idx = np.flatnonzero(near)
-            blocked[idx] = ~scene.segments_free(a[idx], b[idx], static=False, ignore=ignore)
-        return blocked
+        near = ((hi[:, 0] > x - clearance) & (lo[:, 0] < x + clearance)
+                & (hi[:, 1] > y - clearance) & (lo[:, 1] < y + clearance))
+        out = np.zeros(len(a), dtype=bool)
+        idx = np.flatnonzero(near)
+        if len(idx):
+            d = point_segment_distance(np.array([x]), np.array([y]), a[idx], b[idx])[:, 0]
+            out[idx] = d < clearance
+        return out
 
 
 def path_length(points: list[tuple[float, float]] | np.ndarray) -> float:

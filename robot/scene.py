@@ -156,6 +156,13 @@ class Scene:
     def closed_doors(self) -> np.ndarray:
         return self._closed
 
+    def person_at(self, x: float, y: float, tolerance: float = 0.002) -> str | None:
+        """The person whose centre is at ``(x, y)`` (first by name), if any."""
+        for n, d in sorted(self.people.items()):
+            if abs(d.x - x) <= tolerance and abs(d.y - y) <= tolerance:
+                return n
+        return None
+
     def discs(self, ignore: tuple[str, ...] = ()) -> list[Disc]:
         return [d for n, d in sorted(self.people.items()) if n not in ignore]
 

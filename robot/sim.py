@@ -19,14 +19,17 @@ physical and reported as ``("posture", person, posture)``.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
+
+import numpy as np
 
 from robot.control import STOP
 from robot.mjworld import TIMESTEP, MjApartment
-from robot.people import People
-from robot.planner import BasePlanner, DriveLimits, MotionEstimator, open_planner
-from robot.scene import Scene
+from robot.motion import BasePlanner, DriveLimits, MotionEstimator, open_planner
+from robot.people import People, Person
+from robot.recording import PersonState, Recorder
+from robot.scene import Scene, segments_clear
 from robot.skills import SKILLS, Skill
 from robot.spec import WorldSpec, load_world
 from robot.tiago import robot_dimensions
@@ -53,6 +56,7 @@ class Simulation:
         self.rate_hz = float(rate_hz)
         _, _, radius = robot_dimensions()
         self.scene = Scene(self.spec, radius)
+        self._walls = np.array([o.box for o in self.spec.obstacles if o.kind == "wall"], dtype=float).reshape(-1, 4)
         self.people = People(self.spec.people.values())
         self.planner = BasePlanner(self.spec, self.scene, seed=seed, milestones=milestones)
         self.limits = DriveLimits.of(self.spec.robot)
@@ -73,8 +77,14 @@ class Simulation:
         self.skill: Skill | None = None
         self._owner: tuple[str, Stage] | None = None
         self._applied = False
-        self.trajectory: list[tuple[float, float, float, float]] = []
+        self.recording = Recorder(self.spec.name)
+        self.trajectory: list[tuple[float, float, float, float]] = []  # (t, x, y, yaw) at RECORD_HZ
+        self._ticks = 0
+        self._last_cmd = STOP
+        self._synced: dict[str, tuple[float, float, float, str]] = {}
+        self.physics_ticks = 0  # control ticks that stepped MuJoCo (the rest: robot at rest, nothing to do)
         self._sync_people()
+        self._record()
 
     # ---- World -----------------------------------------------------------------------
     def robot_pose(self) -> Pose:
@@ -91,24 +101,90 @@ class Simulation:
 
     def _sync_people(self) -> None:
         for p in self.people:
-            self.scene.set_person(p.name, p.x, p.y, p.posture)
-            self.mj.set_person(p.name, p.x, p.y, p.yaw, p.posture)
+            state = (p.x, p.y, p.yaw, p.posture)
+            if self._synced.get(p.name) != state:  # only who moved: the scene and MuJoCo follow
+                self._synced[p.name] = state
+                self.scene.set_person(p.name, p.x, p.y, p.posture)
+                self.mj.set_person(p.name, p.x, p.y, p.yaw, p.posture)
+
+    def _still_until(self, p: Person) -> float:
+        """Until when person ``p`` certainly stays as they are (``self.time``: they may move now)."""
+        events = p.spec.events
+        nxt = events[p._event][0] if p._event < len(events) else math.inf
+        if ("following", p.name) in self.facts:
+            return self.time
+        if p.posture == "fallen" or ("told_to_wait", p.name) in self.facts or not p.spec.walk:
+            return nxt
+        walk = p.spec.walk
+        if self.time < walk[0][0]:
+            return min(nxt, walk[0][0])
+        if self.time >= walk[-1][0] and math.hypot(p.x - walk[-1][1], p.y - walk[-1][2]) <= 1e-9:
+            return nxt
+        return self.time
+
+    def _fast_forward(self, now: float) -> bool:
+        """Skip the control ticks in which nothing can change: no command, the base at rest,
+        every person still, the running skill only waiting for its time.  Such ticks would
+        leave the state exactly as it is, so skipping them changes no result; samples due
+        meanwhile are recorded."""
+        if self._last_cmd != STOP or not self.mj.at_rest():
+            return False
+        horizon = min(now + 1e-9, self.skill.quiet_until() if self.skill is not None else math.inf)
+        for p in self.people:
+            horizon = min(horizon, self._still_until(p))
+            if horizon <= self.time:
+                return False
+        if not math.isfinite(horizon):
+            return False
+        # ticks k = 1..n with time (ticks + k) * CONTROL_DT strictly before the horizon
+        n = math.ceil((horizon - 1e-9) / CONTROL_DT - 1e-9) - 1 - self._ticks
+        if n < 2:
+            return False
+        for p in self.people:
+            if ("following", p.name) not in self.facts:
+                p._trail = []  # what Person.step does for someone not following
+        end = self._ticks + n
+        while self._ticks < end:
+            due = math.ceil(self.recording.next_time() / CONTROL_DT - 1e-6)
+            self._ticks = min(end, max(due, self._ticks + 1))
+            self.time = round(self._ticks * CONTROL_DT, 9)
+            if self.recording.due(self.time):
+                self._record()
+        return True
 
     def _tick(self) -> None:
-        t = self.time + CONTROL_DT
+        self._ticks += 1
+        t = round(self._ticks * CONTROL_DT, 9)
         x, y, _ = self.mj.pose()
         self.people.step(t, CONTROL_DT, self.facts, (x, y))
         self._sync_people()
         cmd = self.skill.control(t, CONTROL_DT) if self.skill is not None else STOP
+        self._last_cmd = cmd
         self.mj.command(cmd.v, cmd.w)
-        self.mj.step(round(CONTROL_DT / TIMESTEP))
+        # People are mocap bodies that touch nothing, so with no command and the base at
+        # rest a physics step changes nothing worth 25 MuJoCo steps: skip it
+        if cmd != STOP or not self.mj.at_rest():
+            self.mj.step(round(CONTROL_DT / TIMESTEP))
+            self.physics_ticks += 1
         self.time = t
-        self.trajectory.append((t, *self.mj.pose()))
+        if self.recording.due(t):
+            self._record()
+
+    def _record(self) -> None:
+        pose = self.mj.pose()
+        self.recording.record(self.time, pose, [PersonState(p.name, p.x, p.y, p.yaw, p.posture) for p in self.people])
+        self.trajectory.append((self.time, *pose))
+
+    def write_trajectory(self, path: str | Path) -> Path:
+        """Write what was recorded (``trajectory.jsonl``, see :mod:`robot.recording`)."""
+        return self.recording.write(path)
 
     def advance(self, now: float) -> None:
         """Step control and physics in fixed ticks up to simulated time ``now``."""
+        self._sync_people()  # a posture set from outside since the last tick
         while self.time + CONTROL_DT <= now + 1e-9:
-            self._tick()
+            if not self._fast_forward(now):
+                self._tick()
 
     def set_door(self, name: str, is_open: bool) -> None:
         """Open or close a door: the scene (and so every cached estimate) and MuJoCo follow."""
@@ -141,21 +217,41 @@ class Simulation:
         return WorldState(frozenset(facts | self.people.facts()), poses, self.objects(), self.time)
 
     def person_place(self, x: float, y: float) -> str:
-        """Where a person is, symbolically: the nearest place in the same room, not counting
-        the places of devices (people are not "at the stove"); the nearest such place
-        anywhere if their room has none."""
+        """Where a person is, symbolically: :meth:`place_of` among the places that are not
+        the places of devices (people are not "at the stove"), or among all places if none."""
         device_places = {d.place for d in self.spec.devices.values()}
         spots = {n: p for n, p in self.spec.places.items() if n not in device_places} or dict(self.spec.places)
-        room = next((b for _, b in sorted(self.spec.rooms.items()) if b[0] <= x <= b[2] and b[1] <= y <= b[3]), None)
-        if room is not None:
-            inside = {n: p for n, p in spots.items() if room[0] <= p[0] <= room[2] and room[1] <= p[1] <= room[3]}
-            spots = inside or spots
-        return min(spots, key=lambda n: (math.hypot(spots[n][0] - x, spots[n][1] - y), n))
+        return self.place_of(x, y, spots)
 
     def nearest_place(self, x: float, y: float) -> str:
-        """The named place closest to ``(x, y)`` (ties broken by name, so deterministic)."""
-        return min(self.spec.places, key=lambda n: (math.hypot(self.spec.places[n][0] - x,
-                                                               self.spec.places[n][1] - y), n))
+        """Where the robot (or anything) at ``(x, y)`` is: :meth:`place_of` among all places."""
+        return self.place_of(x, y, self.spec.places)
+
+    def room_of(self, x: float, y: float) -> str | None:
+        """The smallest room whose box holds ``(x, y)`` (ties by name), or None."""
+        rooms = [(b[2] - b[0]) * (b[3] - b[1]) for b in self.spec.rooms.values()]
+        inside = [(area, n) for area, (n, b) in zip(rooms, self.spec.rooms.items(), strict=True)
+                  if b[0] <= x <= b[2] and b[1] <= y <= b[3]]
+        return min(inside)[1] if inside else None
+
+    def place_of(self, x: float, y: float, spots: Mapping[str, Pose]) -> str:
+        """The nearest of ``spots`` that is not behind a wall (ties broken by name).
+
+        The nearest place of the room that holds ``(x, y)``; if that room has none, the
+        nearest place in sight (the straight line to it crosses no wall); else the nearest.
+        """
+        def nearest(names: Iterable[str]) -> str:
+            return min(names, key=lambda n: (math.hypot(spots[n][0] - x, spots[n][1] - y), n))
+
+        room = self.room_of(x, y)
+        if room is not None:
+            inside = [n for n in spots if self.room_of(spots[n][0], spots[n][1]) == room]
+            if inside:
+                return nearest(inside)
+        names = sorted(spots)
+        ends = np.array([spots[n][:2] for n in names], dtype=float)
+        seen = segments_clear(np.repeat([[x, y]], len(names), axis=0), ends, self._walls, 1e-6)
+        return nearest([n for n, ok in zip(names, seen, strict=True) if ok] or names)
 
     def apply(self, add: Iterable[Iterable[str]] = (), delete: Iterable[Iterable[str]] = ()) -> None:
         """Change the symbolic state: ``delete`` first, then ``add`` (lists of ground facts)."""
@@ -187,6 +283,10 @@ class Simulation:
         if status.state is SkillState.SUCCEEDED and not self._applied:
             self._applied = True
             self.apply(stage.data.get("add", []), stage.data.get("delete", []))
+            if stage.skill == "manipulate":  # where movable objects were handled, for the pictures
+                x, y, _ = self.robot_pose()
+                for obj in dict.fromkeys(a for a in (*stage.args, stage.data.get("object")) if a in self.spec.objects):
+                    self.recording.mark(self.time, str(obj), stage.action, x, y)
         return status
 
     def stop(self, agent: str, stage: Stage, now: float) -> None:

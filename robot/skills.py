@@ -19,19 +19,40 @@ On success the simulation applies ``data["add"]`` and ``data["delete"]``.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from collections.abc import Mapping
+from typing import Protocol
 
 import numpy as np
 
 from robot.control import STOP, Command, PathFollower
+from robot.motion import BasePlanner, DriveLimits, MotionEstimator
+from robot.people import People
+from robot.scene import Scene
+from robot.spec import WorldSpec
 from tasker.protocols import RUNNING, SUCCEEDED, SkillStatus, failed
 from tasker.stage import Stage
 from tasker.world import Pose
 
-if TYPE_CHECKING:
-    from robot.sim import Simulation
 
-APPROACH = 0.9  # metres from a person's centre when navigating "to" them
+class SkillHost(Protocol):
+    """What a skill may see of the world it runs in (:class:`robot.sim.Simulation` is one).
+
+    The narrow meeting point of skills and simulation: skills read poses, people, the
+    collision scene and the motion planner through it, and never step or change the
+    world themselves (the simulation calls :meth:`Skill.control` and applies results).
+    """
+
+    spec: WorldSpec
+    people: People
+    scene: Scene
+    planner: BasePlanner
+    motion: MotionEstimator
+    limits: DriveLimits
+
+    def robot_pose(self) -> Pose: ...
+
+    def objects(self) -> Mapping[str, str]: ...
+
 BLOCK_TIMEOUT = 5.0  # seconds a blocked path is retried before the skill fails
 CHECK_PERIOD = 0.2  # seconds between checks of the path ahead
 
@@ -39,7 +60,7 @@ CHECK_PERIOD = 0.2  # seconds between checks of the path ahead
 class Skill:
     """A running skill: timed by default; subclasses override :meth:`control`/:meth:`status`."""
 
-    def __init__(self, sim: Simulation, stage: Stage, now: float) -> None:
+    def __init__(self, sim: SkillHost, stage: Stage, now: float) -> None:
         self.sim = sim
         self.stage = stage
         self.started = now
@@ -54,11 +75,17 @@ class Skill:
         if self.result is RUNNING:
             self.result = failed("stopped")
 
+    def quiet_until(self) -> float:
+        """Until when :meth:`control` certainly returns STOP and changes nothing: a timed
+        skill until its end, a finished one forever.  The simulation skips physics and
+        control ticks up to then when nothing else moves."""
+        return self.started + self.stage.duration - 1e-6 if self.result is RUNNING else math.inf
+
 
 class Manipulate(Skill):
     """A timed manipulation; fails at once if its object is gone."""
 
-    def __init__(self, sim: Simulation, stage: Stage, now: float) -> None:
+    def __init__(self, sim: SkillHost, stage: Stage, now: float) -> None:
         super().__init__(sim, stage, now)
         obj = stage.data.get("object")
         if obj is not None and obj not in sim.objects():
@@ -68,7 +95,7 @@ class Manipulate(Skill):
 class Navigate(Skill):
     """Drive the base along a planned path to a place, a person or a pose."""
 
-    def __init__(self, sim: Simulation, stage: Stage, now: float) -> None:
+    def __init__(self, sim: SkillHost, stage: Stage, now: float) -> None:
         super().__init__(sim, stage, now)
         self.target = stage.data.get("to")
         self.follower: PathFollower | None = None
@@ -95,21 +122,11 @@ class Navigate(Skill):
         return f"navigate needs data['to'] = a place, a person or [x, y, yaw]; got {t!r}"
 
     def _approach(self, name: str) -> Pose | str:
-        """The reachable pose ``APPROACH`` metres from the person, facing them, cheapest first."""
+        """The pose next to the person that the estimates use too (``MotionEstimator.approach``)."""
         p = self.sim.people[name]
         self.person_at = (p.x, p.y)
-        rx, ry, ryaw = self.sim.robot_pose()
-        best: tuple[float, Pose] | None = None
-        for k in range(16):
-            a = 2 * math.pi * k / 16
-            gx, gy = p.x + APPROACH * math.cos(a), p.y + APPROACH * math.sin(a)
-            if not self.sim.scene.free(gx, gy, ignore=(name,)):
-                continue
-            goal = (gx, gy, math.atan2(p.y - gy, p.x - gx))
-            est = self.sim.motion.estimate((rx, ry, ryaw), goal)
-            if est.reachable and (best is None or est.time_s < best[0]):
-                best = (est.time_s, goal)
-        return best[1] if best else f"no reachable pose next to {name}"
+        goal, _ = self.sim.motion.approach(self.sim.robot_pose(), name)
+        return goal if goal is not None else f"no reachable pose next to {name}"
 
     def _replan(self) -> str | None:
         goal = self._goal()
@@ -170,6 +187,10 @@ class Navigate(Skill):
         if self.follower is not None:
             self.follower.brake()
         super().stop(now)
+
+    def quiet_until(self) -> float:
+        done = self.follower is None or self.follower.done
+        return math.inf if done and self.result is not RUNNING else -math.inf
 
     def braking(self) -> bool:
         return self.stopping and self.follower is not None and not self.follower.done

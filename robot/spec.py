@@ -1,8 +1,10 @@
 """World files: an apartment described as data, read and checked into frozen dataclasses.
 
-A world file is TOML (read with the standard library's :mod:`tomllib`).  Every field
-is checked here, and a bad one raises :class:`WorldFileError` naming the file and the
-field, e.g. ``paper.toml: people.john.pose: expected [x, y, yaw]``.  Nothing
+A world file is TOML, read with the strict reader :mod:`tasker.reader`.  Every field
+is checked here, and a bad one raises :class:`WorldFileError` naming the file, the line
+and the field, e.g. ``paper.toml:61: people.john.pose: expected [x, y, yaw]``; unknown
+keys, NaN, binary files, decreasing walk times, names used twice, facts naming nothing,
+and places, people or the robot inside a wall or outside the bounds are refused.  Nothing
 downstream (the 2-D scene, the MuJoCo model, the people) re-checks the data.
 
 Boxes are axis-aligned rectangles ``[xmin, ymin, xmax, ymax]`` in metres; poses are
@@ -11,14 +13,13 @@ Boxes are axis-aligned rectangles ``[xmin, ymin, xmax, ymax]`` in metres; poses 
 
 from __future__ import annotations
 
-import math
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from tasker.errors import TaskerError
+from tasker import reader
+from tasker.reader import InputError, Table, check_name, check_number, check_numbers, suggest
 from tasker.world import Pose
 
 WORLDS_DIR = Path(__file__).with_name("worlds")
@@ -27,8 +28,8 @@ POSTURES = ("standing", "sitting", "fallen")
 Box = tuple[float, float, float, float]
 
 
-class WorldFileError(TaskerError, ValueError):
-    """A world file is missing, unreadable or holds a field of the wrong shape."""
+class WorldFileError(InputError):
+    """A world file is missing, unreadable or holds a field of the wrong shape (an :class:`InputError`)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -106,165 +107,184 @@ class WorldSpec:
     objects: Mapping[str, str] = field(default_factory=dict)
 
 
-class _Reader:
-    """Typed access to a parsed TOML table; every failure names file and field."""
-
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, where: str, problem: str) -> WorldFileError:
-        return WorldFileError(f"{self.source}: {where}: {problem}")
-
-    def table(self, data: Any, where: str) -> Mapping[str, Any]:
-        if not isinstance(data, Mapping):
-            raise self.fail(where, "expected a table")
-        return data
-
-    def number(self, value: Any, where: str, positive: bool = False) -> float:
-        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-            raise self.fail(where, f"expected a number, got {value!r}")
-        if positive and value <= 0:
-            raise self.fail(where, f"expected a number > 0, got {value!r}")
-        return float(value)
-
-    def string(self, value: Any, where: str, choices: tuple[str, ...] | None = None) -> str:
-        if not isinstance(value, str) or not value:
-            raise self.fail(where, f"expected a non-empty string, got {value!r}")
-        if choices is not None and value not in choices:
-            raise self.fail(where, f"expected one of {list(choices)}, got {value!r}")
-        return value
-
-    def numbers(self, value: Any, where: str, n: int, shape: str) -> tuple[float, ...]:
-        if not isinstance(value, list) or len(value) != n:
-            raise self.fail(where, f"expected {shape}")
-        try:
-            return tuple(self.number(v, where) for v in value)
-        except WorldFileError:
-            raise self.fail(where, f"expected {shape}") from None
-
-    def pose(self, value: Any, where: str) -> Pose:
-        x, y, yaw = self.numbers(value, where, 3, "[x, y, yaw]")
-        return (x, y, yaw)
-
-    def box(self, value: Any, where: str) -> Box:
-        x0, y0, x1, y1 = self.numbers(value, where, 4, "[xmin, ymin, xmax, ymax]")
-        if x1 <= x0 or y1 <= y0:
-            raise self.fail(where, "expected xmin < xmax and ymin < ymax")
-        return (x0, y0, x1, y1)
-
-    def unknown_keys(self, data: Mapping[str, Any], where: str, known: set[str]) -> None:
-        extra = sorted(set(data) - known)
-        if extra:
-            prefix = f"{where}." if where else ""
-            raise self.fail(f"{prefix}{extra[0]}", f"unknown field; expected one of {sorted(known)}")
+POSE = "[x, y, yaw]"
+BOX = "[xmin, ymin, xmax, ymax]"
+TOP_KEYS = ("name", "description", "bounds", "rooms", "walls", "furniture", "doors", "places", "devices",
+            "people", "robot", "facts", "objects")
 
 
-def _person(r: _Reader, name: str, data: Any) -> PersonSpec:
-    where = f"people.{name}"
-    t = r.table(data, where)
-    r.unknown_keys(t, where, {"pose", "posture", "speed", "walk", "events"})
-    if "pose" not in t:
-        raise r.fail(f"{where}.pose", "missing; expected [x, y, yaw]")
+def _box(t: Table, key: str | int, value: Any) -> Box:
+    x0, y0, x1, y1 = check_numbers(t, key, value, 4, BOX)
+    if x1 <= x0 or y1 <= y0:
+        raise t.error(key, f"expected xmin < xmax and ymin < ymax, got {value!r}")
+    return (x0, y0, x1, y1)
+
+
+def _pose(t: Table, key: str | int, value: Any) -> Pose:
+    x, y, yaw = check_numbers(t, key, value, 3, POSE)
+    return (x, y, yaw)
+
+
+def _person(name: str, t: Table) -> PersonSpec:
+    pose = _pose(t, "pose", t.raw("pose"))
     walk: list[tuple[float, float, float]] = []
-    for k, wp in enumerate(t.get("walk", [])):
-        wt, wx, wy = r.numbers(wp, f"{where}.walk[{k}]", 3, "[t, x, y]")
+    walk_t = t.at("walk", {})  # only to name elements
+    for k, wp in enumerate(t.array("walk", [])):
+        wt, wx, wy = check_numbers(walk_t, k, wp, 3, "[t, x, y]")
+        if wt < 0:
+            raise walk_t.error(k, f"expected a time >= 0, got {wt!r}")
         if walk and wt <= walk[-1][0]:
-            raise r.fail(f"{where}.walk[{k}]", "waypoint times must increase")
+            raise walk_t.error(k, f"waypoint times must increase: {wt!r} after {walk[-1][0]!r}")
         walk.append((wt, wx, wy))
     events = []
-    for k, ev in enumerate(t.get("events", [])):
-        if not isinstance(ev, list) or len(ev) != 2:
-            raise r.fail(f"{where}.events[{k}]", "expected [t, posture]")
-        events.append((r.number(ev[0], f"{where}.events[{k}]"), r.string(ev[1], f"{where}.events[{k}]", POSTURES)))
-    return PersonSpec(
-        name=name,
-        pose=r.pose(t["pose"], f"{where}.pose"),
-        posture=r.string(t.get("posture", "standing"), f"{where}.posture", POSTURES),
-        speed=r.number(t.get("speed", 0.8), f"{where}.speed", positive=True),
-        walk=tuple(walk),
-        events=tuple(sorted(events)),
+    events_t = t.at("events", {})
+    for k, ev in enumerate(t.array("events", [])):
+        if not isinstance(ev, list) or len(ev) != 2 or isinstance(ev[0], bool) \
+                or not isinstance(ev[0], int | float) or not isinstance(ev[1], str):
+            raise events_t.error(k, f"expected [t, posture], got {ev!r}")
+        at = check_number(events_t, k, ev[0], min=0)
+        check_name(events_t, k, ev[1], POSTURES, "posture")
+        events.append((float(at), ev[1]))
+    person = PersonSpec(name=name, pose=pose, posture=t.string("posture", "standing", choices=POSTURES),
+                        speed=t.number("speed", 0.8, positive=True), walk=tuple(walk), events=tuple(sorted(events)))
+    t.done()
+    return person
+
+
+def _robot(t: Table) -> RobotSpec:
+    limits = {k: t.number(k, positive=True) for k in ("max_speed", "max_turn", "max_accel", "max_turn_accel")
+              if k in t}
+    robot = RobotSpec(pose=_pose(t, "pose", t.raw("pose")), **limits)
+    t.done({"max_speed", "max_turn", "max_accel", "max_turn_accel"})
+    return robot
+
+
+def read_world(top: Table, source: str) -> WorldSpec:
+    """Check a world file read by :mod:`tasker.reader` and build a :class:`WorldSpec`."""
+    for key in top.keys():
+        if key not in TOP_KEYS:
+            raise top.error(key, f"unknown key {key!r}{suggest(key, TOP_KEYS)} (valid keys: {', '.join(TOP_KEYS)})")
+    b = top.raw("bounds")
+    if not isinstance(b, list) or len(b) != 2:
+        raise top.error("bounds", f"expected [[xmin, ymin], [xmax, ymax]], got {b!r}")
+    lo = check_numbers(top, "bounds", b[0], 2, "[[xmin, ymin], [xmax, ymax]]")
+    hi = check_numbers(top, "bounds", b[1], 2, "[[xmin, ymin], [xmax, ymax]]")
+    if hi[0] <= lo[0] or hi[1] <= lo[1]:
+        raise top.error("bounds", f"expected xmin < xmax and ymin < ymax, got {b!r}")
+    rooms_t = top.table("rooms", {})
+    rooms = {n: _box(rooms_t, n, v) for n, v in rooms_t.items()}
+    obstacles = []
+    walls_t = top.at("walls", {})
+    for k, w in enumerate(top.array("walls", [])):
+        obstacles.append(Obstacle(f"wall{k}", _box(walls_t, k, w), 2.5, "wall"))
+    for n, t in top.named("furniture"):
+        obstacles.append(Obstacle(n, _box(t, "box", t.raw("box")), t.number("height", 0.8, positive=True),
+                                  "furniture"))
+        t.done()
+    doors = {}
+    for n, t in top.named("doors"):
+        doors[n] = Door(n, _box(t, "box", t.raw("box")), t.boolean("open", True))
+        t.done()
+    places_t = top.table("places", {})
+    places = {n: _pose(places_t, n, v) for n, v in places_t.items()}
+    devices = {}
+    for n, t in top.named("devices"):
+        place = t.name("place", places, "place")
+        devices[n] = Device(n, t.string("type", n), place, t.string("state", "off"))
+        t.done()
+    people = {n: _person(n, t) for n, t in top.named("people")}
+    objects_t = top.table("objects", {})
+    objects = {n: objects_t.string(n) for n in objects_t.keys()}
+    seen: dict[str, str] = {"robot": "robot"}
+    for what, names in (("places", places), ("people", people), ("devices", devices), ("doors", doors),
+                        ("objects", objects)):
+        for n in names:
+            if n in seen:
+                raise top.at(what, {}).error(n, f"the name {n!r} is used twice ({seen[n]} and {what}); "
+                                                "places, people, devices, doors, objects and 'robot' share names")
+            seen[n] = what
+    facts = []
+    facts_t = top.at("facts", {})
+    for k, f in enumerate(top.array("facts", [])):
+        if not isinstance(f, list) or not f or not all(isinstance(a, str) and a for a in f):
+            raise facts_t.error(k, f"expected a fact: a list of non-empty strings, got {f!r}")
+        for a in f[1:]:
+            check_name(facts_t, k, a, seen, "object")
+        facts.append(tuple(f))
+    spec = WorldSpec(
+        name=top.string("name", Path(source).stem), source=source, bounds=((lo[0], lo[1]), (hi[0], hi[1])),
+        rooms=rooms, obstacles=tuple(obstacles), doors=doors, places=places, devices=devices, people=people,
+        robot=_robot(top.table("robot")), facts=tuple(facts), objects=objects,
+        description=top.string("description", "-"),
     )
+    top.done(TOP_KEYS)
+    _check_geometry(spec, top)
+    return spec
 
 
-def _robot(r: _Reader, data: Any) -> RobotSpec:
-    t = r.table(data, "robot")
-    fields = {"max_speed", "max_turn", "max_accel", "max_turn_accel"}
-    r.unknown_keys(t, "robot", fields | {"pose"})
-    if "pose" not in t:
-        raise r.fail("robot.pose", "missing; expected [x, y, yaw]")
-    limits = {k: r.number(t[k], f"robot.{k}", positive=True) for k in fields if k in t}
-    return RobotSpec(pose=r.pose(t["pose"], "robot.pose"), **limits)
+def point_problem(spec: WorldSpec, x: float, y: float) -> str | None:
+    """Why ``(x, y)`` is not a point in the world's free space (outside the bounds, inside a
+    wall or furniture), or ``None``."""
+    from robot.scene import Scene
+
+    if not Scene(spec, 0.0).in_bounds(x, y):
+        (x0, y0), (x1, y1) = spec.bounds
+        return f"outside the world's bounds [[{x0:g}, {y0:g}], [{x1:g}, {y1:g}]]"
+    for o in spec.obstacles:
+        if o.box[0] < x < o.box[2] and o.box[1] < y < o.box[3]:
+            return f"inside {o.kind} {o.name!r} {list(o.box)}"
+    return None
+
+
+def check_point(spec: WorldSpec, t: Table, key: str | int, x: float, y: float) -> None:
+    """``t.error(key)`` unless ``(x, y)`` is in the world's free space."""
+    bad = point_problem(spec, x, y)
+    if bad:
+        raise t.error(key, f"({x:g}, {y:g}) is {bad}; expected a point in free space")
+
+
+def _check_geometry(spec: WorldSpec, top: Table) -> None:
+    """Places, people, walks inside the bounds and not inside a wall or furniture; the robot in free space."""
+    from robot.scene import Scene
+
+    def check(t: Table, key: str | int, x: float, y: float) -> None:
+        check_point(spec, t, key, x, y)
+
+    (bx0, by0), (bx1, by1) = spec.bounds
+    for what, boxes in (("rooms", spec.rooms), ("doors", {n: d.box for n, d in spec.doors.items()}),
+                        ("furniture", {o.name: o.box for o in spec.obstacles if o.kind == "furniture"})):
+        t = top.table(what, {})
+        for n, (x0, y0, x1, y1) in boxes.items():
+            if x0 < bx0 or y0 < by0 or x1 > bx1 or y1 > by1:
+                key: str | int = n
+                owner = t
+                if what != "rooms":
+                    owner, key = t.at(n, t.data[n]), "box"
+                raise owner.error(key, f"{[x0, y0, x1, y1]} reaches outside the world's bounds "
+                                       f"[[{bx0:g}, {by0:g}], [{bx1:g}, {by1:g}]]")
+    places_t = top.table("places", {})
+    for n, (x, y, _) in spec.places.items():
+        check(places_t, n, x, y)
+    people_t = top.table("people", {})
+    for n, p in spec.people.items():
+        pt = people_t.at(n, people_t.data[n])
+        check(pt, "pose", p.pose[0], p.pose[1])
+        for k, (_, x, y) in enumerate(p.walk):
+            check(pt.at("walk", {}), k, x, y)
+    robot_t = top.table("robot")
+    x, y, _ = spec.robot.pose
+    check(robot_t, "pose", x, y)
+    from robot.tiago import robot_dimensions
+
+    radius = robot_dimensions()[2]
+    if not Scene(spec, radius).static_free(x, y):
+        raise robot_t.error("pose", f"the robot (radius {radius:g} m) at ({x:g}, {y:g}) overlaps a wall, "
+                                    "furniture or the world's bounds; expected free space")
 
 
 def parse_world(data: Mapping[str, Any], source: str) -> WorldSpec:
     """Check a parsed world table and build a :class:`WorldSpec`; ``source`` names it in errors."""
-    r = _Reader(source)
-    known = {"name", "description", "bounds", "rooms", "walls", "furniture", "doors", "places",
-             "devices", "people", "robot", "facts", "objects"}
-    r.unknown_keys(data, "", known)
-    for required in ("bounds", "robot"):
-        if required not in data:
-            raise r.fail(required, "missing")
-    b = data["bounds"]
-    if not isinstance(b, list) or len(b) != 2:
-        raise r.fail("bounds", "expected [[xmin, ymin], [xmax, ymax]]")
-    lo = r.numbers(b[0], "bounds", 2, "[[xmin, ymin], [xmax, ymax]]")
-    hi = r.numbers(b[1], "bounds", 2, "[[xmin, ymin], [xmax, ymax]]")
-    if hi[0] <= lo[0] or hi[1] <= lo[1]:
-        raise r.fail("bounds", "expected xmin < xmax and ymin < ymax")
-    rooms = {n: r.box(v, f"rooms.{n}") for n, v in r.table(data.get("rooms", {}), "rooms").items()}
-    obstacles = []
-    walls = data.get("walls", [])
-    if not isinstance(walls, list):
-        raise r.fail("walls", "expected a list of [xmin, ymin, xmax, ymax]")
-    for k, w in enumerate(walls):
-        obstacles.append(Obstacle(f"wall{k}", r.box(w, f"walls[{k}]"), 2.5, "wall"))
-    for n, v in r.table(data.get("furniture", {}), "furniture").items():
-        t = r.table(v, f"furniture.{n}")
-        r.unknown_keys(t, f"furniture.{n}", {"box", "height"})
-        if "box" not in t:
-            raise r.fail(f"furniture.{n}.box", "missing; expected [xmin, ymin, xmax, ymax]")
-        h = r.number(t.get("height", 0.8), f"furniture.{n}.height", positive=True)
-        obstacles.append(Obstacle(n, r.box(t["box"], f"furniture.{n}.box"), h, "furniture"))
-    doors = {}
-    for n, v in r.table(data.get("doors", {}), "doors").items():
-        t = r.table(v, f"doors.{n}")
-        r.unknown_keys(t, f"doors.{n}", {"box", "open"})
-        is_open = t.get("open", True)
-        if not isinstance(is_open, bool):
-            raise r.fail(f"doors.{n}.open", f"expected true or false, got {is_open!r}")
-        doors[n] = Door(n, r.box(t.get("box"), f"doors.{n}.box"), is_open)
-    places = {n: r.pose(v, f"places.{n}") for n, v in r.table(data.get("places", {}), "places").items()}
-    devices = {}
-    for n, v in r.table(data.get("devices", {}), "devices").items():
-        t = r.table(v, f"devices.{n}")
-        r.unknown_keys(t, f"devices.{n}", {"type", "place", "state"})
-        place = r.string(t.get("place"), f"devices.{n}.place")
-        if place not in places:
-            raise r.fail(f"devices.{n}.place", f"unknown place {place!r}; known: {sorted(places)}")
-        devices[n] = Device(n, r.string(t.get("type", n), f"devices.{n}.type"), place,
-                            r.string(t.get("state", "off"), f"devices.{n}.state"))
-    people = {n: _person(r, n, v) for n, v in r.table(data.get("people", {}), "people").items()}
-    clash = sorted((set(places) & set(people)) | (set(places) & set(devices)) | (set(people) & set(devices)))
-    if clash or "robot" in set(places) | set(people) | set(devices):
-        raise r.fail(clash[0] if clash else "robot", "a name is used twice (places, people, devices, 'robot')")
-    objects = {n: r.string(v, f"objects.{n}") for n, v in r.table(data.get("objects", {}), "objects").items()}
-    taken = set(places) | set(people) | set(devices) | {"robot"}
-    if taken & set(objects):
-        raise r.fail(f"objects.{sorted(taken & set(objects))[0]}", "a name is used twice (objects and places, "
-                     "people, devices or 'robot')")
-    facts = []
-    for k, f in enumerate(data.get("facts", [])):
-        if not isinstance(f, list) or not f or not all(isinstance(a, str) and a for a in f):
-            raise r.fail(f"facts[{k}]", "expected a list of non-empty strings")
-        facts.append(tuple(f))
-    name = data.get("name", Path(source).stem)
-    return WorldSpec(
-        name=r.string(name, "name"), source=source, bounds=((lo[0], lo[1]), (hi[0], hi[1])), rooms=rooms,
-        obstacles=tuple(obstacles), doors=doors, places=places, devices=devices, people=people,
-        robot=_robot(r, data["robot"]), facts=tuple(facts), objects=objects,
-        description=r.string(data.get("description", "-"), "description"),
-    )
+    return read_world(Table(source, dict(data), (), None, WorldFileError), source)
 
 
 def shipped_worlds() -> list[str]:
@@ -274,15 +294,18 @@ def shipped_worlds() -> list[str]:
 
 def load_world(name_or_path: str | Path) -> WorldSpec:
     """Read a shipped world by name (``"paper"``) or a world file by path, and check it."""
+    p = world_path(name_or_path)
+    return read_world(reader.load(p, WorldFileError), str(p))
+
+
+def world_path(name_or_path: str | Path) -> Path:
+    """The file of a shipped world name (``"paper"``) or of a path; an unknown name lists the shipped ones."""
     p = Path(name_or_path)
     if p.suffix != ".toml" and not p.exists():
-        if str(name_or_path) not in shipped_worlds():
-            raise WorldFileError(f"{name_or_path}: no such world; shipped: {', '.join(shipped_worlds())}")
+        shipped = shipped_worlds()
+        if str(name_or_path) not in shipped:
+            did = suggest(str(name_or_path), shipped)
+            raise WorldFileError(str(name_or_path), f"no such world file, and not a shipped world{did} "
+                                                    f"(shipped: {', '.join(shipped)})")
         p = WORLDS_DIR / f"{name_or_path}.toml"
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except OSError as e:
-        raise WorldFileError(f"{p.name}: cannot read: {e.strerror or e}") from None
-    except tomllib.TOMLDecodeError as e:
-        raise WorldFileError(f"{p.name}: not valid TOML: {e}") from None
-    return parse_world(data, p.name)
+    return p

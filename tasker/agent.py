@@ -13,18 +13,24 @@ hooks.  It is stepped by a clock (:mod:`tasker.loop`) at the times it asks for:
 Suspension follows eqs. 25-26: ``susp`` ends a suspendable stage at once; a
 blocking stage runs to its goal and the pending ``susp`` is honoured when the FSM
 reaches the next suspendable stage.  ``term`` while in ``cmd`` is handled as a safe
-suspension followed by ``end`` (a task is never dropped mid-manoeuvre).
+suspension followed by ``end`` (a task is never dropped mid-manoeuvre); so is the
+task's own ``ic_term`` (``check_terminate``) while it executes.
+
+The agent never names a target state: it fires events through the one FSM table of
+:mod:`tasker.fsm`, whose guards it evaluates.  Every call into a task hook or the core
+agent is contained (:meth:`DynamicAgent.step`): an exception ends this task only.
 """
 
 from __future__ import annotations
 
 import math
+import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 from tasker import fsm
-from tasker.errors import ConfigError, PlanningFailed
+from tasker.errors import AgentEnded, ConfigError, FSMError, InvariantViolation, PlanningFailed, WorldError
 from tasker.messages import Command, Flag, FsmState, Report, ScheduleParams, SPRequest
 from tasker.protocols import CoreAgent, SkillState
 from tasker.stage import Purpose, Stage, StagePlan
@@ -106,11 +112,13 @@ class DynamicAgent:
         self._ack = 0
         self._pending_start = False
         self._pending_susp = False
-        self._pending_term: str | None = None
+        self._pending_term: tuple[str, str] | None = None  # (reason, cause: "term" or "self")
         self._runner: StageRunner | None = None
         self._ready_at = 0.0  # end of a planning hook's simulated time
         self._next_sp = 0.0
         self._params: ScheduleParams | None = None
+        self._params_at: float | None = None  # when _params was computed (None: not since the last change)
+        self._fresh: tuple[float, ScheduleParams | None] | None = None  # fresh_params' answer at one moment
         self.planner_calls: list[dict[str, Any]] = []
 
     # -- the harmoniser's side ----------------------------------------------------------
@@ -125,14 +133,59 @@ class DynamicAgent:
         """A requester changed the task's arguments (R2); parameters are recomputed at once."""
         changed = {k: v for k, v in args.items() if self.ctx.args.get(k) != v}
         self.ctx.args = dict(args)
+        self._params_at = self._fresh = None
         self._trace.emit(now, "change", agent=self.id, args=changed, requester=requester)
         if self._waker is not None:
             self._waker(self)
 
     def request_sp(self, request: SPRequest, now: float) -> Any:
-        """Answer ``[spID, args]`` with ``[scheduleParam]`` (eqs. 20-21, 23)."""
-        self._refresh(now)
-        return self.task.request_sp(self.ctx, request)
+        """Answer ``[spID, args]`` with ``[scheduleParam]`` (eqs. 20-21, 23).
+
+        A hook that raises ends this agent (cause ``error``) and raises
+        :class:`~tasker.errors.AgentEnded`, so the harmoniser drops it as a candidate.
+        """
+        if self.state is S.END:
+            raise AgentEnded(self.id, self.end_reason or "ended")
+        try:
+            self._refresh(now)
+            return self.task.request_sp(self.ctx, request)
+        except _UNCONTAINED:
+            raise
+        except Exception as exc:
+            self._fail(now, exc)
+            raise AgentEnded(self.id, self.end_reason or "error") from exc
+
+    def fresh_params(self, now: float) -> ScheduleParams | None:
+        """``compute_params`` at ``now``, without publishing: for a decision made from one moment.
+
+        Parameters already computed at ``now`` (by the agent's own timer, or by an
+        earlier call) are of this moment and are returned as they are: nothing the
+        hook reads changes between them, since the agent is not stepped in between.
+        Returns None when the task type reports no parameters; raises
+        :class:`~tasker.errors.AgentEnded` (after ending the agent) if the hook raises.
+        """
+        if self.state is S.END:
+            raise AgentEnded(self.id, self.end_reason or "ended")
+        if self._params_at == now:
+            return self._params
+        if self._fresh is not None and self._fresh[0] == now:
+            return self._fresh[1]
+        try:
+            self._refresh(now)
+            params = self.task.compute_params(self.ctx)
+            self._fresh = (now, params)
+            return params
+        except _UNCONTAINED:
+            raise
+        except Exception as exc:
+            self._fail(now, exc)
+            raise AgentEnded(self.id, self.end_reason or "error") from exc
+
+    def abort(self, now: float, reason: str) -> None:
+        """End at once with cause ``error`` (the run is aborted): stop the running stage, guarded."""
+        if self.state is not S.END:
+            self._stop_stage(now, "failed", reason=reason)
+            self._end(now, reason, cause="error", event="error")
 
     @property
     def ended(self) -> bool:
@@ -141,14 +194,24 @@ class DynamicAgent:
     # -- stepping ---------------------------------------------------------------------------
 
     def step(self, now: float) -> None:
-        """Run the transition functions due at ``now``; set :attr:`next_wake`."""
+        """Run the transition functions due at ``now``; set :attr:`next_wake`.
+
+        This is the containment boundary: an exception from a task hook, the core
+        agent or a planner ends this task (``end`` with cause ``error`` and the
+        exception in the reason); it never reaches the harmoniser or the loop.
+        """
         if self.state is S.END:
             self.next_wake = math.inf
             return
-        self._refresh(now)
-        self._read_inbox()
-        handler = _HANDLERS[self.state]
-        handler(self, now)
+        self._params_at = self._fresh = None  # stepping may change what the parameters depend on
+        try:
+            self._refresh(now)
+            self._read_inbox()
+            _HANDLERS[self.state](self, now)
+        except _UNCONTAINED:
+            raise
+        except Exception as exc:
+            self._fail(now, exc)
 
     def _refresh(self, now: float) -> None:
         self.ctx.now = now
@@ -165,20 +228,22 @@ class DynamicAgent:
                 if "expected_s" in cmd.data:  # how long the interruption is expected to last
                     self.ctx.memory["interruption_s"] = float(cmd.data["expected_s"])
             elif cmd.flag is Flag.TERM:
-                self._pending_term = str(cmd.data.get("reason", "terminated by the harmoniser"))
+                if self._pending_term is None or self._pending_term[1] != "term":
+                    self._pending_term = (str(cmd.data.get("reason", "terminated by the harmoniser")), "term")
         self._inbox.clear()
 
     # -- state behaviours ---------------------------------------------------------------
 
     def _init_comm(self, now: float) -> None:
         self.task.initialise(self.ctx)
-        self._go(S.COMP_SP, now)
+        self._fire("initialised", now)
         self._comp_sp(now)
 
     def _comp_sp(self, now: float) -> None:
         """``compSP`` and ``wait``: f^compSP (eq. 22), f^wait = f^compSP (eq. 27)."""
         if self._pending_term is not None:
-            self._end(now, self._pending_term, cause="term")
+            reason, cause = self._pending_term
+            self._end(now, reason, cause=cause, event="term")
             return
         if self._pending_start:
             self._pending_start = False
@@ -188,19 +253,20 @@ class DynamicAgent:
         self._pending_susp = False
         why = self.task.check_terminate(self.ctx)
         if why:
-            self._end(now, why, cause="self")
+            self._end(now, why, cause="self", event="term")
             return
         self._params = self.task.compute_params(self.ctx)
+        self._params_at = now
         self._publish()
         self.next_wake = _next_tick_of(now, self.rates.rep_rate)
 
     def _start_up_tsk(self, now: float) -> None:
-        self._go(S.UP_TSK, now)
+        self._fire("start", now)
         self._refresh(now)  # plan from the world as it is now, after any effect applied this step
         try:
             plan = self.task.update_task(self.ctx)
         except PlanningFailed as exc:
-            self._end(now, f"upTsk {exc.status}: {exc}", cause="failed")
+            self._end(now, f"upTsk {exc.status}: {exc}", cause="failed", event="plan_failed")
             return
         self._emit_plan(now, plan)
         self.ctx.plan = plan
@@ -217,22 +283,22 @@ class DynamicAgent:
             return
         plan = self.ctx.plan
         assert plan is not None
-        if not plan.stages:
-            self._end(now, "finished", cause="finished")  # nothing left to do (R6: done by someone else)
+        if not plan.stages:  # nothing left to do (R6: done by someone else)
+            self._end(now, "finished", cause="finished", event="planned")
             return
         self._runner = StageRunner(plan)
-        self._go(S.EXE_TSK, now)
+        self._fire("planned", now)
         self._next_sp = _next_tick_of(now, self.rates.sp_up_rate)
         self._enter_stage(now)
 
     def _enter_stage(self, now: float) -> None:
-        """Start the runner's current stage, or suspend first if a susp is pending (eq. 26)."""
+        """Start the runner's current stage, or suspend first if a susp or term is pending (eq. 26)."""
         runner = self._runner
         assert runner is not None
         stage = runner.stage
         if stage is None:
             if self.state is S.EXE_TSK:
-                self._end(now, "finished", cause="finished")
+                self._end(now, "finished", cause="finished", event="finished")
             else:
                 self._finish_susp(now)
             return
@@ -243,41 +309,31 @@ class DynamicAgent:
             return
         if self.core is None:
             raise ConfigError(f"agent {self.id}: a stage must run but no core agent was given")
-        self.core.begin(self.id, stage, now)
-        runner.running = True
+        runner.running = True  # before begin: a begin that raises still gets a guarded stop and its closing event
         if in_task:
             self.ctx.stage_started = now
-        self._trace.emit(now, "stage", agent=self.id, fsm=self.state.value, index=runner.index,
-                         action=stage.action, args=list(stage.args), kind=stage.kind.value, status="begin")
+        self._stage_event(now, "begin")
+        self.core.begin(self.id, stage, now)
         self.next_wake = _next_tick_of(now, self.rates.task_exe_rate)
 
     def _exe(self, now: float) -> None:
         """``exeTsk`` / ``exeSusp``: f^stage,k at taskExeRate, f^compSP at SPupRate (eq. 24)."""
         runner = self._runner
-        assert runner is not None and runner.stage is not None
+        assert runner is not None and runner.stage is not None and self.core is not None
         stage = runner.stage
         in_task = self.state is S.EXE_TSK
         if in_task and (self._pending_susp or self._pending_term) and not stage.blocking:
-            assert self.core is not None
-            self.core.stop(self.id, stage, now)
-            runner.running = False
-            self.ctx.interrupted = stage
-            self.ctx.stage_started = None
-            self._stage_event(now, "stopped")
-            self._start_gen_susp(now)
+            self._suspend_now(now, stage)
             return
         if in_task and self._pending_start:
             self._pending_start = False
-        assert self.core is not None
         status = self.core.poll(self.id, stage, now)
         if status.state is SkillState.FAILED:
-            runner.running = False
-            self._stage_event(now, "failed", reason=status.reason)
-            self._end(now, f"stage {stage.label} failed: {status.reason}", cause="failed")
+            self._close_stage(now, "failed", reason=status.reason)
+            self._end(now, f"stage {stage.label} failed: {status.reason}", cause="failed", event="stage_failed")
             return
         if status.state is SkillState.SUCCEEDED:
-            runner.running = False
-            self._stage_event(now, "done")
+            self._close_stage(now, "done")
             if in_task:
                 self.ctx.stage_started = None
                 self.ctx.done.append(stage)
@@ -287,29 +343,38 @@ class DynamicAgent:
             self._enter_stage(now)
             if self.state is not S.EXE_TSK:
                 return
-        elif in_task:
+        elif in_task and self._pending_term is None:
             why = self.task.check_terminate(self.ctx)
-            if why:
-                self.core.stop(self.id, stage, now)
-                self._end(now, why, cause="self")
-                return
+            if why:  # ic_term: finish a blocking stage, then suspend safely, then end (eqs. 25-26)
+                self._pending_term = (why, "self")
+                if not stage.blocking:
+                    self._suspend_now(now, stage)
+                    return
         if in_task and now >= self._next_sp:
             self._params = self.task.compute_params(self.ctx)
+            self._params_at = now
             self._publish()
             self._next_sp = _next_tick_of(now, self.rates.sp_up_rate)
         if runner.running:
             self.next_wake = _next_tick_of(now, self.rates.task_exe_rate)
 
+    def _suspend_now(self, now: float, stage: Stage) -> None:
+        """A suspendable stage of exeTsk ends at once for a pending susp or term (eq. 26)."""
+        self._stop_stage(now, "stopped")
+        self.ctx.interrupted = stage
+        self.ctx.stage_started = None
+        self._start_gen_susp(now)
+
     def _start_gen_susp(self, now: float) -> None:
         self._pending_susp = False
         self.ctx.suspended = True
         self.ctx.terminating = self._pending_term is not None
-        self._go(S.GEN_SUSP, now)
+        self._fire("suspend", now)
         self._refresh(now)  # the stage that just ended may have changed the world (a pan put on the cooker)
         try:
             plan = self.task.generate_suspension(self.ctx)
         except PlanningFailed as exc:
-            self._end(now, f"genSusp {exc.status}: {exc}", cause="failed")
+            self._end(now, f"genSusp {exc.status}: {exc}", cause="failed", event="plan_failed")
             return
         self._emit_plan(now, plan)
         self._runner = StageRunner(plan)
@@ -323,38 +388,85 @@ class DynamicAgent:
         if now < self._ready_at:
             self.next_wake = self._ready_at
             return
-        self._go(S.EXE_SUSP, now)
+        self._fire("planned", now)
         self._enter_stage(now)
 
     def _finish_susp(self, now: float) -> None:
         if self._pending_term is not None:
-            self._end(now, self._pending_term, cause="term")
+            reason, cause = self._pending_term
+            self._end(now, reason, cause=cause, event="finished")
             return
         self._pending_start = False
-        self._go(S.WAIT, now)
+        self._fire("finished", now)
         self._comp_sp(now)
 
     # -- helpers ------------------------------------------------------------------------------
 
-    def _go(self, target: FsmState, now: float) -> None:
-        """A transition of Fig. 5 (checked), traced and reported.  Ending goes through :meth:`_end`."""
-        fsm.check(self.state, target)
-        self._trace.emit(now, "transition", agent=self.id, **{"from": self.state.value, "to": target.value})
-        self.state = target
-        self._publish()
+    def _guard(self, name: str) -> bool:
+        """Evaluate a guard named in :data:`tasker.fsm.TRANSITIONS`."""
+        if name == "has_stages":
+            return self.ctx.plan is not None and bool(self.ctx.plan.stages)
+        if name == "no_stages":
+            return self.ctx.plan is None or not self.ctx.plan.stages
+        if name == "terminating":
+            return self._pending_term is not None
+        if name == "not_terminating":
+            return self._pending_term is None
+        raise ConfigError(f"agent {self.id}: the FSM names a guard {name!r} the agent does not know")
 
-    def _end(self, now: float, reason: str, *, cause: str) -> None:
-        runner = self._runner
-        if runner is not None and runner.running and runner.stage is not None and self.core is not None:
-            self.core.stop(self.id, runner.stage, now)
-            runner.running = False
-        fsm.check(self.state, S.END)
-        self._trace.emit(now, "transition", agent=self.id, **{"from": self.state.value, "to": S.END.value})
-        self.state = S.END
+    def _fire(self, event: str, now: float) -> None:
+        """Fire ``event`` through the FSM table: the table picks the target; traced and reported."""
+        t = fsm.resolve(self.state, event, self._guard)
+        self._trace.emit(now, "transition", agent=self.id, trigger=event,
+                         **{"from": self.state.value, "to": t.target.value})
+        self.state = t.target
+        if t.target is S.END:
+            self.next_wake = math.inf
+        else:
+            self._publish()
+
+    def _end(self, now: float, reason: str, *, cause: str, event: str) -> None:
+        """Every end goes through here: the running stage is stopped (once), then ``event`` leads to ``end``."""
+        self._stop_stage(now, "stopped")
+        self._fire(event, now)
+        if self.state is not S.END:
+            raise FSMError(f"agent {self.id}: event {event!r} did not end the task")
         self.end_reason = reason
-        self.next_wake = math.inf
         self._trace.emit(now, "end", agent=self.id, task_type=self.ctx.task_type, reason=reason, cause=cause)
         self._publish()
+
+    def _fail(self, now: float, exc: BaseException) -> None:
+        """A hook, the core agent or a planner raised: end this task with cause ``error``."""
+        if self.state is S.END:
+            return
+        reason = _describe(exc, self.state)
+        self._stop_stage(now, "failed", reason=reason)
+        self._end(now, reason, cause="error", event="error")
+
+    def _stop_stage(self, now: float, status: str, **extra: Any) -> None:
+        """Stop the running stage, if any: ``core.stop`` at most once a stage, guarded, then its closing event."""
+        runner = self._runner
+        if runner is None or not runner.running or runner.stage is None:
+            return
+        runner.running = False  # first: a stop that raises is never attempted twice
+        if self.core is not None:
+            try:
+                self.core.stop(self.id, runner.stage, now)
+            except _UNCONTAINED:
+                raise
+            except Exception as exc:
+                if status == "failed":
+                    extra["reason"] = f"{extra.get('reason', '')}; then {_describe(exc, self.state)}".lstrip("; ")
+                else:  # a stop that raises during a suspension is the task's error
+                    self._close_stage(now, "failed", reason=_describe(exc, self.state))
+                    raise
+        self._close_stage(now, status, **extra)
+
+    def _close_stage(self, now: float, status: str, **extra: Any) -> None:
+        runner = self._runner
+        assert runner is not None
+        runner.running = False
+        self._stage_event(now, status, **extra)
 
     def _publish(self) -> None:
         """pf^report: write the report buffer; tell the harmoniser only if it changed (newData)."""
@@ -372,6 +484,9 @@ class DynamicAgent:
                          action=stage.action, args=list(stage.args), kind=stage.kind.value, status=status, **extra)
 
     def _emit_plan(self, now: float, plan: StagePlan) -> None:
+        if not isinstance(plan, StagePlan):
+            raise ConfigError(f"task type {self.ctx.task_type!r} returned a {type(plan).__name__} in "
+                              f"{self.state.value}, expected a StagePlan")
         fields: dict[str, Any] = {
             "agent": self.id,
             "purpose": plan.purpose.value,
@@ -392,6 +507,27 @@ class DynamicAgent:
                 f"task type {self.ctx.task_type!r} returned a {plan.purpose.value} plan in {self.state.value}"
             )
         self._trace.emit(now, "plan", **fields)
+
+
+_UNCONTAINED = (InvariantViolation, WorldError)
+"""Exceptions that are not one task's fault: a broken model invariant or a broken world."""
+
+_HERE = __file__
+
+
+def _describe(exc: BaseException, state: FsmState) -> str:
+    """``"<hook>() raised <Type>: <message> (in <state>)"``: where it came from, without file paths.
+
+    The hook is the first frame outside this module, so the reason names the task
+    hook or core-agent method the agent called (``update_task``, ``poll``, ...).
+    """
+    where = None
+    for frame in traceback.extract_tb(exc.__traceback__):
+        if frame.filename != _HERE:
+            where = frame.name
+            break
+    origin = f"{where}() raised " if where else ""
+    return f"{origin}{type(exc).__name__}: {exc} (in {state.value})"
 
 
 def _next_tick_of(now: float, rate: float) -> float:

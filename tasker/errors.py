@@ -55,3 +55,40 @@ class InvariantViolation(TaskerError, AssertionError):
 
 class FSMError(TaskerError, RuntimeError):
     """A transition that the hierarchical FSM of Fig. 5 does not allow was attempted."""
+
+
+class WorldError(TaskerError):
+    """The world (``World.advance`` or ``World.snapshot``) raised: the run cannot go on meaningfully.
+
+    Unlike an exception in one task's hook or skill, which ends only that task, a
+    broken world leaves every task blind; the loop ends every live agent (cause
+    ``error``) and stops the run with a ``run`` event ``{"status": "aborted"}``.
+    """
+
+
+class RunAborted(TaskerError):
+    """A run stopped before its end because something outside the tasks failed.
+
+    ``reason`` says what; ``result`` carries what the run produced so far (the runner
+    puts its partial :class:`~experiments.runner.RunResult` here after writing the trace,
+    ``run.json`` and ``metrics.json``), or ``None`` when raised by the loop itself.
+    The original exception is the ``__cause__``.
+    """
+
+    def __init__(self, reason: str, result: object = None) -> None:
+        self.reason = reason
+        self.result = result
+        super().__init__(f"run aborted: {reason}")
+
+
+class AgentEnded(TaskerError):
+    """An agent ended (a hook raised) while the harmoniser was asking it something (``reqSP``).
+
+    The harmoniser catches it: the agent is no longer a candidate, the schedule is
+    made again without it.
+    """
+
+    def __init__(self, agent: str, reason: str) -> None:
+        self.agent = agent
+        self.reason = reason
+        super().__init__(f"agent {agent} ended: {reason}")

@@ -27,16 +27,20 @@ so that if ``irrDA`` ends meanwhile the suspended agent still leaves ``exeDA``
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any
 
 from tasker.agent import DynamicAgent
-from tasker.errors import ConfigError, InvariantViolation, TaskerError
-from tasker.messages import Command, Flag, FsmState, SPRequest
+from tasker.errors import AgentEnded, ConfigError, InvariantViolation, TaskerError, WorldError
+from tasker.messages import Command, Flag, FsmState, ScheduleParams, SPRequest
 from tasker.schedulers.base import Candidate, Scheduler, ScheduleView
 from tasker.trace import Trace
+
+_TRACED = frozenset({"by", "expected_s", "predicted_s"})
+"""Command data copied into the ``command`` trace event."""
 
 
 class Mode(StrEnum):
@@ -55,6 +59,31 @@ class Request:
     requester: str = "user"
 
 
+@dataclass(frozen=True, slots=True)
+class OscillationGuard:
+    """Hysteresis in the harmoniser: no task becomes ``exeDA`` more than ``count`` times in ``window_s``.
+
+    After the oscillation definition of the TaBSA benchmark: with no new request in
+    between, no task becomes ``exeDA`` a third time within 180 s.  The harmoniser
+    holds back a preemption (the scheduler chose a candidate while an agent
+    executes) when either the candidate or the executing agent has already become
+    ``exeDA`` ``count`` times within the last ``window_s`` seconds: the candidate
+    would be one too many, and the executing agent would have to become ``exeDA``
+    again to finish.  A new request clears the history (it may legitimately
+    preempt again, as in Appendix B).  Starting a task when no agent executes is
+    never held, so nothing starves.  Independent of the scheduler.
+    """
+
+    window_s: float = 180.0
+    count: int = 2
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.window_s, int | float) or not self.window_s >= 0 or math.isinf(self.window_s):
+            raise ConfigError(f"OscillationGuard.window_s must be a number of seconds >= 0, got {self.window_s!r}")
+        if isinstance(self.count, bool) or not isinstance(self.count, int) or self.count < 1:
+            raise ConfigError(f"OscillationGuard.count must be an integer >= 1, got {self.count!r}")
+
+
 AgentFactory = Callable[[str, Request, float, Callable[[DynamicAgent], None]], DynamicAgent]
 
 
@@ -69,12 +98,15 @@ class TaskHarmoniser:
         trace: Trace,
         mode: Mode = Mode.IT,
         s_freq: float = 1.0,
+        guard: OscillationGuard | None = OscillationGuard(),
     ) -> None:
         if not isinstance(s_freq, int | float) or s_freq <= 0:
             raise ConfigError(f"sFreq must be a positive number of Hz, got {s_freq!r}")
         self.scheduler = scheduler
         self.mode = Mode(mode)
         self.s_freq = float(s_freq)
+        self.guard = guard  # None: no oscillation guard
+        self._became: dict[str, list[float]] = {}  # when each agent became exeDA since the last new request
         self._factory = agent_factory
         self._trace = trace
         self.agents: dict[str, DynamicAgent] = {}  # A_da
@@ -168,6 +200,7 @@ class TaskHarmoniser:
             self._trace.emit(now, "request", agent=agent_id, task_type=request.task_type,
                              args=dict(request.args), requester=request.requester)
         self._requests.clear()
+        self._became.clear()  # a new request may legitimately preempt again
         self._roles_dirty = True
 
     def _deliver_terms(self) -> None:
@@ -182,6 +215,7 @@ class TaskHarmoniser:
             self._idle.pop(agent_id, None)
             self._cands.pop(agent_id, None)
             self._susp_seq.pop(agent_id, None)
+            self._became.pop(agent_id, None)
             if self.exe_da == agent_id:
                 self.exe_da = None
             if self.irr_da == agent_id:
@@ -190,22 +224,60 @@ class TaskHarmoniser:
         self._roles_dirty = True
 
     def _pf_schedule(self, now: float) -> None:
-        exe = self._cands.get(self.exe_da) if self.exe_da is not None else None
-        candidates = [c for a in self._idle if (c := self._cands.get(a)) is not None]
-        if not candidates:
+        """``pf_schedule`` (eq. 35), contained: a scheduler that raises is recorded and changes nothing."""
+        name = self.scheduler.name
+        for _ in range(len(self._idle) + 2):  # each retry follows an agent that ended while asked
+            exe = self._cands.get(self.exe_da) if self.exe_da is not None else None
+            candidates = [c for a in self._idle if (c := self._cands.get(a)) is not None]
+            if not candidates:
+                return
+            view = ScheduleView(now=now, exe=exe, candidates=candidates, req_sp=self._req_sp, fresh=self._fresh)
+            try:
+                decision = self.scheduler.schedule(view)
+            except AgentEnded:
+                self._remove_ended()  # no longer a candidate (or no longer executing): decide again
+                continue
+            except (InvariantViolation, WorldError):
+                raise
+            except Exception as exc:
+                self._trace.emit(now, "decision", algorithm=name, rule="error", switch=False,
+                                 error=f"{type(exc).__name__}: {exc}")
+                return
+            break
+        else:
             return
-        view = ScheduleView(now=now, exe=exe, candidates=candidates, req_sp=self._req_sp)
-        decision = self.scheduler.schedule(view)
-        if decision.record is not None:
-            self._trace.emit(now, "decision", **decision.record)
-        if decision.irr_da is not None:
-            if decision.irr_da not in self._idle:
-                raise InvariantViolation(
-                    f"scheduler {self.scheduler.name!r} chose {decision.irr_da!r}, which is not idle"
-                )
-            del self._idle[decision.irr_da]
-            self.irr_da = decision.irr_da
+        choice = decision.irr_da
+        if choice is not None and choice not in self._idle:
+            self._trace.emit(now, "decision", algorithm=name, rule="error", switch=False,
+                             error=f"the scheduler chose {choice!r}, which is not idle; idle: {list(self._idle)}")
+            return
+        record = decision.record
+        if choice is not None and record is None:  # every choice leaves a decision, whatever the scheduler
+            record = {"algorithm": name, "dac": choice, "exeDA": exe.id if exe is not None else None,
+                      "rule": "no exeDA" if exe is None else "choice", "switch": True}
+        if choice is not None and exe is not None and record is not None:
+            held = self._held(choice, exe.id, now)
+            if held is not None:
+                record = {**record, "switch": False, "held": held}
+                choice = None
+        if record is not None:
+            self._trace.emit(now, "decision", **record)
+        if choice is not None:
+            del self._idle[choice]
+            self.irr_da = choice
             self._roles_dirty = True
+
+    def _held(self, dac: str, exe: str, now: float) -> dict[str, Any] | None:
+        """The oscillation guard: why a preemption of ``exe`` by ``dac`` is held back, or None."""
+        guard = self.guard
+        if guard is None:
+            return None
+        for agent in (dac, exe):
+            recent = [t for t in self._became.get(agent, ()) if now - t < guard.window_s]
+            if len(recent) >= guard.count:
+                return {"guard": "oscillation", "agent": agent, "became_exeDA": recent,
+                        "window_s": guard.window_s, "count": guard.count}
+        return None
 
     def _pf_switch_da(self, now: float) -> None:
         """Alg. 1."""
@@ -227,31 +299,63 @@ class TaskHarmoniser:
             if self._in_cmd:
                 raise InvariantViolation(f"about to start {self.irr_da} while {sorted(self._in_cmd)} is in cmd")
             self.exe_da, self.irr_da = self.irr_da, None  # lines 10-11
-            self._send(self.exe_da, Flag.START)  # line 12
+            self._became.setdefault(self.exe_da, []).append(now)
+            self._send(self.exe_da, Flag.START, self._start_data(self.exe_da))  # line 12
             self._roles_dirty = True
 
     # -- agents' side -----------------------------------------------------------------------
 
     def _send(self, agent_id: str, flag: Flag, data: Mapping[str, Any] | None = None) -> int:
         self._seq += 1
-        self._trace.emit(self.now, "command", agent=agent_id, flag=flag.value)
+        fields = {k: v for k, v in (data or {}).items() if k in _TRACED}
+        self._trace.emit(self.now, "command", agent=agent_id, flag=flag.value, **fields)
         self.agents[agent_id].deliver(Command(flag, self._seq, dict(data or {})))
         return self._seq
 
-    def _susp_data(self, replacement: str) -> dict[str, Any]:
-        """``data`` of a ``susp``: who takes over and how long it is expected to take (its cTime).
+    def _start_data(self, agent_id: str) -> dict[str, Any]:
+        """``data`` of a ``start``: the cTime the agent last reported, as ``predicted_s``."""
+        c_time = self._c_time(agent_id)
+        return {} if c_time is None else {"predicted_s": c_time}
 
-        A task's suspension may depend on it (a cooker left on for a short interruption).
+    def _c_time(self, agent_id: str) -> float | None:
+        cand = self._cands.get(agent_id)
+        c_time = getattr(cand.params, "c_time", None) if cand is not None else None
+        return float(c_time) if isinstance(c_time, int | float) else None
+
+    def _susp_data(self, replacement: str) -> dict[str, Any]:
+        """``data`` of a ``susp``: who takes over (``by``) and how long the interruption is expected to last.
+
+        ``expected_s`` is estimated from the queue: the replacement's cTime, plus the
+        cTime of every waiting agent the scheduler ranks ahead of the suspended one
+        (:meth:`Scheduler.queue_key`): they run before it resumes.  Still a lower
+        bound (later requests, suspensions and re-planning are not foreseen).  A
+        task's suspension may depend on it (a cooker left on for a short interruption).
         """
         data: dict[str, Any] = {"by": replacement}
-        cand = self._cands.get(replacement)
-        c_time = getattr(cand.params, "c_time", None) if cand is not None else None
-        if c_time is not None:
-            data["expected_s"] = c_time
+        c_time = self._c_time(replacement)
+        if c_time is None:
+            return data
+        ahead = 0.0
+        exe = self._cands.get(self.exe_da) if self.exe_da is not None else None
+        if exe is not None:
+            try:
+                mine = self.scheduler.queue_key(exe)
+                for agent in self._idle:
+                    cand = self._cands.get(agent)
+                    other = self._c_time(agent)
+                    if cand is not None and other is not None and math.isfinite(other) \
+                            and self.scheduler.queue_key(cand) < mine:
+                        ahead += other
+            except Exception:  # a queue key the parameters do not support: the replacement alone
+                ahead = 0.0
+        data["expected_s"] = c_time + ahead
         return data
 
     def _req_sp(self, agent_id: str, request: SPRequest) -> Any:
         return self.agents[agent_id].request_sp(request, self.now)
+
+    def _fresh(self, agent_id: str) -> ScheduleParams | None:
+        return self.agents[agent_id].fresh_params(self.now)
 
     def _on_report(self, agent: DynamicAgent) -> None:
         """A report buffer changed (newData, eq. 37)."""

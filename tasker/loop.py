@@ -24,7 +24,7 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 from tasker.agent import DynamicAgent, Rates
-from tasker.errors import ConfigError
+from tasker.errors import ConfigError, RunAborted, WorldError
 from tasker.harmoniser import Mode, Request, TaskHarmoniser
 from tasker.protocols import CoreAgent, World
 from tasker.schedulers.base import Scheduler
@@ -80,6 +80,7 @@ class SimulationLoop:
         self._pending_events = 0
         self._tokens: dict[str, int] = {}
         self._started = False
+        self.aborted: str | None = None  # why the run was aborted, if it was
         self.all_agents: list[DynamicAgent] = []  # every agent created, ended ones included
 
     # -- time ---------------------------------------------------------------------------------
@@ -134,12 +135,43 @@ class SimulationLoop:
             core=self.core,
             motion=self.motion,
         )
-        world = self.world.snapshot if self.world is not None else None
+        world = self._snapshot if self.world is not None else None
         agent = DynamicAgent(agent_id, task, ctx, trace=self.trace, rates=self.rates, core=self.core,
                              world=world, on_report=on_report, waker=self._wake_next_tick)
         self._wake(agent, self._tick + 1)
         self.all_agents.append(agent)
         return agent
+
+    def _snapshot(self) -> Any:
+        """The world's snapshot for a hook; a world that raises stops the run (:class:`WorldError`)."""
+        assert self.world is not None
+        try:
+            return self.world.snapshot()
+        except Exception as exc:
+            raise WorldError(f"World.snapshot raised {type(exc).__name__}: {exc}") from exc
+
+    def _advance_world(self, now: float) -> None:
+        assert self.world is not None
+        try:
+            self.world.advance(now)
+        except Exception as exc:
+            raise WorldError(f"World.advance raised {type(exc).__name__}: {exc}") from exc
+
+    def _abort(self, exc: BaseException) -> RunAborted:
+        """End every live agent (cause ``error``), close the trace with ``run`` ``aborted``; never lose it."""
+        reason = str(exc) if isinstance(exc, WorldError) else f"{type(exc).__name__}: {exc}"
+        now = self.now
+        self.aborted = reason
+        live = [a for a in self.all_agents if not a.ended]
+        for agent in live:
+            if not agent.ended:
+                try:
+                    agent.abort(now, f"run aborted: {reason}")
+                except Exception:  # ending the others matters more than this one's report
+                    pass
+        self.trace.emit(now, "run", status="aborted", reason=reason, active=sorted(a.id for a in live))
+        self._heap.clear()
+        return RunAborted(reason)
 
     def _wake(self, agent: DynamicAgent, tick: int) -> None:
         token = self._tokens.get(agent.id, 0) + 1
@@ -172,9 +204,21 @@ class SimulationLoop:
         """Run until every request is served and every agent has ended, or until ``until``.
 
         Returns the trace.  Stops at ``horizon`` with a ``run`` event saying so.
+        A task's exceptions end only that task (the agent contains them); anything
+        else that raises (the world, a scheduled event, a broken invariant) ends
+        every live agent with cause ``error``, writes ``run`` ``{"status":
+        "aborted"}`` and raises :class:`~tasker.errors.RunAborted` from it.
         """
+        if self.aborted is not None:
+            raise RunAborted(self.aborted)
         if not self._started:
             self._start()
+        try:
+            return self._run(until)
+        except Exception as exc:
+            raise self._abort(exc) from exc
+
+    def _run(self, until: float | None) -> Trace:
         stop_tick = self._to_tick(until) if until is not None else None
         horizon_tick = self._to_tick(self.horizon)
         harm = self.harmoniser
@@ -207,7 +251,7 @@ class SimulationLoop:
                     item()
                 elif phase == _WORLD:
                     assert self.world is not None
-                    self.world.advance(now)
+                    self._advance_world(now)
                     self._push(tick + max(1, round(1.0 / (self.world.rate_hz * self.resolution))), _WORLD, None)
                 else:
                     timer = True

@@ -18,6 +18,13 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any
 
+from tasker.fsm import FsmState
+
+__all__ = [
+    "SP_COMPLETION", "Command", "CompletionCost", "CostParams", "Flag", "FsmState", "Report", "SPRequest",
+    "ScheduleParams",
+]
+
 
 class Flag(StrEnum):
     """``triggerFlag`` of the command buffer (eq. 14)."""
@@ -25,41 +32,6 @@ class Flag(StrEnum):
     START = "start"
     SUSP = "susp"
     TERM = "term"
-
-
-class FsmState(StrEnum):
-    """Leaf states of the dynamic agent's hierarchical FSM (Fig. 5)."""
-
-    INIT_COMM = "initComm"
-    COMP_SP = "compSP"
-    UP_TSK = "upTsk"
-    EXE_TSK = "exeTsk"
-    GEN_SUSP = "genSusp"
-    EXE_SUSP = "exeSusp"
-    WAIT = "wait"
-    END = "end"
-
-    @property
-    def superstate(self) -> str:
-        """The top-level state of Fig. 5a that holds this leaf: ``init``, ``cmd``, ``wait`` or ``end``."""
-        return _SUPER[self]
-
-    @property
-    def in_cmd(self) -> bool:
-        """True for the leaves of ``cmd``: the agent commands the robot (at most one may)."""
-        return _SUPER[self] == "cmd"
-
-
-_SUPER = {
-    FsmState.INIT_COMM: "init",
-    FsmState.COMP_SP: "init",
-    FsmState.UP_TSK: "cmd",
-    FsmState.EXE_TSK: "cmd",
-    FsmState.GEN_SUSP: "cmd",
-    FsmState.EXE_SUSP: "cmd",
-    FsmState.WAIT: "wait",
-    FsmState.END: "end",
-}
 
 
 @dataclass(frozen=True, slots=True)

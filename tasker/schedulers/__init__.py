@@ -28,6 +28,10 @@ _BUILTIN = {
     "sjf": "tasker.schedulers.sjf:ShortestJobFirst",
     "srtf": "tasker.schedulers.srtf:ShortestRemainingTimeFirst",
     "edf": "tasker.schedulers.edf:EarliestDeadlineFirst",
+    "simple": "tasker.schedulers.simple:LongestFirst",
+    "simple2": "tasker.schedulers.simple2:ShortestFirst",
+    "distance": "tasker.schedulers.distance:DistanceOverDuration",
+    "lookahead": "tasker.schedulers.lookahead:LookAhead",
 }
 _registry: dict[str, str | Callable[..., Scheduler]] = dict(_BUILTIN)
 _entry_points_loaded = False

@@ -13,14 +13,24 @@ The paper's algorithm has two classes, ``humanFell`` above ``guideHuman``:
       c_wait   = cost_exeDA + cc_dac + cps_dac * cTime_exeDA
 
   and the switch is made when ``c_switch < hysteresis * c_wait`` (the paper: 1.0;
-  the original ROS code used 0.9);
+  the original ROS code used 0.9); both agents' ``cost``, ``cps`` and ``cTime`` are
+  computed afresh at the decision's moment (``ScheduleView.params_now``), and so are
+  the ``reqSP`` answers, so the comparison never mixes reports of different ticks;
+* a non-finite ``c_switch`` or ``c_wait`` (an infeasible task reports ``cost = inf``)
+  never switches: the comparison is recorded with ``undecided: "non-finite"``; a
+  candidate of a higher class whose cost is infinite does not preempt either;
 * an executing agent of a higher class is never preempted.
 
 Generalisation: ``classes`` is a list of lists of task-type names, highest first;
 types not listed form one implicit class below all others.  The paper's Alg. 2
 reads ``exeDA``'s parameters in lines 22-26 even when no agent executes; here an
 empty ``exeDA`` means the candidate is started directly, as lines 9-12 do for
-``humanFell``.
+``humanFell`` (recorded as a decision with ``rule: "no exeDA"``).  In the paper only
+the top class (``humanFell``) preempts without a cost comparison; a ``guideHuman``
+candidate is compared on cost with any executing task that is not ``humanFell``
+(lines 16-17).  Here any higher class preempts at once (``rule: "priority class"``):
+with more than two classes, "more urgent class first" is the point of having
+classes; ``docs/model.md`` states the departure.
 """
 
 from __future__ import annotations
@@ -30,7 +40,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from tasker.errors import ConfigError
-from tasker.messages import SP_COMPLETION, CompletionCost, SPRequest
+from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, ScheduleParams, SPRequest
 from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, ScheduleView
 
 DEFAULT_CLASSES: tuple[tuple[str, ...], ...] = (("human_fell",), ("guide_human",))
@@ -67,36 +77,44 @@ class Alg2(Scheduler):
         """Priority class of a task type: 0 is the highest."""
         return self._rank.get(task_type, self._lowest)
 
+    def queue_key(self, c: Candidate) -> tuple[int, float, int]:
+        """Lowest (class, reported cost, request order) first: the order Alg. 2 picks ``dac`` in."""
+        return (self.rank(c.task_type), self.cost_params(c, self.name).cost, c.order)
+
     def schedule(self, view: ScheduleView) -> Decision:
         best: Candidate | None = None
         best_key: tuple[int, float, int] | None = None
-        for c in view.candidates:  # one pass: lowest (class, cost, request order)
-            p = self.cost_params(c, self.name)
-            key = (self.rank(c.task_type), p.cost, c.order)
+        for c in view.candidates:  # one pass: lowest (class, cost, request order), lines 3-4
+            key = (self._rank.get(c.task_type, self._lowest), self.cost_params(c, self.name).cost, c.order)
             if best_key is None or key < best_key:
                 best, best_key = c, key
         if best is None or best_key is None:
             return NO_CHANGE
         exe = view.exe
-        if exe is None:
-            return Decision(best.id)
+        if exe is None:  # departure 4 (docs/model.md): start the best candidate, and say so
+            return Decision(best.id, {"algorithm": self.name, "dac": best.id, "exeDA": None, "rule": "no exeDA",
+                                      "cost_dac": best_key[1], "switch": True})
         r_exe = self.rank(exe.task_type)
-        if r_exe > best_key[0]:
-            record = {"algorithm": self.name, "dac": best.id, "exeDA": exe.id, "rule": "priority class",
-                      "switch": True}
-            return Decision(best.id, record)
-        if r_exe < best_key[0]:
+        if r_exe < best_key[0]:  # an executing agent of a higher class is never preempted
             return NO_CHANGE
+        if r_exe > best_key[0]:  # lines 9-12, generalised: a higher class preempts without a cost comparison
+            record: dict[str, Any] = {"algorithm": self.name, "dac": best.id, "exeDA": exe.id,
+                                      "rule": "priority class", "cost_dac": best_key[1]}
+            if not math.isfinite(best_key[1]):  # an infeasible candidate never forces a switch
+                record.update(switch=False, undecided="non-finite cost_dac")
+                return Decision(None, record)
+            record["switch"] = True
+            return Decision(best.id, record)
         return self._compare(view, best, exe)
 
     def _compare(self, view: ScheduleView, dac: Candidate, exe: Candidate) -> Decision:
-        p_dac = self.cost_params(dac, self.name)
-        p_exe = self.cost_params(exe, self.name)
+        """Lines 20-33 with parameters of one moment: both agents compute them at ``view.now``."""
+        p_dac = self._cost(view.params_now(dac), dac)
+        p_exe = self._cost(view.params_now(exe), exe)
         a_dac = self._completion(view, dac, p_exe.end_pose)
         a_exe = self._completion(view, exe, p_dac.end_pose)
         c_switch = p_dac.cost + a_exe.cc + _mul(p_exe.cps, p_dac.c_time)
         c_wait = p_exe.cost + a_dac.cc + _mul(p_dac.cps, p_exe.c_time)
-        switch = bool(c_switch < self.hysteresis * c_wait) if not math.isnan(c_switch + c_wait) else False
         record: dict[str, Any] = {
             "algorithm": self.name, "dac": dac.id, "exeDA": exe.id, "rule": "cost",
             "cost_dac": p_dac.cost, "cost_exeDA": p_exe.cost,
@@ -104,9 +122,21 @@ class Alg2(Scheduler):
             "cTime_dac": p_dac.c_time, "cTime_exeDA": p_exe.c_time,
             "cc_dac": a_dac.cc, "cc_exeDA": a_exe.cc,
             "ccps_dac": a_dac.ccps, "ccps_exeDA": a_exe.ccps,
-            "c_switch": c_switch, "c_wait": c_wait, "hysteresis": self.hysteresis, "switch": switch,
+            "c_switch": c_switch, "c_wait": c_wait, "hysteresis": self.hysteresis,
         }
+        if math.isfinite(c_switch) and math.isfinite(c_wait):
+            switch = bool(c_switch < self.hysteresis * c_wait)
+        else:  # inf (or NaN) on either side: the comparison says nothing, so the executing task stays
+            switch = False
+            record["undecided"] = "non-finite"
+        record["switch"] = switch
         return Decision(dac.id if switch else None, record)
+
+    def _cost(self, params: ScheduleParams, c: Candidate) -> CostParams:
+        if not isinstance(params, CostParams):
+            raise ConfigError(f"scheduler {self.name!r} needs CostParams from task type {c.task_type!r} "
+                              f"(agent {c.id}), got {type(params).__name__}")
+        return params
 
     @staticmethod
     def _completion(view: ScheduleView, c: Candidate, pose: Any) -> CompletionCost:

@@ -32,13 +32,30 @@ class ScheduleView:
     """Read-only input of ``pf_schedule``.
 
     ``exe`` is the executing agent (``exeDA``) or None; ``candidates`` are the idle
-    agents (``D_r``) whose report is initialised, in request order.
+    agents (``D_r``) whose report is initialised, in request order.  ``req_sp``
+    and ``fresh`` ask an agent now; either raises
+    :class:`~tasker.errors.AgentEnded` if the agent's hook raised (the harmoniser
+    then schedules again without it).
     """
 
     now: float
     exe: Candidate | None
     candidates: Sequence[Candidate]
     req_sp: Callable[[str, SPRequest], Any]
+    fresh: Callable[[str], ScheduleParams | None] | None = None
+
+    def params_now(self, c: Candidate) -> ScheduleParams:
+        """``c``'s parameters computed by its agent at :attr:`now` (``compute_params``).
+
+        Reports arrive at each agent's own rate, so two candidates' reports may be
+        from different ticks; a scheduler that compares two agents asks both for
+        parameters of this moment.  Without ``fresh`` (a unit test's view) or when
+        the task type has none, the reported parameters are returned.
+        """
+        if self.fresh is None:
+            return c.params
+        params = self.fresh(c.id)
+        return c.params if params is None else params
 
 
 @dataclass(frozen=True, slots=True)
@@ -64,6 +81,15 @@ class Scheduler:
 
     def schedule(self, view: ScheduleView) -> Decision:
         raise NotImplementedError
+
+    def queue_key(self, c: Candidate) -> tuple[Any, ...]:
+        """Where ``c`` stands in this scheduler's queue: lower runs first.
+
+        The harmoniser uses it to estimate how long a suspended task will wait (the
+        ``expected_s`` of ``susp``): the tasks ranked ahead of it run before it
+        resumes.  Default: request order.
+        """
+        return (c.order,)
 
     @staticmethod
     def cost_params(c: Candidate, algorithm: str) -> CostParams:

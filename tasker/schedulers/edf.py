@@ -18,10 +18,13 @@ class EarliestDeadlineFirst(Scheduler):
         d = self.cost_params(c, self.name).deadline
         return math.inf if d is None else d
 
+    def queue_key(self, c: Candidate) -> tuple[float, int]:
+        return (self.deadline(c), c.order)
+
     def schedule(self, view: ScheduleView) -> Decision:
         if not view.candidates:
             return NO_CHANGE
-        best = min(view.candidates, key=lambda c: (self.deadline(c), c.order))
+        best = min(view.candidates, key=self.queue_key)
         if view.exe is None:
             return Decision(best.id)
         d_dac, d_exe = self.deadline(best), self.deadline(view.exe)

@@ -24,10 +24,13 @@ class FixedPriority(Scheduler):
         p = getattr(c.params, "priority", None)
         return p if p is not None else self.priorities.get(c.task_type, self.default)
 
+    def queue_key(self, c: Candidate) -> tuple[int, int]:
+        return (-self.priority(c), c.order)
+
     def schedule(self, view: ScheduleView) -> Decision:
         if not view.candidates:
             return NO_CHANGE
-        best = min(view.candidates, key=lambda c: (-self.priority(c), c.order))
+        best = min(view.candidates, key=self.queue_key)
         if view.exe is None:
             return Decision(best.id)
         p_dac, p_exe = self.priority(best), self.priority(view.exe)

@@ -3,17 +3,20 @@ than what remains of the executing one (its current ``cTime``)."""
 
 from __future__ import annotations
 
-from tasker.schedulers.base import NO_CHANGE, Decision, Scheduler, ScheduleView
+from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, ScheduleView
 
 
 class ShortestRemainingTimeFirst(Scheduler):
     name = "srtf"
     preemptive = True
 
+    def queue_key(self, c: Candidate) -> tuple[float, int]:
+        return (self.cost_params(c, self.name).c_time, c.order)
+
     def schedule(self, view: ScheduleView) -> Decision:
         if not view.candidates:
             return NO_CHANGE
-        best = min(view.candidates, key=lambda c: (self.cost_params(c, self.name).c_time, c.order))
+        best = min(view.candidates, key=self.queue_key)
         if view.exe is None:
             return Decision(best.id)
         t_dac = self.cost_params(best, self.name).c_time

@@ -22,6 +22,7 @@ def test_compute_params(task: PddlTaskType) -> None:
 def test_params_follow_the_plan_once_made(task: PddlTaskType) -> None:
     ctx = make_ctx(task)
     ctx.plan = task.update_task(ctx)
+    ctx.stage_started = ctx.now  # executing: its plan is its plan from the state now
     full = task.compute_params(ctx).c_time
     ctx.stage_index = 1
     assert task.compute_params(ctx).c_time < full

@@ -89,6 +89,22 @@ def test_all_plots(events: list[dict[str, Any]], tmp_path: Path) -> None:
     assert [p.name for p in plots.all_plots(events, tmp_path)] == ["timeline.png", "gantt.png"]
 
 
+def test_world_path_with_trace_and_recording(tmp_path: Path) -> None:
+    from robot.recording import PersonState, Recorder
+
+    rec = Recorder("paper")
+    for k in range(40):
+        rec.record(k * 0.5, (6.0, 1.0 + 0.1 * k, 1.57), [PersonState("sara", 5.4, 3.2, 0.0, "fallen")])
+    rec.mark(10.0, "pan", "put_down", 6.0, 3.0)
+    events = [{"t": 0.0, "event": "request", "agent": "d1", "task_type": "cook"},
+              {"t": 0.0, "event": "roles", "exeDA": "d1"},
+              {"t": 8.0, "event": "command", "agent": "d1", "flag": "susp"},
+              {"t": 9.0, "event": "roles", "exeDA": None},
+              {"t": 19.0, "event": "end", "agent": "d1", "reason": "finished"}]
+    traj = [(s.t, *s.robot) for s in rec.samples]
+    assert is_png(plots.world_path("paper", traj, tmp_path / "w.png", events=events, recording=rec), 10_000)
+
+
 def _lines(ax: Any) -> set[str]:
     return {str(line.get_label()) for line in ax.get_lines() if not str(line.get_label()).startswith("_")}
 

@@ -43,13 +43,13 @@ def test_good_file_loads(tmp_path: Path, change: str, field: str | None) -> None
 
 
 @pytest.mark.parametrize("old, new, message", [
-    ('t = 0.0', 't = "soon"', "requests[0].t: expected float"),
-    ('t = 0.0', 't = -1.0', "requests[0].t: expected >= 0"),
-    ('scheduler = "alg2"', 'scheduler = "roundrobin"', "settings.scheduler: unknown scheduler 'roundrobin'"),
+    ('t = 0.0', 't = "soon"', "requests[0].t: expected a number"),
+    ('t = 0.0', 't = -1.0', "requests[0].t: expected a number >= 0"),
+    ('scheduler = "alg2"', 'scheduler = "roundrobin"', "settings.scheduler: expected one of"),
     ('scheduler = "alg2"', 'scheduler = "alg2"\nmode = "XT"', "settings.mode: expected one of ['IT', 'CT']"),
     ('scheduler = "alg2"', 'scheduler = "alg2"\nsuspension = "random"', "settings.suspension: expected one of"),
-    ('scheduler = "alg2"', 'scheduler = "alg2"\nrep_rate = 0', "settings.rep_rate: expected a positive number"),
-    ('kind = "robot"', 'kind = "robot"\ncolour = "red"', "colour: unknown field"),
+    ('scheduler = "alg2"', 'scheduler = "alg2"\nrep_rate = 0', "settings.rep_rate: expected a number > 0"),
+    ('kind = "robot"', 'kind = "robot"\ncolour = "red"', "colour: unknown key"),
     ('task = "guide_human"', '', "requests[0].task: missing"),
     ('world = "paper"', 'world = "nowhere.toml"', "world: no world file"),
     ('scheduler = "alg2"', 'scheduler = "alg2"\nscheduler_options = { hysteresis = 3 }', "scheduler_options"),
@@ -67,7 +67,7 @@ def test_bad_world_event_is_named(tmp_path: Path) -> None:
 
 def test_terminating_an_agent_never_requested_is_refused(tmp_path: Path) -> None:
     text = GOOD + '[[terminations]]\nt = 3.0\nagent = "d7"\n'
-    with pytest.raises(ScenarioError, match="agent 'd7' at t=3.0: agents are d1..d1"):
+    with pytest.raises(ScenarioError, match="terminations.0..agent: no agent 'd7'.*agents are d1..d1"):
         scenarios.load(write(tmp_path, text))
 
 

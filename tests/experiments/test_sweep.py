@@ -76,10 +76,11 @@ def test_spec_file_expands_to_jobs(tmp_path: Path) -> None:
     ('scenarios = ["paper"]\nseeds = [1, "2"]\nstrategies = ["default"]', "seeds[1]"),
     ('scenarios = ["paper"]\nseeds = [1, 1]\nstrategies = ["default"]', "seeds: duplicates"),
     ('scenarios = ["paper"]\nseeds = 2\nstrategies = ["update=sometimes"]', "strategies[0]"),
-    ('scenarios = ["paper"]\nseeds = 2\nstrategies = [{update = "static", speed = 2}]', "strategies[0]: unknown field"),
+    ('scenarios = ["paper"]\nseeds = 2\nstrategies = [{update = "static", speed = 2}]',
+     "strategies[0].speed: unknown key"),
     ('scenarios = ["paper"]\nseeds = 2\nstrategies = ["update=static", "update=static"]', "strategies: duplicates"),
-    ('scenarios = ["paper"]\nseeds = 2\nstrategies = []', "strategies: expected a non-empty list"),
-    ('scenarios = ["paper"]\nseeds = 2\nstrategies = ["default"]\nworkers = 3', "workers: unknown field"),
+    ('scenarios = ["paper"]\nseeds = 2\nstrategies = []', "strategies: expected a non-empty array"),
+    ('scenarios = ["paper"]\nseeds = 2\nstrategies = ["default"]\nworkers = 3', "workers: unknown key"),
     ('scenarios = ["paper"\n', "not valid TOML"),
 ])
 def test_bad_spec_names_the_field(tmp_path: Path, body: str, field: str) -> None:

@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-import argparse
 import re
 from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
+from experiments.cli import main
 from planners.checks import DefinitionError, PddlError, load_problem
-from planners.cli import plan_command
 from tests.planners.conftest import DOMAIN, problem_text
 
 Mutation = Callable[[str, str], tuple[str, str]]
@@ -69,8 +68,7 @@ def test_malformed_input_is_refused_with_file_and_line(name: str, tmp_path: Path
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_plan_command_exits_2_without_traceback(name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     d, p, fault, _, _ = _write(tmp_path, name)
-    args = argparse.Namespace(domain=str(d), problem=str(p), planner="tasker-fd", json=False, timeout=10.0)
-    assert plan_command(args) == 2
+    assert main(["plan", str(d), str(p)]) == 2
     out = capsys.readouterr()
     assert fault in out.err and "Traceback" not in out.err + out.out
 

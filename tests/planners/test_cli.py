@@ -1,24 +1,20 @@
-"""``plan``, ``domains`` and ``fsm`` through their handlers and argparse."""
+"""``plan``, ``domains``, ``fsm`` and ``new`` through the ``tasker`` command line."""
 
 from __future__ import annotations
 
-import argparse
 import json
 from pathlib import Path
 
 import pytest
 
+from experiments.cli import main
 from planners.checks import load_problem
-from planners.cli import register
 from planners.validate import validate_plan
 from tests.planners.conftest import DOMAIN, problem_text
 
 
 def _run(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(prog="tasker")
-    register(parser.add_subparsers(dest="command", required=True))
-    args = parser.parse_args(argv)
-    return int(args.func(args))
+    return main(argv)
 
 
 @pytest.mark.parametrize("name", ["depot", "miconic", "safe_road"])
@@ -60,7 +56,7 @@ def test_plan_timeout_exits_1(up_pddl: Path, capsys: pytest.CaptureFixture[str])
 def test_unknown_planner_exits_2(pddl_files: tuple[Path, Path], capsys: pytest.CaptureFixture[str]) -> None:
     assert _run(["plan", *map(str, pddl_files), "--planner", "nope"]) == 2
     err = capsys.readouterr().err
-    assert "unknown planner 'nope'" in err and "tasker-fd" in err
+    assert err.startswith("tasker plan: error: unknown planner 'nope'") and "tasker-fd" in err
 
 
 def test_domains_lists_bundled(capsys: pytest.CaptureFixture[str]) -> None:
@@ -83,4 +79,62 @@ def test_fsm_static_and_unknown_task(capsys: pytest.CaptureFixture[str]) -> None
     assert _run(["fsm", "cook", "--strategy", "static"]) == 0
     assert "(static)" in capsys.readouterr().out
     assert _run(["fsm", "no_such_task"]) == 2
-    assert "unknown task type 'no_such_task'" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "unknown task type 'no_such_task'" in err and "--path DIR or TASKER_TASKS" in err
+    assert _run(["fsm", "guide_humn"]) == 2
+    assert "did you mean 'guide_human'?" in capsys.readouterr().err
+
+
+def test_plan_with_another_planner_prints_no_warnings(pddl_files: tuple[Path, Path],
+                                                      capfd: pytest.CaptureFixture[str]) -> None:
+    assert _run(["plan", *map(str, pddl_files), "--planner", "fast-downward-opt"]) == 0
+    out, err = capfd.readouterr()
+    assert "cost 6" in out and err == "" and "Warning" not in out
+
+
+def test_plan_warm_cache_skips_the_reader_and_gives_the_same_plan(
+        pddl_files: tuple[Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setenv("TASKER_CACHE", str(tmp_path / "cache"))
+    assert _run(["plan", *map(str, pddl_files), "--json"]) == 0
+    cold = json.loads(capsys.readouterr().out)
+    import planners.checks
+
+    def no_reader(*_: object) -> None:
+        raise AssertionError("a checked problem is not read again")
+
+    monkeypatch.setattr(planners.checks, "load_problem", no_reader)
+    assert _run(["plan", *map(str, pddl_files), "--json"]) == 0
+    warm = json.loads(capsys.readouterr().out)
+    assert warm["plan"] == cold["plan"] and warm["cost"] == cold["cost"]
+    Path(pddl_files[1]).write_text(Path(pddl_files[1]).read_text() + "\n; changed\n")
+    assert _run(["plan", *map(str, pddl_files), "--json"]) == 3  # new content: checked again (here: our stub)
+    assert "not read again" in capsys.readouterr().err
+
+
+def test_new_check_plan_run_as_a_new_user_would(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    folder = tmp_path / "fetch"
+    assert _run(["new", "fetch", str(folder)]) == 0
+    assert {p.name for p in folder.iterdir()} == {"domain.pddl", "task.toml", "problem.pddl", "scenario.toml"}
+    toml = (folder / "task.toml").read_text()
+    for key in ("planning_time_s", "timeout_s", "suspended_facts", "min_interruption_s", "travel_s", "[example]",
+                "Sections added by later parts of tasker"):
+        assert key in toml
+    assert _run(["check", str(folder)]) == 0
+    assert "0 problems" in capsys.readouterr().out
+    assert _run(["plan", str(folder / "domain.pddl"), str(folder / "problem.pddl"), "--path", str(folder)]) == 0
+    out = capsys.readouterr().out
+    assert "(pick robot vase kitchen)" in out and "skill=manipulate" in out
+    assert _run(["domains", "--path", str(folder)]) == 0
+    assert "fetch(item, destination?)" in capsys.readouterr().out
+    assert _run(["fsm", "fetch", "--path", str(folder), "--purpose", "genSusp", "--after", "2"]) == 0
+    assert "put_down" in capsys.readouterr().out
+
+
+def test_new_refuses_a_bad_name_and_a_full_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert _run(["new", "Bad-Name", str(tmp_path / "a")]) == 2
+    assert "argument TASK" in capsys.readouterr().err and not (tmp_path / "a").exists()
+    (tmp_path / "b").mkdir()
+    (tmp_path / "b" / "keep.txt").write_text("mine")
+    assert _run(["new", "ok", str(tmp_path / "b")]) == 2
+    assert "argument DIR" in capsys.readouterr().err and (tmp_path / "b" / "keep.txt").read_text() == "mine"

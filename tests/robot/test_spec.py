@@ -39,7 +39,7 @@ BASE = 'bounds = [[0, 0], [5, 5]]\n[robot]\npose = [1, 1, 0]\n'
     (BASE + '[furniture.sofa]\nbox = [2, 2, 1, 3]\n', "furniture.sofa.box"),
     (BASE + '[doors.d]\nbox = [1, 1, 2, 2]\nopen = "yes"\n', "doors.d.open"),
     (BASE + '[places]\nk = [1, 1, 0]\n[devices.cooker]\nplace = "kitchen"\n', "devices.cooker.place"),
-    (BASE + 'colour = 3\n', "colour: unknown field"),
+    (BASE + 'colour = 3\n', "robot.colour: unknown key"),
     ('[robot]\npose = [1, 1, 0]\n', "bounds: missing"),
     ('bounds = [[0, 0], [5, 5]]\n[robot]\npose = [1, 1]\n', "robot.pose"),
 ])
@@ -48,15 +48,16 @@ def test_bad_world_file_names_the_field(tmp_path: Path, text: str, field: str) -
     f.write_text(text)
     with pytest.raises(WorldFileError) as err:
         load_world(f)
-    assert str(err.value).startswith("bad.toml: ")
+    assert str(err.value).startswith(str(f))
     assert field in str(err.value)
+    assert err.value.field and err.value.field in field
     assert isinstance(err.value, TaskerError)
 
 
 def test_invalid_toml_and_unknown_names(tmp_path: Path) -> None:
     f = tmp_path / "broken.toml"
     f.write_text("bounds = [[0, 0], [5, 5]\n")
-    with pytest.raises(WorldFileError, match="broken.toml: not valid TOML"):
+    with pytest.raises(WorldFileError, match="broken.toml:2: not valid TOML"):
         load_world(f)
     with pytest.raises(WorldFileError, match="shipped: .*paper"):
         load_world("no_such_world")

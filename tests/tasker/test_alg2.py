@@ -102,8 +102,46 @@ def test_lowest_cost_of_the_highest_class_is_the_candidate() -> None:
 def test_no_executing_agent_starts_best_candidate_without_comparing() -> None:
     g1 = cand("d1", "guide_human", cost=10, cps=1, c_time=1, pose=(0.0, 0.0, 0.0))
     g2 = cand("d2", "guide_human", cost=5, cps=1, c_time=1, pose=(0.0, 0.0, 0.0), order=1)
-    d = schedulers.create("alg2").schedule(view(None, [g1, g2], Answers({})))
-    assert d.irr_da == "d2" and d.record is None
+    ans = Answers({})
+    d = schedulers.create("alg2").schedule(view(None, [g1, g2], ans))
+    assert d.irr_da == "d2" and ans.asked == []  # no reqSP: nothing to compare with
+    assert d.record is not None and d.record["rule"] == "no exeDA" and d.record["switch"] is True
+
+
+def test_a_non_finite_estimate_never_forces_a_switch() -> None:
+    inf = float("inf")
+    # the executing task became infeasible (cost inf): c_wait = inf, c_switch finite -- still no switch
+    exe = cand("d1", "t", cost=inf, cps=1, c_time=5, pose=(0.0, 0.0, 0.0))
+    dac = cand("d2", "t", cost=1, cps=1, c_time=1, pose=(0.0, 0.0, 0.0), order=1)
+    d = schedulers.create("alg2").schedule(view(exe, [dac], Answers({"d2": (1.0, 1.0), "d1": (2.0, 1.0)})))
+    assert d.record is not None and d.record["c_wait"] == inf and d.record["c_switch"] < inf
+    assert d.irr_da is None and d.record["switch"] is False and d.record["undecided"] == "non-finite"
+    # a higher-class candidate with an infinite cost does not preempt either
+    low = cand("d1", "guide", cost=5, cps=1, c_time=5, pose=(0.0, 0.0, 0.0))
+    fell = cand("d2", "fell", cost=inf, cps=1, c_time=1, pose=(0.0, 0.0, 0.0), order=1)
+    s = schedulers.create("alg2", classes=[["fell"], ["guide"]])
+    d = s.schedule(view(low, [fell], Answers({})))
+    assert d.irr_da is None and d.record is not None and d.record["rule"] == "priority class"
+    assert d.record["switch"] is False
+
+
+def test_the_comparison_uses_parameters_of_one_moment() -> None:
+    """Reports of different ticks are not mixed: both agents compute their parameters at the view's now."""
+    exe = cand("d1", "t", cost=50, cps=2, c_time=30, pose=(1.0, 1.0, 0.0))
+    dac = cand("d2", "t", cost=20, cps=1, c_time=10, pose=(5.0, 5.0, 0.0), order=1)
+    now = {"d1": CostParams("t", cost=80, cps=2, c_time=30, end_pose=(1.0, 1.0, 0.0)),
+           "d2": CostParams("t", cost=20, cps=1, c_time=10, end_pose=(5.0, 5.0, 0.0))}
+    asked: list[str] = []
+
+    def fresh(agent: str) -> CostParams:
+        asked.append(agent)
+        return now[agent]
+
+    v = ScheduleView(10.0, exe, [dac], Answers({"d2": (25.0, 1.0), "d1": (55.0, 2.0)}), fresh=fresh)
+    d = schedulers.create("alg2").schedule(v)
+    assert sorted(asked) == ["d1", "d2"]
+    assert d.record is not None and d.record["cost_exeDA"] == 80  # the fresh value, not the report's 50
+    assert d.record["c_wait"] == pytest.approx(80 + 25 + 1 * 30)
 
 
 def test_infinite_cost_never_wins_and_zero_times_inf_is_zero() -> None:

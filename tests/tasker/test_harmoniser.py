@@ -231,8 +231,8 @@ def test_plan_purpose_is_checked() -> None:
 
     loop = make_loop([Wrong("w", [st("x", 1)])])
     loop.request(0.0, "w")
-    with pytest.raises(Exception, match="returned a genSusp plan in upTsk"):
-        loop.run()
+    end = loop.run().of("end", agent="d1")[0]  # a task type's mistake ends that task, not the run
+    assert end["cause"] == "error" and "returned a genSusp plan in upTsk" in end["reason"]
 
 
 def test_replacement_ending_while_exe_suspends_does_not_strand_it() -> None:
@@ -245,3 +245,31 @@ def test_replacement_ending_while_exe_suspends_does_not_strand_it() -> None:
     tr = loop.run()
     assert ("exeSusp", "wait") in transitions(tr, "d1") and ("wait", "upTsk") in transitions(tr, "d1")
     assert tr.of("end", agent="d1")[0]["reason"] == "finished"
+
+
+def test_expected_interruption_counts_the_queue_ahead_of_the_suspended_task() -> None:
+    """susp's expected_s = the replacement's cTime + cTime of waiting tasks ranked ahead of the suspended one."""
+    tasks = [guide("guide"), SyntheticTask("short", [st("s", 5)]), SyntheticTask("fell", [st("check", 2)])]
+    loop = make_loop(tasks, classes=[["fell"], ["guide", "short"]], hysteresis=0.5)
+    loop.request(0.0, "guide")  # d1: 19 s of stages
+    loop.request(1.0, "short")  # d2: cheaper than d1 (ranked ahead), but not enough to switch with h = 0.5
+    loop.request(3.0, "fell")  # d3: a higher class preempts d1
+    tr = loop.run()
+    start = first(tr.events, event="command", agent="d1", flag="start")
+    assert start["predicted_s"] == pytest.approx(19.0)
+    assert not [e for e in tr.of("decision") if e.get("dac") == "d2" and e["switch"] and e["t"] < 3.0]
+    susp = first(tr.events, event="command", agent="d1", flag="susp")
+    assert susp["by"] == "d3" and susp["expected_s"] == pytest.approx(2.0 + 5.0)
+    assert first(tr.events, event="command", agent="d3", flag="start")["predicted_s"] == pytest.approx(2.0)
+
+
+def test_a_choice_with_no_executing_agent_leaves_a_decision() -> None:
+    loop = make_loop([guide("a"), guide("b")], scheduler="fifo")
+    loop.request(0.0, "a")
+    loop.request(0.0, "b")
+    tr = loop.run()
+    starts = tr.of("command", flag="start")
+    decisions = [e for e in tr.of("decision") if e["switch"]]
+    assert [(d["dac"], d["exeDA"], d["rule"]) for d in decisions] == [("d1", None, "no exeDA"),
+                                                                      ("d2", None, "no exeDA")]
+    assert [d["t"] for d in decisions] == [s["t"] for s in starts]

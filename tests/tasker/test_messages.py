@@ -87,3 +87,29 @@ def test_fsm_allows_only_the_transitions_of_fig5() -> None:
         fsm.check(FsmState.INIT_COMM, FsmState.UP_TSK)
     assert [s.superstate for s in FsmState] == ["init", "init", "cmd", "cmd", "cmd", "cmd", "wait", "end"]
     assert "state susp {" in fsm.to_mermaid()
+
+
+def test_one_table_drives_states_checks_and_diagrams() -> None:
+    # the hierarchy, the checks and both diagrams come from fsm.PARENT and fsm.TRANSITIONS
+    assert {s: s.superstate for s in FsmState} == {s: fsm._top(s) for s in FsmState}
+    assert [s for s in FsmState if s.in_cmd] == [s for s in FsmState if fsm._top(s) == "cmd"]
+    mermaid, dot = fsm.to_mermaid(), fsm.to_dot()
+    for t in fsm.TRANSITIONS:
+        fsm.check(t.source, t.target)
+        if t.event != "error":
+            assert f"{t.source.value} --> {t.target.value} : {t.event}" in mermaid
+            assert f'"{t.source.value}" -> "{t.target.value}" [label="{t.event}' in dot
+    assert "state susp {" in mermaid and "subgraph cluster_susp {" in dot
+    assert "--> end : error" in fsm.to_mermaid(errors=True) and "error" not in mermaid
+
+
+def test_events_resolve_through_guards() -> None:
+    S = FsmState
+    t = fsm.resolve(S.EXE_SUSP, "finished", lambda g: g == "terminating")
+    assert t.target is S.END
+    assert fsm.resolve(S.EXE_SUSP, "finished", lambda g: g == "not_terminating").target is S.WAIT
+    with pytest.raises(FSMError, match=r"no event 'start' in exeTsk; it accepts \['suspend', 'finished'"):
+        fsm.resolve(S.EXE_TSK, "start", lambda g: True)
+    with pytest.raises(FSMError, match="no guard holds"):
+        fsm.resolve(S.UP_TSK, "planned", lambda g: False)
+    assert set(fsm.GUARDS) == {"has_stages", "no_stages", "terminating", "not_terminating"}

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from robot import roadmap
-from robot.planner import BasePlanner, DriveLimits, profile_time
+from robot.motion import BasePlanner, DriveLimits, profile_time
 from robot.scene import Scene
 from robot.tiago import RobotCollision, robot_dimensions
 from tasker.world import UNREACHABLE, MotionModel
@@ -102,3 +102,40 @@ def test_people_block_and_cache_follows_the_scene(paper) -> None:
 def test_drive_limits_reject_nonsense() -> None:
     with pytest.raises(ValueError, match="v_max"):
         DriveLimits(v_max=0)
+
+
+def test_estimate_to_a_person_is_to_the_pose_navigation_drives_to(paper) -> None:
+    from robot.motion import APPROACH, motion_model
+
+    motion = motion_model(paper)
+    scene = motion.planner.scene
+    scene.set_person("sara", 9.3, 0.5, "fallen")  # lying against the bathroom's south wall
+    start = paper.places["hall"]
+    est = motion.estimate(start, (9.3, 0.5, 0.0))
+    goal, via_approach = motion.approach(start, "sara")
+    assert est.reachable and math.isfinite(est.time_s)  # the centre itself is in collision
+    assert goal is not None and est == via_approach and est.end_pose == goal
+    assert math.dist(goal[:2], (9.3, 0.5)) == pytest.approx(APPROACH)
+
+
+def test_travel_matrix_in_one_call(paper) -> None:
+    from robot.motion import travel_matrix
+    from tasker.errors import UnknownName
+
+    m = travel_matrix(paper, ["hall", "kitchen", "john", (6.0, 2.0)], seed=1)
+    assert m.labels == ("hall", "kitchen", "john", "6,2") and m.time_s.shape == (4, 4)
+    assert (np.diag(m.time_s) == 0).all() and np.isfinite(m.time_s).all()
+    assert m.to_json()["labels"] == list(m.labels)
+    with pytest.raises(UnknownName, match="kitchen"):
+        travel_matrix(paper, ["hall", "kitchn"])
+
+
+def test_table_is_one_search_per_source(paper) -> None:
+    from robot.motion import motion_model
+
+    motion = motion_model(paper)
+    poses = [paper.places[n] for n in sorted(paper.places)]
+    before = motion.planner.searches
+    table = motion.table(poses)
+    assert motion.planner.searches - before <= 2 * len(poses)  # door layer, and people where they are in the way
+    assert table[0, 1] == motion.estimate(poses[0], poses[1]).time_s

@@ -1,0 +1,309 @@
+"""Protocol metrics of simulated days, and the table that compares schedulers over many days.
+
+:func:`day_metrics` reads one day's trace (never the model) and returns the TaBSA-like
+metrics — tasks completed per type, completion minus deadline, falls that died,
+interruptions per type and per task, oscillation, how the day ended — plus ours:
+suspensions (interruptions that needed an ``exeSusp``), time spent suspending,
+switches, and for whole-queue schedulers the longest queue ordered and the decisions
+whose search hit its budget.  Abandonment and travel distance need the robot's path (robot backend) and
+are not computed here.
+
+:func:`run_days` runs N days x schedulers in local processes and :func:`table` writes the
+Markdown table with 95 % confidence intervals and paired comparisons of ``lookahead``
+against each baseline (Wilcoxon signed-rank over days, Holm-corrected)::
+
+    python -m experiments.dayreport --protocol experiments/protocols/tabsa.toml --days 100 \\
+        --schedulers lookahead alg2 simple simple2 distance --out out/day
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Iterable, Mapping, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy import stats
+
+from experiments import protocol as protocols
+from tasker.trace import number
+
+OSCILLATION_SWITCHES = 3
+OSCILLATION_WINDOW_S = 180.0
+ENDINGS = ("all done", "a fall died", "oscillation", "time ran out")
+
+
+# -- one day -----------------------------------------------------------------------------------------
+
+def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = None) -> dict[str, Any]:
+    """The protocol metrics of one day's trace (see the module docstring and ``docs/benchmark.md``).
+
+    ``day_end`` is when the day stops (default: the time of the last event).  A fall is
+    dead when it was not finished by its request's ``death_at`` and that time falls
+    within the day.  A switch to a task is a ``start`` command to its agent; the day
+    oscillates when a task gets its third switch within 180 s of the first of the three.
+    """
+    events = list(events)
+    end_t = day_end if day_end is not None else (events[-1]["t"] if events else 0.0)
+    kind: dict[str, str] = {}
+    args: dict[str, Mapping[str, Any]] = {}
+    finished: dict[str, float] = {}
+    starts: dict[str, list[float]] = {}
+    interruptions: dict[str, int] = {}
+    suspensions = 0
+    suspension_time = 0.0
+    entered: dict[str, float] = {}
+    longest_order = anytime = 0
+    for e in events:
+        ev = e["event"]
+        if ev == "request":
+            kind[e["agent"]], args[e["agent"]] = e["task_type"], e["args"]
+        elif ev == "end" and e.get("cause") == "finished":
+            finished[e["agent"]] = e["t"]
+        elif ev == "command" and e.get("flag") == "start":
+            starts.setdefault(e["agent"], []).append(e["t"])
+        elif ev == "transition":
+            a, to = e["agent"], e["to"]
+            if to == "genSusp":
+                interruptions[a] = interruptions.get(a, 0) + 1
+                entered[a] = e["t"]
+            elif e["from"] == "exeSusp" or (e["from"] == "genSusp" and to != "exeSusp"):
+                suspension_time += e["t"] - entered.pop(a, e["t"])
+        elif ev == "plan" and e.get("purpose") == "genSusp" and e.get("stages"):
+            suspensions += 1
+        elif ev == "decision" and "order" in e:  # whole-queue decisions (lookahead)
+            longest_order = max(longest_order, len(e["order"]))
+            anytime += e.get("rule") == "anytime"
+    types = sorted(set(kind.values()))
+    per_type: dict[str, dict[str, Any]] = {}
+    dead: list[float] = []
+    for t in types:
+        agents = [a for a in kind if kind[a] == t]
+        done = [a for a in agents if a in finished]
+        gaps = [finished[a] - number(args[a]["deadline"]) for a in done if args[a].get("deadline") is not None]
+        n_int = sum(interruptions.get(a, 0) for a in agents)
+        per_type[t] = {"requested": len(agents), "completed": len(done),
+                       "completion_minus_deadline_s": _mean(gaps), "lateness_s": sum(max(0.0, g) for g in gaps),
+                       "late": sum(1 for g in gaps if g > 0), "interruptions": n_int,
+                       "interruptions_per_task": n_int / len(agents) if agents else None}
+        for a in agents:
+            death = args[a].get("death_at")
+            if death is not None and number(death) <= end_t and finished.get(a, math.inf) > number(death):
+                dead.append(number(death))
+    oscillation = _oscillation(starts)
+    first_death = min(dead) if dead else None
+    stops = [(first_death, "a fall died"), (oscillation, "oscillation")]
+    stops_at = [(t, why) for t, why in stops if t is not None]
+    if stops_at:
+        ending = min(stops_at)[1]
+    else:
+        ending = "all done" if len(finished) == len(kind) else "time ran out"
+    all_gaps = [finished[a] - number(args[a]["deadline"]) for a in finished if args[a].get("deadline") is not None]
+    return {
+        "requested": len(kind), "completed": len(finished),
+        "completion_minus_deadline_s": _mean(all_gaps), "lateness_s": sum(max(0.0, g) for g in all_gaps),
+        "dead_falls": len(dead), "first_death_t": first_death,
+        "interruptions": sum(interruptions.values()), "suspensions": suspensions,
+        "suspension_time_s": suspension_time, "switches": sum(len(v) for v in starts.values()),
+        "oscillation_t": oscillation, "ending": ending, "per_type": per_type,
+        "longest_order": longest_order, "anytime_decisions": anytime,
+    }
+
+
+def _mean(values: Sequence[float]) -> float | None:
+    return sum(values) / len(values) if values else None
+
+
+def _oscillation(starts: Mapping[str, list[float]]) -> float | None:
+    """Earliest time a task got its third switch within the window, or None."""
+    k = OSCILLATION_SWITCHES - 1
+    hits = [ts[i + k] for ts in starts.values() for i in range(len(ts) - k)
+            if ts[i + k] - ts[i] <= OSCILLATION_WINDOW_S]
+    return min(hits) if hits else None
+
+
+# -- many days -----------------------------------------------------------------------------------------
+
+def scheduler_options(proto: protocols.Protocol, name: str) -> dict[str, Any]:
+    """Options each scheduler gets from the protocol: what it can know of the day's task types."""
+    if name == "alg2":  # priority classes, highest first
+        prios = sorted({s.priority for s in proto.tasks.values()}, reverse=True)
+        return {"classes": [[k for k, s in proto.tasks.items() if s.priority == p] for p in prios]}
+    if name == "lookahead":
+        budgets = {k: s.death_after_s for k, s in proto.tasks.items() if s.death_after_s is not None}
+        penalty = max((s.suspend_s for s in proto.tasks.values()), default=0.0) + proto.planning_time_s
+        return {"switch_penalty_s": penalty, "budgets": budgets}
+    return {}
+
+
+def run_day(protocol_path: str, seed: int, scheduler: str) -> dict[str, Any]:
+    """One day under one scheduler: its metrics (a top-level function, so processes can run it)."""
+    proto = protocols.load(protocol_path)
+    loop = protocols.build_day(proto, seed, scheduler, scheduler_options(proto, scheduler))
+    trace = loop.run()
+    return {"scheduler": scheduler, "seed": seed, **day_metrics(trace.events, day_end=proto.length_s)}
+
+
+def run_days(protocol_path: str | Path, days: int, names: Sequence[str], *, first_seed: int = 1,
+             workers: int = 2) -> list[dict[str, Any]]:
+    """Every (day, scheduler) pair, in ``workers`` local processes; results sorted by scheduler then seed."""
+    protocols.load(protocol_path)  # a bad protocol fails here, once, with its file and line
+    jobs = [(str(protocol_path), seed, name) for name in names for seed in range(first_seed, first_seed + days)]
+    if workers <= 1:
+        results = [run_day(*j) for j in jobs]
+    else:
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            results = list(pool.map(run_day, *zip(*jobs, strict=True), chunksize=8))
+    order = {n: k for k, n in enumerate(names)}
+    return sorted(results, key=lambda r: (order[r["scheduler"]], r["seed"]))
+
+
+# -- the table -------------------------------------------------------------------------------------------
+
+def _ci(values: Sequence[float]) -> tuple[float, float]:
+    """Mean and the half-width of its 95 % t confidence interval."""
+    x = np.asarray(values, dtype=float)
+    if len(x) < 2:
+        return float(x.mean()) if len(x) else math.nan, math.nan
+    half = float(stats.t.ppf(0.975, len(x) - 1) * x.std(ddof=1) / math.sqrt(len(x)))
+    return float(x.mean()), half
+
+
+def _fmt(mean: float, half: float) -> str:
+    if math.isnan(mean):
+        return "–"
+    return f"{mean:.2f} ± {half:.2f}" if not math.isnan(half) else f"{mean:.2f}"
+
+
+def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
+    rows: list[tuple[str, str, Any]] = [
+        ("completed (of requested)", "completed", lambda r: r["completed"]),
+        *((f"completed: {t}", f"completed_{t}", lambda r, t=t: r["per_type"].get(t, {}).get("completed", 0))
+          for t in types),
+        ("completion − deadline, mean (s)", "gap", lambda r: r["completion_minus_deadline_s"]),
+        ("lateness, sum over tasks (s)", "lateness", lambda r: r["lateness_s"]),
+        *((f"completion − deadline: {t} (s)", f"gap_{t}",
+           lambda r, t=t: r["per_type"].get(t, {}).get("completion_minus_deadline_s")) for t in types),
+        ("dead falls", "dead", lambda r: r["dead_falls"]),
+        ("interruptions", "interruptions", lambda r: r["interruptions"]),
+        *((f"interruptions per task: {t}", f"int_{t}",
+           lambda r, t=t: r["per_type"].get(t, {}).get("interruptions_per_task")) for t in types),
+        ("suspensions with exeSusp (ours)", "suspensions", lambda r: r["suspensions"]),
+        ("time suspending (s, ours)", "susp_time", lambda r: r["suspension_time_s"]),
+        ("switches (ours)", "switches", lambda r: r["switches"]),
+        ("longest queue ordered (lookahead)", "longest", lambda r: r["longest_order"] or None),
+        ("decisions not proven optimal (lookahead)", "anytime", lambda r: r["anytime_decisions"] if r["longest_order"]
+         else None),
+    ]
+    return rows
+
+
+PAIRED = ("dead", "lateness", "gap", "completed", "interruptions")
+
+
+def holm(pvalues: Sequence[float]) -> list[float]:
+    """Holm–Bonferroni adjusted p-values, in the input order."""
+    m = len(pvalues)
+    order = sorted(range(m), key=lambda i: pvalues[i])
+    out = [0.0] * m
+    running = 0.0
+    for rank, i in enumerate(order):
+        running = max(running, min(1.0, (m - rank) * pvalues[i]))
+        out[i] = running
+    return out
+
+
+def _wilcoxon(diff: np.ndarray) -> float:
+    if len(diff) == 0 or np.all(diff == 0):
+        return 1.0
+    return float(stats.wilcoxon(diff, zero_method="zsplit").pvalue)
+
+
+def table(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead", title: str = "") -> str:
+    """The Markdown report: metrics per scheduler (mean ± 95 % CI over days), endings, paired tests."""
+    names = list(dict.fromkeys(r["scheduler"] for r in results))
+    by = {n: [r for r in results if r["scheduler"] == n] for n in names}
+    types = sorted({t for r in results for t in r["per_type"]})
+    rows = _metric_rows(types)
+    days = len(by[names[0]]) if names else 0
+    out = [f"## {title}" if title else "", f"{days} days per scheduler; mean ± half-width of the 95 % CI over days.",
+           "", "| metric | " + " | ".join(names) + " |", "|---|" + "---|" * len(names)]
+    for label, _, get in rows:
+        cells = []
+        for n in names:
+            vals = [v for v in (get(r) for r in by[n]) if v is not None]
+            cells.append(_fmt(*_ci(vals)) if vals else "–")
+        out.append(f"| {label} | " + " | ".join(cells) + " |")
+    out += ["", "How the days ended (TaBSA's first stopping condition; the day is run to its end):", "",
+            "| ending | " + " | ".join(names) + " |", "|---|" + "---|" * len(names)]
+    for ending in ENDINGS:
+        out.append(f"| {ending} | " + " | ".join(str(sum(1 for r in by[n] if r["ending"] == ending)) for n in names)
+                   + " |")
+    if reference in by and len(names) > 1:
+        out += ["", f"Paired over days: {reference} − baseline (mean ± 95 % CI; negative is fewer/earlier); "
+                "Wilcoxon signed-rank, Holm-corrected over every test in this table.", "",
+                "| metric | baseline | difference | p (Holm) |", "|---|---|---|---|"]
+        tests = []
+        getters = {key: (label, get) for label, key, get in rows}
+        for key in PAIRED:
+            label, get = getters[key]
+            for n in names:
+                if n == reference:
+                    continue
+                ref = {r["seed"]: get(r) for r in by[reference]}
+                pairs = [(ref[r["seed"]], get(r)) for r in by[n] if ref.get(r["seed"]) is not None
+                         and get(r) is not None]
+                diff = np.array([a - b for a, b in pairs], dtype=float)
+                tests.append((label, n, diff, _wilcoxon(diff)))
+        adjusted = holm([p for *_, p in tests])
+        for (label, n, diff, _), p in zip(tests, adjusted, strict=True):
+            out.append(f"| {label} | {n} | {_fmt(*_ci(list(diff)))} | {p:.3g} |")
+    return "\n".join(line for line in out if line is not None).lstrip("\n") + "\n"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m experiments.dayreport", description=__doc__.splitlines()[0])
+    ap.add_argument("--protocol", default="experiments/protocols/tabsa.toml")
+    ap.add_argument("--days", type=int, default=100)
+    ap.add_argument("--first-seed", type=int, default=1)
+    ap.add_argument("--schedulers", nargs="+", default=["lookahead", "alg2", "simple", "simple2", "distance"])
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--out", required=True, type=Path)
+    a = ap.parse_args(argv)
+    from tasker import schedulers
+    from tasker.errors import TaskerError
+
+    unknown = [n for n in a.schedulers if n not in schedulers.names()]
+    if unknown:
+        from tasker.reader import suggest
+
+        print(f"error: unknown scheduler {unknown[0]!r}{suggest(unknown[0], schedulers.names())}; "
+              f"known: {', '.join(schedulers.names())}", file=sys.stderr)
+        return 2
+    if a.days < 1:
+        print(f"error: --days: expected >= 1, got {a.days}", file=sys.stderr)
+        return 2
+    try:
+        results = run_days(a.protocol, a.days, a.schedulers, first_seed=a.first_seed, workers=a.workers)
+    except TaskerError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    a.out.mkdir(parents=True, exist_ok=True)
+    with (a.out / "days.jsonl").open("w", encoding="utf-8") as f:
+        for r in results:
+            f.write(json.dumps(r, sort_keys=True) + "\n")
+    cmd = (f"python -m experiments.dayreport --protocol {a.protocol} --days {a.days} --first-seed {a.first_seed} "
+           f"--schedulers {' '.join(a.schedulers)} --out {a.out}")
+    text = table(results, title=f"{Path(a.protocol).stem}: seeds {a.first_seed}–{a.first_seed + a.days - 1}")
+    (a.out / "table.md").write_text(text + f"\nGenerated by `{cmd}`.\n", encoding="utf-8")
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

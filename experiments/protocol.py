@@ -1,0 +1,331 @@
+"""Day protocols (TaBSA-like) and a seeded generator of synthetic days.
+
+A protocol file (``experiments/protocols/tabsa.toml``, documented in ``docs/benchmark.md``)
+says how a day is drawn: its length and step, the robot's speed, the apartment's sites,
+the arrival process, and for each task type (transport, fall, pick_place) how many a day,
+priority, cost weight, deadline window and stage durations.  :func:`load` reads it with
+the strict reader; :func:`generate` draws one day from a seed and returns it as a
+:class:`experiments.synthetic.SyntheticScenario` — the one scenario representation the
+synthetic backend runs (:func:`experiments.synthetic.run`).
+
+The day's task types are :class:`DayTask`, synthetic tasks whose stages are built from
+each request's arguments and from where the robot is: a motion stage lasts the distance
+over the speed of whoever sets the pace (the robot, or the person it escorts).  Each
+request records its ``deadline`` and, for a fall, ``death_at`` (deadline +
+``death_after_s``), so the metrics can judge from the trace alone.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from experiments import synthetic
+from experiments.actions import TimedAction
+from experiments.synthetic import SyntheticScenario
+from tasker.agent import Rates
+from tasker.loop import SimulationLoop
+from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
+from tasker.reader import Table
+from tasker.reader import load as read_table
+from tasker.stage import Purpose, Stage, StageKind, StagePlan
+from tasker.synthetic import SyntheticTask
+from tasker.task import ArgSpec, TaskContext
+
+Pose = tuple[float, ...]
+KINDS = ("transport", "fall", "pick_place")
+SUSP, BLOCK = StageKind.SUSPENDABLE, StageKind.BLOCKING
+_RESUME_STAGES = ("go_back", "apologise", "pick_again")
+
+
+@dataclass(frozen=True)
+class TaskSpec:
+    """One task type of a protocol.  Durations in seconds, speeds in m/s; pairs are uniform ranges."""
+
+    kind: str
+    count: int
+    priority: int
+    weight: float
+    deadline_s: tuple[float, float]
+    person_speed: tuple[float, float] = (0.0, 0.0)
+    work_s: tuple[float, float] = (0.0, 0.0)
+    greet_s: float = 0.0
+    goodbye_s: float = 0.0
+    pick_s: float = 0.0
+    place_s: float = 0.0
+    suspend_s: float = 0.0
+    resume_s: float = 0.0
+    death_after_s: float | None = None
+
+
+@dataclass(frozen=True)
+class Protocol:
+    """A checked day protocol."""
+
+    name: str
+    source: str
+    start: str
+    length_s: float
+    step_s: float
+    robot_speed: float
+    start_site: str
+    planning_time_s: float
+    sites: dict[str, Pose]
+    last_call_s: float
+    tasks: dict[str, TaskSpec]
+
+    @property
+    def death_after_s(self) -> float | None:
+        return self.tasks["fall"].death_after_s if "fall" in self.tasks else None
+
+
+# -- reading ---------------------------------------------------------------------------------------
+
+def _range(t: Table, key: str, *, positive: bool = False) -> tuple[float, float]:
+    value = t.raw(key)
+    if not (isinstance(value, list) and len(value) == 2 and all(isinstance(v, int | float) and not isinstance(v, bool)
+                                                               for v in value)):
+        raise t.error(key, f"expected a range [low, high] of two numbers, got {value!r}")
+    low, high = float(value[0]), float(value[1])
+    if low > high:
+        raise t.error(key, f"expected low <= high, got [{low:g}, {high:g}]")
+    if low < 0 or (positive and low <= 0):
+        raise t.error(key, f"expected numbers {'> 0' if positive else '>= 0'}, got [{low:g}, {high:g}]")
+    return low, high
+
+
+def _pose(t: Table, key: str, value: Any) -> Pose:
+    if not (isinstance(value, list) and len(value) == 2 and all(isinstance(v, int | float) and not isinstance(v, bool)
+                                                               for v in value)):
+        raise t.error(key, f"expected a site [x, y] in metres, got {value!r}")
+    return float(value[0]), float(value[1])
+
+
+def _task(t: Table, kind: str) -> TaskSpec:
+    common: dict[str, Any] = dict(
+        kind=kind, count=t.number("count", integer=True, min=0), priority=t.number("priority", integer=True),
+        weight=t.number("weight", min=0), deadline_s=_range(t, "deadline_s"),
+    )
+    if kind == "transport":
+        spec = TaskSpec(**common, person_speed=_range(t, "person_speed", positive=True),
+                        greet_s=t.number("greet_s", min=0), goodbye_s=t.number("goodbye_s", min=0),
+                        suspend_s=t.number("suspend_s", min=0), resume_s=t.number("resume_s", min=0))
+    elif kind == "fall":
+        spec = TaskSpec(**common, work_s=_range(t, "work_s"), death_after_s=t.number("death_after_s", min=0))
+    else:
+        spec = TaskSpec(**common, pick_s=t.number("pick_s", min=0), place_s=t.number("place_s", min=0),
+                        suspend_s=t.number("suspend_s", min=0), resume_s=t.number("resume_s", min=0))
+    t.done()
+    return spec
+
+
+def load(path: str | Path) -> Protocol:
+    """Read and check a protocol file; every fault names the file, line and field."""
+    top = read_table(path)
+    top.string("name")
+    day, robot, apartment = top.table("day"), top.table("robot"), top.table("apartment")
+    arrivals, tasks_t = top.table("arrivals"), top.table("tasks")
+    length = day.number("length_s", positive=True)
+    step = day.number("step_s", positive=True)
+    start = day.string("start", "00:00")
+    day.done()
+    sites_t = apartment.table("sites")
+    sites = {name: _pose(sites_t, name, v) for name, v in sites_t.items()}
+    if len(sites) < 2:
+        raise sites_t.error(None, f"expected at least two sites (tasks go from one to another), got {len(sites)}")
+    apartment.done()
+    speed = robot.number("speed", positive=True)
+    start_site = robot.name("start_site", sites, "site")
+    planning = robot.number("planning_time_s", 0.0, min=0)
+    robot.done()
+    arrivals.string("process", "uniform", choices=("uniform",))
+    last_call = arrivals.number("last_call_s", length, positive=True, max=length)
+    arrivals.done()
+    tasks: dict[str, TaskSpec] = {}
+    for kind in tasks_t.keys():
+        if kind not in KINDS:
+            from tasker.reader import suggest
+
+            raise tasks_t.error(kind, f"unknown task type {kind!r}{suggest(kind, KINDS)} (known: {', '.join(KINDS)})")
+        tasks[kind] = _task(tasks_t.table(kind), kind)
+    if not tasks:
+        raise tasks_t.error(None, f"expected at least one of {', '.join(KINDS)}")
+    tasks_t.done()
+    top.done()
+    return Protocol(name=top.data["name"], source=str(path), start=start, length_s=length, step_s=step,
+                    robot_speed=speed, start_site=start_site, planning_time_s=planning, sites=sites,
+                    last_call_s=last_call, tasks=tasks)
+
+
+# -- the day's task types --------------------------------------------------------------------------
+
+def _dist(a: Pose | None, b: Pose | None) -> float:
+    if a is None or b is None:
+        return 0.0
+    return math.hypot(a[0] - b[0], a[1] - b[1])
+
+
+def _move(action: str, target: Pose, speed: float, origin: Pose | None = None) -> Stage:
+    """A motion stage; ``origin`` set means the motion has a fixed start (escort, carry)."""
+    return Stage(action, kind=SUSP, duration=0.0 if origin is None else _dist(origin, target) / speed,
+                 skill="timed", data={"site": target, "from": origin, "speed": speed})
+
+
+class DayTask(SyntheticTask):
+    """A protocol task type; its stages come from the request (site, dest, work, walk speed).
+
+    ``transport``: go to the person, greet (blocking), escort at the person's pace to
+    ``dest``, goodbye (blocking); suspended while escorting, the robot asks the person to
+    wait (blocking) and apologises on return.  ``fall``: go to the person, help for
+    ``work`` seconds (blocking: not interruptible).  ``pick_place``: go to the object,
+    pick (blocking), carry to ``dest``, place (blocking); suspended while carrying, the
+    robot puts the object down and picks it up again on return.
+
+    A stopped motion stage restarts from its origin (the synthetic executor does not
+    track partial motion), after the robot has travelled back there: progress lost to
+    an interruption is a real cost here, as is the travel.
+    """
+
+    def __init__(self, spec: TaskSpec, robot_speed: float, planning_time: float) -> None:
+        super().__init__(spec.kind, [Stage("placeholder")], weight=spec.weight, speed=robot_speed,
+                         planning_time=planning_time)
+        self.spec = spec
+        self.description = f"protocol task {spec.kind!r}"
+        self.arg_specs = (*self.arg_specs,
+                          ArgSpec("dest", "pose", required=False, help="where the person or object goes"),
+                          ArgSpec("work", "float", required=False, default=0.0, help="seconds of work on site"),
+                          ArgSpec("walk_speed", "float", required=False, default=robot_speed,
+                                  help="pace of the escorted person (m/s)"),
+                          ArgSpec("death_at", "float", required=False,
+                                  help="time the person is dead if not helped (falls; for metrics)"))
+
+    # -- stages -------------------------------------------------------------------------------------
+    def _template(self, args: dict[str, Any]) -> list[Stage]:
+        s, site, dest = self.spec, args["site"], args["dest"]
+        go = _move("go_to", site, self.speed)
+        if s.kind == "transport":
+            return [go, Stage("greet", kind=BLOCK, duration=s.greet_s),
+                    _move("escort", dest, args["walk_speed"], site), Stage("goodbye", kind=BLOCK, duration=s.goodbye_s)]
+        if s.kind == "fall":
+            return [go, Stage("help", kind=BLOCK, duration=args["work"])]
+        return [go, Stage("pick", kind=BLOCK, duration=s.pick_s), _move("carry", dest, self.speed, site),
+                Stage("place", kind=BLOCK, duration=s.place_s)]
+
+    def _build(self, ctx: TaskContext, start: Pose | None, resume: bool) -> list[Stage]:
+        rest = list(ctx.remaining) if ctx.plan is not None else self._template(ctx.args)
+        rest = [st for st in rest if st.action not in _RESUME_STAGES]  # an unfinished resume is rebuilt below
+        out: list[Stage] = []
+        pose = start
+        first = rest[0] if rest else None
+        if resume and first is not None and first.data.get("from") is not None:
+            origin = first.data["from"]
+            out.append(Stage("go_back", kind=SUSP, duration=_dist(pose, origin) / self.speed, skill="timed",
+                             data={"site": origin, "from": None, "speed": self.speed}))
+            pose = origin
+            if self.spec.resume_s:
+                action = "apologise" if self.spec.kind == "transport" else "pick_again"
+                out.append(Stage(action, kind=BLOCK, duration=self.spec.resume_s))
+        for st in rest:
+            if "speed" in st.data:
+                origin = st.data["from"]
+                d = _dist(pose if origin is None else origin, st.data["site"]) / st.data["speed"]
+                st = Stage(st.action, kind=st.kind, duration=d, skill="timed", data=st.data)
+                pose = st.data["site"]
+            out.append(st)
+        return out
+
+    def update_task(self, ctx: TaskContext) -> StagePlan:
+        ctx.memory["waiting"] = False
+        stages = self._build(ctx, self._robot_pose(ctx), resume=ctx.suspended)
+        return StagePlan(tuple(stages), Purpose.UP_TSK, strategy="static", sim_time=self.planning_time)
+
+    def generate_suspension(self, ctx: TaskContext) -> StagePlan:
+        ctx.memory["waiting"] = True
+        stopped = ctx.interrupted
+        stages: tuple[Stage, ...] = ()
+        if stopped is not None and stopped.data.get("from") is not None and self.spec.suspend_s:
+            action = "ask_to_wait" if self.spec.kind == "transport" else "put_down"
+            stages = (Stage(action, kind=BLOCK, duration=self.spec.suspend_s),)
+        return StagePlan(stages, Purpose.GEN_SUSP, strategy="static", sim_time=self.planning_time)
+
+    # -- estimates ----------------------------------------------------------------------------------
+    def _c_time(self, ctx: TaskContext, start: Pose | None) -> float:
+        started = ctx.plan is not None and not ctx.memory.get("waiting", False)
+        if started and start is None:
+            return self._remaining(ctx)  # executing: what is left of the current plan
+        # not started, waiting, or asked "from another pose" (i.e. resumed later): the plan it would build
+        stages = self._build(ctx, start, resume=started or ctx.suspended)
+        return sum(s.duration for s in stages) + self.planning_time
+
+    def _end_pose(self, ctx: TaskContext) -> Pose | None:
+        return ctx.args["dest"] if ctx.args["dest"] is not None else ctx.args["site"]
+
+    def compute_params(self, ctx: TaskContext) -> CostParams:
+        c_time = self._c_time(ctx, None if ctx.plan is not None and not ctx.memory.get("waiting")
+                              else self._robot_pose(ctx))
+        w = ctx.args["weight"]
+        return CostParams(self.name, cost=w * (ctx.age + c_time), cps=w, c_time=c_time, end_pose=self._end_pose(ctx),
+                          deadline=ctx.args["deadline"], priority=ctx.args["priority"])
+
+    def request_sp(self, ctx: TaskContext, request: SPRequest) -> CompletionCost:
+        if request.sp_id != SP_COMPLETION:
+            return super().request_sp(ctx, request)
+        pose = request.args.get("pose")
+        c_time = self._c_time(ctx, tuple(pose) if pose is not None else self._robot_pose(ctx))
+        w = ctx.args["weight"]
+        return CompletionCost(cc=w * (ctx.age + c_time), ccps=w)
+
+
+# -- generating a day ------------------------------------------------------------------------------
+
+def task_types(protocol: Protocol) -> tuple[DayTask, ...]:
+    return tuple(DayTask(spec, protocol.robot_speed, protocol.planning_time_s) for spec in protocol.tasks.values())
+
+
+def generate(protocol: Protocol, seed: int, *, scheduler: str = "alg2",
+             scheduler_options: dict[str, Any] | None = None) -> SyntheticScenario:
+    """One day of ``protocol`` drawn from ``seed``: the same seed gives the same day.
+
+    Each task type draws its own stream (``random.Random(f"{name}:{seed}:{kind}")``),
+    so adding a type to a protocol leaves the other types' draws unchanged.
+    """
+    sites = sorted(protocol.sites)
+    requests: list[tuple[float, int, str, dict[str, Any]]] = []
+    for kind, spec in protocol.tasks.items():
+        rng = random.Random(f"{protocol.name}:{seed}:{kind}")
+        for _ in range(spec.count):
+            call = round(rng.uniform(0.0, protocol.last_call_s), 1)
+            deadline = round(call + rng.uniform(*spec.deadline_s), 1)
+            a, b = rng.sample(sites, 2)
+            args: dict[str, Any] = {"site": list(protocol.sites[a]), "deadline": deadline, "priority": spec.priority,
+                                    "weight": spec.weight}
+            if kind == "transport":
+                args["dest"] = list(protocol.sites[b])
+                args["walk_speed"] = round(rng.uniform(*spec.person_speed), 3)
+            elif kind == "fall":
+                args["work"] = round(rng.uniform(*spec.work_s), 1)
+                assert spec.death_after_s is not None
+                args["death_at"] = round(deadline + spec.death_after_s, 1)
+            else:
+                args["dest"] = list(protocol.sites[b])
+            requests.append((call, len(requests), kind, args))
+    requests.sort(key=lambda r: (r[0], r[1]))
+    actions = tuple(TimedAction(t, "request", {"task": kind, "args": args}) for t, _, kind, args in requests)
+    rate = 1.0 / protocol.step_s
+    return SyntheticScenario(
+        name=f"{protocol.name}-day{seed}", tasks=task_types(protocol), actions=actions, scheduler=scheduler,
+        scheduler_options=dict(scheduler_options or {}), mode="IT", s_freq=rate, rates=Rates(rate, rate, rate),
+        jitter=0.0, seed=seed, horizon=protocol.length_s,
+    )
+
+
+def build_day(protocol: Protocol, seed: int, scheduler: str, scheduler_options: dict[str, Any] | None = None,
+              ) -> SimulationLoop:
+    """A ready-to-run loop for day ``seed`` under ``scheduler``; the robot starts at ``start_site``."""
+    scn = generate(protocol, seed, scheduler=scheduler, scheduler_options=scheduler_options)
+    loop = synthetic.build(scn, seed=seed)
+    loop.core.pose = protocol.sites[protocol.start_site]  # type: ignore[union-attr]  # the TimedExecutor
+    return loop

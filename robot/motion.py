@@ -1,0 +1,534 @@
+"""Base path planning and motion-cost estimates over the roadmap.
+
+:class:`BasePlanner` answers "how does the base get from here to there" on the
+:class:`~robot.roadmap.Roadmap` grown once by OMPL:
+
+1. start and goal are linked to their nearest visible roadmap nodes (exact tests,
+   people standing at the start or goal are ignored: the robot is beside them);
+2. if nothing dynamic (closed door, person) blocks a roadmap edge, the best route is
+   a look-up in the all-pairs table; otherwise a Dijkstra search (scipy) runs on the
+   roadmap less its blocked edges;
+3. the route is shortened: the shortest chain of mutually visible route points.
+
+:class:`MotionEstimator` implements :class:`tasker.world.MotionModel`: time comes from
+:class:`DriveLimits` with the same stop–turn–drive profile the controller executes
+(:mod:`robot.control`), so estimates match what MuJoCo takes.
+
+**Caching.**  Results are cached by (start, goal, ``Scene.version``).  The version
+changes whenever a door opens or closes or a person moves or changes posture, so a
+cached answer can never describe a scene that no longer exists; the roadmap itself
+covers only walls and furniture and never needs rebuilding.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import OrderedDict
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from robot.roadmap import Roadmap, heading, path_length
+from robot.scene import Disc, Scene, point_box_distance, point_segment_distance, segments_clear
+from robot.spec import RobotSpec, WorldSpec
+from tasker.world import UNREACHABLE, MotionEstimate, Pose
+
+Point = tuple[float, float]
+
+
+def wrap(angle: float) -> float:
+    """An angle brought into [-pi, pi)."""
+    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+
+def profile_time(distance: float, v_max: float, accel: float) -> float:
+    """Time to cover ``distance`` from rest to rest with a trapezoidal speed profile."""
+    distance = abs(distance)
+    if distance * accel >= v_max * v_max:
+        return distance / v_max + v_max / accel
+    return 2.0 * math.sqrt(distance / accel)
+
+
+@dataclass(frozen=True, slots=True)
+class DriveLimits:
+    """Speed and acceleration limits of the base (m/s, rad/s, m/s², rad/s²)."""
+
+    v_max: float = 0.5
+    w_max: float = 1.0
+    accel: float = 0.5
+    turn_accel: float = 2.0
+    turn_tolerance: float = 0.02  # radians: a turn smaller than this is skipped
+
+    def __post_init__(self) -> None:
+        for name in ("v_max", "w_max", "accel", "turn_accel"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"DriveLimits.{name} must be > 0, got {getattr(self, name)}")
+
+    @classmethod
+    def of(cls, robot: RobotSpec) -> DriveLimits:
+        return cls(robot.max_speed, robot.max_turn, robot.max_accel, robot.max_turn_accel)
+
+    def turn_time(self, angle: float) -> float:
+        angle = abs(wrap(angle))
+        return 0.0 if angle < self.turn_tolerance else profile_time(angle, self.w_max, self.turn_accel)
+
+    def drive_time(self, distance: float) -> float:
+        return profile_time(distance, self.v_max, self.accel) if distance > 1e-6 else 0.0
+
+    def travel_time(self, path: list[Point], start_yaw: float, goal_yaw: float | None) -> float:
+        """Stop, turn toward the next point, drive to it; at the end turn to ``goal_yaw``."""
+        t, yaw = 0.0, start_yaw
+        for a, b in zip(path, path[1:], strict=False):
+            d = math.hypot(b[0] - a[0], b[1] - a[1])
+            if d < 1e-6:
+                continue
+            h = heading(a, b)
+            t += self.turn_time(h - yaw) + self.drive_time(d)
+            yaw = h
+        if goal_yaw is not None:
+            t += self.turn_time(goal_yaw - yaw)
+        return t
+
+
+Layer = tuple[tuple[str, ...], tuple[Disc, ...]]  # closed doors, people in the way
+RING = 16  # milestones around a person in the way
+SNAP_STEP = 0.01  # metres between the rings searched for a free start
+SNAP_REACH = 0.6  # metres: a start deeper in collision than this is not snapped
+
+
+class BasePlanner:
+    """Collision-free paths for the disc robot in ``scene``, from the world's roadmap.
+
+    A query ``plan(start, goal)`` is answered in layers, each cached by exactly what it
+    depends on, so a change in the scene invalidates only what it can affect:
+
+    1. the **door layer** (walls, furniture, closed doors): a Dijkstra tree from the
+       start over the roadmap less the edges closed doors block, cached by
+       (start, closed doors); the goal is linked to it, the route shortened;
+    2. if that path is clear of people, it is the answer (people only add constraints,
+       so it is still the shortest);
+    3. otherwise the **people layer**: the roadmap less the edges people block, plus a
+       ring of milestones around each person in the way (so the path hugs them), searched
+       from the start and cached by (start, closed doors, people in the way).
+
+    A start in collision (braked next to a door jamb, pushed against a wall) is snapped
+    to the nearest free point first; the path then starts with that short move.
+    """
+
+    def __init__(self, spec: WorldSpec, scene: Scene, seed: int = 1, milestones: int | None = None,
+                 cache_size: int = 4096) -> None:
+        self.scene = scene
+        self.roadmap = Roadmap.for_world(spec, scene, seed, milestones)
+        self._cache: OrderedDict[tuple[object, ...], tuple[Point, ...] | None] = OrderedDict()
+        self._cache_size = cache_size
+        self._door_masks: dict[tuple[str, ...], np.ndarray] = {}
+        self._disc_masks: OrderedDict[Disc, np.ndarray] = OrderedDict()
+        self._rings: OrderedDict[tuple[Disc, tuple[str, ...]], tuple[np.ndarray, np.ndarray]] = OrderedDict()
+        self._trees: OrderedDict[tuple[object, ...], tuple[np.ndarray, np.ndarray, np.ndarray]] = OrderedDict()
+        self.searches = 0  # Dijkstra runs so far (benchmarks and tests read it)
+        self._boxes_key: tuple[str, ...] | None = None
+        self._all_boxes = np.zeros((0, 4))
+
+    # ---- the scene, by layer -----------------------------------------------------------
+    def _doors(self) -> tuple[str, ...]:
+        return tuple(n for n, o in sorted(self.scene.door_open.items()) if not o)
+
+    def _boxes(self) -> np.ndarray:
+        """Walls, furniture and closed doors as one array (cached per set of closed doors)."""
+        doors = self._doors()
+        if self._boxes_key != doors:
+            self._boxes_key = doors
+            self._all_boxes = np.vstack([self.scene.static, self.scene.closed_doors()])
+        return self._all_boxes
+
+    def _free_segments(self, a: np.ndarray, b: np.ndarray, discs: tuple[Disc, ...]) -> np.ndarray:
+        """Which segments are clear of the bounds, walls, furniture, closed doors and ``discs``."""
+        scene, r = self.scene, self.scene.radius
+        a, b = np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2)
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        ok = (lo[:, 0] >= scene.xmin + r) & (hi[:, 0] <= scene.xmax - r) & (lo[:, 1] >= scene.ymin + r)
+        ok &= hi[:, 1] <= scene.ymax - r
+        ok &= segments_clear(a, b, self._boxes(), r)
+        if discs and ok.any():
+            px, py = np.array([d.x for d in discs]), np.array([d.y for d in discs])
+            rr = np.array([d.r for d in discs]) + r
+            ok &= (point_segment_distance(px, py, a, b) >= rr[None, :]).all(axis=1)
+        return ok
+
+    def _free_points(self, pts: np.ndarray, discs: tuple[Disc, ...]) -> np.ndarray:
+        scene, r = self.scene, self.scene.radius
+        x, y = pts[:, 0], pts[:, 1]
+        ok = (x >= scene.xmin + r) & (x <= scene.xmax - r) & (y >= scene.ymin + r) & (y <= scene.ymax - r)
+        if len(scene.static):
+            ok &= point_box_distance(x, y, scene.static).min(axis=1) >= r
+        if len(scene.closed_doors()):
+            ok &= point_box_distance(x, y, scene.closed_doors()).min(axis=1) >= r
+        for d in discs:
+            ok &= np.hypot(x - d.x, y - d.y) >= d.r + r
+        return ok
+
+    def _door_mask(self, doors: tuple[str, ...]) -> np.ndarray:
+        if doors not in self._door_masks:
+            boxes = np.array([self.scene.door_boxes[n] for n in doors], dtype=float).reshape(-1, 4)
+            self._door_masks[doors] = self.roadmap.box_blocked(boxes, self.scene.radius)
+        return self._door_masks[doors]
+
+    def _disc_mask(self, d: Disc) -> np.ndarray:
+        if d not in self._disc_masks:
+            self._disc_masks[d] = self.roadmap.disc_blocked(d.x, d.y, d.r + self.scene.radius)
+            if len(self._disc_masks) > 256:
+                self._disc_masks.popitem(last=False)
+        return self._disc_masks[d]
+
+    def _ring(self, d: Disc, doors: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """Milestones around person ``d`` and their edges (ring-local index, roadmap node or
+        ``-1 - ring index``), clear of walls, furniture and closed doors."""
+        key = (d, doors)
+        if key not in self._rings:
+            radius = (d.r + self.scene.radius) / math.cos(math.pi / RING) + 0.005
+            ang = 2 * math.pi * np.arange(RING) / RING
+            pts = np.stack([d.x + radius * np.cos(ang), d.y + radius * np.sin(ang)], axis=1)
+            keep = self._free_points(pts, ())
+            pts = pts[keep]
+            local = np.flatnonzero(keep)
+            rm = self.roadmap
+            a_idx, b_idx = [], []
+            for k in range(len(pts)):  # neighbours on the ring, then nearby roadmap nodes
+                nxt = np.flatnonzero(local == (local[k] + 1) % RING)
+                if len(nxt):
+                    a_idx.append(k)
+                    b_idx.append(-1 - int(nxt[0]))
+                near, _ = rm.nearest(pts[k, 0], pts[k, 1], 24)
+                a_idx += [k] * len(near)
+                b_idx += [int(n) for n in near]
+            a_arr, b_arr = np.array(a_idx, dtype=int), np.array(b_idx, dtype=int)
+            ends = np.where(b_arr[:, None] >= 0, rm.nodes[np.maximum(b_arr, 0)], pts[-1 - np.minimum(b_arr, -1)])
+            ok = self._free_segments(pts[a_arr], ends, ()) if len(a_arr) else np.zeros(0, dtype=bool)
+            self._rings[key] = (pts, np.stack([a_arr[ok], b_arr[ok]], axis=1).reshape(-1, 2))
+            if len(self._rings) > 256:
+                self._rings.popitem(last=False)
+        return self._rings[key]
+
+    # ---- search ------------------------------------------------------------------------
+    def _graph(self, layer: Layer) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Nodes, undirected edges and lengths of the roadmap as ``layer`` leaves it."""
+        doors, discs = layer
+        rm = self.roadmap
+        blocked = self._door_mask(doors).copy()
+        for d in discs:
+            blocked |= self._disc_mask(d)
+        nodes, edges = [rm.nodes], [rm.edges[~blocked]]
+        n = len(rm.nodes)
+        for d in discs:
+            pts, ring_edges = self._ring(d, doors)
+            if not len(pts):
+                continue
+            a = ring_edges[:, 0] + n
+            b = np.where(ring_edges[:, 1] >= 0, ring_edges[:, 1], n - 1 - ring_edges[:, 1])
+            nodes.append(pts)
+            edges.append(np.stack([a, b], axis=1))
+            n += len(pts)
+        all_nodes = np.vstack(nodes)
+        all_edges = np.vstack(edges)
+        if len(discs) and len(all_edges) > len(edges[0]):
+            ring_part = all_edges[len(edges[0]):]
+            others = [d for d in discs]
+            ok = self._free_segments(all_nodes[ring_part[:, 0]], all_nodes[ring_part[:, 1]], tuple(others))
+            all_edges = np.vstack([edges[0], ring_part[ok]])
+        lengths = np.hypot(*(all_nodes[all_edges[:, 0]] - all_nodes[all_edges[:, 1]]).T)
+        return all_nodes, all_edges, lengths
+
+    def _links(self, p: Point, nodes: np.ndarray, discs: tuple[Disc, ...], k: int = 16,
+               also: Point | None = None) -> tuple[np.ndarray, np.ndarray, bool]:
+        """Nodes visible from ``p`` among its ``k`` nearest and the nearest 24 milestones within
+        3 m that are not OMPL samples (corners, doors, places, rings), with distances; and
+        whether ``p`` sees ``also`` directly (one vectorised test for all)."""
+        d = np.hypot(nodes[:, 0] - p[0], nodes[:, 1] - p[1])
+        first = int(self.roadmap.corner_nodes[0]) if len(self.roadmap.corner_nodes) else len(self.roadmap.nodes)
+        near = np.argpartition(d, min(k, len(d) - 1))[:k]
+        special = first + np.flatnonzero(d[first:] <= 3.0)
+        if len(special) > 24:
+            special = special[np.argsort(d[special], kind="stable")[:24]]
+        cand = np.unique(np.concatenate([near, special]))
+        ends = nodes[cand] if also is None else np.vstack([nodes[cand], [also]])
+        ok = self._free_segments(np.repeat([p], len(ends), axis=0), ends, discs)
+        direct = bool(ok[-1]) if also is not None else False
+        ok = ok[: len(cand)]
+        return cand[ok], d[cand[ok]], direct
+
+    def _tree(self, s: Point, layer: Layer) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Distances and predecessors from ``s`` over ``layer``'s graph (cached), and its nodes."""
+        key = (s, layer)
+        if key in self._trees:
+            self._trees.move_to_end(key)
+            return self._trees[key]
+        nodes, edges, lengths = self._graph(layer)
+        n = len(nodes)
+        si, sd, _ = self._links(s, nodes, layer[1])
+        rows = np.concatenate([edges[:, 0], edges[:, 1], np.full(len(si), n)])
+        cols = np.concatenate([edges[:, 1], edges[:, 0], si])
+        graph = csr_matrix((np.concatenate([lengths, lengths, sd + 1e-9]), (rows, cols)), shape=(n + 1, n + 1))
+        dist, pred = dijkstra(graph, directed=True, indices=n, return_predecessors=True)
+        self.searches += 1
+        self._trees[key] = (dist, pred, nodes)
+        if len(self._trees) > 512:
+            self._trees.popitem(last=False)
+        return self._trees[key]
+
+    def _shortcut(self, pts: list[Point], discs: tuple[Disc, ...]) -> list[Point]:
+        """The shortest chain through ``pts`` whose links are all collision-free."""
+        n = len(pts)
+        if n <= 2:
+            return pts
+        P = np.asarray(pts)
+        ii, jj = np.triu_indices(n, 1)
+        free = np.zeros((n, n), dtype=bool)
+        free[ii, jj] = self._free_segments(P[ii], P[jj], discs)
+        free[np.arange(n - 1), np.arange(1, n)] = True  # route links are valid by construction
+        seg = np.hypot(*(P[None, :, :] - P[:, None, :]).transpose(2, 0, 1))
+        best = np.full(n, math.inf)
+        back = np.zeros(n, dtype=int)
+        best[0] = 0.0
+        for j in range(1, n):
+            cand = np.where(free[:j, j], best[:j] + seg[:j, j], math.inf)
+            back[j] = int(np.argmin(cand))
+            best[j] = cand[back[j]]
+        out = [n - 1]
+        while out[-1] != 0:
+            out.append(int(back[out[-1]]))
+        return [pts[k] for k in reversed(out)]
+
+    def snap(self, p: Point, discs: tuple[Disc, ...] = ()) -> Point | None:
+        """The nearest free point to ``p`` (``p`` itself when free), within ``SNAP_REACH``."""
+        if self._free_points(np.array([p]), discs)[0]:
+            return p
+        radii = np.arange(1, int(SNAP_REACH / SNAP_STEP) + 1) * SNAP_STEP
+        ang = 2 * math.pi * np.arange(32) / 32
+        pts = np.stack([p[0] + np.outer(radii, np.cos(ang)).ravel(), p[1] + np.outer(radii, np.sin(ang)).ravel()], 1)
+        ok = np.flatnonzero(self._free_points(pts, discs))
+        if not len(ok):
+            return None
+        return (round(float(pts[ok[0], 0]), 4), round(float(pts[ok[0], 1]), 4))
+
+    def _query(self, s: Point, g: Point, layer: Layer) -> tuple[Point, ...] | None:
+        discs = layer[1]
+        if not self._free_points(np.array([g]), discs)[0]:
+            return None
+        s0 = s
+        snapped = self.snap(s, discs)
+        if snapped is None:
+            return None
+        s = snapped
+        head = (s0,) if s != s0 else ()
+        if math.hypot(g[0] - s[0], g[1] - s[1]) < 1e-6:
+            return (*head, s, g)
+        dist, pred, nodes = self._tree(s, layer)
+        gi, gd, direct = self._links(g, nodes, discs, also=s)
+        if direct:
+            return (*head, s, g)
+        if not len(gi):
+            return None
+        total = dist[gi] + gd
+        b = int(np.argmin(total))
+        if not math.isfinite(total[b]):
+            return None
+        route = [int(gi[b])]
+        n = len(nodes)
+        while route[-1] != n:
+            route.append(int(pred[route[-1]]))
+        pts = [s] + [(float(x), float(y)) for x, y in nodes[route[-2::-1]]] + [g]
+        return (*head, *self._shortcut(pts, discs))
+
+    def plan(self, start: Point, goal: Point) -> tuple[Point, ...] | None:
+        """A collision-free polyline from ``start`` to ``goal``, or None when there is none."""
+        s = (round(float(start[0]), 4), round(float(start[1]), 4))
+        g = (round(float(goal[0]), 4), round(float(goal[1]), 4))
+        doors = self._doors()
+        ignore = self.scene.blocking_discs([s, g])
+        discs = tuple(self.scene.discs(ignore))
+        path = self._cached((s, g, doors, ()))
+        if path is None or not discs:
+            return path
+        pts = np.asarray(path)
+        if self._free_segments(pts[:-1], pts[1:], discs).all():
+            return path
+        return self._cached((s, g, doors, discs))
+
+    def _cached(self, key: tuple[Point, Point, tuple[str, ...], tuple[Disc, ...]]) -> tuple[Point, ...] | None:
+        if key in self._cache:
+            self._cache.move_to_end(key)
+            return self._cache[key]
+        s, g, doors, discs = key
+        result = self._query(s, g, (doors, discs))
+        self._cache[key] = result
+        if len(self._cache) > self._cache_size:
+            self._cache.popitem(last=False)
+        return result
+
+
+APPROACH = 0.9  # metres from a person's centre when the robot goes "to" them
+APPROACH_DIRECTIONS = 16
+
+
+class MotionEstimator:
+    """:class:`tasker.world.MotionModel` for the base: OMPL-roadmap paths, profile-timed.
+
+    An unreachable goal (walled off, behind a closed door, in collision) gives
+    :data:`tasker.world.UNREACHABLE`: infinite time, never zero.  A goal at a person's
+    position means "go to that person": the estimate is for :meth:`approach`'s pose, the
+    very pose the ``navigate`` skill drives to, so estimate and motion agree.
+    """
+
+    def __init__(self, planner: BasePlanner, limits: DriveLimits, open_planner: BasePlanner | None = None) -> None:
+        self.planner = planner
+        self.limits = limits
+        self.open_planner = open_planner
+
+    def estimate(self, start: Pose, goal: Pose) -> MotionEstimate:
+        person = self.planner.scene.person_at(goal[0], goal[1])
+        if person is not None:
+            return self.approach(start, person)[1]
+        return self._estimate(self.planner, start, goal)
+
+    def estimate_ignoring_doors(self, start: Pose, goal: Pose) -> MotionEstimate:
+        """As :meth:`estimate` with every door open and nobody in the way.
+
+        A task domain that models doors (``door_between``, ``open``) needs the geometry
+        behind a closed door: whether the door is open is the plan's business.
+        """
+        return self._estimate(self.open_planner or self.planner, start, goal)
+
+    def approach(self, start: Pose, person: str) -> tuple[Pose | None, MotionEstimate]:
+        """The cheapest reachable pose ``APPROACH`` metres from ``person``, facing them.
+
+        Candidates lie in ``APPROACH_DIRECTIONS`` directions around the person; ties go to
+        the first direction (east, then counter-clockwise), so the choice is deterministic.
+        ``(None, UNREACHABLE)`` when no candidate is reachable.
+        """
+        scene = self.planner.scene
+        d = scene.people[person]
+        best: tuple[Pose, MotionEstimate] | None = None
+        for k in range(APPROACH_DIRECTIONS):
+            a = 2 * math.pi * k / APPROACH_DIRECTIONS
+            gx, gy = d.x + APPROACH * math.cos(a), d.y + APPROACH * math.sin(a)
+            if not scene.free(gx, gy, ignore=(person,)):
+                continue
+            goal = (gx, gy, math.atan2(d.y - gy, d.x - gx))
+            est = self._estimate(self.planner, start, goal)
+            if est.reachable and (best is None or est.time_s < best[1].time_s):
+                best = (goal, est)
+        return best if best is not None else (None, UNREACHABLE)
+
+    def table(self, poses: list[Pose] | tuple[Pose, ...]) -> np.ndarray:
+        """Seconds from every pose to every other: an ``(n, n)`` matrix, ``inf`` if unreachable.
+
+        One shortest-path search per source and scene state (the planner caches the
+        search tree), so a table costs ``n`` searches plus ``n²`` cheap goal links.
+        """
+        n = len(poses)
+        out = np.zeros((n, n))
+        for i, a in enumerate(poses):
+            for j, b in enumerate(poses):
+                if i != j:
+                    out[i, j] = self.estimate(a, b).time_s
+        return out
+
+    def _estimate(self, planner: BasePlanner, start: Pose, goal: Pose) -> MotionEstimate:
+        path = planner.plan((start[0], start[1]), (goal[0], goal[1]))
+        if path is None:
+            return UNREACHABLE
+        pts = list(path)
+        time_s = self.limits.travel_time(pts, start[2], goal[2])
+        end = (float(goal[0]), float(goal[1]), float(goal[2]))
+        return MotionEstimate(True, time_s, path_length(pts), end, tuple(pts))
+
+
+@dataclass(frozen=True, slots=True)
+class TravelMatrix:
+    """Travel between given places or points of a world: ``time_s[i, j]`` and
+    ``distance_m[i, j]`` from ``labels[i]`` to ``labels[j]`` (``inf`` when unreachable)."""
+
+    world: str
+    seed: int
+    labels: tuple[str, ...]
+    poses: tuple[Pose, ...]
+    time_s: np.ndarray
+    distance_m: np.ndarray
+
+    def __post_init__(self) -> None:
+        n = len(self.labels)
+        if len(self.poses) != n or self.time_s.shape != (n, n) or self.distance_m.shape != (n, n):
+            raise ValueError(f"TravelMatrix: {n} labels need {n} poses and ({n}, {n}) matrices")
+
+    def to_json(self) -> dict[str, object]:
+        """Plain JSON: unreachable entries are ``null``."""
+        def rows(m: np.ndarray) -> list[list[float | None]]:
+            return [[float(v) if math.isfinite(v) else None for v in row] for row in m]
+
+        return {"world": self.world, "seed": self.seed, "labels": list(self.labels),
+                "poses": [list(p) for p in self.poses], "time_s": rows(self.time_s),
+                "distance_m": rows(self.distance_m)}
+
+
+def travel_matrix(world: str | WorldSpec, targets: list[str | tuple[float, ...]] | tuple[str | tuple[float, ...], ...],
+                  seed: int = 1, people: bool = True) -> TravelMatrix:
+    """Travel times and distances between ``targets`` in ``world``, in one call.
+
+    A target is a place name, a person's name (the robot goes next to them, see
+    :meth:`MotionEstimator.approach`) or a point ``(x, y)`` / pose ``(x, y, yaw)``.
+    People stand where the world file puts them unless ``people`` is False.  An unknown
+    name raises :class:`tasker.errors.UnknownName` listing the known ones.
+    """
+    from robot.spec import load_world
+    from tasker.errors import UnknownName
+
+    spec = world if isinstance(world, WorldSpec) else load_world(world)
+    model = motion_model(spec, seed=seed, people=people)
+    labels: list[str] = []
+    poses: list[Pose] = []
+    for t in targets:
+        if isinstance(t, str):
+            if t in spec.places:
+                poses.append(spec.places[t])
+            elif t in spec.people:
+                poses.append(spec.people[t].pose)
+            else:
+                raise UnknownName(f"place or person of world {spec.name!r}", t, [*spec.places, *spec.people])
+            labels.append(t)
+        else:
+            v = [float(c) for c in t]
+            if len(v) not in (2, 3) or not all(math.isfinite(c) for c in v):
+                raise ValueError(f"travel_matrix: a point is (x, y) or (x, y, yaw) of finite numbers, got {t!r}")
+            poses.append((v[0], v[1], v[2] if len(v) == 3 else 0.0))
+            labels.append(",".join(f"{c:g}" for c in v))
+    n = len(poses)
+    times, dists = np.zeros((n, n)), np.zeros((n, n))
+    for i, a in enumerate(poses):
+        for j, b in enumerate(poses):
+            if i != j:
+                est = model.estimate(a, b)
+                times[i, j], dists[i, j] = est.time_s, est.distance_m
+    return TravelMatrix(spec.name, seed, tuple(labels), tuple(poses), times, dists)
+
+
+def motion_model(spec: WorldSpec, seed: int = 1, people: bool = True) -> MotionEstimator:
+    """A ready estimator for ``spec`` in its initial state (people where the file puts them)."""
+    from robot.tiago import robot_dimensions
+
+    scene = Scene(spec, robot_dimensions()[2])
+    if people:
+        for p in spec.people.values():
+            scene.set_person(p.name, p.pose[0], p.pose[1], p.posture)
+    return MotionEstimator(BasePlanner(spec, scene, seed=seed), DriveLimits.of(spec.robot),
+                           open_planner(spec, scene.radius, seed))
+
+
+def open_planner(spec: WorldSpec, radius: float, seed: int = 1, milestones: int | None = None) -> BasePlanner:
+    """A planner over the same roadmap with every door open and no people (see
+    :meth:`MotionEstimator.estimate_ignoring_doors`)."""
+    scene = Scene(spec, radius)
+    for name in spec.doors:
+        scene.set_door(name, True)
+    return BasePlanner(spec, scene, seed=seed, milestones=milestones)

@@ -1,0 +1,248 @@
+"""A look-ahead scheduler: orders the whole queue, not a pair.
+
+Each decision solves a single-machine sequencing problem over the executing task
+(``exeDA``) and every candidate, and starts the first task of the best order:
+
+* **durations are sequence-dependent**: task *j* started after task *i* lasts
+  ``d(i, j) = cTime_j + (cc_j(endPose_i) - cost_j) / cps_j`` — the task's own
+  ``reqSP`` answer for a start at *i*'s end pose, turned back into seconds (``cc`` and
+  ``cost`` differ only by the cps-weighted extra time).  For the executing task asked
+  from another pose, that answer is what resuming it costs (travel back, the resume
+  stages, planning): the switch cost comes from the task's own plans and motion;
+* **preempting** ``exeDA`` adds ``switch_penalty_s`` (its suspension) before the first
+  task, and makes ``exeDA`` a later job resumed from its predecessor's end pose;
+* the **objective** of an order with completion times ``C_j`` is
+
+      sum_j  cps_j * (C_j - now)                                (cost: harm grows with delay)
+           + lateness_weight * cps_j * max(0, C_j - deadline_j)  (deadlines)
+           + hazard_weight * max(0, C_j - deadline_j - budget_j) (hazard budgets, per task type)
+
+* the **search** starts from a greedy order improved by insertion moves, then runs a
+  depth-first branch and bound over orders, children tried best first, pruned by the
+  lower bound ``C_j >= t + min_i d(i, j)`` for every job not yet placed.  It is exact
+  when it ends within ``node_budget`` (moves evaluated + nodes expanded), and anytime
+  otherwise: the best order found so far.  The budget counts work, never wall time, so
+  traces are reproducible.
+
+The executing task keeps the robot unless the best order that starts with another
+task beats the best order that continues it by the factor ``hysteresis``.
+Every decision leaves a ``decision`` record: ``rule`` (``exact`` or ``anytime``),
+``order``, ``objective``, ``objective_continue``, ``nodes``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from tasker.errors import ConfigError
+from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
+from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, ScheduleView
+
+
+class Problem:
+    """The sequencing instance of one decision.  Job 0 is ``exeDA`` when ``has_exe``.
+
+    ``first[j]`` is job *j*'s duration when it goes first, ``after[i][j]`` when it follows
+    job *i*; ``weight``, ``deadline``, ``budget`` per job; ``now`` the clock.
+    """
+
+    def __init__(self, now: float, first: Sequence[float], after: Sequence[Sequence[float]],
+                 weight: Sequence[float], deadline: Sequence[float], budget: Sequence[float], *,
+                 has_exe: bool = False, lateness_weight: float = 1.0, hazard_weight: float = 1e4) -> None:
+        n = len(first)
+        self.n, self.now, self.has_exe = n, now, has_exe
+        self.first, self.after = list(first), [list(r) for r in after]
+        self.weight, self.deadline, self.budget = list(weight), list(deadline), list(budget)
+        self.lateness_weight, self.hazard_weight = lateness_weight, hazard_weight
+        self.dmin = [min([self.first[j], *(self.after[i][j] for i in range(n) if i != j)]) for j in range(n)]
+
+    def cost(self, j: int, c: float) -> float:
+        """Objective term of job ``j`` completing at absolute time ``c``."""
+        w = self.weight[j]
+        late = c - self.deadline[j]
+        out = w * (c - self.now)
+        if late > 0:
+            out += self.lateness_weight * w * late
+            if late > self.budget[j]:
+                out += self.hazard_weight * (late - self.budget[j])
+        return out
+
+    def evaluate(self, order: Sequence[int]) -> float:
+        t, total, prev = self.now, 0.0, -1
+        for j in order:
+            t += self.first[j] if prev < 0 else self.after[prev][j]
+            total += self.cost(j, t)
+            prev = j
+        return total
+
+
+def _greedy(p: Problem, allowed_first: list[int]) -> list[int]:
+    """Each step, the job whose completion now costs least above its earliest possible one."""
+    order: list[int] = []
+    left = set(range(p.n))
+    t, prev = p.now, -1
+    while left:
+        pool = allowed_first if prev < 0 else sorted(left)
+        best = min(pool, key=lambda j: (p.cost(j, t + (p.first[j] if prev < 0 else p.after[prev][j]))
+                                        - p.cost(j, t + p.dmin[j]), j))
+        t += p.first[best] if prev < 0 else p.after[prev][best]
+        order.append(best)
+        left.discard(best)
+        prev = best
+    return order
+
+
+def _improve(p: Problem, order: list[int], allowed_first: set[int], budget: int) -> tuple[list[int], float, int]:
+    """Insertion local search (move one job elsewhere; first improvement) within ``budget`` evaluations."""
+    best = p.evaluate(order)
+    used = 0
+    improved = True
+    while improved:
+        improved = False
+        for i in range(p.n):
+            for k in range(p.n):
+                if i == k:
+                    continue
+                cand = order[:i] + order[i + 1:]
+                cand.insert(k, order[i])
+                if cand[0] not in allowed_first:
+                    continue
+                if used >= budget:
+                    return order, best, used
+                used += 1
+                v = p.evaluate(cand)
+                if v < best - 1e-9 * max(1.0, abs(best)):
+                    order, best, improved = cand, v, True
+                    break
+            if improved:
+                break
+    return order, best, used
+
+
+def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
+          exclude_first: int | None = None) -> tuple[list[int], float, int, bool]:
+    """Best order: ``(order, objective, nodes expanded, exact)``.
+
+    A greedy order, improved by insertion moves with up to half the budget, is the
+    incumbent of a depth-first branch and bound that uses the rest; ``exact`` is true
+    when that search ended on its own.  Every evaluated move and every expanded node
+    counts against ``node_budget``.  ``fixed_first`` forces the first job;
+    ``exclude_first`` forbids one as first.
+    """
+    n = p.n
+    allowed = [j for j in range(n) if (fixed_first is None or j == fixed_first) and j != exclude_first]
+    if n == 0 or not allowed:
+        return [], (0.0 if n == 0 else math.inf), 0, True
+    best_order, best, nodes = _improve(p, _greedy(p, allowed), set(allowed), node_budget // 2)
+    nodes += n
+    exhausted = False
+    order: list[int] = []
+    placed = [False] * n
+
+    def bound(t: float, acc: float) -> float:
+        return acc + sum(p.cost(j, t + p.dmin[j]) for j in range(n) if not placed[j])
+
+    def dfs(prev: int, t: float, acc: float) -> None:
+        nonlocal best, best_order, nodes, exhausted
+        if len(order) == n:
+            if acc < best:
+                best, best_order = acc, list(order)
+            return
+        children = []
+        for j in (allowed if prev < 0 else range(n)):
+            if placed[j]:
+                continue
+            c = t + (p.first[j] if prev < 0 else p.after[prev][j])
+            children.append((p.cost(j, c) - p.cost(j, t + p.dmin[j]), c, j))
+        children.sort()
+        for _, c, j in children:
+            if nodes >= node_budget:
+                exhausted = True
+                return
+            nodes += 1
+            acc_j = acc + p.cost(j, c)
+            placed[j] = True
+            order.append(j)
+            if bound(c, acc_j) < best:
+                dfs(j, c, acc_j)
+            order.pop()
+            placed[j] = False
+            if exhausted:
+                return
+
+    dfs(-1, p.now, 0.0)
+    return best_order, best, nodes, not exhausted
+
+
+class LookAhead(Scheduler):
+    """Whole-queue sequencing by branch and bound within a node budget; see the module docstring."""
+
+    name = "lookahead"
+    preemptive = True
+
+    def __init__(self, node_budget: int = 2000, switch_penalty_s: float = 0.0, lateness_weight: float = 1.0,
+                 hazard_weight: float = 1e4, budgets: Mapping[str, float] | None = None,
+                 hysteresis: float = 1.0) -> None:
+        if isinstance(node_budget, bool) or not isinstance(node_budget, int) or node_budget < 1:
+            raise ConfigError(f"lookahead: node_budget must be an integer >= 1, got {node_budget!r}")
+        for key, value in (("switch_penalty_s", switch_penalty_s), ("lateness_weight", lateness_weight),
+                           ("hazard_weight", hazard_weight)):
+            if isinstance(value, bool) or not isinstance(value, int | float) or not value >= 0 or value == math.inf:
+                raise ConfigError(f"lookahead: {key} must be a finite number >= 0, got {value!r}")
+        if not isinstance(hysteresis, int | float) or not 0 < hysteresis <= 1:
+            raise ConfigError(f"lookahead: hysteresis must be in (0, 1], got {hysteresis!r}")
+        self.node_budget = node_budget
+        self.switch_penalty_s = float(switch_penalty_s)
+        self.lateness_weight = float(lateness_weight)
+        self.hazard_weight = float(hazard_weight)
+        self.budgets = {str(k): float(v) for k, v in (budgets or {}).items()}
+        self.hysteresis = float(hysteresis)
+
+    def _duration(self, view: ScheduleView, c: Candidate, p: CostParams, pose: Any) -> float:
+        """Seconds ``c`` takes if started at ``pose``: its reqSP answer back in seconds."""
+        if pose is None or p.cps == 0:
+            return p.c_time
+        answer = view.req_sp(c.id, SPRequest(SP_COMPLETION, {"pose": pose}))
+        if not isinstance(answer, CompletionCost):
+            raise ConfigError(f"lookahead: task type {c.task_type!r} answered reqSP {SP_COMPLETION!r} with "
+                              f"{type(answer).__name__}, expected CompletionCost")
+        extra = (answer.cc - p.cost) / p.cps
+        return max(0.0, p.c_time + extra) if math.isfinite(extra) else math.inf
+
+    def problem(self, view: ScheduleView) -> tuple[Problem, list[Candidate]]:
+        jobs = ([view.exe] if view.exe is not None else []) + list(view.candidates)
+        params = [self.cost_params(c, self.name) for c in jobs]
+        has_exe = view.exe is not None
+        first = [p.c_time + (self.switch_penalty_s if has_exe and k > 0 else 0.0) for k, p in enumerate(params)]
+        after = [[0.0 if i == j else self._duration(view, jobs[j], params[j], params[i].end_pose)
+                  for j in range(len(jobs))] for i in range(len(jobs))]
+        deadline = [math.inf if p.deadline is None else p.deadline for p in params]
+        budget = [self.budgets.get(c.task_type, math.inf) for c in jobs]
+        return Problem(view.now, first, after, [p.cps for p in params], deadline, budget, has_exe=has_exe,
+                       lateness_weight=self.lateness_weight, hazard_weight=self.hazard_weight), jobs
+
+    def schedule(self, view: ScheduleView) -> Decision:
+        if not view.candidates:
+            return NO_CHANGE
+        prob, jobs = self.problem(view)
+        if view.exe is None:
+            order, obj, nodes, exact = solve(prob, node_budget=self.node_budget)
+            keep_obj = math.inf
+        else:  # two searches share the budget: continue exeDA, or start with someone else
+            half = max(1, self.node_budget // 2)
+            keep, keep_obj, n1, e1 = solve(prob, node_budget=half, fixed_first=0)
+            alt, alt_obj, n2, e2 = solve(prob, node_budget=self.node_budget - n1, exclude_first=0)
+            nodes, exact = n1 + n2, e1 and e2
+            switch = alt_obj < self.hysteresis * keep_obj
+            order, obj = (alt, alt_obj) if switch else (keep, keep_obj)
+        first = jobs[order[0]].id
+        switch = view.exe is None or first != view.exe.id
+        record: dict[str, Any] = {
+            "algorithm": self.name, "rule": "exact" if exact else "anytime",
+            "dac": first if switch else None, "exeDA": view.exe.id if view.exe is not None else None,
+            "order": [jobs[k].id for k in order], "objective": obj, "objective_continue": keep_obj,
+            "nodes": nodes, "switch": switch,
+        }
+        return Decision(first if switch else None, record)

@@ -1,0 +1,25 @@
+"""TaBSA's ``simple2`` agent, re-implemented from its description: shortest task first.
+
+The mirror of :mod:`tasker.schedulers.simple`: priority first (higher first), then
+``cTime`` shortest first; at equal priority the executing task is preempted when
+
+    (1 + hesitance) * cTime_dac < cTime_exeDA
+"""
+
+from __future__ import annotations
+
+from tasker.schedulers.base import Candidate
+from tasker.schedulers.simple import LongestFirst, priority
+
+
+class ShortestFirst(LongestFirst):
+    name = "simple2"
+
+    def __init__(self, hesitance: float = 0.0) -> None:
+        super().__init__(hesitance)
+
+    def key(self, c: Candidate) -> tuple[float, float, int]:
+        return (-priority(self, c), self.cost_params(c, self.name).c_time, c.order)
+
+    def better(self, dac: float, exe: float) -> bool:
+        return (1 + self.hesitance) * dac < exe

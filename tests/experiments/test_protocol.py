@@ -1,0 +1,137 @@
+"""Day protocols: strict reading, reproducible days, every scheduler on every task type, metrics by hand."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from experiments import dayreport, protocol
+from tasker import schedulers
+from tasker.reader import InputError
+
+TABSA = Path(__file__).resolve().parents[2] / "experiments" / "protocols" / "tabsa.toml"
+
+
+@pytest.fixture(scope="module")
+def tabsa() -> protocol.Protocol:
+    return protocol.load(TABSA)
+
+
+def test_the_shipped_protocol_reads(tabsa: protocol.Protocol) -> None:
+    assert set(tabsa.tasks) == {"transport", "fall", "pick_place"}
+    assert tabsa.robot_speed == 0.5 and tabsa.step_s == 5.0 and tabsa.length_s == 4 * 3600
+    assert all(s.count == 12 for s in tabsa.tasks.values())
+    assert tabsa.death_after_s == 900.0
+
+
+def test_a_day_is_reproducible_per_seed(tabsa: protocol.Protocol) -> None:
+    a, b, c = protocol.generate(tabsa, 7), protocol.generate(tabsa, 7), protocol.generate(tabsa, 8)
+    assert a.actions == b.actions and a.actions != c.actions
+    assert len(a.actions) == 36
+    falls = [x.fields["args"] for x in a.actions if x.fields["task"] == "fall"]
+    assert all(f["death_at"] == pytest.approx(f["deadline"] + 900.0) for f in falls)
+    assert all(60.0 <= f["work"] <= 300.0 for f in falls)
+    t1 = protocol.build_day(tabsa, 7, "lookahead").run().dumps()
+    t2 = protocol.build_day(tabsa, 7, "lookahead").run().dumps()
+    assert t1 == t2  # byte for byte
+
+
+@pytest.mark.parametrize("name", schedulers.names())
+def test_every_scheduler_runs_every_task_type(tabsa: protocol.Protocol, name: str) -> None:
+    trace = protocol.build_day(tabsa, 2, name, dayreport.scheduler_options(tabsa, name)).run()
+    finished = {e["task_type"] for e in trace.of("end", cause="finished")}
+    assert finished == {"transport", "fall", "pick_place"}
+    assert not trace.of("end", cause="failed")
+
+
+def test_a_transport_interrupted_while_escorting_asks_to_wait_and_goes_back(tabsa: protocol.Protocol) -> None:
+    trace = protocol.build_day(tabsa, 2, "alg2", dayreport.scheduler_options(tabsa, "alg2")).run()
+    susp = [e for e in trace.of("plan", purpose="genSusp") if e["stages"]]
+    assert susp, "day 2 under alg2 interrupts a task mid-motion"
+    agent = susp[0]["agent"]
+    resumed = [e for e in trace.of("plan", purpose="upTsk", agent=agent)][1]
+    assert resumed["stages"][0]["action"] == "go_back"
+
+
+def write(tmp_path: Path, text: str) -> Path:
+    p = tmp_path / "p.toml"
+    p.write_text(text, encoding="utf-8")
+    return p
+
+
+def test_bad_protocols_name_file_line_and_field(tmp_path: Path) -> None:
+    text = TABSA.read_text(encoding="utf-8")
+    with pytest.raises(InputError, match=r"p\.toml:\d+: tasks\.fal: unknown task type 'fal'; did you mean 'fall'"):
+        protocol.load(write(tmp_path, text.replace("[tasks.fall]", "[tasks.fal]")))
+    with pytest.raises(InputError, match=r"tasks\.fall\.work_s: expected low <= high"):
+        protocol.load(write(tmp_path, text.replace("work_s = [60.0, 300.0]", "work_s = [300.0, 60.0]")))
+    with pytest.raises(InputError, match=r"robot\.start_site: no site 'hal'; did you mean 'hall'"):
+        protocol.load(write(tmp_path, text.replace('start_site = "hall"', 'start_site = "hal"')))
+    with pytest.raises(InputError, match=r"robot\.planing_time_s: unknown key .*did you mean 'planning_time_s'"):
+        protocol.load(write(tmp_path, text.replace("planning_time_s =", "planing_time_s =")))
+
+
+# -- metrics on a hand-made day -----------------------------------------------------------------------
+
+def ev(t: float, event: str, **f: object) -> dict[str, object]:
+    return {"t": t, "event": event, **f}
+
+
+HAND = [
+    ev(0, "request", agent="d1", task_type="transport", args={"deadline": 100.0}),
+    ev(0, "command", agent="d1", flag="start"),
+    ev(10, "request", agent="d2", task_type="fall", args={"deadline": 50.0, "death_at": 950.0}),
+    ev(10, "command", agent="d1", flag="susp"),
+    ev(10, "transition", agent="d1", **{"from": "exeTsk", "to": "genSusp"}),
+    ev(11, "plan", agent="d1", purpose="genSusp", stages=[{"action": "ask_to_wait"}]),
+    ev(11, "transition", agent="d1", **{"from": "genSusp", "to": "exeSusp"}),
+    ev(15, "transition", agent="d1", **{"from": "exeSusp", "to": "wait"}),
+    ev(15, "command", agent="d2", flag="start"),
+    ev(80, "end", agent="d2", task_type="fall", cause="finished"),         # 30 s late
+    ev(80, "command", agent="d1", flag="start"),
+    ev(90, "request", agent="d3", task_type="fall", args={"deadline": 100.0, "death_at": 1000.0}),
+    ev(90, "transition", agent="d1", **{"from": "exeTsk", "to": "genSusp"}),
+    ev(90, "plan", agent="d1", purpose="genSusp", stages=[]),
+    ev(90, "transition", agent="d1", **{"from": "genSusp", "to": "exeSusp"}),
+    ev(90, "transition", agent="d1", **{"from": "exeSusp", "to": "wait"}),
+    ev(90, "command", agent="d3", flag="start"),
+    ev(95, "command", agent="d1", flag="start"),                               # third start of d1 within 95 s
+    ev(120, "end", agent="d1", task_type="transport", cause="finished"),     # 20 s late
+]
+
+
+def test_metrics_agree_with_hand_computed_values() -> None:
+    m = dayreport.day_metrics(HAND, day_end=2000.0)
+    assert m["requested"] == 3 and m["completed"] == 2
+    assert m["dead_falls"] == 1 and m["first_death_t"] == 1000.0  # d3 never finished
+    assert m["interruptions"] == 2 and m["suspensions"] == 1
+    assert m["suspension_time_s"] == pytest.approx(5.0)  # 10 -> 15, then 90 -> 90
+    assert m["switches"] == 5
+    assert m["oscillation_t"] == 95.0 and m["ending"] == "oscillation"  # before the death at 1000
+    assert m["completion_minus_deadline_s"] == pytest.approx((30 + 20) / 2)
+    assert m["lateness_s"] == pytest.approx(50.0)
+    t = m["per_type"]["transport"]
+    assert t["completed"] == 1 and t["interruptions"] == 2 and t["interruptions_per_task"] == 2.0
+    f = m["per_type"]["fall"]
+    assert f["requested"] == 2 and f["completed"] == 1 and f["completion_minus_deadline_s"] == pytest.approx(30.0)
+
+
+def test_endings() -> None:
+    before_death = dayreport.day_metrics(HAND[:11], day_end=500.0)  # d3 not requested, d1 unfinished
+    assert before_death["ending"] == "time ran out" and before_death["dead_falls"] == 0
+    done = [e for e in HAND if e.get("agent") != "d3" and not (e["t"] == 95)]
+    assert dayreport.day_metrics(done, day_end=2000.0)["ending"] == "all done"
+    no_osc = [e for e in HAND if e["t"] != 95]
+    assert dayreport.day_metrics(no_osc, day_end=2000.0)["ending"] == "a fall died"
+
+
+def test_holm_adjustment() -> None:
+    assert dayreport.holm([0.01, 0.04, 0.03]) == pytest.approx([0.03, 0.06, 0.06])
+
+
+def test_table_has_every_scheduler_and_the_paired_tests(tabsa: protocol.Protocol) -> None:
+    results = dayreport.run_days(TABSA, 3, ["lookahead", "simple2"], workers=1)
+    text = dayreport.table(results)
+    assert "| metric | lookahead | simple2 |" in text
+    assert "| dead falls | simple2 |" in text and "Holm" in text

@@ -1,0 +1,84 @@
+"""The recorded trajectory: a fixed rate, people and postures, a documented file, reproducible."""
+
+from __future__ import annotations
+
+import pytest
+
+from robot.recording import RECORD_HZ, Recorder, read_trajectory
+from robot.sim import Simulation
+from tasker.protocols import SkillState
+from tasker.stage import Stage
+
+
+def _drive(sim: Simulation, to: str, until: float) -> float:
+    stage = Stage("navigate", ("robot", to), skill="navigate", data={"to": to})
+    now = sim.time
+    sim.begin("d1", stage, now)
+    while sim.poll("d1", stage, now).state is SkillState.RUNNING and now < until:
+        now += 0.1
+    return now
+
+
+def test_trajectory_has_robot_and_people_at_a_fixed_rate(paper, tmp_path) -> None:
+    sim = Simulation(paper)
+    end = _drive(sim, "kitchen", 60.0)
+    sim.advance(end + 1.0)
+    head, samples, _ = read_trajectory(sim.write_trajectory(tmp_path / "trajectory.jsonl"))
+    assert head["world"] == "paper" and head["rate_hz"] == RECORD_HZ
+    times = [s.t for s in samples]
+    steps = [b - a for a, b in zip(times, times[1:], strict=False)]
+    assert times[0] == 0.0 and steps == pytest.approx([1 / RECORD_HZ] * len(steps))
+    assert {p.name for p in samples[-1].people} == set(paper.people)
+    assert samples[-1].robot[:2] == pytest.approx(sim.robot_pose()[:2], abs=1e-3)
+    moved = [p for p in samples[-1].people if p.name == "john"][0]
+    assert (moved.x, moved.y) != paper.people["john"].pose[:2]  # John walks his script
+
+
+def test_postures_are_recorded_as_they_change(paper, tmp_path) -> None:
+    sim = Simulation(paper)
+    sim.advance(62.0)  # Peter falls at 60 s
+    _, samples, _ = read_trajectory(sim.write_trajectory(tmp_path / "t.jsonl"))
+    peter = [next(p for p in s.people if p.name == "peter").posture for s in samples]
+    assert peter[0] == "standing" and peter[-1] == "fallen"
+
+
+def test_same_run_same_file(paper, tmp_path) -> None:
+    texts = []
+    for k in range(2):
+        sim = Simulation(paper)
+        _drive(sim, "bedroom", 40.0)
+        texts.append(sim.write_trajectory(tmp_path / f"{k}.jsonl").read_text())
+    assert texts[0] == texts[1]
+
+
+def test_a_still_robot_costs_no_physics(paper) -> None:
+    sim = Simulation(paper)
+    sim.advance(10.0)
+    assert sim.physics_ticks < 50  # settling only: 500 ticks passed
+    x, y, _ = sim.robot_pose()
+    assert (x, y) == pytest.approx(paper.robot.pose[:2], abs=1e-3)
+
+
+def test_bad_files_and_rates_are_refused(tmp_path) -> None:
+    with pytest.raises(ValueError, match="rate_hz"):
+        Recorder("paper", rate_hz=0)
+    bad = tmp_path / "x.jsonl"
+    bad.write_text('{"format": "other"}\n')
+    with pytest.raises(ValueError, match="x.jsonl:1: format"):
+        read_trajectory(bad)
+
+
+def test_skipping_still_ticks_changes_nothing(paper, monkeypatch) -> None:
+    """The same drive and waits with and without skipping: identical samples and physics."""
+    def scenario(sim: Simulation) -> tuple[list[str], object]:
+        sim.advance(12.0)  # still: John waits until 10 s, then walks
+        end = _drive(sim, "bedroom", 80.0)
+        wait = Stage("wait", (), skill="wait", duration=7.0)
+        sim.begin("d1", wait, end)
+        sim.advance(end + 30.0)
+        return sim.recording.lines(), sim.mj.state().tolist()
+
+    fast = scenario(Simulation(paper))
+    monkeypatch.setattr(Simulation, "_fast_forward", lambda self, now: False)
+    slow = scenario(Simulation(paper))
+    assert fast == slow

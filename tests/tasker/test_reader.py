@@ -1,0 +1,112 @@
+"""The strict reader: every fault names the file, the line, the field and what was expected."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from tasker import reader
+from tasker.reader import InputError
+
+TEXT = """\
+name = "demo"
+
+[task]
+kindd = "blocking"
+
+[[args]]
+name = "a"
+
+[[args]]
+name = "b"
+typo = 1
+
+[schedule]
+cps = nan
+count = 3.5
+flag = 1
+"""
+
+
+def doc() -> reader.Table:
+    return reader.loads(TEXT, "task.toml")
+
+
+def test_unknown_key_names_line_field_valid_keys_and_suggestion() -> None:
+    t = doc().table("task")
+    t.string("kind", "suspendable")
+    with pytest.raises(InputError) as e:
+        t.done()
+    assert str(e.value).startswith("task.toml:4: task.kindd: unknown key 'kindd'; did you mean 'kind'?")
+    assert e.value.line == 4 and e.value.field == "task.kindd"
+
+
+def test_array_of_tables_elements_have_their_own_lines() -> None:
+    second = doc().tables("args")[1]
+    second.string("name")
+    with pytest.raises(InputError, match=r"task.toml:11: args\[1\].typo: unknown key"):
+        second.done()
+
+
+@pytest.mark.parametrize(("key", "kw", "expected"), [
+    ("cps", {}, "expected a finite number, got nan"),
+    ("count", {"integer": True}, "expected an integer, got 3.5"),
+    ("flag", {}, None),
+    ("count", {"max": 2}, "expected a number <= 2, got 3.5"),
+])
+def test_numbers_are_finite_typed_and_in_range(key: str, kw: dict, expected: str | None) -> None:
+    t = doc().table("schedule")
+    if expected is None:
+        assert t.number(key, **kw) == 1.0
+        return
+    with pytest.raises(InputError, match=expected):
+        t.number(key, **kw)
+
+
+def test_a_boolean_is_not_a_number() -> None:
+    t = reader.loads("x = true\n", "f.toml")
+    with pytest.raises(InputError, match="f.toml:1: x: expected a number, got a boolean True"):
+        t.number("x")
+
+
+def test_names_are_checked_with_did_you_mean() -> None:
+    t = reader.loads('person = "jhon"\n', "s.toml")
+    with pytest.raises(InputError, match=r"s.toml:1: person: no person 'jhon'; did you mean 'john'\?"):
+        t.name("person", ["john", "alice"], "person")
+
+
+def test_missing_required_key() -> None:
+    with pytest.raises(InputError, match="f.toml: world: missing"):
+        reader.loads("", "f.toml").string("world")
+
+
+def test_syntax_error_names_the_line(tmp_path: Path) -> None:
+    p = tmp_path / "bad.toml"
+    p.write_text("a = 1\nb = [1,\n")
+    with pytest.raises(InputError, match=r"bad.toml:\d+: not valid TOML"):
+        reader.load(p)
+
+
+@pytest.mark.parametrize(("content", "message"), [
+    (b"a = 1\n\x00\x01", "binary file"),
+    (b'a = "ok"\nb = "\xff"\n', "bad.toml:2: is not UTF-8"),
+])
+def test_binary_and_non_utf8_files(tmp_path: Path, content: bytes, message: str) -> None:
+    p = tmp_path / "bad.toml"
+    p.write_bytes(content)
+    with pytest.raises(InputError, match=message):
+        reader.load(p)
+
+
+def test_missing_file_and_directory(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="no such file"):
+        reader.load(tmp_path / "nope.toml")
+    with pytest.raises(InputError, match="is a directory"):
+        reader.load(tmp_path)
+
+
+def test_not_a_table() -> None:
+    t = reader.loads("task = 3\n", "f.toml")
+    with pytest.raises(InputError, match="f.toml:1: task: expected a table, got an integer"):
+        t.table("task")
