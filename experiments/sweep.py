@@ -371,7 +371,7 @@ def _grid(t: reader.Table) -> list[Strategy]:
         if key not in FACTORS:
             raise t.error(key, f"unknown factor {key!r}{reader.suggest(key, FACTORS)} (factors: {', '.join(FACTORS)})")
         levels = t.array(key, nonempty=True)
-        lt = t.at(key, levels)
+        lt = t.at(key, {})  # for errors located at an element of the array
         for i, v in enumerate(levels):
             if key == "hazard_waiting":
                 if not isinstance(v, bool):
