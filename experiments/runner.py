@@ -41,6 +41,7 @@ from tasker.task import Strategy
 from tasker.trace import Trace
 
 
+
 @dataclass(frozen=True)
 class RunResult:
     """What one run produced: its record, its metrics and its trace."""
@@ -53,10 +54,12 @@ class RunResult:
 
 def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None = None,
                 suspension: str | None = None, scheduler: str | None = None,
-                trace: Trace | None = None, task_paths: tuple[str, ...] = ()) -> tuple[SimulationLoop, Any]:
+                trace: Trace | None = None, task_paths: tuple[str, ...] = (), policy: str | None = None,
+                hazard_waiting: bool = False) -> tuple[SimulationLoop, Any]:
     """The loop and the simulation for a robot scenario, with every request and event scheduled.
 
-    ``task_paths`` are task folders loaded besides the bundled ones and ``$TASKER_TASKS``."""
+    ``task_paths`` are task folders loaded besides the bundled ones and ``$TASKER_TASKS``.
+    ``policy`` (default: the scenario's) reaches every task's :class:`Strategy`; ``hazard_waiting`` is passed to the loop."""
     from planners.bundled import task_types
     from robot.sim import Simulation
     from robot.spec import load_world
@@ -80,15 +83,16 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
     store = TaskStore(task_types(task_paths))
     types = [store.get(n) for n in store.names()]
     sim.bind(b for t in types for b in t.meaning.bindings)  # the world reads the folders' bindings
-    default = Strategy(update or scn.update, suspension or scn.suspension, scn.policy)
+    default = Strategy(update or scn.update, suspension or scn.suspension, policy or scn.policy)
     per_type = {t: Strategy(update or s.get("update", default.update),
-                            suspension or s.get("suspension", default.suspension), scn.policy)
+                            suspension or s.get("suspension", default.suspension), default.policy)
                 for t, s in scn.strategies.items()}
     options = scn.scheduler_options if scheduler in (None, scn.scheduler) else {}
     loop = SimulationLoop(
         store, schedulers.create(scheduler or scn.scheduler, **options), seed=seed, trace=trace,
         mode=Mode(scn.mode), s_freq=scn.s_freq, rates=Rates(scn.rep_rate, scn.task_exe_rate, scn.sp_up_rate),
         strategy=default, strategies=per_type, core=sim, world=sim, motion=sim.motion, horizon=scn.horizon,
+        hazard_waiting=hazard_waiting,
     )
     monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning,
                       lambda: sim.snapshot().facts, task_types=store.names(),
@@ -154,10 +158,15 @@ def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: TimedAction
 def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | None = None,
                  update: str | None = None, suspension: str | None = None, scheduler: str | None = None,
                  mode: str | None = None, out: Path | None = None, randomize: bool = False,
-                 progress: bool = False, pictures: bool = True, task_paths: tuple[str, ...] = ()) -> RunResult:
+                 progress: bool = False, pictures: bool = True, task_paths: tuple[str, ...] = (),
+                 policy: str | None = None, hazard_waiting: bool | None = None,
+                 interruption: scenarios.InterruptionGrid | None = None) -> RunResult:
     """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced.
 
-    ``task_paths``: task folders to load besides the bundled ones (``tasker run --path``)."""
+    ``task_paths``: task folders to load besides the bundled ones (``tasker run --path``).
+    ``policy`` (``strict``/``conditional``) overrides the scenario's; ``hazard_waiting`` switches
+    hazard-aware waiting on; ``interruption`` (with ``randomize``) places the interrupting request
+    in the seed's stratum (:class:`experiments.scenario.InterruptionGrid`)."""
     if isinstance(source, scenarios.RobotScenario):
         kind, scn_path = "robot", Path(source.source)
     else:
@@ -175,11 +184,11 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         scn = source if isinstance(source, scenarios.RobotScenario) else scenarios.load(scn_path, task_paths=task_paths)
         run_seed = scn.seed if seed is None else seed
         if randomize:
-            scn = scenarios.randomize(scn, run_seed)
+            scn = scenarios.randomize(scn, run_seed, interruption=interruption)
         if mode is not None:
             scn = dataclasses.replace(scn, mode=mode)
         loop, sim = build_robot(scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler,
-                                task_paths=task_paths)
+                                task_paths=task_paths, policy=policy, hazard_waiting=bool(hazard_waiting))
         spec_json = {"kind": "robot", **scn.to_json()}
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")
@@ -202,8 +211,10 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
                      # synthetic task types have only static strategies: say what was used
                      "update": "static" if kind == "synthetic" else (update or loop.strategy.update),
                      "suspension": "static" if kind == "synthetic" else (suspension or loop.strategy.suspension),
-                     "policy": loop.strategy.policy,
-                     "randomized": randomize},
+                     "randomized": randomize,
+                     "policy": None if kind == "synthetic" else loop.strategy.policy,
+                     "hazard_waiting": bool(hazard_waiting),
+                     **({"interruption": interruption.to_json()} if interruption and randomize else {})},
         "planner": _planner_config() if kind == "robot" else None,
         "host": platform.node(), "platform": platform.platform(), "python": sys.version.split()[0],
         "date": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "tasker_version": tasker.__version__,
