@@ -71,12 +71,10 @@ class PrimaryOutcome:
     """The declared primary outcome: hazard-unattended seconds against time-to-help.
 
     Each is a list of dotted metric paths into ``metrics.json``; the first one a run has is
-    used, so the report keeps working as the metric names change."""
+    used (the names of :mod:`experiments.metrics`)."""
 
-    hazard: tuple[str, ...] = ("safety.unattended_s", "hazards.unattended_s", "hazards.total.unattended_s", "hazards.overrun_s",
-                               "safety.hazard_unattended_s", "safety.cooker_unattended_s")
-    help: tuple[str, ...] = ("people.time_to_help_s.mean", "people.time_to_help_s", "people.help.mean_s",
-                             "people.people_waiting_s")
+    hazard: tuple[str, ...] = ("safety.unattended_s",)
+    help: tuple[str, ...] = ("people.time_to_help_s.mean",)
 
 
 @dataclass(frozen=True)

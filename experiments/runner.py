@@ -41,7 +41,6 @@ from tasker.task import Strategy
 from tasker.trace import Trace
 
 
-
 @dataclass(frozen=True)
 class RunResult:
     """What one run produced: its record, its metrics and its trace."""
@@ -59,7 +58,8 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
     """The loop and the simulation for a robot scenario, with every request and event scheduled.
 
     ``task_paths`` are task folders loaded besides the bundled ones and ``$TASKER_TASKS``.
-    ``policy`` (default: the scenario's) reaches every task's :class:`Strategy`; ``hazard_waiting`` is passed to the loop."""
+    ``policy`` (default: the scenario's) reaches every task's :class:`Strategy`;
+    ``hazard_waiting`` is passed to the loop."""
     from planners.bundled import task_types
     from robot.sim import Simulation
     from robot.spec import load_world

@@ -248,8 +248,7 @@ class Estimator:
         # static, or as genSusp: an unsolvable suspension falls back to the decision list
         world = ctx.world
         assert isinstance(world, WorldState)
-        b = Bindings(ctx.args, world)
-        branch = task._branch(task.spec.static_suspension, b, world, ctx)
+        branch, b = task.branch(ctx, world)
         return task.builder.from_templates(branch.stages, b, {}, ctx.suspended)
 
     # -- planning and timing -------------------------------------------------------------

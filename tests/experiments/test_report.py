@@ -150,12 +150,12 @@ def test_failed_and_unfinished_tasks_are_out_of_the_duration_mean_and_counted() 
 
 
 def test_primary_outcome_reads_configured_paths(tmp_path: Path) -> None:
-    rows = [RunRow("s", seed, st, Status.OK, {}, {"hazards": {"unattended_s": h}, "people": {"time_to_help_s":
+    rows = [RunRow("s", seed, st, Status.OK, {}, {"safety": {"unattended_s": h}, "people": {"time_to_help_s":
                                                                                               {"mean": w}}})
             for seed in range(4) for st, h, w in ((STATIC, 10.0 + seed, 30.0), (PLANNED, 1.0, 40.0 + seed))]
     cells = report.primary_cells(rows, report.PrimaryOutcome())
     assert cells[("s", STATIC)][0].mean == pytest.approx(11.5) and cells[("s", PLANNED)][1].mean == 41.5
-    custom = report.PrimaryOutcome(hazard=("people.time_to_help_s.mean",), help=("hazards.unattended_s",))
+    custom = report.PrimaryOutcome(hazard=("people.time_to_help_s.mean",), help=("safety.unattended_s",))
     assert report.primary_cells(rows, custom)[("s", STATIC)][0].mean == 30.0
     assert report.plot_frontier(rows, custom, tmp_path) == tmp_path / "primary_frontier.png"
 

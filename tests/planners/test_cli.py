@@ -117,8 +117,8 @@ def test_new_check_plan_run_as_a_new_user_would(tmp_path: Path, capsys: pytest.C
     assert _run(["new", "fetch", str(folder)]) == 0
     assert {p.name for p in folder.iterdir()} == {"domain.pddl", "task.toml", "problem.pddl", "scenario.toml"}
     toml = (folder / "task.toml").read_text()
-    for key in ("planning_time_s", "timeout_s", "suspended_facts", "min_interruption_s", "travel_s", "[example]",
-                "Sections added by later parts of tasker"):
+    for key in ("planning_time_s", "timeout_s", "suspended_facts", "max_interruption_s", "travel_s", "[example]",
+                "[[hazards]]", "[[bindings]]", "[people]", "stages = ["):
         assert key in toml
     assert _run(["check", str(folder)]) == 0
     assert "0 problems" in capsys.readouterr().out
