@@ -34,7 +34,8 @@ __version__ = "0.1.0"
 
 __all__ = [
     "SP_COMPLETION", "ArgSpec", "BadRequest", "Command", "CompletionCost", "ConfigError", "CostParams",
-    "DynamicAgent", "Flag", "FsmState", "Mode", "OscillationGuard", "PlanningFailed", "Purpose", "Rates", "Report", "Request",
+    "DynamicAgent", "Flag", "FsmState", "Mode", "OscillationGuard", "PlanningFailed", "Purpose", "Rates",
+    "Report", "Request",
     "Requester", "RunAborted", "SPRequest", "ScheduleParams", "SimulationLoop", "Stage", "StageKind", "StagePlan",
     "Strategy", "TaskContext", "TaskHarmoniser", "TaskStore", "TaskType", "TaskerError", "Trace",
     "UnknownName", "__version__",
