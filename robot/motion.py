@@ -3,21 +3,25 @@
 :class:`BasePlanner` answers "how does the base get from here to there" on the
 :class:`~robot.roadmap.Roadmap` grown once by OMPL:
 
-1. start and goal are linked to their nearest visible roadmap nodes (exact tests,
-   people standing at the start or goal are ignored: the robot is beside them);
-2. if nothing dynamic (closed door, person) blocks a roadmap edge, the best route is
-   a look-up in the all-pairs table; otherwise a Dijkstra search (scipy) runs on the
-   roadmap less its blocked edges;
+1. a start in collision is snapped off it; start and goal are linked to their nearest
+   visible roadmap nodes (exact tests; people judged by
+   :meth:`Scene.people_clear <robot.scene.Scene.people_clear>`, the rule the
+   ``navigate`` skill checks paths with: a path may leave a person's clearance or
+   stop inside it, never enter it);
+2. a Dijkstra search (scipy) from the start over the roadmap less the edges closed
+   doors block; if its path is clear of people it is the answer, otherwise a second
+   search over the roadmap less the edges people block, plus rings of milestones
+   around them;
 3. the route is shortened: the shortest chain of mutually visible route points.
 
 :class:`MotionEstimator` implements :class:`tasker.world.MotionModel`: time comes from
 :class:`DriveLimits` with the same stop–turn–drive profile the controller executes
 (:mod:`robot.control`), so estimates match what MuJoCo takes.
 
-**Caching.**  Results are cached by (start, goal, ``Scene.version``).  The version
-changes whenever a door opens or closes or a person moves or changes posture, so a
-cached answer can never describe a scene that no longer exists; the roadmap itself
-covers only walls and furniture and never needs rebuilding.
+**Caching.**  Results and search trees are cached by exactly what they depend on
+(start, goal, closed doors, people), so a cached answer can never describe a scene
+that no longer exists; the roadmap itself covers only walls and furniture and never
+needs rebuilding.
 """
 
 from __future__ import annotations
@@ -112,10 +116,13 @@ class BasePlanner:
        so it is still the shortest);
     3. otherwise the **people layer**: the roadmap less the edges people block, plus a
        ring of milestones around each person in the way (so the path hugs them), searched
-       from the start and cached by (start, closed doors, people in the way).
+       from the start and cached by (start, closed doors, people).
 
-    A start in collision (braked next to a door jamb, pushed against a wall) is snapped
-    to the nearest free point first; the path then starts with that short move.
+    People are judged by :meth:`Scene.people_clear <robot.scene.Scene.people_clear>`,
+    the rule the ``navigate`` skill checks the path ahead with, so every path returned
+    is one the skill drives.  A start in collision (braked next to a door jamb, pushed
+    against a wall) is snapped to the nearest free point first (:meth:`snap`); the
+    path then starts with that short move.
     """
 
     def __init__(self, spec: WorldSpec, scene: Scene, seed: int = 1, milestones: int | None = None,
