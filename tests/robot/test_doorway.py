@@ -127,3 +127,22 @@ def test_navigate_leaves_the_doorway_in_mujoco(paper, to: str) -> None:
         now += 0.1
         status = sim.poll("d1", stage, now)
     assert status.state is SkillState.SUCCEEDED, status
+
+
+def test_navigate_retries_a_failed_replan_once_the_doorway_clears(paper) -> None:
+    """Peter steps into the only door of the bedroom while the robot drives there (no path:
+    it brakes), then walks on: the robot re-plans at the next check and gets there, rather
+    than waiting on its braked old path until the stall watchdog fails it."""
+    people = {"peter": PersonSpec("peter", (7.6, 7.0, 0.0), "standing", 1.0,
+                                  ((0.0, 7.6, 7.0), (2.0, 7.0, 6.0), (4.0, 7.0, 6.0), (5.5, 8.2, 7.3)), ())}
+    sim = Simulation(dataclasses.replace(paper, people=people))
+    stage = Stage("navigate", ("robot", "bedroom"), skill="navigate", data={"to": "bedroom"})
+    sim.begin("d1", stage, 0.0)
+    now, status, blocked = 0.0, sim.poll("d1", stage, 0.0), False
+    while status.state is SkillState.RUNNING and now < 120.0:
+        now += 0.1
+        status = sim.poll("d1", stage, now)
+        if 3.0 <= now <= 4.0:
+            blocked |= sim.planner.plan(sim.robot_pose()[:2], paper.places["bedroom"][:2]) is None
+    assert blocked  # the doorway really was shut while Peter stood in it
+    assert status.state is SkillState.SUCCEEDED, status
