@@ -373,7 +373,8 @@ class BasePlanner:
         s = (round(float(start[0]), 4), round(float(start[1]), 4))
         g = (round(float(goal[0]), 4), round(float(goal[1]), 4))
         doors = self._doors()
-        discs = tuple(self.scene.discs())
+        # people the goal is beside do not block the way to it (Scene.people_clear)
+        discs = tuple(d for d in self.scene.discs() if not self.scene.holds(d, g))
         path = self._cached((s, g, doors, ()))
         if path is None or not discs:
             return path

@@ -188,6 +188,10 @@ class Scene:
         """How close the robot's centre may come to person ``d``'s centre: their radius plus its."""
         return d.r + self.radius
 
+    def holds(self, d: Disc, point: tuple[float, float]) -> bool:
+        """Is ``point`` inside person ``d``'s clearance (the robot there would touch them)?"""
+        return math.hypot(point[0] - d.x, point[1] - d.y) < self.clearance(d)
+
     def people_clear(self, a: np.ndarray, b: np.ndarray, discs: tuple[Disc, ...] | list[Disc] | None = None,
                      leaving: bool = True, goal: tuple[float, float] | None = None,
                      slack: float = 0.0) -> np.ndarray:
@@ -196,33 +200,34 @@ class Scene:
         so that a path the planner returns is one the skill drives.
 
         Segment ``a[i]→b[i]`` is blocked by a person when it comes closer to their centre
-        than :meth:`clearance` — except that the robot may already be closer (a person
-        walked up to it, it braked beside them) and may stop closer (next to a fallen
-        person): with ``leaving``, a segment that starts inside a clearance is clear as long
-        as it never comes closer than its start; a segment that ends at ``goal`` is clear
-        as long as it comes no closer than ``goal`` is.  Only a path's start (or a segment
-        start reached by leaving) can be inside a clearance, so a path never *enters* one
-        except to stop at its goal.  Without ``leaving`` (the undirected roadmap edges)
-        both ends count as entering: blocked whenever closer than the clearance.
-        ``discs`` defaults to everyone in the scene.  ``slack`` metres closer are tolerated:
-        the planner plans with none, the skill, which checks from the base's true pose
-        (a waypoint counts as reached within a couple of centimetres), with a little, so
-        that it accepts every path the planner returns as the base really drives it.
+        than :meth:`clearance` — except that
+
+        * the robot may already be closer (a person walked up to it, it braked beside
+          them): with ``leaving``, a segment that starts inside a clearance is clear as
+          long as it never comes closer than its start, so the robot can always back
+          away, and a path never *enters* a clearance on its way;
+        * the robot may be sent next to someone (0.9 m from a fallen person, to a place
+          a person stands on): people whose clearance holds ``goal`` do not block the
+          path to it — they are who the robot is going to stop beside.
+
+        Without ``leaving`` (the undirected roadmap edges) a segment is blocked whenever
+        it comes closer than the clearance.  ``discs`` defaults to everyone in the scene.
+        ``slack`` metres closer are tolerated: the planner plans with none; the skill,
+        which checks from the base's true pose (a waypoint counts as reached within a
+        couple of centimetres), with a little, so that it accepts every path the planner
+        returns as the base really drives it.
         """
         a, b = np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2)
         ok = np.ones(len(a), dtype=bool)
         discs = self.discs() if discs is None else list(discs)
+        if goal is not None:
+            discs = [d for d in discs if not self.holds(d, goal)]
         if not discs or not len(a):
             return ok
         px, py = np.array([d.x for d in discs]), np.array([d.y for d in discs])
         limit = np.broadcast_to(np.array([self.clearance(d) for d in discs])[None, :], (len(a), len(discs)))
         if leaving:
             limit = np.minimum(limit, np.hypot(a[:, :1] - px[None, :], a[:, 1:] - py[None, :]))
-        if goal is not None:
-            at_goal = (np.abs(b[:, 0] - goal[0]) <= 1e-9) & (np.abs(b[:, 1] - goal[1]) <= 1e-9)
-            if at_goal.any():
-                db = np.hypot(b[:, :1] - px[None, :], b[:, 1:] - py[None, :])
-                limit = np.where(at_goal[:, None], np.minimum(limit, db), limit)
         near = point_segment_distance(px, py, a, b) < limit - (PEOPLE_TOLERANCE + slack)
         return np.asarray(~near.any(axis=1), dtype=bool)
 
@@ -236,11 +241,13 @@ class Scene:
         return all(math.hypot(x - d.x, y - d.y) >= d.r + self.radius for d in self.discs(ignore))
 
     def segments_free(self, a: np.ndarray, b: np.ndarray, dynamic: bool = True, static: bool = True,
-                      goal: tuple[float, float] | None = None, slack: float = 0.0) -> np.ndarray:
+                      goal: tuple[float, float] | None = None, slack: float = 0.0,
+                      ignore: tuple[str, ...] = ()) -> np.ndarray:
         """Which segments ``a[i]→b[i]`` the disc robot can sweep along (exact, vectorised).
 
         The dynamic layer is closed doors and people; people by :meth:`people_clear`
-        (driven from ``a`` to ``b``, stopping at ``goal``, ``slack`` metres tolerated).
+        (driven from ``a`` to ``b``, stopping at ``goal``, ``slack`` metres tolerated),
+        less the people named in ``ignore``.
         """
         a, b = np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2)
         ok = np.ones(len(a), dtype=bool)
@@ -252,5 +259,5 @@ class Scene:
             ok &= segments_clear(a, b, self.static, r)
         if dynamic:
             ok &= segments_clear(a, b, self._closed, r)
-            ok &= self.people_clear(a, b, goal=goal, slack=slack)
+            ok &= self.people_clear(a, b, self.discs(ignore), goal=goal, slack=slack)
         return ok

@@ -154,10 +154,13 @@ class Navigate(Skill):
         ahead = [(x, y)] + f.path[f.leg + 1 :]
         if len(ahead) < 2:
             return False
-        # people by the planner's own rule (Scene.people_clear): what it plans, this accepts
+        # people by the planner's own rule (Scene.people_clear): what it plans, this accepts.
+        # Whoever follows the robot was planned around but is not checked against: they walk
+        # its trail, up to it, and would otherwise make it re-plan at each of their steps.
+        followers = tuple(p.name for p in self.sim.people if p.following)
         pts = np.asarray(ahead)
         return not self.sim.scene.segments_free(pts[:-1], pts[1:], static=False, goal=ahead[-1],
-                                                slack=TRACKING_SLACK).all()
+                                                slack=TRACKING_SLACK, ignore=followers).all()
 
     def control(self, now: float, dt: float) -> Command:
         f = self.follower
