@@ -16,6 +16,10 @@ reaches the next suspendable stage.  ``term`` while in ``cmd`` is handled as a s
 suspension followed by ``end`` (a task is never dropped mid-manoeuvre); so is the
 task's own ``ic_term`` (``check_terminate``) while it executes.
 
+Hazard-aware waiting (``docs/model.md``): a ``start`` whose data has ``secure`` makes a
+waiting agent *secure* its hazard — ``wait --secure--> genSusp``, the suspension of the
+``strict`` policy, ``exeSusp``, then ``wait`` again — instead of resuming its task.
+
 The agent never names a target state: it fires events through the one FSM table of
 :mod:`tasker.fsm`, whose guards it evaluates.  Every call into a task hook or the core
 agent is contained (:meth:`DynamicAgent.step`): an exception ends this task only.
@@ -26,7 +30,7 @@ from __future__ import annotations
 import math
 import traceback
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from tasker import fsm
@@ -112,6 +116,7 @@ class DynamicAgent:
         self._ack = 0
         self._pending_start = False
         self._pending_susp = False
+        self._pending_secure = False  # the pending start asks to secure (hazard-aware waiting)
         self._pending_term: tuple[str, str] | None = None  # (reason, cause: "term" or "self")
         self._runner: StageRunner | None = None
         self._ready_at = 0.0  # end of a planning hook's simulated time
@@ -181,6 +186,86 @@ class DynamicAgent:
             self._fail(now, exc)
             raise AgentEnded(self.id, self.end_reason or "error") from exc
 
+    def secure_estimate(self, now: float) -> float:
+        """Seconds from ``now`` until a waiting agent asked to secure is safe (hazard-aware waiting).
+
+        The task's own suspension under the ``strict`` policy from the world now (the
+        robot wherever it is: travel included), estimated with the ``static`` strategy —
+        the decision list, which reaches the same goal as a planned suspension without a
+        planner call —: its planning time plus its stages' durations.  ``inf`` if it
+        cannot be planned; raises :class:`~tasker.errors.AgentEnded` (after ending the
+        agent) if the hook raises otherwise, like :meth:`fresh_params`.
+        """
+        return self._suspension_estimate(now, "strict", self.ctx.interrupted, None)
+
+    def suspend_estimate(self, now: float, expected_s: float | None = None) -> float:
+        """Seconds from ``now`` until an agent in ``cmd`` reports ``wait`` if it is sent ``susp`` now.
+
+        In ``exeTsk``: what is left of a blocking stage and the blocking stages after it
+        (eq. 25), then its suspension (own policy, the interruption expected to last
+        ``expected_s``; static estimate as in :meth:`secure_estimate`).  In ``upTsk``: the
+        planning time left, then the same from the first stage.  In ``genSusp``/``exeSusp``:
+        what is left of the suspension.  0 outside ``cmd``.
+        """
+        if self.state is S.END:
+            raise AgentEnded(self.id, self.end_reason or "ended")
+        runner = self._runner
+        if self.state in (S.GEN_SUSP, S.EXE_SUSP):
+            left = max(0.0, self._ready_at - now) if self.state is S.GEN_SUSP else 0.0
+            if runner is not None:
+                left += self._stages_left(now, runner, runner.index, lambda s: True)
+            return left
+        if self.state is S.UP_TSK:
+            plan = self.ctx.plan
+            first = plan.stages[0] if plan is not None and plan.stages else None
+            left = max(0.0, self._ready_at - now)
+            if plan is not None:
+                left += self._stages_left(now, StageRunner(plan), 0, lambda s: s.blocking)
+            return left + self._suspension_estimate(now, self.ctx.strategy.policy, first, expected_s)
+        if self.state is S.EXE_TSK and runner is not None:
+            left = self._stages_left(now, runner, runner.index, lambda s: s.blocking)
+            return left + self._suspension_estimate(now, self.ctx.strategy.policy, runner.stage, expected_s)
+        return 0.0
+
+    def _stages_left(self, now: float, runner: StageRunner, index: int, take: Callable[[Stage], bool]) -> float:
+        """Durations of the runner's stages from ``index`` while ``take`` holds (the running one: what is left)."""
+        total = 0.0
+        for i in range(index, len(runner.plan.stages)):
+            stage = runner.plan.stages[i]
+            if not take(stage):
+                break
+            d = stage.duration
+            if i == runner.index and runner.running and self.ctx.stage_started is not None \
+                    and self.state is S.EXE_TSK:
+                d = max(0.0, d - (now - self.ctx.stage_started))
+            total += d
+        return total
+
+    def _suspension_estimate(self, now: float, policy: str, interrupted: Stage | None,
+                             expected_s: float | None) -> float:
+        """``generate_suspension`` on a copy of the context (static strategy, ``policy``): seconds it takes."""
+        if self.state is S.END:
+            raise AgentEnded(self.id, self.end_reason or "ended")
+        try:
+            self._refresh(now)
+            memory = dict(self.ctx.memory)
+            if expected_s is not None:
+                memory["interruption_s"] = float(expected_s)
+            ctx = replace(self.ctx, memory=memory, done=list(self.ctx.done), interrupted=interrupted,
+                          suspended=True, strategy=replace(self.ctx.strategy, suspension="static", policy=policy))
+            plan = self.task.generate_suspension(ctx)
+            if not isinstance(plan, StagePlan):
+                raise ConfigError(f"task type {self.ctx.task_type!r} returned a {type(plan).__name__} "
+                                  f"from generate_suspension, expected a StagePlan")
+            return float(plan.sim_time) + float(plan.expected_duration)
+        except PlanningFailed:
+            return math.inf
+        except _UNCONTAINED:
+            raise
+        except Exception as exc:
+            self._fail(now, exc)
+            raise AgentEnded(self.id, self.end_reason or "error") from exc
+
     def abort(self, now: float, reason: str) -> None:
         """End at once with cause ``error`` (the run is aborted): stop the running stage, guarded."""
         if self.state is not S.END:
@@ -223,6 +308,7 @@ class DynamicAgent:
             self._ack = cmd.seq
             if cmd.flag is Flag.START:
                 self._pending_start = True
+                self._pending_secure = bool(cmd.data.get("secure"))
             elif cmd.flag is Flag.SUSP:
                 self._pending_susp = True
                 if "expected_s" in cmd.data:  # how long the interruption is expected to last
@@ -248,7 +334,11 @@ class DynamicAgent:
         if self._pending_start:
             self._pending_start = False
             self._pending_susp = False  # a susp that reached a non-executing agent is void
-            self._start_up_tsk(now)
+            if self._pending_secure and self.state is S.WAIT:
+                self._start_secure(now)
+            else:
+                self._pending_secure = False
+                self._start_up_tsk(now)
             return
         self._pending_susp = False
         why = self.task.check_terminate(self.ctx)
@@ -376,6 +466,31 @@ class DynamicAgent:
         except PlanningFailed as exc:
             self._end(now, f"genSusp {exc.status}: {exc}", cause="failed", event="plan_failed")
             return
+        self._run_suspension(now, plan)
+
+    def _start_secure(self, now: float) -> None:
+        """Hazard-aware waiting: from ``wait``, reach the ``strict`` policy's safe state, then wait again.
+
+        The same hook as any suspension (``generate_suspension``), asked under the
+        ``strict`` policy: whatever a ``conditional`` branch left unsafe for a short
+        interruption is made safe now that the interruption has lasted.
+        """
+        self._pending_secure = False
+        self.ctx.terminating = False
+        self._fire("secure", now)
+        self._refresh(now)
+        strategy = self.ctx.strategy
+        self.ctx.strategy = replace(strategy, policy="strict")
+        try:
+            plan = self.task.generate_suspension(self.ctx)
+        except PlanningFailed as exc:
+            self._end(now, f"genSusp (secure) {exc.status}: {exc}", cause="failed", event="plan_failed")
+            return
+        finally:
+            self.ctx.strategy = strategy
+        self._run_suspension(now, plan)
+
+    def _run_suspension(self, now: float, plan: StagePlan) -> None:
         self._emit_plan(now, plan)
         self._runner = StageRunner(plan)
         self._ready_at = now + plan.sim_time
