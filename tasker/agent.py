@@ -186,6 +186,11 @@ class DynamicAgent:
             self._fail(now, exc)
             raise AgentEnded(self.id, self.end_reason or "error") from exc
 
+    @property
+    def progress(self) -> tuple[FsmState, int]:
+        """Where the agent is: its state and the index of its current stage (estimates change with it)."""
+        return self.state, self._runner.index if self._runner is not None else -1
+
     def secure_estimate(self, now: float) -> float:
         """Seconds from ``now`` until a waiting agent asked to secure is safe (hazard-aware waiting).
 

@@ -147,6 +147,8 @@ class TaskHarmoniser:
         self._securing: _Securing | None = None
         self._secured: set[tuple[str, str, tuple[str, ...], float]] = set()  # hazard episodes already secured
         self._left_cmd: dict[str, float] = {}  # when each agent last left cmd (its hazards unattended since)
+        # per watched agent: (re-estimate at, exeDA and its progress then, secure_s, suspend_s)
+        self._estimates: dict[str, tuple[float, tuple[str | None, Any], float, float]] = {}
         self._became: dict[str, list[float]] = {}  # when each agent became exeDA since the last new request
         self._factory = agent_factory
         self._trace = trace
@@ -367,11 +369,14 @@ class TaskHarmoniser:
         return secure_s + suspend_s + 1.0 / self.s_freq + self.secure_margin_s
 
     def _watch_hazards(self, now: float) -> None:
-        """Choose a waiting agent whose unattended hazard's budget is about to run out, if any."""
+        """Choose a waiting agent whose unattended hazard's budget is about to run out, if any.
+
+        Estimates cost a suspension hook call each, so an agent's are reused until half
+        its slack (budget left minus lead time) has passed, or the executing agent moved
+        on (another agent, state or stage): far from due they are rarely asked, near due
+        at every period."""
         assert self.hazards is not None
-        due: list[tuple[float, int, str, Any, float, float, float]] = []
-        secure_at: dict[str, float] = {}
-        suspend_s: float | None = None
+        watched: dict[str, tuple[float, Any]] = {}  # agent -> (budget left, that hazard), least first
         episodes: dict[str, list[tuple[str, str, tuple[str, ...], float]]] = {}
         for hz in self.hazards():
             agent = hz.agent
@@ -388,29 +393,39 @@ class TaskHarmoniser:
             if not math.isfinite(budget):
                 continue
             remaining = budget - (now - max(float(hz.since), self._left_cmd.get(agent, float(hz.since))))
-            try:
-                if agent not in secure_at:
-                    secure_at[agent] = da.secure_estimate(now)
-                if suspend_s is None:
-                    exe = self.exe_da
-                    suspend_s = self.agents[exe].suspend_estimate(now, secure_at[agent]) \
-                        if exe is not None and exe in self.agents else 0.0
-            except AgentEnded:
-                self._remove_ended()
-                return
-            lead = self.lead_time(secure_at[agent], suspend_s)
+            if agent not in watched or remaining < watched[agent][0]:
+                watched[agent] = (remaining, hz)
+        for agent in [a for a in self._estimates if a not in watched]:
+            del self._estimates[agent]
+        exe = self.exe_da
+        exe_at = self.agents[exe].progress if exe is not None and exe in self.agents else None
+        due: list[tuple[float, int, str]] = []
+        for agent, (remaining, _) in watched.items():
+            cached = self._estimates.get(agent)
+            if cached is None or now >= cached[0] or cached[1] != (exe, exe_at):
+                try:
+                    secure_s = self.agents[agent].secure_estimate(now)
+                    suspend_s = self.agents[exe].suspend_estimate(now, secure_s) if exe_at is not None and exe else 0.0
+                except AgentEnded:
+                    self._remove_ended()
+                    return
+                slack = remaining - self.lead_time(secure_s, suspend_s)
+                recheck = now + max(0.0, slack / 2) if math.isfinite(slack) else now
+                cached = self._estimates[agent] = (recheck, (exe, exe_at), secure_s, suspend_s)
+            lead = self.lead_time(cached[2], cached[3])
             if remaining <= lead:
-                due.append((remaining - lead, self._order.get(agent, 0), agent, hz, remaining,
-                            secure_at[agent], suspend_s))
+                due.append((remaining - lead, self._order.get(agent, 0), agent))
         if not due:
             return
-        _, _, agent, hz, remaining, secure_s, susp_s = min(due, key=lambda d: (d[0], d[1]))
+        agent = min(due)[2]
+        remaining, hz = watched[agent]
+        _, _, secure_s, suspend_s = self._estimates.pop(agent)
         chosen = episodes[agent]
         self._secured.update(chosen)
         self._securing = _Securing(agent, chosen, secure_s)
         self._trace.emit(now, "decision", algorithm=self.scheduler.name, rule="secure", dac=agent,
                          exeDA=self.exe_da, switch=True, hazard=str(hz.name), args=list(hz.fact[1:]),
-                         remaining_s=remaining, secure_s=secure_s, suspend_s=susp_s,
+                         remaining_s=remaining, secure_s=secure_s, suspend_s=suspend_s,
                          margin_s=self.secure_margin_s + 1.0 / self.s_freq)
         self._trace.emit(now, "secure", agent=agent, status="start",
                          hazards=[{"hazard": e[1], "args": list(e[2][1:])} for e in chosen])
