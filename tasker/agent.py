@@ -207,10 +207,11 @@ class DynamicAgent:
         """Seconds from ``now`` until an agent in ``cmd`` reports ``wait`` if it is sent ``susp`` now.
 
         In ``exeTsk``: what is left of a blocking stage and the blocking stages after it
-        (eq. 25), then its suspension (own policy, the interruption expected to last
-        ``expected_s``; static estimate as in :meth:`secure_estimate`).  In ``upTsk``: the
-        planning time left, then the same from the first stage.  In ``genSusp``/``exeSusp``:
-        what is left of the suspension.  0 outside ``cmd``.
+        (eq. 25), then its suspension at the first suspendable stage (own policy, the
+        interruption expected to last ``expected_s``; static estimate as in
+        :meth:`secure_estimate`), or nothing more if no suspendable stage is left (it
+        ends instead).  In ``upTsk``: the planning time left, then the same from the first
+        stage.  In ``genSusp``/``exeSusp``: what is left of the suspension.  0 outside ``cmd``.
         """
         if self.state is S.END:
             raise AgentEnded(self.id, self.end_reason or "ended")
@@ -220,17 +221,18 @@ class DynamicAgent:
             if runner is not None:
                 left += self._stages_left(now, runner, runner.index, lambda s: True)
             return left
-        if self.state is S.UP_TSK:
-            plan = self.ctx.plan
-            first = plan.stages[0] if plan is not None and plan.stages else None
-            left = max(0.0, self._ready_at - now)
-            if plan is not None:
-                left += self._stages_left(now, StageRunner(plan), 0, lambda s: s.blocking)
-            return left + self._suspension_estimate(now, self.ctx.strategy.policy, first, expected_s)
-        if self.state is S.EXE_TSK and runner is not None:
-            left = self._stages_left(now, runner, runner.index, lambda s: s.blocking)
-            return left + self._suspension_estimate(now, self.ctx.strategy.policy, runner.stage, expected_s)
-        return 0.0
+        if self.state is S.UP_TSK and self.ctx.plan is not None:
+            runner, left = StageRunner(self.ctx.plan), max(0.0, self._ready_at - now)
+        elif self.state is S.EXE_TSK and runner is not None:
+            left = 0.0
+        else:
+            return 0.0
+        left += self._stages_left(now, runner, runner.index, lambda s: s.blocking)
+        # the suspension happens at the first suspendable stage (eq. 26); none left: the task ends instead
+        at = next((s for s in runner.plan.stages[runner.index:] if not s.blocking), None)
+        if at is None:
+            return left
+        return left + self._suspension_estimate(now, self.ctx.strategy.policy, at, expected_s)
 
     def _stages_left(self, now: float, runner: StageRunner, index: int, take: Callable[[Stage], bool]) -> float:
         """Durations of the runner's stages from ``index`` while ``take`` holds (the running one: what is left)."""

@@ -27,7 +27,7 @@ from tasker.stage import Stage
 from tasker.store import TaskStore
 from tasker.synthetic import SyntheticTask, TimedExecutor
 from tasker.task import Strategy, TaskContext
-from tests.tasker.helpers import st
+from tests.tasker.helpers import BLOCK, st
 
 FLAME = ("flame", "burner")
 BUDGET = 20.0
@@ -197,3 +197,80 @@ def test_the_margin_must_be_a_finite_number() -> None:
         with pytest.raises(ConfigError, match="secure_margin_s"):
             TaskHarmoniser(schedulers.create("fifo"), lambda *a: None, trace=None,  # type: ignore[arg-type]
                            secure_margin_s=bad)  # type: ignore[arg-type]
+
+
+def test_a_task_terminated_while_securing_ends_after_reaching_its_safe_state() -> None:
+    world = Facts()
+    store = TaskStore([stew(world), chore()])
+    loop = SimulationLoop(store, schedulers.create("priority"), core=EffectExecutor(world),
+                          strategy=Strategy("static", "static", "conditional"), hazard_waiting=True)
+    monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning, world.snapshot,
+                      task_types=store.names())
+    loop.observers.append(monitor.observe)
+    loop.harmoniser.hazards = monitor.active
+    loop.request(0.0, "stew", {"priority": 1})
+    loop.request(5.0, "chore", {"priority": 5})
+    trace = loop.trace
+
+    def term_when_securing() -> None:
+        if any(e["event"] == "secure" for e in trace.events):
+            loop.harmoniser.terminate("d1", "not hungry any more")
+        else:
+            loop.at(loop.now + 0.5, term_when_securing)
+
+    loop.at(6.0, term_when_securing)
+    events = loop.run().events
+    end = next(e for e in events if e["event"] == "end" and e["agent"] == "d1")
+    assert end["cause"] == "term"
+    assert FLAME not in world.facts  # it put the flame out before ending
+    assert [e["status"] for e in events if e["event"] == "secure"] == ["start", "ended"]
+    assert overruns(events) == 0
+    assert next(e for e in events if e["event"] == "end" and e["agent"] == "d2")["cause"] == "finished"
+
+
+def test_a_hazard_whose_task_ended_is_not_secured() -> None:
+    world = Facts()
+    store = TaskStore([stew(world), chore()])
+    loop = SimulationLoop(store, schedulers.create("priority"), core=EffectExecutor(world),
+                          strategy=Strategy("static", "static", "conditional"), hazard_waiting=True)
+    monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning, world.snapshot,
+                      task_types=store.names())
+    loop.observers.append(monitor.observe)
+    loop.harmoniser.hazards = monitor.active
+    loop.request(0.0, "stew", {"priority": 1})
+    loop.request(5.0, "chore", {"priority": 5})
+    loop.terminate(7.0, "d1", "ends in wait: the flame stays on, nobody's task")
+    events = loop.run().events
+    assert FLAME in world.facts and not secures(events)
+
+
+def test_the_monitor_says_since_when_each_hazard_holds() -> None:
+    world = Facts()
+    store = TaskStore([stew(world), chore()])
+    loop = SimulationLoop(store, schedulers.create("priority"), core=EffectExecutor(world))
+    monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning, world.snapshot,
+                      task_types=store.names())
+    loop.observers.append(monitor.observe)
+    loop.request(0.0, "stew", {"priority": 1})
+    loop.run(until=10.0)
+    [hz] = monitor.active()
+    on = next(e for e in loop.trace.events if e["event"] == "hazard" and e["status"] == "on")
+    assert (hz.agent, hz.name, hz.fact, hz.budget_s, hz.since) == ("d1", "flame", FLAME, BUDGET, on["t"])
+    loop.run()
+    assert monitor.active() == ()
+
+
+def test_suspend_estimate_counts_the_blocking_stages_left() -> None:
+    world = Facts()
+    task = SyntheticTask("bake", [st("prep", 2.0), st("bake", 30.0, BLOCK), st("cool", 3.0, BLOCK), st("serve", 1.0)],
+                         suspension={"bake": [st("tidy", 9.0)], "serve": [st("tidy", 4.0)]})
+    loop = SimulationLoop(TaskStore([task]), schedulers.create("fifo"), core=EffectExecutor(world))
+    loop.request(0.0, "bake")
+    loop.run(until=12.0)
+    [agent] = loop.all_agents
+    assert agent.state is FsmState.EXE_TSK and agent.progress == (FsmState.EXE_TSK, 1)
+    started = agent.ctx.stage_started
+    assert started is not None
+    # what is left of bake, all of cool (blocking), then the suspension at serve, where it would stop
+    assert agent.suspend_estimate(12.0) == pytest.approx(started + 30.0 - 12.0 + 3.0 + 4.0)
+    assert agent.secure_estimate(12.0) == 0.0  # nothing interrupted yet: the tree has no branch
