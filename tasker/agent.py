@@ -33,7 +33,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
-from tasker import fsm
+from tasker import fsm, securing
 from tasker.errors import AgentEnded, ConfigError, FSMError, InvariantViolation, PlanningFailed, WorldError
 from tasker.messages import Command, Flag, FsmState, Report, ScheduleParams, SPRequest
 from tasker.protocols import CoreAgent, SkillState
@@ -192,86 +192,12 @@ class DynamicAgent:
         return self.state, self._runner.index if self._runner is not None else -1
 
     def secure_estimate(self, now: float) -> float:
-        """Seconds from ``now`` until a waiting agent asked to secure is safe (hazard-aware waiting).
-
-        The task's own suspension under the ``strict`` policy from the world now (the
-        robot wherever it is: travel included), estimated with the ``static`` strategy —
-        the decision list, which reaches the same goal as a planned suspension without a
-        planner call —: its planning time plus its stages' durations.  ``inf`` if it
-        cannot be planned; raises :class:`~tasker.errors.AgentEnded` (after ending the
-        agent) if the hook raises otherwise, like :meth:`fresh_params`.
-        """
-        return self._suspension_estimate(now, "strict", self.ctx.interrupted, None)
+        """Seconds until this waiting agent, asked to secure now, is safe (:func:`tasker.securing.secure_estimate`)."""
+        return securing.secure_estimate(self, now)
 
     def suspend_estimate(self, now: float, expected_s: float | None = None) -> float:
-        """Seconds from ``now`` until an agent in ``cmd`` reports ``wait`` if it is sent ``susp`` now.
-
-        In ``exeTsk``: what is left of a blocking stage and the blocking stages after it
-        (eq. 25), then its suspension at the first suspendable stage (own policy, the
-        interruption expected to last ``expected_s``; static estimate as in
-        :meth:`secure_estimate`), or nothing more if no suspendable stage is left (it
-        ends instead).  In ``upTsk``: the planning time left, then the same from the first
-        stage.  In ``genSusp``/``exeSusp``: what is left of the suspension.  0 outside ``cmd``.
-        """
-        if self.state is S.END:
-            raise AgentEnded(self.id, self.end_reason or "ended")
-        runner = self._runner
-        if self.state in (S.GEN_SUSP, S.EXE_SUSP):
-            left = max(0.0, self._ready_at - now) if self.state is S.GEN_SUSP else 0.0
-            if runner is not None:
-                left += self._stages_left(now, runner, runner.index, lambda s: True)
-            return left
-        if self.state is S.UP_TSK and self.ctx.plan is not None:
-            runner, left = StageRunner(self.ctx.plan), max(0.0, self._ready_at - now)
-        elif self.state is S.EXE_TSK and runner is not None:
-            left = 0.0
-        else:
-            return 0.0
-        left += self._stages_left(now, runner, runner.index, lambda s: s.blocking)
-        # the suspension happens at the first suspendable stage (eq. 26); none left: the task ends instead
-        at = next((s for s in runner.plan.stages[runner.index:] if not s.blocking), None)
-        if at is None:
-            return left
-        return left + self._suspension_estimate(now, self.ctx.strategy.policy, at, expected_s)
-
-    def _stages_left(self, now: float, runner: StageRunner, index: int, take: Callable[[Stage], bool]) -> float:
-        """Durations of the runner's stages from ``index`` while ``take`` holds (the running one: what is left)."""
-        total = 0.0
-        for i in range(index, len(runner.plan.stages)):
-            stage = runner.plan.stages[i]
-            if not take(stage):
-                break
-            d = stage.duration
-            if i == runner.index and runner.running and self.ctx.stage_started is not None \
-                    and self.state is S.EXE_TSK:
-                d = max(0.0, d - (now - self.ctx.stage_started))
-            total += d
-        return total
-
-    def _suspension_estimate(self, now: float, policy: str, interrupted: Stage | None,
-                             expected_s: float | None) -> float:
-        """``generate_suspension`` on a copy of the context (static strategy, ``policy``): seconds it takes."""
-        if self.state is S.END:
-            raise AgentEnded(self.id, self.end_reason or "ended")
-        try:
-            self._refresh(now)
-            memory = dict(self.ctx.memory)
-            if expected_s is not None:
-                memory["interruption_s"] = float(expected_s)
-            ctx = replace(self.ctx, memory=memory, done=list(self.ctx.done), interrupted=interrupted,
-                          suspended=True, strategy=replace(self.ctx.strategy, suspension="static", policy=policy))
-            plan = self.task.generate_suspension(ctx)
-            if not isinstance(plan, StagePlan):
-                raise ConfigError(f"task type {self.ctx.task_type!r} returned a {type(plan).__name__} "
-                                  f"from generate_suspension, expected a StagePlan")
-            return float(plan.sim_time) + float(plan.expected_duration)
-        except PlanningFailed:
-            return math.inf
-        except _UNCONTAINED:
-            raise
-        except Exception as exc:
-            self._fail(now, exc)
-            raise AgentEnded(self.id, self.end_reason or "error") from exc
+        """Seconds until this agent, sent ``susp`` now, waits (:func:`tasker.securing.suspend_estimate`)."""
+        return securing.suspend_estimate(self, now, expected_s)
 
     def abort(self, now: float, reason: str) -> None:
         """End at once with cause ``error`` (the run is aborted): stop the running stage, guarded."""

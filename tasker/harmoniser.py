@@ -27,7 +27,7 @@ so that if ``irrDA`` ends meanwhile the suspended agent still leaves ``exeDA``
 **Hazard-aware waiting** (``hazard_waiting=True`` and a ``hazards`` source, e.g.
 :meth:`tasker.meaning.Monitor.active`), not in the paper: at each ``timer(sFreq)``
 the harmoniser checks every waiting agent whose hazard holds and is unattended; when
-the budget left is no more than the time to secure it (:meth:`TaskHarmoniser.lead_time`),
+the budget left is no more than the time to secure it (:class:`tasker.securing.HazardWatch`),
 it makes that agent ``irrDA`` whatever the scheduler says — the executing agent is
 suspended safely the normal way — and starts it with ``secure``: the agent reaches
 its ``strict`` safe state and waits again (``docs/model.md``).
@@ -36,7 +36,7 @@ its ``strict`` safe state and waits again (``docs/model.md``).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any
@@ -45,6 +45,7 @@ from tasker.agent import DynamicAgent
 from tasker.errors import AgentEnded, ConfigError, InvariantViolation, TaskerError, WorldError
 from tasker.messages import Command, Flag, FsmState, ScheduleParams, SPRequest
 from tasker.schedulers.base import Candidate, Scheduler, ScheduleView
+from tasker.securing import HazardSource, HazardWatch
 from tasker.trace import Trace
 
 _TRACED = frozenset({"by", "expected_s", "predicted_s", "secure"})
@@ -94,17 +95,12 @@ class OscillationGuard:
 
 AgentFactory = Callable[[str, Request, float, Callable[[DynamicAgent], None]], DynamicAgent]
 
-HazardSource = Callable[[], Iterable[Any]]
-"""The hazards that hold now, each with ``agent``, ``name``, ``fact``, ``budget_s`` and ``since``
-(:class:`tasker.meaning.ActiveHazard`; :meth:`tasker.meaning.Monitor.active` is one)."""
-
 
 @dataclass(slots=True)
 class _Securing:
-    """The agent chosen to secure its hazard: the hazards' episodes, and the ``start`` it was sent."""
+    """The agent chosen to secure its hazard, its estimated time to secure, and the ``start`` it was sent."""
 
     agent: str
-    episodes: list[tuple[str, str, tuple[str, ...], float]]
     secure_s: float
     seq: int | None = None
 
@@ -113,7 +109,7 @@ class TaskHarmoniser:
     """The robot's task harmoniser.  ``exe_da``, ``irr_da`` and ``idle_da`` are its roles.
 
     ``hazard_waiting`` (default off) selects hazard-aware waiting, one factor of the
-    static-versus-planned sweep (``docs/sweeps.md``): with a ``hazards`` source (set
+    static-versus-planned sweep (``docs/model.md``): with a ``hazards`` source (set
     here or later as :attr:`hazards`), a waiting agent secures its hazard before the
     hazard's budget runs out (module docstring).  ``secure_margin_s`` is the slack
     added to the estimated time to secure.
@@ -134,21 +130,14 @@ class TaskHarmoniser:
     ) -> None:
         if not isinstance(s_freq, int | float) or s_freq <= 0:
             raise ConfigError(f"sFreq must be a positive number of Hz, got {s_freq!r}")
-        if isinstance(secure_margin_s, bool) or not isinstance(secure_margin_s, int | float) \
-                or not math.isfinite(secure_margin_s) or secure_margin_s < 0:
-            raise ConfigError(f"secure_margin_s must be a finite number of seconds >= 0, got {secure_margin_s!r}")
         self.scheduler = scheduler
         self.mode = Mode(mode)
         self.s_freq = float(s_freq)
         self.guard = guard  # None: no oscillation guard
         self.hazard_waiting = bool(hazard_waiting)  # hazard-aware waiting, a sweep factor
         self.hazards = hazards  # where hazard-aware waiting learns of hazards (None: it has nothing to watch)
-        self.secure_margin_s = float(secure_margin_s)
+        self.watch = HazardWatch(secure_margin_s, 1.0 / self.s_freq)  # hazard-aware waiting's memory
         self._securing: _Securing | None = None
-        self._secured: set[tuple[str, str, tuple[str, ...], float]] = set()  # hazard episodes already secured
-        self._left_cmd: dict[str, float] = {}  # when each agent last left cmd (its hazards unattended since)
-        # per watched agent: (re-estimate at, exeDA and its progress then, secure_s, suspend_s)
-        self._estimates: dict[str, tuple[float, tuple[str | None, Any], float, float]] = {}
         self._became: dict[str, list[float]] = {}  # when each agent became exeDA since the last new request
         self._factory = agent_factory
         self._trace = trace
@@ -362,73 +351,29 @@ class TaskHarmoniser:
 
     # -- hazard-aware waiting ----------------------------------------------------------------
 
-    def lead_time(self, secure_s: float, suspend_s: float) -> float:
-        """How early to secure: the time to secure (``secure_s``), the executing agent's safe
-        suspension first (``suspend_s``), one scheduling period (the next check may be too
-        late) and :attr:`secure_margin_s`."""
-        return secure_s + suspend_s + 1.0 / self.s_freq + self.secure_margin_s
-
     def _watch_hazards(self, now: float) -> None:
-        """Choose a waiting agent whose unattended hazard's budget is about to run out, if any.
-
-        Estimates cost a suspension hook call each, so an agent's are reused until half
-        its slack (budget left minus lead time) has passed, or the executing agent moved
-        on (another agent, state or stage): far from due they are rarely asked, near due
-        at every period."""
+        """Hazard-aware waiting: if a waiting agent must secure its hazard now, make it ``irrDA``."""
         assert self.hazards is not None
-        watched: dict[str, tuple[float, Any]] = {}  # agent -> (budget left, that hazard), least first
-        episodes: dict[str, list[tuple[str, str, tuple[str, ...], float]]] = {}
-        for hz in self.hazards():
-            agent = hz.agent
-            if agent is None or agent not in self._idle:  # nobody's, ended, executing or already chosen
-                continue
-            da = self.agents.get(agent)
-            if da is None or da.ended or da.report is None or da.report.fsm_state is not FsmState.WAIT:
-                continue
-            episode = (agent, str(hz.name), tuple(hz.fact), float(hz.since))
-            if episode in self._secured:  # never twice for the same hazard episode
-                continue
-            episodes.setdefault(agent, []).append(episode)
-            budget = float(hz.budget_s)
-            if not math.isfinite(budget):
-                continue
-            remaining = budget - (now - max(float(hz.since), self._left_cmd.get(agent, float(hz.since))))
-            if agent not in watched or remaining < watched[agent][0]:
-                watched[agent] = (remaining, hz)
-        for agent in [a for a in self._estimates if a not in watched]:
-            del self._estimates[agent]
-        exe = self.exe_da
-        exe_at = self.agents[exe].progress if exe is not None and exe in self.agents else None
-        due: list[tuple[float, int, str]] = []
-        for agent, (remaining, _) in watched.items():
-            cached = self._estimates.get(agent)
-            if cached is None or now >= cached[0] or cached[1] != (exe, exe_at):
-                try:
-                    secure_s = self.agents[agent].secure_estimate(now)
-                    suspend_s = self.agents[exe].suspend_estimate(now, secure_s) if exe_at is not None and exe else 0.0
-                except AgentEnded:
-                    self._remove_ended()
-                    return
-                slack = remaining - self.lead_time(secure_s, suspend_s)
-                recheck = now + max(0.0, slack / 2) if math.isfinite(slack) else now
-                cached = self._estimates[agent] = (recheck, (exe, exe_at), secure_s, suspend_s)
-            lead = self.lead_time(cached[2], cached[3])
-            if remaining <= lead:
-                due.append((remaining - lead, self._order.get(agent, 0), agent))
-        if not due:
+        waiting = {a: da for a in self._idle if (da := self.agents.get(a)) is not None and not da.ended
+                   and da.report is not None and da.report.fsm_state is FsmState.WAIT}
+        if not waiting:
             return
-        agent = min(due)[2]
-        remaining, hz = watched[agent]
-        _, _, secure_s, suspend_s = self._estimates.pop(agent)
-        chosen = episodes[agent]
-        self._secured.update(chosen)
-        self._securing = _Securing(agent, chosen, secure_s)
+        exe = self.agents.get(self.exe_da) if self.exe_da is not None else None
+        try:
+            due = self.watch.due(now, self.hazards(), waiting, exe, self._order)
+        except AgentEnded:
+            self._remove_ended()
+            return
+        if due is None:
+            return
+        agent, hz = due.agent, due.hazard
+        self._securing = _Securing(agent, due.secure_s)
         self._trace.emit(now, "decision", algorithm=self.scheduler.name, rule="secure", dac=agent,
                          exeDA=self.exe_da, switch=True, hazard=str(hz.name), args=list(hz.fact[1:]),
-                         remaining_s=remaining, secure_s=secure_s, suspend_s=suspend_s,
-                         margin_s=self.secure_margin_s + 1.0 / self.s_freq)
+                         remaining_s=due.remaining_s, secure_s=due.secure_s, suspend_s=due.suspend_s,
+                         margin_s=self.watch.margin_s + self.watch.period_s)
         self._trace.emit(now, "secure", agent=agent, status="start",
-                         hazards=[{"hazard": e[1], "args": list(e[2][1:])} for e in chosen])
+                         hazards=[{"hazard": e[1], "args": list(e[2][1:])} for e in due.episodes])
         if self.irr_da is not None:  # a switch already under way: the hazard goes first
             self._idle[self.irr_da] = None
         del self._idle[agent]
@@ -512,7 +457,7 @@ class TaskHarmoniser:
                 raise InvariantViolation(f"agents {sorted(self._in_cmd)} are in cmd at once")
         else:
             if agent.id in self._in_cmd:
-                self._left_cmd[agent.id] = self.now  # its hazards are unattended from now on
+                self.watch.left_cmd[agent.id] = self.now  # its hazards are unattended from now on
             self._in_cmd.discard(agent.id)
         if report.fsm_state is FsmState.END:
             self._ended.append(agent.id)
