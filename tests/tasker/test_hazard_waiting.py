@@ -274,3 +274,14 @@ def test_suspend_estimate_counts_the_blocking_stages_left() -> None:
     # what is left of bake, all of cool (blocking), then the suspension at serve, where it would stop
     assert agent.suspend_estimate(12.0) == pytest.approx(started + 30.0 - 12.0 + 3.0 + 4.0)
     assert agent.secure_estimate(12.0) == 0.0  # nothing interrupted yet: the tree has no branch
+
+
+def test_the_runner_gives_the_harmoniser_the_monitors_hazards() -> None:
+    from experiments import scenario as scenarios
+    from experiments.runner import build_robot
+
+    loop, _ = build_robot(scenarios.load(scenarios.resolve("household")), seed=1, hazard_waiting=True)
+    harm = loop.harmoniser
+    assert harm.hazard_waiting and harm.hazards is not None
+    assert isinstance(harm.hazards.__self__, Monitor)  # type: ignore[attr-defined]
+    assert harm.hazards() == ()  # nothing observed yet
