@@ -1,13 +1,31 @@
-"""The sequence of the paper's Appendix B, checked on a trace.
+"""The sequence of the paper's Appendix B, checked on a trace: order *and* causes.
 
 :func:`check` walks a trace of the paper scenario (``tasker run paper``) and returns
-one :class:`Step` per step of Appendix B, each with the time it happened and the
-events that show it, or why it was not found.  ``docs/paper.md`` explains each
-step; the end-to-end test asserts they all hold, in order.
+one :class:`Step` per step of Appendix B, each with the time it happened, what shows
+it, and — for the steps Alg. 2 decides by comparing costs — the decision's ``c_switch``
+and ``c_wait`` and its margin ``1 - c_switch / c_wait``.  A step holds only when its
+cause shows in the trace too:
+
+* guide Alice takes over by a finite cost comparison, and guide John is suspended with
+  eq. 47's *save* (John was not greeted yet);
+* guide John takes back over by a finite cost comparison *because his task got
+  cheaper*: its ``cTime`` at that decision is below its ``cTime`` when it lost the
+  robot (John walked toward his destination), and it resumes with
+  ``greet_and_apologise`` (Alg. 3);
+* Peter fell preempts by priority class while John is in the ``guide`` stage, and the
+  suspension asks John to wait (eq. 47's *apologise*);
+* Sara fell wins a finite cost comparison because her task is the shorter one;
+* Peter fell ends from ``wait`` after the world says Peter got up, by itself
+  (``cause: "self"``), without ever having been started again.
+
+Trace values may be ``inf`` (written as the string ``"inf"``): every number is read
+through :func:`num`, and a non-finite comparison never counts as a cost-decided step.
+``docs/paper.md`` explains each step; ``experiments/paper_report.py`` tabulates them.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -21,21 +39,66 @@ class Step:
     ok: bool
     t: float | None
     detail: str
+    c_switch: float | None = None
+    c_wait: float | None = None
+
+    @property
+    def margin(self) -> float | None:
+        """``1 - c_switch / c_wait`` of the deciding comparison (None without one, or if not finite)."""
+        if self.c_switch is None or self.c_wait is None or not (math.isfinite(self.c_switch)
+                                                               and math.isfinite(self.c_wait)) or self.c_wait <= 0:
+            return None
+        return 1.0 - self.c_switch / self.c_wait
+
+
+def num(value: Any) -> float:
+    """A trace number: floats, ints, and the strings ``"inf"``/``"-inf"``/``"nan"``; anything else is NaN."""
+    if isinstance(value, bool):
+        return math.nan
+    if isinstance(value, int | float):
+        return float(value)
+    if isinstance(value, str):
+        try:
+            return float(value)
+        except ValueError:
+            return math.nan
+    return math.nan
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.1f}" if math.isfinite(x) else str(x)
 
 
 def _first(events: Sequence[Event], after: float, **match: Any) -> Event | None:
     for e in events:
-        if e["t"] >= after and all(e.get(k) == v for k, v in match.items()):
+        if num(e.get("t")) >= after and all(e.get(k) == v for k, v in match.items()):
             return e
     return None
 
 
 def _switch(events: Sequence[Event], after: float, dac: str, exe: str, rule: str) -> tuple[Event | None, Event | None]:
-    d = next((e for e in events if e["event"] == "decision" and e["t"] >= after and e.get("dac") == dac
-              and e.get("exeDA") == exe and e.get("rule") == rule and e.get("switch")), None)
+    """The first switching decision ``dac`` over ``exe`` by ``rule`` at or after ``after``, and ``dac``'s start."""
+    d = next((e for e in events if e.get("event") == "decision" and num(e.get("t")) >= after
+              and e.get("dac") == dac and e.get("exeDA") == exe and e.get("rule") == rule and e.get("switch")), None)
     if d is None:
         return None, None
-    return d, _first(events, d["t"], event="command", agent=dac, flag="start")
+    return d, _first(events, num(d["t"]), event="command", agent=dac, flag="start")
+
+
+def _compared(d: Event | None) -> tuple[bool, float | None, float | None, str]:
+    """Is ``d`` a finite cost comparison that switched, and its numbers."""
+    if d is None:
+        return False, None, None, "no such decision"
+    cs, cw, h = num(d.get("c_switch")), num(d.get("c_wait")), num(d.get("hysteresis", 1.0))
+    finite = math.isfinite(cs) and math.isfinite(cw)
+    ok = finite and cs < (h if math.isfinite(h) else 1.0) * cw
+    return ok, cs, cw, f"c_switch={_fmt(cs)} < {_fmt(h)}·c_wait={_fmt(cw)}" if ok else \
+        f"not a finite comparison won: c_switch={_fmt(cs)}, c_wait={_fmt(cw)}"
+
+
+def _last_stage(events: Sequence[Event], agent: str, before: float) -> Event | None:
+    return next((e for e in reversed(events) if e.get("event") == "stage" and e.get("agent") == agent
+                 and e.get("fsm") == "exeTsk" and num(e.get("t")) <= before), None)
 
 
 def check(events: Sequence[Event]) -> list[Step]:
@@ -44,54 +107,84 @@ def check(events: Sequence[Event]) -> list[Step]:
     t = 0.0
 
     start = _first(events, 0.0, event="command", flag="start")
-    ok = start is not None and start["agent"] == "d1"
-    steps.append(Step("guide John (d1) starts", ok, start["t"] if start else None,
-                      f"first start goes to {start['agent'] if start else 'nobody'}"))
+    ok = start is not None and start.get("agent") == "d1"
+    steps.append(Step("guide John (d1) starts", ok, num(start["t"]) if start else None,
+                      f"first start goes to {start.get('agent') if start else 'nobody'}"))
 
-    d, s = _switch(events, t, "d2", "d1", "cost")
-    steps.append(Step("guide Alice (d2) takes over: c_switch < c_wait", s is not None, s["t"] if s else None,
-                      f"c_switch={d['c_switch']:.1f} < c_wait={d['c_wait']:.1f}" if d else "no such decision"))
-    t = s["t"] if s else t
+    # 2. guide Alice takes over on cost; d1 (John not greeted) suspends with `save`
+    d2_dec, s = _switch(events, t, "d2", "d1", "cost")
+    won, cs, cw, why = _compared(d2_dec)
+    saved = None
+    if d2_dec is not None:
+        saved = next((e for e in events if e.get("event") == "plan" and e.get("agent") == "d1"
+                      and e.get("purpose") == "genSusp" and num(e["t"]) >= num(d2_dec["t"])), None)
+    is_save = saved is not None and "save" in str(saved.get("note", "")) and not saved.get("stages")
+    steps.append(Step("guide Alice (d2) takes over: c_switch < c_wait; guide John suspends with save",
+                      s is not None and won and is_save, num(s["t"]) if s else None,
+                      f"{why}; d1 genSusp: {saved.get('note') if saved else None}", cs, cw))
+    t = num(s["t"]) if s else t
 
+    # 3. John walked: d1's cTime fell since it lost the robot, and that wins the comparison
     d, s = _switch(events, t, "d1", "d2", "cost")
-    worked = d is not None and any(e["event"] == "stage" and e.get("agent") == "d2" and e.get("fsm") == "exeTsk"
-                                   and e.get("status") == "done" and t <= e["t"] <= d["t"] for e in events)
-    steps.append(Step("John walked toward his destination: guide John (d1) takes back over", s is not None and worked,
-                      s["t"] if s else None,
-                      f"c_switch={d['c_switch']:.1f} < c_wait={d['c_wait']:.1f}" if d else "no such decision"))
-    t = s["t"] if s else t
+    won, cs, cw, why = _compared(d)
+    before = num(d2_dec.get("cTime_exeDA")) if d2_dec else math.nan
+    after = num(d.get("cTime_dac")) if d else math.nan
+    cheaper = math.isfinite(before) and math.isfinite(after) and after < before
+    resumed = None
+    if s is not None:
+        resumed = next((e for e in events if e.get("event") == "plan" and e.get("agent") == "d1"
+                        and e.get("purpose") == "upTsk" and num(e["t"]) >= num(s["t"])), None)
+    apologises = resumed is not None and any(st.get("action") == "greet_and_apologise"
+                                             for st in resumed.get("stages", ()))
+    steps.append(Step("John walked toward his destination: guide John (d1) takes back over",
+                      s is not None and won and cheaper and apologises, num(s["t"]) if s else None,
+                      f"{why}; d1 cTime {_fmt(before)} -> {_fmt(after)} s; resumes with greet_and_apologise: "
+                      f"{apologises}", cs, cw))
+    t = num(s["t"]) if s else t
 
+    # 4. Peter fell preempts by class while John is guided; John is asked to wait
     d, s = _switch(events, t, "d3", "d1", "priority class")
-    guiding = None
-    told = None
+    guiding = told = None
     if d is not None:
-        guiding = next((e for e in reversed([e for e in events if e["t"] <= d["t"]]) if e["event"] == "stage"
-                        and e.get("agent") == "d1"), None)
-        told = next((e for e in events if e["event"] == "stage" and e["t"] >= d["t"] and e.get("agent") == "d1"
-                     and e.get("fsm") == "exeSusp" and e.get("action") == "ask_to_wait" and e.get("status") == "done"),
-                    None)
-    ok = s is not None and guiding is not None and guiding.get("action") == "guide" and told is not None
+        guiding = _last_stage(events, "d1", num(d["t"]))
+        told = next((e for e in events if e.get("event") == "stage" and num(e["t"]) >= num(d["t"])
+                     and e.get("agent") == "d1" and e.get("fsm") == "exeSusp" and e.get("action") == "ask_to_wait"
+                     and e.get("status") == "done"), None)
+    ok = (s is not None and guiding is not None and guiding.get("action") == "guide"
+          and guiding.get("status") == "begin" and told is not None and num(told["t"]) <= num(s["t"]))
     steps.append(Step("Peter fell (d3) preempts guide John at once while John is guided; John is asked to wait",
-                      ok, s["t"] if s else None,
-                      f"d1 was in stage {guiding.get('action') if guiding else None}; ask_to_wait done at "
+                      ok, num(s["t"]) if s else None,
+                      f"d1 was in stage {guiding.get('action') if guiding else None} "
+                      f"({guiding.get('status') if guiding else None}); ask_to_wait done at "
                       f"{told['t'] if told else None}"))
-    t = s["t"] if s else t
+    t = num(s["t"]) if s else t
 
+    # 5. Sara fell wins the comparison: her task is the shorter one
     d, s = _switch(events, t, "d4", "d3", "cost")
-    steps.append(Step("Sara fell (d4) takes over from Peter fell after comparing costs", s is not None,
-                      s["t"] if s else None,
-                      f"c_switch={d['c_switch']:.1f} < c_wait={d['c_wait']:.1f}" if d else "no such decision"))
-    t = s["t"] if s else t
+    won, cs, cw, why = _compared(d)
+    shorter = d is not None and num(d.get("cTime_dac")) < num(d.get("cTime_exeDA"))
+    steps.append(Step("Sara fell (d4) takes over from Peter fell after comparing costs", s is not None and won
+                      and shorter, num(s["t"]) if s else None,
+                      f"{why}; cTime d4 {_fmt(num(d.get('cTime_dac')))} vs d3 {_fmt(num(d.get('cTime_exeDA')))}"
+                      if d else why, cs, cw))
+    t = num(s["t"]) if s else t
 
-    w = next((e for e in events if e["event"] == "transition" and e.get("agent") == "d3" and e.get("to") == "end"),
+    # 6. Peter gets up while d3 waits: d3 ends itself from wait
+    up = next((e for e in events if e.get("event") == "world" and e.get("value") == ["peter", "standing"]
+               and num(e["t"]) >= t), None)
+    w = next((e for e in events if e.get("event") == "transition" and e.get("agent") == "d3" and e.get("to") == "end"),
              None)
     end = _first(events, 0.0, event="end", agent="d3")
-    ok = w is not None and w.get("from") == "wait" and end is not None and "fine" in str(end.get("reason"))
-    steps.append(Step("Peter fell (d3) ends while waiting: Peter is fine", ok, w["t"] if w else None,
-                      f"d3 ended from {w.get('from') if w else None}: {end.get('reason') if end else None}"))
+    restarted = any(e.get("event") == "command" and e.get("agent") == "d3" and e.get("flag") == "start"
+                    and num(e["t"]) > t for e in events)
+    ok = (up is not None and w is not None and w.get("from") == "wait" and num(w["t"]) >= num(up["t"])
+          and end is not None and "fine" in str(end.get("reason")) and end.get("cause") == "self" and not restarted)
+    steps.append(Step("Peter fell (d3) ends while waiting: Peter is fine", ok, num(w["t"]) if w else None,
+                      f"Peter up at {up['t'] if up else None}; d3 ended from {w.get('from') if w else None}: "
+                      f"{end.get('reason') if end else None} ({end.get('cause') if end else None})"))
 
-    ends = {e["agent"]: e for e in events if e["event"] == "end"}
+    ends = {e["agent"]: e for e in events if e.get("event") == "end"}
     rest = {a: ends.get(a, {}).get("reason") for a in ("d1", "d2", "d4")}
     steps.append(Step("the rest complete", all(r == "finished" for r in rest.values()),
-                      max((ends[a]["t"] for a in rest if a in ends), default=None), f"end reasons: {rest}"))
+                      max((num(ends[a]["t"]) for a in rest if a in ends), default=None), f"end reasons: {rest}"))
     return steps
