@@ -10,14 +10,17 @@ cause shows in the trace too:
   eq. 47's *save* (John was not greeted yet);
 * guide John takes back over by a finite cost comparison *because his task got
   cheaper*: its ``cTime`` at that decision is below its ``cTime`` when it lost the
-  robot (John walked toward his destination), and it resumes with
-  ``greet_and_apologise`` (Alg. 3);
-* Peter fell preempts by priority class while John is in the ``guide`` stage, and the
+  robot (John walked toward his destination), and its new plan greets him again with
+  the apology its task folder declares for a suspended task (Alg. 3: the ``suspended``
+  variant of a ``[static] update`` stage);
+* Peter fell preempts by priority class while John follows the robot, and the
   suspension asks John to wait (eq. 47's *apologise*);
 * Sara fell wins a finite cost comparison because her task is the shorter one;
 * Peter fell ends from ``wait`` after the world says Peter got up, by itself
   (``cause: "self"``), without ever having been started again.
 
+What a person does (follows the robot, is told to wait, waits) is read from the
+trace's ``role`` events, which the task folders declare, never from action names.
 Trace values may be ``inf`` (written as the string ``"inf"``): every number is read
 through :func:`num`, and a non-finite comparison never counts as a cost-decided step.
 ``docs/paper.md`` explains each step; ``experiments/paper_report.py`` tabulates them.
@@ -96,9 +99,29 @@ def _compared(d: Event | None) -> tuple[bool, float | None, float | None, str]:
         f"not a finite comparison won: c_switch={_fmt(cs)}, c_wait={_fmt(cw)}"
 
 
-def _last_stage(events: Sequence[Event], agent: str, before: float) -> Event | None:
-    return next((e for e in reversed(events) if e.get("event") == "stage" and e.get("agent") == agent
-                 and e.get("fsm") == "exeTsk" and num(e.get("t")) <= before), None)
+def _role_at(events: Sequence[Event], t: float, agent: str, role: str) -> bool:
+    """Whether ``agent``'s person had ``role`` at time ``t`` (the last role edge at or before it)."""
+    edges = [e for e in events if e.get("event") == "role" and num(e.get("t")) <= t and e.get("agent") == agent
+             and e.get("role") == role]
+    return bool(edges) and edges[-1].get("status") == "on"
+
+
+def _apologies(events: Sequence[Event], agent: str) -> frozenset[str]:
+    """The actions ``agent``'s task folder runs instead of a stage after a suspension (Alg. 3).
+
+    Read from the folder the trace's ``request`` names (``[static] update``'s ``suspended``),
+    so no action is named here.
+    """
+    from planners.bundled import task_types
+    from planners.pddl_task import PddlTaskType
+
+    req = next((e for e in events if e.get("event") == "request" and e.get("agent") == agent), None)
+    if req is None:
+        return frozenset()
+    for tt in task_types():
+        if isinstance(tt, PddlTaskType) and tt.name == req.get("task_type"):
+            return frozenset(st.suspended for st in tt.spec.static_update if st.suspended)
+    return frozenset()
 
 
 def check(events: Sequence[Event]) -> list[Step]:
@@ -118,10 +141,14 @@ def check(events: Sequence[Event]) -> list[Step]:
     if d2_dec is not None:
         saved = next((e for e in events if e.get("event") == "plan" and e.get("agent") == "d1"
                       and e.get("purpose") == "genSusp" and num(e["t"]) >= num(d2_dec["t"])), None)
-    is_save = saved is not None and "save" in str(saved.get("note", "")) and not saved.get("stages")
+    # eq. 47's save: nothing to do to suspend (John was not greeted, so he is not told to wait)
+    is_save = saved is not None and not saved.get("stages") and d2_dec is not None and not _role_at(
+        events, num(d2_dec["t"]), "d1", "told_to_wait") and not _role_at(events, num(d2_dec["t"]), "d1", "following")
     steps.append(Step("guide Alice (d2) takes over: c_switch < c_wait; guide John suspends with save",
                       s is not None and won and is_save, num(s["t"]) if s else None,
-                      f"{why}; d1 genSusp: {saved.get('note') if saved else None}", cs, cw))
+                      f"{why}; d1 genSusp stages: {saved.get('stages') if saved else None} "
+                      f"({saved.get('note') if saved else None})",
+                      cs, cw))
     t = num(s["t"]) if s else t
 
     # 3. John walked: d1's cTime fell since it lost the robot, and that wins the comparison
@@ -134,29 +161,27 @@ def check(events: Sequence[Event]) -> list[Step]:
     if s is not None:
         resumed = next((e for e in events if e.get("event") == "plan" and e.get("agent") == "d1"
                         and e.get("purpose") == "upTsk" and num(e["t"]) >= num(s["t"])), None)
-    apologises = resumed is not None and any(st.get("action") == "greet_and_apologise"
-                                             for st in resumed.get("stages", ()))
+    apologies = _apologies(events, "d1")
+    apologises = resumed is not None and any(st.get("action") in apologies for st in resumed.get("stages", ()))
     steps.append(Step("John walked toward his destination: guide John (d1) takes back over",
                       s is not None and won and cheaper and apologises, num(s["t"]) if s else None,
                       f"{why}; d1 cTime {_fmt(before)} -> {_fmt(after)} s; resumes with greet_and_apologise: "
                       f"{apologises}", cs, cw))
     t = num(s["t"]) if s else t
 
-    # 4. Peter fell preempts by class while John is guided; John is asked to wait
+    # 4. Peter fell preempts by class while John follows the robot; John is asked to wait
     d, s = _switch(events, t, "d3", "d1", "priority class")
-    guiding = told = None
+    following = False
+    told = None
     if d is not None:
-        guiding = _last_stage(events, "d1", num(d["t"]))
-        told = next((e for e in events if e.get("event") == "stage" and num(e["t"]) >= num(d["t"])
-                     and e.get("agent") == "d1" and e.get("fsm") == "exeSusp" and e.get("action") == "ask_to_wait"
-                     and e.get("status") == "done"), None)
-    ok = (s is not None and guiding is not None and guiding.get("action") == "guide"
-          and guiding.get("status") == "begin" and told is not None and num(told["t"]) <= num(s["t"]))
+        # read from the trace's role edges, which the task folder declares: no task or action names here
+        following = _role_at(events, num(d["t"]), "d1", "following")
+        told = next((e for e in events if e.get("event") == "role" and num(e["t"]) >= num(d["t"])
+                     and e.get("agent") == "d1" and e.get("role") == "told_to_wait" and e.get("status") == "on"), None)
+    ok = s is not None and following and told is not None and num(told["t"]) <= num(s["t"])
     steps.append(Step("Peter fell (d3) preempts guide John at once while John is guided; John is asked to wait",
                       ok, num(s["t"]) if s else None,
-                      f"d1 was in stage {guiding.get('action') if guiding else None} "
-                      f"({guiding.get('status') if guiding else None}); ask_to_wait done at "
-                      f"{told['t'] if told else None}"))
+                      f"John following d1 at the decision: {following}; told to wait at {told['t'] if told else None}"))
     t = num(s["t"]) if s else t
 
     # 5. Sara fell wins the comparison: her task is the shorter one

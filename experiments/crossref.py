@@ -66,7 +66,10 @@ def arg_types(task: TaskType) -> dict[str, set[str]]:
         literals.extend(branch.when)
         literals.extend(branch.goal)
     out: dict[str, set[str]] = {}
-    model: Any = getattr(getattr(domain, "checked", None), "model", None)
+    try:
+        model: Any = domain.checked.model  # type: ignore[union-attr]
+    except AttributeError:  # a task type without a checked PDDL domain
+        model = None
     templates = [*getattr(spec, "static_update", ())]
     for branch in getattr(spec, "static_suspension", ()):
         templates.extend(branch.stages)

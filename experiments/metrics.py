@@ -4,9 +4,10 @@ A metric family is a small collector: it observes events one at a time through
 ``on_event`` and never touches the model (STYLE principle 10), and ``result`` gives
 a JSON-ready dict.  :func:`compute` feeds every collector the same events in order
 and composes their results; the same collectors can subscribe to a live
-:class:`tasker.trace.Trace`.  Hazards (a cooker on, an object held, a door open, a
-person following) are declared in :data:`HAZARDS`, keyed on the bundled domains'
-action names, so a new domain adds rows there rather than code.
+:class:`tasker.trace.Trace`.  What is hazardous and who waits is declared by each
+task folder and reaches the metrics only through the trace's ``hazard`` and ``role``
+events (:mod:`tasker.meaning`): this module names no task, action or predicate, so a
+user's new domain is measured exactly like a bundled one.
 """
 
 from __future__ import annotations
@@ -14,58 +15,13 @@ from __future__ import annotations
 import math
 from collections import Counter
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
+from tasker.meaning import CMD_STATES as CMD
 from tasker.trace import read
 
-CMD = frozenset({"upTsk", "exeTsk", "genSusp", "exeSusp"})
-"""Leaves of the ``cmd`` superstate (Fig. 5): the agent owns the robot."""
-
 Event = Mapping[str, Any]
-
-
-@dataclass(frozen=True)
-class HazardRule:
-    """A stage whose ``status`` turns a hazard on (``starts``) or off for ``args[1]``."""
-
-    action: str
-    hazard: str
-    starts: bool
-    status: str = "done"
-
-
-HAZARDS: tuple[HazardRule, ...] = (
-    HazardRule("turn_on", "cooker_on", True),  # cook
-    HazardRule("turn_off", "cooker_on", False),
-    HazardRule("pick_pan", "object_held", True),
-    HazardRule("take_off_cooker", "object_held", True),
-    HazardRule("put_on_cooker", "object_held", False),
-    HazardRule("put_down", "object_held", False),
-    HazardRule("pick", "object_held", True),  # carry_object
-    HazardRule("place", "object_held", False),
-    HazardRule("open_door", "door_open", True),
-    HazardRule("close_door", "door_open", False),
-    HazardRule("ask_to_follow", "person_following", True),  # guide_human
-    HazardRule("guide", "person_following", True, "begin"),  # guiding implies following
-    HazardRule("say_goodbye", "person_following", False),
-    HazardRule("goodbye", "person_following", False),  # the synthetic demo's name
-    HazardRule("ask_to_wait", "person_following", False),
-)
-"""The hazard table: every other action leaves hazards as they are."""
-
-HAZARD_KINDS = ("cooker_on", "object_held", "door_open", "person_following")
-PERSON_HAZARDS = frozenset({"person_following"})
-"""Hazards that end with their task: nobody follows a robot whose task is over."""
-
-WAITING_TASKS = frozenset({"guide_human", "human_fell"})
-"""Task types whose person waits for the robot from the request on."""
-WAIT_ENDS = frozenset({"greet", "greet_and_apologise", "apologise", "check_consciousness"})
-WAIT_STARTS = frozenset({"ask_to_wait"})
-"""A ``done`` stage of these actions ends / restarts the person's wait."""
-
-_RULES = {(r.action, r.status): r for r in HAZARDS}
 
 
 class Collector(Protocol):
@@ -74,12 +30,6 @@ class Collector(Protocol):
     def on_event(self, e: Event) -> None: ...
 
     def result(self) -> dict[str, Any]: ...
-
-
-def _subject(e: Event) -> str:
-    """What a stage acts on: ``args[1]`` in the bundled domains (``args[0]`` is the robot)."""
-    args = e.get("args") or []
-    return str(args[1]) if len(args) > 1 else str(e["agent"])
 
 
 def _stats(values: list[float]) -> dict[str, float | None]:
@@ -225,121 +175,157 @@ class DecisionCollector:
 
 
 class HazardCollector:
-    """Hazard exposure (from :data:`HAZARDS`) and what each switch left behind.
+    """Hazard exposure from the trace's ``hazard`` edges, and what each switch left behind.
 
-    A hazard is owned by the agent whose stage started it; it is *unattended* while
-    its owner is not in ``cmd``.  A *switch* here is an agent entering ``wait``.
+    A hazard is *unattended* while it is on and its agent is not ``exeDA`` (not in
+    ``cmd``); a stretch of unattended time longer than the hazard's ``budget_s`` is an
+    *overrun*.  A hazard nobody owns (``agent: null``, e.g. a door open in the world
+    file) is counted apart: nobody could attend to it.  A *switch* here is an agent
+    entering ``wait``; what it leaves on is read at the end of that instant (a hazard
+    its suspension turned off in the same tick is not left behind).
     """
 
     def __init__(self) -> None:
         self.state: dict[str, str] = {}
-        self.active: dict[tuple[str, str], dict[str, Any]] = {}
+        self.active: dict[tuple[str, str, tuple[str, ...]], dict[str, Any]] = {}
         self.episodes: list[dict[str, Any]] = []
         self.at_switch: list[dict[str, Any]] = []
+        self._pending: list[tuple[float, str]] = []
         self.t = 0.0
 
     def _advance(self, t: float) -> None:
+        dt = t - self.t
         for h in self.active.values():
-            if self.state.get(h["agent"]) not in CMD:
-                h["unattended_s"] += t - self.t
+            if h["agent"] is None or dt <= 0:
+                continue
+            if self.state.get(h["agent"]) in CMD:
+                h["stretch"] = 0.0
+                continue
+            before = h["stretch"]
+            h["stretch"] += dt
+            h["unattended_s"] += dt
+            h["longest_unattended_s"] = max(h["longest_unattended_s"], h["stretch"])
+            over = h["stretch"] - max(h["budget_s"], before)
+            if over > 0:
+                h["overrun_s"] += over
+                if before <= h["budget_s"]:
+                    h["overruns"] += 1
         self.t = max(self.t, t)
 
-    def _close(self, key: tuple[str, str]) -> None:
+    def _settle(self, t: float) -> None:
+        """Switches of an earlier instant see the hazards as that instant left them."""
+        while self._pending and self._pending[0][0] < t:
+            t0, agent = self._pending.pop(0)
+            owned = [h for h in self.active.values() if h["agent"] is not None]
+            own = [h for h in owned if h["agent"] == agent]
+            self.at_switch.append({"t": t0, "agent": agent, "own": [(h["hazard"], h["args"]) for h in own],
+                                   "all": len(owned)})
+
+    def _close(self, key: tuple[str, str, tuple[str, ...]]) -> None:
         h = self.active.pop(key)
         self.episodes.append(dict(h, end=self.t, active_s=self.t - h["start"]))
 
     def on_event(self, e: Event) -> None:
-        self._advance(float(e["t"]))
-        kind, agent = e["event"], str(e.get("agent", ""))
+        t = float(e["t"])
+        self._settle(t)
+        self._advance(t)
+        kind, agent = e["event"], e.get("agent")
         if kind == "request":
-            self.state[agent] = "initComm"
+            self.state[str(agent)] = "initComm"
         elif kind == "transition":
-            self.state[agent] = e["to"]
+            self.state[str(agent)] = e["to"]
             if e["to"] == "wait":
-                own = [h for h in self.active.values() if h["agent"] == agent]
-                self.at_switch.append({"t": self.t, "agent": agent, "own": [(h["hazard"], h["subject"]) for h in own],
-                                       "all": len(self.active)})
-        elif kind == "stage":
-            rule = _RULES.get((e["action"], e["status"]))
-            if rule is not None:
-                key = (rule.hazard, _subject(e))
-                if rule.starts and key not in self.active:
-                    self.active[key] = {"hazard": rule.hazard, "subject": key[1], "agent": agent,
-                                        "start": self.t, "unattended_s": 0.0}
-                elif not rule.starts and key in self.active:
-                    self._close(key)
-        elif kind == "end":
-            for key in [k for k, h in self.active.items() if h["agent"] == agent and h["hazard"] in PERSON_HAZARDS]:
+                self._pending.append((t, str(agent)))
+        elif kind == "hazard":
+            key = (str(agent), str(e["hazard"]), tuple(str(a) for a in e.get("args", [])))
+            if e["status"] == "on" and key not in self.active:
+                self.active[key] = {"hazard": e["hazard"], "args": list(key[2]), "agent": agent,
+                                    "budget_s": float(e.get("budget_s", 0.0)), "severity": e.get("severity", 1.0),
+                                    "start": self.t, "unattended_s": 0.0, "longest_unattended_s": 0.0,
+                                    "stretch": 0.0, "overruns": 0, "overrun_s": 0.0}
+            elif e["status"] == "off" and key in self.active:
                 self._close(key)
 
     def result(self) -> dict[str, Any]:
+        self._settle(math.inf)
         open_now = [dict(h, end=None, active_s=self.t - h["start"]) for h in self.active.values()]
-        episodes = sorted(self.episodes + open_now, key=lambda h: (h["start"], h["hazard"], h["subject"]))
+        episodes = sorted(self.episodes + open_now, key=lambda h: (h["start"], h["hazard"], h["args"],
+                                                                    str(h["agent"])))
+        for h in episodes:
+            h.pop("stretch", None)
+        owned = [h for h in episodes if h["agent"] is not None]
         kinds = {}
-        for k in HAZARD_KINDS:
-            mine = [h for h in episodes if h["hazard"] == k]
-            kinds[k] = {"episodes": len(mine), "active_s": math.fsum(h["active_s"] for h in mine),
+        for k in sorted({h["hazard"] for h in episodes}):
+            mine = [h for h in owned if h["hazard"] == k]
+            kinds[k] = {"episodes": len(mine), "budget_s": max((h["budget_s"] for h in mine), default=None),
+                        "active_s": math.fsum(h["active_s"] for h in mine),
                         "unattended_s": math.fsum(h["unattended_s"] for h in mine),
+                        "longest_unattended_s": max((h["longest_unattended_s"] for h in mine), default=0.0),
+                        "overruns": sum(h["overruns"] for h in mine),
+                        "overrun_s": math.fsum(h["overrun_s"] for h in mine),
                         "at_switch": sum(1 for s in self.at_switch for hz, _ in s["own"] if hz == k),
-                        "active_at_end": sum(1 for h in open_now if h["hazard"] == k)}
-        switches = [{"t": s["t"], "agent": s["agent"], "hazards": [f"{hz}({subj})" for hz, subj in s["own"]]}
+                        "active_at_end": sum(1 for h in open_now if h["hazard"] == k and h["agent"] is not None),
+                        "unowned": sum(1 for h in episodes if h["hazard"] == k and h["agent"] is None)}
+        switches = [{"t": s["t"], "agent": s["agent"], "hazards": [f"{hz}({', '.join(a)})" for hz, a in s["own"]]}
                     for s in self.at_switch]
         return {
             "hazards": kinds, "episodes": episodes, "switches_into_wait": switches,
             "violations_at_switch": sum(len(s["own"]) for s in self.at_switch),
             "hazards_active_at_switch": sum(s["all"] for s in self.at_switch),
-            "cooker_unattended_s": kinds["cooker_on"]["unattended_s"],
-            "objects_held_at_switch": kinds["object_held"]["at_switch"],
-            "doors_open_at_switch": kinds["door_open"]["at_switch"],
-            "people_following_at_switch": kinds["person_following"]["at_switch"],
+            "unattended_s": math.fsum(h["unattended_s"] for h in owned),
+            "longest_unattended_s": max((h["longest_unattended_s"] for h in owned), default=0.0),
+            "budget_overruns": sum(h["overruns"] for h in owned),
+            "overrun_s": math.fsum(h["overrun_s"] for h in owned),
+            "unowned_hazards": len(episodes) - len(owned),
         }
 
 
 class PeopleCollector:
-    """Time people spend waiting for the robot and following it (per agent of a person task)."""
+    """People's roles from the trace's ``role`` edges: time waiting for the robot, following
+    it, told to wait; and, for people who need help, the time from request to help."""
 
     def __init__(self) -> None:
+        self.requests: dict[str, dict[str, Any]] = {}
         self.people: dict[str, dict[str, Any]] = {}
-        self._waiting: dict[str, float] = {}
-        self._following: dict[str, float] = {}
+        self._on: dict[tuple[str, str], float] = {}
         self.t = 0.0
 
     def on_event(self, e: Event) -> None:
-        t, kind, agent = float(e["t"]), e["event"], e.get("agent", "")
+        t, kind, agent = float(e["t"]), e["event"], str(e.get("agent", ""))
         self.t = max(self.t, t)
-        if kind == "request" and e["task_type"] in WAITING_TASKS:
-            person = str((e.get("args") or {}).get("person", agent))
-            self.people[agent] = {"person": person, "task_type": e["task_type"], "waiting_s": 0.0, "following_s": 0.0}
-            self._waiting[agent] = t
-        if agent not in self.people:
-            return
-        p = self.people[agent]
-        if kind == "stage":
-            rule = _RULES.get((e["action"], e["status"]))
-            if rule is not None and rule.hazard == "person_following":
-                if rule.starts:
-                    self._following.setdefault(agent, t)
-                elif agent in self._following:
-                    p["following_s"] += t - self._following.pop(agent)
-            if e["status"] == "done" and e["action"] in WAIT_ENDS and agent in self._waiting:
-                p["waiting_s"] += t - self._waiting.pop(agent)
-            elif e["status"] == "done" and e["action"] in WAIT_STARTS:
-                self._waiting.setdefault(agent, t)
-        elif kind == "end":
-            self._flush(agent, t)
+        if kind == "request":
+            self.requests[agent] = {"task_type": e["task_type"], "request_t": t}
+        elif kind == "role" and agent in self.requests:
+            p = self.people.setdefault(agent, {
+                "person": e.get("person"), "task_type": self.requests[agent]["task_type"], "waiting_s": 0.0,
+                "following_s": 0.0, "told_to_wait_s": 0.0, "needs_help": False, "time_to_help_s": None})
+            role = str(e["role"])
+            if e["status"] == "on":
+                self._on.setdefault((agent, role), t)
+                if role == "needs_help":
+                    p["needs_help"] = True
+                elif role == "helped" and p["time_to_help_s"] is None:
+                    p["time_to_help_s"] = t - self.requests[agent]["request_t"]
+            elif (agent, role) in self._on:
+                self._add(agent, role, t - self._on.pop((agent, role)))
 
-    def _flush(self, agent: str, t: float) -> None:
-        p = self.people[agent]
-        if agent in self._waiting:
-            p["waiting_s"] += t - self._waiting.pop(agent)
-        if agent in self._following:
-            p["following_s"] += t - self._following.pop(agent)
+    def _add(self, agent: str, role: str, seconds: float) -> None:
+        key = f"{role}_s"
+        if key in self.people[agent]:
+            self.people[agent][key] += seconds
 
     def result(self) -> dict[str, Any]:
-        for agent in sorted(set(self._waiting) | set(self._following)):  # still open when the run stopped
-            self._flush(agent, self.t)
-        return {"people": self.people, "people_waiting_s": math.fsum(p["waiting_s"] for p in self.people.values()),
-                "people_following_s": math.fsum(p["following_s"] for p in self.people.values())}
+        for (agent, role), t0 in sorted(self._on.items()):  # still on when the run stopped
+            self._add(agent, role, self.t - t0)
+        self._on.clear()
+        ps = self.people.values()
+        helped = [p["time_to_help_s"] for p in ps if p["needs_help"] and p["time_to_help_s"] is not None]
+        return {"people": self.people, "people_waiting_s": math.fsum(p["waiting_s"] for p in ps),
+                "people_following_s": math.fsum(p["following_s"] for p in ps),
+                "people_told_to_wait_s": math.fsum(p["told_to_wait_s"] for p in ps),
+                "needing_help": sum(1 for p in ps if p["needs_help"]),
+                "not_helped": sum(1 for p in ps if p["needs_help"] and p["time_to_help_s"] is None),
+                "time_to_help_s": _stats(helped)}
 
 
 class RunCollector:

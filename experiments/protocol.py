@@ -207,11 +207,11 @@ class DayTask(SyntheticTask):
         s, site, dest = self.spec, args["site"], args["dest"]
         go = _move("go_to", site, self.speed)
         if s.kind == "transport":
-            return [go, Stage("greet", kind=BLOCK, duration=s.greet_s),
+            return [go, Stage("meet", kind=BLOCK, duration=s.greet_s),
                     _move("escort", dest, args["walk_speed"], site), Stage("goodbye", kind=BLOCK, duration=s.goodbye_s)]
         if s.kind == "fall":
             return [go, Stage("help", kind=BLOCK, duration=args["work"])]
-        return [go, Stage("pick", kind=BLOCK, duration=s.pick_s), _move("carry", dest, self.speed, site),
+        return [go, Stage("pick_up", kind=BLOCK, duration=s.pick_s), _move("carry", dest, self.speed, site),
                 Stage("place", kind=BLOCK, duration=s.place_s)]
 
     def _build(self, ctx: TaskContext, start: Pose | None, resume: bool) -> list[Stage]:
@@ -247,7 +247,7 @@ class DayTask(SyntheticTask):
         stopped = ctx.interrupted
         stages: tuple[Stage, ...] = ()
         if stopped is not None and stopped.data.get("from") is not None and self.spec.suspend_s:
-            action = "ask_to_wait" if self.spec.kind == "transport" else "put_down"
+            action = "ask_to_stay" if self.spec.kind == "transport" else "set_down"
             stages = (Stage(action, kind=BLOCK, duration=self.spec.suspend_s),)
         return StagePlan(stages, Purpose.GEN_SUSP, strategy="static", sim_time=self.planning_time)
 

@@ -282,7 +282,8 @@ def read_trajectory(run_dir: Path) -> tuple[list[Sample], dict[str, list[tuple[f
 
     Rows are read tolerantly: ``t`` and the robot as ``x``/``y``/``yaw`` or ``robot``
     (``[x, y, yaw]`` or ``{"x", "y", "yaw"}``/``{"pose"}``); people under ``people`` as
-    ``name -> [x, y, ...]`` or ``{"pose"|"x","y", "posture"}``."""
+    ``name -> [x, y, yaw, posture]`` or ``{"pose"|"x","y", "posture"}``; rows without ``t``
+    (a header) and ``mark`` rows are skipped (``tasker-trajectory/1`` of ``robot.recording``)."""
     jsonl, csv_path = run_dir / "trajectory.jsonl", run_dir / "trajectory.csv"
     rows: list[Mapping[str, Any]] = []
     try:
@@ -296,6 +297,8 @@ def read_trajectory(run_dir: Path) -> tuple[list[Sample], dict[str, list[tuple[f
         robot: list[Sample] = []
         people: dict[str, list[tuple[float, float, float, str]]] = {}
         for r in rows:
+            if "t" not in r or "mark" in r:  # a header line (format, fields) or an event mark
+                continue
             t = float(r["t"])
             pose = _pose(r.get("robot", r))
             if pose is not None:
@@ -303,11 +306,12 @@ def read_trajectory(run_dir: Path) -> tuple[list[Sample], dict[str, list[tuple[f
             for name, p in (r.get("people") or {}).items():
                 pp = _pose(p)
                 if pp is not None:
-                    posture = str(p.get("posture", "")) if isinstance(p, Mapping) else ""
+                    posture = str(p.get("posture", "")) if isinstance(p, Mapping) else (
+                        p[3] if isinstance(p, list | tuple) and len(p) > 3 and isinstance(p[3], str) else "")
                     people.setdefault(name, []).append((t, pp[0], pp[1], posture))
     except (ValueError, KeyError, TypeError, AttributeError):
         return None  # a format this page does not know: fall back to the run's own trajectory
-    return robot, people
+    return (robot, people) if robot else None
 
 
 def _pose(v: Any) -> tuple[float, float, float] | None:
@@ -350,7 +354,8 @@ _FILL = {"wall": "#444", "furniture": "#c8b48a", "door": "#7a4f2a"}
 def world_figure(world: Any, robot: Sequence[Sample], people: Mapping[str, Sequence[tuple[float, float, float, str]]],
                  events: Sequence[Event], hazards: Sequence[tuple[str, str, float, float]]) -> dict[str, Any]:
     """The world from above, a time slider over the trajectory: the robot, its path so far,
-    people, the hazards on and the agent executing at that moment.  A figure dict: its
+    people, the hazards on and the agent executing at that moment; red crosses where the robot
+    was at each ``susp`` command.  A figure dict: its
     frames are built as plain data (validating hundreds of frames would cost seconds)."""
     robot = _thin(robot, MAX_POINTS)
     people = {n: _thin(track, MAX_POINTS) for n, track in people.items()} or _people_from_trace(world, events)
@@ -373,12 +378,18 @@ def world_figure(world: Any, robot: Sequence[Sample], people: Mapping[str, Seque
                              textfont={"size": 9, "color": "#2a7a2a"}, hoverinfo="text"))
     fig.add_trace(go.Scatter(x=[s[1] for s in robot], y=[s[2] for s in robot], mode="lines", name="robot path",
                              line={"color": "#1f5fbf", "width": 1}, opacity=0.25, hoverinfo="skip"))
+    susp_at = [(float(e["t"]), e["agent"], _at(robot, float(e["t"]))) for e in events
+               if e["event"] == "command" and e["flag"] == "susp"]
+    fig.add_trace(go.Scatter(x=[p[1] for _, _, p in susp_at if p], y=[p[2] for _, _, p in susp_at if p],
+                             text=[f"susp {a} at {t:.1f} s" for t, a, p in susp_at if p], mode="markers",
+                             marker={"symbol": "x-thin-open", "size": 14, "color": "#c0392b", "line": {"width": 3}},
+                             name="robot at susp", hoverinfo="text"))
     t_end = max(robot[-1][0] if robot else 0.0, _end_time(events))
     n = min(MAX_FRAMES, max(2, len(robot)))
     times = [round(t_end * i / (n - 1), 3) for i in range(n)]
     suspended = _suspension_spans(events, t_end)
     roles = [(float(e["t"]), e.get("exeDA")) for e in events if e["event"] == "roles"]
-    frames = [{"name": f"{t:g}", "data": _world_state(t, robot, people), "traces": [2, 3, 4],
+    frames = [{"name": f"{t:g}", "data": _world_state(t, robot, people), "traces": [3, 4, 5],
                "layout": {"title": {"text": _world_title(t, hazards, suspended, roles, t_end)}}} for t in times]
     for trace in _world_state(times[0], robot, people):
         fig.add_trace(go.Scatter(**{k: v for k, v in trace.items() if k != "type"}))
@@ -418,7 +429,7 @@ def _people_from_trace(world: Any, events: Sequence[Event]) -> dict[str, list[tu
 
 def _world_state(t: float, robot: Sequence[Sample], people: Mapping[str, Sequence[tuple[float, float, float, str]]]
                  ) -> list[dict[str, Any]]:
-    """Traces 2–4 of the world figure at time ``t`` (plain dicts): path so far, robot, people."""
+    """Traces 3–5 of the world figure at time ``t`` (plain dicts): path so far, robot, people."""
     done = [s for s in robot if s[0] <= t] or list(robot[:1])
     r = _at(robot, t)
     heading = ([r[1], r[1] + 0.45 * math.cos(r[3])], [r[2], r[2] + 0.45 * math.sin(r[3])]) if r else ([], [])

@@ -34,6 +34,7 @@ from tasker.agent import Rates
 from tasker.errors import RunAborted
 from tasker.harmoniser import Mode
 from tasker.loop import SimulationLoop
+from tasker.meaning import Monitor
 from tasker.requester import Requester
 from tasker.store import TaskStore
 from tasker.task import Strategy
@@ -52,10 +53,13 @@ class RunResult:
 
 def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None = None,
                 suspension: str | None = None, scheduler: str | None = None,
-                trace: Trace | None = None, task_paths: tuple[str, ...] = ()) -> tuple[SimulationLoop, Any]:
+                trace: Trace | None = None, task_paths: tuple[str, ...] = (), policy: str | None = None,
+                hazard_waiting: bool = False) -> tuple[SimulationLoop, Any]:
     """The loop and the simulation for a robot scenario, with every request and event scheduled.
 
-    ``task_paths`` are task folders loaded besides the bundled ones and ``$TASKER_TASKS``."""
+    ``task_paths`` are task folders loaded besides the bundled ones and ``$TASKER_TASKS``.
+    ``policy`` (default: the scenario's) reaches every task's :class:`Strategy`;
+    ``hazard_waiting`` is passed to the loop."""
     from planners.bundled import task_types
     from robot.sim import Simulation
     from robot.spec import load_world
@@ -74,24 +78,54 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
                 changes["walk"] = tuple(tuple(w) for w in entry["walk"])
             people[name] = dataclasses.replace(people[name], **changes)
         spec = dataclasses.replace(spec, people=people)
+    spec = _with_objects(scn, spec)
     sim = Simulation(spec, seed=seed)
     store = TaskStore(task_types(task_paths))
-    default = Strategy(update or scn.update, suspension or scn.suspension)
-    per_type = {t: Strategy(update or s.get("update", default.update), suspension or s.get("suspension",
-                                                                                           default.suspension))
+    types = [store.get(n) for n in store.names()]
+    sim.bind(b for t in types for b in t.meaning.bindings)  # the world reads the folders' bindings
+    default = Strategy(update or scn.update, suspension or scn.suspension, policy or scn.policy)
+    per_type = {t: Strategy(update or s.get("update", default.update),
+                            suspension or s.get("suspension", default.suspension), default.policy)
                 for t, s in scn.strategies.items()}
     options = scn.scheduler_options if scheduler in (None, scn.scheduler) else {}
     loop = SimulationLoop(
         store, schedulers.create(scheduler or scn.scheduler, **options), seed=seed, trace=trace,
         mode=Mode(scn.mode), s_freq=scn.s_freq, rates=Rates(scn.rep_rate, scn.task_exe_rate, scn.sp_up_rate),
         strategy=default, strategies=per_type, core=sim, world=sim, motion=sim.motion, horizon=scn.horizon,
+        hazard_waiting=hazard_waiting,
     )
+    monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning,
+                      lambda: sim.snapshot().facts, task_types=store.names(),
+                      version=lambda: (sim.time, sim.version))
+    loop.observers.append(monitor.observe)
     requester = Requester(store, loop.harmoniser, "scenario")
     for a in scn.actions:
         loop.at(a.t, _action(loop, sim, requester, a, scn))
         if a.kind == "request":
             store.validate(a.fields["task"], a.fields["args"])  # bad requests fail before the run
     return loop, sim
+
+
+def _with_objects(scn: scenarios.RobotScenario, spec: Any) -> Any:
+    """The world with the scenario's ``[objects]``: each gets its type, ``("at", name, place)``
+    and its facts (its pose is its place's, see :meth:`robot.sim.Simulation.snapshot`)."""
+    if not scn.objects:
+        return spec
+    objects = dict(spec.objects)
+    facts = list(spec.facts)
+    for name, o in sorted(scn.objects.items()):
+        if o["place"] not in spec.places:
+            raise scenarios.ScenarioError(f"{scn.source}: objects.{name}.place: no place {o['place']!r} in world "
+                                          f"{scn.world!r}; known: {sorted(spec.places)}")
+        taken = set(spec.places) | set(spec.people) | set(spec.devices) | set(spec.doors) | {"robot"}
+        if name in taken:
+            raise scenarios.ScenarioError(f"{scn.source}: objects.{name}: the world already has something "
+                                          f"called {name!r}")
+        objects[name] = o["type"]
+        facts = [f for f in facts if not (f[0] == "at" and len(f) == 3 and f[1] == name)]
+        facts.append(("at", name, o["place"]))
+        facts += [tuple(f) for f in o.get("facts", [])]
+    return dataclasses.replace(spec, objects=objects, facts=tuple(dict.fromkeys(facts)))
 
 
 def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: TimedAction,
@@ -124,10 +158,15 @@ def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: TimedAction
 def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | None = None,
                  update: str | None = None, suspension: str | None = None, scheduler: str | None = None,
                  mode: str | None = None, out: Path | None = None, randomize: bool = False,
-                 progress: bool = False, pictures: bool = True, task_paths: tuple[str, ...] = ()) -> RunResult:
+                 progress: bool = False, pictures: bool = True, task_paths: tuple[str, ...] = (),
+                 policy: str | None = None, hazard_waiting: bool | None = None,
+                 interruption: scenarios.InterruptionGrid | None = None) -> RunResult:
     """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced.
 
-    ``task_paths``: task folders to load besides the bundled ones (``tasker run --path``)."""
+    ``task_paths``: task folders to load besides the bundled ones (``tasker run --path``).
+    ``policy`` (``strict``/``conditional``) overrides the scenario's; ``hazard_waiting`` switches
+    hazard-aware waiting on; ``interruption`` (with ``randomize``) places the interrupting request
+    in the seed's stratum (:class:`experiments.scenario.InterruptionGrid`)."""
     if isinstance(source, scenarios.RobotScenario):
         kind, scn_path = "robot", Path(source.source)
     else:
@@ -145,11 +184,11 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         scn = source if isinstance(source, scenarios.RobotScenario) else scenarios.load(scn_path, task_paths=task_paths)
         run_seed = scn.seed if seed is None else seed
         if randomize:
-            scn = scenarios.randomize(scn, run_seed)
+            scn = scenarios.randomize(scn, run_seed, interruption=interruption)
         if mode is not None:
             scn = dataclasses.replace(scn, mode=mode)
         loop, sim = build_robot(scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler,
-                                task_paths=task_paths)
+                                task_paths=task_paths, policy=policy, hazard_waiting=bool(hazard_waiting))
         spec_json = {"kind": "robot", **scn.to_json()}
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")
@@ -172,7 +211,10 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
                      # synthetic task types have only static strategies: say what was used
                      "update": "static" if kind == "synthetic" else (update or loop.strategy.update),
                      "suspension": "static" if kind == "synthetic" else (suspension or loop.strategy.suspension),
-                     "randomized": randomize},
+                     "randomized": randomize,
+                     "policy": None if kind == "synthetic" else loop.strategy.policy,
+                     "hazard_waiting": bool(hazard_waiting),
+                     **({"interruption": interruption.to_json()} if interruption and randomize else {})},
         "planner": _planner_config() if kind == "robot" else None,
         "host": platform.node(), "platform": platform.platform(), "python": sys.version.split()[0],
         "date": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "tasker_version": tasker.__version__,

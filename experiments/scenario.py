@@ -14,18 +14,21 @@ people's positions and walks), for sweeps.
 from __future__ import annotations
 
 import dataclasses
+import math
 import random
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from experiments import fields
 from experiments.actions import TABLES, TimedAction, read_actions
 from experiments.fields import MODES, POLICIES, STRATEGIES, ScenarioError
 from tasker import reader
 
-__all__ = ["RobotScenario", "ScenarioError", "load", "randomize", "resolve", "kind_of", "SCENARIOS"]
+__all__ = ["InterruptionGrid", "RobotScenario", "ScenarioError", "load", "randomize", "resolve", "kind_of", "SCENARIOS"]
 
 SCENARIOS = Path(__file__).resolve().parent / "scenarios"
 
@@ -171,28 +174,118 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
     return crossref.check_robot(scenario, top, task_types(list(task_paths)))
 
 
-def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, pose_jitter: float = 0.5
-              ) -> RobotScenario:
-    """A variant of ``scenario`` drawn from ``seed``: request and event times scaled by up to
-    ``±time_jitter`` (so interruptions fall at other stages), people's scripted walk
-    waypoints and explicit poses moved by up to ``pose_jitter`` metres.  The same seed
-    gives the same variant."""
+@dataclass(frozen=True)
+class InterruptionGrid:
+    """Where a sweep's variants place "the interruption": a stratified grid of times.
+
+    ``interrupt`` names the request that interrupts (``"requests[1]"``: the second
+    ``[[requests]]`` of the scenario file).  The window ``[start, stop)`` is cut into
+    strata of ``step`` seconds; the variant of seed ``s`` puts the request — and every
+    action written at the same time as it, such as the fall that causes it — at a
+    uniformly drawn time inside stratum ``s mod strata``.  So ``strata`` consecutive
+    seeds cover every stratum once, and the same seed always gives the same time.
+    """
+
+    interrupt: str
+    start: float
+    stop: float
+    step: float
+
+    def __post_init__(self) -> None:
+        table, sep, rest = self.interrupt.partition("[")
+        if table != "requests" or not sep or not rest.endswith("]") or not rest[:-1].isdigit():
+            raise ValueError(f"interrupt: expected 'requests[N]', got {self.interrupt!r}")
+        if not (0 <= self.start < self.stop) or not self.step > 0 or not math.isfinite(self.stop):
+            raise ValueError(f"times: expected 0 <= start < stop and step > 0, got start={self.start!r}, "
+                             f"stop={self.stop!r}, step={self.step!r}")
+
+    @property
+    def index(self) -> int:
+        return int(self.interrupt.partition("[")[2][:-1])
+
+    @property
+    def strata(self) -> int:
+        return math.ceil((self.stop - self.start) / self.step - 1e-9)
+
+    def stratum(self, seed: int) -> tuple[float, float]:
+        """The ``[low, high)`` window of the seed's stratum."""
+        k = seed % self.strata
+        low = self.start + k * self.step
+        return low, min(self.stop, low + self.step)
+
+    def to_json(self) -> dict[str, Any]:
+        return {"interrupt": self.interrupt, "times": {"start": self.start, "stop": self.stop, "step": self.step}}
+
+
+def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, pose_jitter: float = 0.5,
+              interruption: InterruptionGrid | None = None) -> RobotScenario:
+    """A variant of ``scenario`` drawn from ``seed``.
+
+    * Request and event times are scaled by up to ``±time_jitter`` (what happens together
+      stays together, order kept).  With an ``interruption`` grid, the interrupting request
+      and what happens with it are placed in the seed's stratum instead (see
+      :class:`InterruptionGrid`).
+    * **Every** person — those of the world file as well as those the scenario lists — has
+      the start pose and each scripted walk waypoint moved by up to ``pose_jitter`` metres,
+      and walk times scaled like the rest, keeping each point in free space (the person's disc
+      clear of walls and furniture, :class:`robot.scene.Scene`) and each leg clear of walls;
+      a draw that fails 20 times keeps the original point.
+
+    The same seed gives the same variant."""
+    from robot.scene import PERSON_RADIUS, Scene
+    from robot.spec import load_world
+
     rng = random.Random(f"randomize:{scenario.name}:{seed}")
     # one new time per distinct time (what happens together stays together), order kept
     times = sorted({a.t for a in scenario.actions})
     drawn = sorted(t if t == 0 else max(0.0, t * (1 + rng.uniform(-time_jitter, time_jitter))) for t in times)
     new_t = dict(zip(times, drawn, strict=True))
+    placed: float | None = None
+    if interruption is not None:
+        origin = ("requests", interruption.index)
+        hit = [a for a in scenario.actions if a.origin == origin]
+        if not hit:
+            n = sum(1 for a in scenario.actions if a.kind == "request")
+            raise ScenarioError(scenario.source, f"variants: interrupt: no {interruption.interrupt} (the scenario "
+                                                 f"has {n} requests, requests[0]..requests[{n - 1}])")
+        low, high = interruption.stratum(seed)
+        # its own stream, so the draw does not depend on how many other times there are
+        placed = round(random.Random(f"interrupt:{scenario.name}:{seed}").uniform(low, high), 3)
+        new_t[hit[0].t] = placed
     actions = [TimedAction(round(new_t[a.t], 3), a.kind, dict(a.fields), a.origin) for a in scenario.actions]
+    spec = load_world(scenario.world)
+    scene = Scene(spec, PERSON_RADIUS["standing"])
+
+    def moved(x: float, y: float, prev: tuple[float, float] | None) -> tuple[float, float]:
+        for _ in range(20):
+            nx, ny = x + rng.uniform(-pose_jitter, pose_jitter), y + rng.uniform(-pose_jitter, pose_jitter)
+            if not scene.static_free(nx, ny):
+                continue
+            if prev is not None and not scene.segments_free(np.array([prev]), np.array([(nx, ny)]), dynamic=False,
+                                                            static=True)[0] and \
+                    scene.segments_free(np.array([prev]), np.array([(x, y)]), dynamic=False, static=True)[0]:
+                continue  # the original leg was clear: keep it clear
+            return round(nx, 3), round(ny, 3)
+        return x, y
+
     people: dict[str, dict[str, Any]] = {}
-    for name, entry in sorted(scenario.people.items()):
-        e = dict(entry)
-        if "pose" in e:
-            x, y, yaw = e["pose"]
-            e["pose"] = [x + rng.uniform(-pose_jitter, pose_jitter), y + rng.uniform(-pose_jitter, pose_jitter), yaw]
-        if "walk" in e:
-            e["walk"] = [(t * (1 + rng.uniform(-time_jitter, time_jitter)), x + rng.uniform(-pose_jitter, pose_jitter),
-                          y + rng.uniform(-pose_jitter, pose_jitter)) for t, x, y in e["walk"]]
-            e["walk"].sort()
+    for name in sorted(set(spec.people) | set(scenario.people)):
+        e = dict(scenario.people.get(name, {}))
+        world = spec.people.get(name)
+        pose = e.get("pose", list(world.pose) if world else None)
+        walk = e.get("walk", [tuple(w) for w in world.walk] if world else [])
+        here: tuple[float, float] | None = None
+        if pose is not None:
+            x, y, yaw = pose
+            here = moved(float(x), float(y), None)
+            e["pose"] = [here[0], here[1], yaw]
+        if walk:
+            new_walk = []
+            for t, x, y in walk:
+                here = moved(float(x), float(y), here)
+                new_walk.append((round(t * (1 + rng.uniform(-time_jitter, time_jitter)), 3), *here))
+            new_walk.sort()
+            e["walk"] = [w for i, w in enumerate(new_walk) if i == 0 or w[0] > new_walk[i - 1][0]]
         people[name] = e
     return dataclasses.replace(scenario, actions=tuple(sorted(actions, key=lambda a: a.t)), people=people,
                                seed=seed, name=f"{scenario.name}~{seed}")

@@ -42,6 +42,7 @@ from pathlib import Path
 from typing import Any
 
 import tasker
+from experiments.scenario import InterruptionGrid
 from experiments.store import JobKey, ResultStore, RunRow, Status
 from tasker import reader
 from tasker.errors import TaskerError
@@ -70,47 +71,93 @@ class SweepError(TaskerError, RuntimeError):
 
 @dataclass(frozen=True)
 class Strategy:
-    """The strategies a run compares: how ``upTsk`` and ``genSusp`` build their plans, and the scheduler.
+    """One cell of the sweep's factorial design: the factors a run varies.
 
-    ``None`` leaves the scenario's own setting.
+    ``update``/``suspension``: how ``upTsk`` and ``genSusp`` build their plans (``static`` or
+    ``planned``); ``policy``: when a suspension is required (``strict`` or ``conditional``,
+    applied to both suspension strategies); ``hazard_waiting``: hazard-aware waiting off or
+    on; ``scheduler``: the harmoniser's scheduler.  ``None`` leaves the scenario's own setting.
     """
 
     update: str | None = None
     suspension: str | None = None
     scheduler: str | None = None
+    policy: str | None = None
+    hazard_waiting: bool | None = None
 
     def __post_init__(self) -> None:
         for name in ("update", "suspension"):
             value = getattr(self, name)
             if value is not None and value not in STRATEGY_VALUES:
                 raise ValueError(f"{name}: expected one of {list(STRATEGY_VALUES)}, got {value!r}")
+        if self.policy is not None and self.policy not in POLICY_VALUES:
+            raise ValueError(f"policy: expected one of {list(POLICY_VALUES)}, got {self.policy!r}")
+        if self.hazard_waiting is not None and not isinstance(self.hazard_waiting, bool):
+            raise ValueError(f"hazard_waiting: expected true or false, got {self.hazard_waiting!r}")
         if self.scheduler is not None and (not isinstance(self.scheduler, str) or not self.scheduler):
             raise ValueError(f"scheduler: expected a scheduler name, got {self.scheduler!r}")
 
     @property
     def label(self) -> str:
-        """The key of the strategy in the results database, e.g. ``update=planned,suspension=static``."""
-        parts = [f"{k}={v}" for k, v in self.items()]
+        """The key of the strategy in the results database, e.g. ``update=planned,suspension=static``.
+
+        Factors left out (``None``) do not appear, so labels of older sweeps stay what they were."""
+        parts = [f"{k}={_show(v)}" for k, v in self.items()]
         return ",".join(parts) if parts else "default"
 
-    def items(self) -> list[tuple[str, str]]:
-        return [(k, v) for k in ("update", "suspension", "scheduler") if (v := getattr(self, k)) is not None]
+    def items(self) -> list[tuple[str, Any]]:
+        """The factors that are set, in label order (see :data:`FACTORS`)."""
+        return [(k, v) for k in FACTORS if (v := getattr(self, k)) is not None]
 
     @classmethod
     def parse(cls, text: str) -> Strategy:
-        """The inverse of :attr:`label`: ``"update=planned,suspension=static,scheduler=alg2"``."""
+        """The inverse of :attr:`label`: ``"update=planned,suspension=static,policy=strict,hazard_waiting=on"``."""
         if text.strip() == "default":
             return cls()
-        fields: dict[str, str] = {}
+        fields: dict[str, Any] = {}
         for part in text.split(","):
             key, sep, value = part.partition("=")
             key, value = key.strip(), value.strip()
-            if not sep or key not in ("update", "suspension", "scheduler") or not value:
-                raise ValueError(f"expected 'update=…,suspension=…[,scheduler=…]', got {text!r}")
+            if not sep or key not in FACTORS or not value:
+                raise ValueError(f"expected 'update=…,suspension=…[,policy=…][,hazard_waiting=on|off]"
+                                 f"[,scheduler=…]', got {text!r}{reader.suggest(key, list(FACTORS))}")
             if key in fields:
                 raise ValueError(f"{key} given twice in {text!r}")
-            fields[key] = value
+            fields[key] = _switch(value) if key == "hazard_waiting" else value
         return cls(**fields)
+
+
+FACTORS = ("update", "suspension", "policy", "hazard_waiting", "scheduler")
+"""The factors of a :class:`Strategy`, in the order of its label."""
+
+POLICY_VALUES = ("strict", "conditional")
+
+_SWITCH = {"on": True, "off": False, "true": True, "false": False}
+
+
+def _show(value: Any) -> str:
+    return ("on" if value else "off") if isinstance(value, bool) else str(value)
+
+
+def _switch(value: Any) -> bool:
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, str) and value.lower() in _SWITCH:
+        return _SWITCH[value.lower()]
+    raise ValueError(f"hazard_waiting: expected on/off (or true/false), got {value!r}")
+
+
+def expand(factors: Mapping[str, Sequence[Any]]) -> list[Strategy]:
+    """Every combination of the levels of ``factors`` (a grid), in :data:`FACTORS` order, the first
+    factor varying slowest: ``{"suspension": ["static", "planned"], "hazard_waiting": [False, True]}``
+    gives four strategies."""
+    unknown = [k for k in factors if k not in FACTORS]
+    if unknown:
+        raise ValueError(f"unknown factor {unknown[0]!r}{reader.suggest(unknown[0], list(FACTORS))}")
+    names = [k for k in FACTORS if k in factors]
+    levels: list[list[Any]] = [[_switch(v) if k == "hazard_waiting" else v for v in factors[k]] for k in names]
+    combos: list[dict[str, Any]] = [dict(zip(names, c, strict=True)) for c in itertools.product(*levels)]
+    return [Strategy(**c) for c in combos]
 
 
 @dataclass(frozen=True)
@@ -122,6 +169,7 @@ class Job:
     seed: int
     strategy: Strategy
     task_paths: tuple[str, ...] = ()  # absolute task folders (--path), so a Dask worker elsewhere loads the same
+    interruption: InterruptionGrid | None = None  # where variants place the interruption ([variants.NAME])
 
     @property
     def key(self) -> JobKey:
@@ -138,6 +186,7 @@ class SweepSpec:
     name: str = "sweep"
     sources: Mapping[str, str] = field(default_factory=dict)
     task_paths: tuple[str, ...] = ()
+    variants: Mapping[str, InterruptionGrid] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if not self.scenarios:
@@ -146,6 +195,9 @@ class SweepSpec:
             raise ValueError("seeds: expected at least one seed")
         if not self.strategies:
             raise ValueError("strategies: expected at least one strategy")
+        unknown = sorted(set(self.variants) - set(self.scenarios))
+        if unknown:
+            raise ValueError(f"variants: {unknown[0]!r} is not one of the scenarios {list(self.scenarios)}")
         for what, items in (("scenarios", self.scenarios), ("seeds", self.seeds),
                             ("strategies", [s.label for s in self.strategies])):
             if len(set(items)) != len(items):
@@ -156,12 +208,15 @@ class SweepSpec:
 
     def jobs(self) -> list[Job]:
         """Every job, scenario-major then seed then strategy (so paired runs finish close together)."""
-        return [Job(sc, self.sources.get(sc, sc), seed, st, self.task_paths)
+        return [Job(sc, self.sources.get(sc, sc), seed, st, self.task_paths, self.variants.get(sc))
                 for sc in self.scenarios for seed in self.seeds for st in self.strategies]
 
     def to_json(self) -> dict[str, Any]:
-        return {"name": self.name, "scenarios": list(self.scenarios), "seeds": list(self.seeds),
-                "strategies": [s.label for s in self.strategies], "sources": dict(self.sources)}
+        out: dict[str, Any] = {"name": self.name, "scenarios": list(self.scenarios), "seeds": list(self.seeds),
+                               "strategies": [s.label for s in self.strategies], "sources": dict(self.sources)}
+        if self.variants:
+            out["variants"] = {sc: g.to_json() for sc, g in sorted(self.variants.items())}
+        return out
 
 
 @dataclass(frozen=True)
@@ -198,7 +253,12 @@ def _looks_like_path(text: str) -> bool:
     return "/" in text or os.sep in text or text.endswith((".toml", ".json"))
 
 
-SPEC_KEYS = ("name", "scenarios", "seeds", "seed_start", "strategies")
+SPEC_KEYS = ("name", "scenarios", "seeds", "seed_start", "strategies", "factors", "variants")
+
+FACTOR_LEVELS: dict[str, tuple[Any, ...] | None] = {
+    "update": STRATEGY_VALUES, "suspension": STRATEGY_VALUES, "policy": POLICY_VALUES,
+    "hazard_waiting": (False, True), "scheduler": None}
+"""The levels each factor of a ``[factors]`` grid may take (``None``: a registered scheduler)."""
 
 
 def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
@@ -258,17 +318,22 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
         seeds = tuple(seeds_raw)
     else:
         raise top.error("seeds", f"expected a count or a non-empty list of integers, got {seeds_raw!r}")
-    strategies = []
+    strategies: list[Strategy] = []
     strategies_t = top.at("strategies", {})
-    for i, st in enumerate(top.array("strategies", nonempty=True)):
+    if "strategies" not in top and "factors" not in top:
+        raise top.error("strategies", "missing: give a list of strategies, a [factors] grid, or both")
+    for i, st in enumerate(top.array("strategies", [], nonempty="strategies" in top)):
         try:
             if isinstance(st, str):
                 strategies.append(Strategy.parse(st))
             elif isinstance(st, dict):
                 t = strategies_t.at(i, st)
-                strategies.append(Strategy(**{k: t.string(k, choices=STRATEGY_VALUES if k != "scheduler" else None)
-                                              for k in ("update", "suspension", "scheduler") if k in t}))
-                t.done(("update", "suspension", "scheduler"))
+                values: dict[str, Any] = {k: t.string(k, choices=FACTOR_LEVELS[k]) for k in FACTORS
+                                          if k in t and k != "hazard_waiting"}
+                if "hazard_waiting" in t:
+                    values["hazard_waiting"] = t.boolean("hazard_waiting")
+                strategies.append(Strategy(**values))
+                t.done(FACTORS)
             else:
                 raise ValueError(f"expected a string such as 'update=planned,suspension=static' or a table, "
                                  f"got {st!r}")
@@ -276,10 +341,9 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
             if isinstance(exc, reader.InputError):
                 raise
             raise strategies_t.error(i, str(exc)) from None
-        if strategies[-1].scheduler is not None:
-            from tasker import schedulers
-
-            reader.check_name(strategies_t, i, strategies[-1].scheduler, schedulers.names(), "scheduler")
+        _check_scheduler(strategies_t, i, strategies[-1])
+    if "factors" in top:
+        strategies += _grid(top.table("factors"))
     labels = [s.label for s in strategies]
     dup_labels = sorted({x for x in labels if labels.count(x) > 1})
     if dup_labels:
@@ -289,7 +353,70 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
     if n > limit:
         raise top.error("seeds", f"the spec expands to {len(scenario_list)} scenarios x {len(seeds)} seeds x "
                                  f"{len(strategies)} strategies = {n} jobs, more than the {limit} a sweep may have")
-    return SweepSpec(tuple(scenario_list), seeds, tuple(strategies), name=name, sources=sources)
+    variants = _variants(top.table("variants", {}), scenario_list)
+    return SweepSpec(tuple(scenario_list), seeds, tuple(strategies), name=name, sources=sources, variants=variants)
+
+
+def _check_scheduler(t: reader.Table, key: str | int, strategy: Strategy) -> None:
+    if strategy.scheduler is not None:
+        from tasker import schedulers
+
+        reader.check_name(t, key, strategy.scheduler, schedulers.names(), "scheduler")
+
+
+def _grid(t: reader.Table) -> list[Strategy]:
+    """The strategies of a ``[factors]`` table: every combination of the factors' levels."""
+    factors: dict[str, list[Any]] = {}
+    for key in t.keys():
+        if key not in FACTORS:
+            raise t.error(key, f"unknown factor {key!r}{reader.suggest(key, FACTORS)} (factors: {', '.join(FACTORS)})")
+        levels = t.array(key, nonempty=True)
+        lt = t.at(key, {})  # for errors located at an element of the array
+        for i, v in enumerate(levels):
+            if key == "hazard_waiting":
+                if not isinstance(v, bool):
+                    raise lt.error(i, f"expected true or false, got {v!r}")
+            elif key == "scheduler":
+                if not isinstance(v, str) or not v:
+                    raise lt.error(i, f"expected a scheduler name, got {v!r}")
+                _check_scheduler(lt, i, Strategy(scheduler=v))
+            else:
+                choices = FACTOR_LEVELS[key] or ()
+                if v not in choices:
+                    raise lt.error(i, f"expected one of {list(choices)}, got {v!r}{reader.suggest(str(v), choices)}")
+        dup = sorted({str(v) for v in levels if levels.count(v) > 1})
+        if dup:
+            raise t.error(key, f"duplicates {dup}")
+        factors[key] = levels
+    if not factors:
+        raise t.error(None, "expected at least one factor, e.g. suspension = [\"static\", \"planned\"]")
+    return expand(factors)
+
+
+def _variants(t: reader.Table, scenario_list: Sequence[str]) -> dict[str, InterruptionGrid]:
+    """``[variants.NAME]`` tables: where the variants of scenario NAME place its interruption."""
+    out: dict[str, InterruptionGrid] = {}
+    for sc, value in t.items():
+        vt = t.at(sc, value)
+        if sc not in scenario_list:
+            raise t.error(sc, f"not one of the spec's scenarios{reader.suggest(sc, scenario_list)} "
+                              f"(scenarios: {list(scenario_list)})")
+        if not isinstance(value, dict):
+            raise t.error(sc, f"expected a table (interrupt = \"requests[N]\", times = {{start, stop, step}}), "
+                              f"got {value!r}")
+        interrupt = vt.string("interrupt")
+        times = vt.table("times")
+        start = float(times.number("start", min=0))
+        stop = float(times.number("stop", positive=True))
+        step = float(times.number("step", positive=True))
+        times.done()
+        vt.done()
+        try:
+            out[sc] = InterruptionGrid(interrupt, start, stop, step)
+        except ValueError as exc:
+            key = "interrupt" if str(exc).startswith("interrupt") else "times"
+            raise vt.error(key, str(exc).partition(": ")[2]) from None
+    return out
 
 
 # ----------------------------------------------------------------------------------------- running
@@ -299,9 +426,10 @@ def run_job(job: Job) -> tuple[dict[str, Any], dict[str, Any]]:
     """The default ``run_fn``: a randomised run of the job's scenario with its seed and strategy."""
     from experiments.runner import run_scenario  # imported in the worker, never shared across processes
 
-    result = run_scenario(job.source, seed=job.seed, update=job.strategy.update,
-                          suspension=job.strategy.suspension, scheduler=job.strategy.scheduler, randomize=True,
-                          task_paths=job.task_paths)
+    st = job.strategy
+    result = run_scenario(job.source, seed=job.seed, update=st.update, suspension=st.suspension,
+                          scheduler=st.scheduler, randomize=True, task_paths=job.task_paths, policy=st.policy,
+                          hazard_waiting=st.hazard_waiting, interruption=job.interruption)
     return dict(result.record), dict(result.metrics)
 
 

@@ -83,12 +83,14 @@ def _task_folders(extra: list[str]) -> list[Path]:
     return out
 
 
-def _task_for_domain(domain_text: str, extra: list[str]) -> PddlTaskType | None:
-    """The registered task whose domain has this domain's name; only that folder is loaded."""
+def _task_for_domain(domain_text: str, extra: list[str], beside: Path | None = None) -> PddlTaskType | None:
+    """The task whose domain has this domain's name — a registered one, or the task folder the
+    domain file sits in (``beside``) — or ``None``; only that folder is loaded."""
     m = _DOMAIN_NAME.search(domain_text)
     if not m:
         return None
-    for folder in _task_folders(extra):
+    own = [beside] if beside is not None and (beside / "task.toml").is_file() else []
+    for folder in [*own, *_task_folders(extra)]:
         dm = _DOMAIN_NAME.search((folder / "domain.pddl").read_text(encoding="utf-8", errors="replace")) \
             if (folder / "domain.pddl").is_file() else None
         if dm and dm.group(1).lower() == m.group(1).lower():
@@ -98,14 +100,15 @@ def _task_for_domain(domain_text: str, extra: list[str]) -> PddlTaskType | None:
     return None
 
 
-def _stages_for(domain_text: str, result: PlanResult, extra: list[str]) -> tuple[Stage, ...]:
+def _stages_for(domain_text: str, result: PlanResult, extra: list[str],
+                beside: Path | None = None) -> tuple[Stage, ...]:
     """Stages of a plan: the task type's skills when the domain is a registered task's."""
     from tasker.errors import TaskerError
     from tasker.stage import Stage
 
     assert result.plan is not None
     try:
-        task = _task_for_domain(domain_text, extra)
+        task = _task_for_domain(domain_text, extra, beside)
     except TaskerError:
         task = None
     if task is not None:
@@ -159,7 +162,7 @@ def plan_command(args: argparse.Namespace) -> int:
             print(f"  {k:3d}. ({' '.join(step)})")
         if not getattr(args, "quiet", False):
             print("stages:")
-            for k, s in enumerate(_stages_for(domain_text, result, extra), 1):
+            for k, s in enumerate(_stages_for(domain_text, result, extra, Path(args.domain).parent), 1):
                 print(f"  {k:3d}. {s.label} [{s.kind.value}, skill={s.skill or '-'}, {s.duration:g} s]")
     else:
         print(f"{result.status.value}: {result.message or 'no plan'} ({result.planner})")

@@ -247,14 +247,18 @@ class Estimator:
         return world
 
     def _suspension_stages(self, ctx: TaskContext) -> tuple[Stage, ...]:
+        """What genSusp would do now; only its effects matter here, so no travel table is built."""
         task = self.task
-        if ctx.strategy.suspension == "static":
-            return task.static_suspension(ctx).stages
-        world, goal, _ = task.suspension_inputs(ctx)
-        steps, status, _ = self._plan(ctx, world, goal, task.suspension_facts(ctx, world))
-        if status is not PlanStatus.SOLVED:  # as genSusp: an unsolvable suspension falls back to static
-            return task.static_suspension(ctx).stages
-        return task.builder.from_steps(steps, {}, ctx.args)
+        if ctx.strategy.suspension != "static":
+            world, goal, _ = task.suspension_inputs(ctx)
+            steps, status, _ = self._plan(ctx, world, goal, task.suspension_facts(ctx, world))
+            if status is PlanStatus.SOLVED:
+                return task.builder.from_steps(steps, {}, ctx.args)
+        # static, or as genSusp: an unsolvable suspension falls back to the decision list
+        world = ctx.world
+        assert isinstance(world, WorldState)
+        branch, b = task.branch(ctx, world)
+        return task.builder.from_templates(branch.stages, b, {}, ctx.suspended)
 
     # -- planning and timing -------------------------------------------------------------
 

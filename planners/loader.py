@@ -25,10 +25,13 @@ from planners.pddl_task import PddlTaskType
 from planners.problem import DomainModel
 from planners.results import PlanStatus
 from planners.stages import Bindings
-from planners.taskspec import TaskSpec, read_task_toml
+from planners.taskspec import TaskSpec, meaning_of, read_task_toml
+from tasker import reader
+from tasker.meaning import Binding
 
-HOOK_NAMES = ("extra_facts", "suspension_goal", "check_args", "check_terminate")
-"""Functions a ``task.py`` may define (see ``docs/domains.md``)."""
+HOOK_NAMES = ("extra_facts", "check_args", "check_terminate")
+"""Functions a ``task.py`` may define (see ``docs/domains.md``).  There is no hook that changes
+the suspension goal: that is declared in ``[[suspension]]``, so both strategies pursue it."""
 
 
 def _load_hooks(spec: TaskSpec) -> dict[str, Any]:
@@ -71,7 +74,6 @@ def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
     lits = [("problem.goal", spec.goal), ("problem.facts", spec.facts),
             ("problem.suspended_facts", spec.suspended_facts)]
     lits += [(f"suspension[{k}]", b.when + b.goal) for k, b in enumerate(spec.suspension)]
-    lits += [(f"static.suspension[{k}].when", b.when) for k, b in enumerate(spec.static_suspension)]
     for where, group in lits:
         for lit in group:
             try:
@@ -79,7 +81,7 @@ def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
             except DefinitionError as exc:
                 raise DefinitionError(toml, exc.reason) from None
     templates = [("static.update", t) for t in spec.static_update]
-    templates += [(f"static.suspension[{k}]", t) for k, b in enumerate(spec.static_suspension) for t in b.stages]
+    templates += [(f"suspension[{k}].stages", t) for k, b in enumerate(spec.suspension) for t in b.stages]
     for where, t in templates:
         for action in filter(None, (t.action, t.suspended)):
             if action not in dm.actions:
@@ -87,6 +89,77 @@ def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
             if len(t.args) != len(dm.actions[action].params):
                 raise DefinitionError(toml, f"[{where}] {action} takes {len(dm.actions[action].params)} "
                                             f"argument(s), got {len(t.args)}")
+
+
+def _check_suspension(spec: TaskSpec, dm: DomainModel) -> None:
+    """Strategies differ only in method: each branch's static ``stages`` must reach its
+    ``goal`` from any state where its ``when`` holds.  The stages' PDDL effects are applied
+    in order to what ``when`` says (facts it does not mention are unknown), so every goal
+    literal must be stated by ``when`` or made so by a stage, and not undone later."""
+    for k, b in enumerate(spec.suspension):
+        where = f"suspension[{k}]"
+        bound = {tok for lit in b.when if lit[0] != "not" for tok in lit if tok.startswith("?")}
+        for lit in [*b.goal, *(("stage", *t.args) for t in b.stages)]:
+            free = sorted(tok for tok in lit if tok.startswith("?") and tok not in bound)
+            if free:
+                raise spec.error(where, f"{free[0]} is not bound by a positive `when` literal of this branch")
+        true = {lit for lit in b.when if lit[0] != "not"}
+        false = {lit[1:] for lit in b.when if lit[0] == "not"}
+        for t in b.stages:
+            add, delete = dm.ground(t.action, t.args)
+            true -= set(delete)
+            false |= set(delete)
+            true |= set(add)
+            false -= set(add)
+        for lit in b.goal:
+            ok = lit[1:] in false if lit[0] == "not" else lit in true
+            if not ok:
+                shown = " then ".join(f"{t.action}({', '.join(t.args)})" for t in b.stages) or "no stages"
+                raise spec.error(where, f"static and planned must pursue the same goal, but {shown} does not "
+                                        f"reach {list(lit)} from a state where `when` holds "
+                                        f"(say it in `when`, or add the stage that achieves it)")
+
+
+def _check_pattern(spec: TaskSpec, dm: DomainModel, where: str, lit: tuple[str, ...], variables: bool) -> None:
+    """A declared pattern names a predicate of the domain with its arity, and only request
+    arguments it has (``$robot`` too) or, where allowed, ``?variables``."""
+    atom = lit[1:] if lit[0] == "not" else lit
+    if atom[0] not in dm.predicates:
+        raise spec.error(where, f"unknown predicate {atom[0]!r}{reader.suggest(atom[0], dm.predicates)} "
+                                f"(the domain declares {', '.join(sorted(dm.predicates))})")
+    arity = len(dm.predicates[atom[0]])
+    if len(atom) - 1 != arity:
+        raise spec.error(where, f"{atom[0]!r} takes {arity} argument(s), got {len(atom) - 1}: {list(lit)}")
+    args = [a.name for a in spec.args] + ["robot"]
+    for tok in atom[1:]:
+        if tok.startswith("$") and tok[1:] not in args:
+            raise spec.error(where, f"unknown request argument {tok!r}"
+                                    f"{reader.suggest(tok, ['$' + a for a in args])} "
+                                    f"(this task's: {', '.join('$' + a for a in args)})")
+        if tok.startswith("?") and not variables:
+            raise spec.error(where, f"{tok}: a ?variable is not allowed here")
+
+
+def _check_meaning(spec: TaskSpec, dm: DomainModel) -> tuple[Binding, ...]:
+    """Hazards, people's roles and bindings against the domain; bindings get their object types."""
+    for k, h in enumerate(spec.hazards):
+        _check_pattern(spec, dm, f"hazards[{k}].fact", h.fact, variables=True)
+    if spec.people is not None:
+        args = [a.name for a in spec.args]
+        if spec.people.person not in args:
+            raise spec.error("people.person", f"no request argument {spec.people.person!r}"
+                                              f"{reader.suggest(spec.people.person, args)} (this task's: "
+                                              f"{', '.join(args) or 'none'})")
+        for role, lits in spec.people.roles.items():
+            for lit in lits:
+                _check_pattern(spec, dm, f"people.{role}", lit, variables=True)
+    out = []
+    for k, b in enumerate(spec.bindings):
+        _check_pattern(spec, dm, f"bindings[{k}].fact", b.fact, variables=True)
+        wanted = dm.predicates[b.fact[0]][b.fact.index(b.object) - 1]
+        types = tuple(sorted(t for t, chain in dm.types.items() if wanted in chain)) if wanted else ()
+        out.append(b.resolve(types))
+    return tuple(out)
 
 
 def _check_example(task: PddlTaskType) -> None:
@@ -113,7 +186,10 @@ def load_task(folder: str | Path, *, use_cache: bool = True) -> PddlTaskType:
     spec = read_task_toml(folder / "task.toml")
     dm = DomainModel(load_domain(spec.domain_file))
     _cross_check(spec, dm)
+    _check_suspension(spec, dm)
+    bindings = _check_meaning(spec, dm)
     task = PddlTaskType(spec, dm, hooks=_load_hooks(spec))
+    task.meaning = meaning_of(spec, bindings)
     # what the checks read: task.toml, the domain and task.py (not, e.g., a problem.pddl lying beside them)
     key = cache.content_key("task-folder", cache.file_parts([folder / "task.toml", spec.domain_file,
                                                               folder / "task.py"]))

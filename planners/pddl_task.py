@@ -5,9 +5,12 @@ Hooks, and what they do here:
 * ``update_task`` (upTsk) — ``planned``: a PDDL problem from ``ctx.world`` as it is now
   (R6: what the robot or a person already did is not redone), solved optimally;
   ``static``: the template ``exeTsk`` of ``[static] update`` (Alg. 3).
-* ``generate_suspension`` (genSusp) — ``planned``: the first ``[[suspension]]`` branch
-  whose ``when`` holds in the state at interruption gives the goal, planned from that
-  state; ``static``: the decision list ``[[static.suspension]]`` (eq. 47).
+* ``generate_suspension`` (genSusp) — one decision list ``[[suspension]]`` (eq. 47) for
+  both strategies: the first branch whose ``when`` holds in the state at interruption
+  (see :meth:`PddlTaskType.branch`) gives the suspension goal; ``planned`` plans to it
+  from that state, ``static`` runs the branch's ``stages`` (checked at load to reach the
+  same goal).  Strategies differ only in method; ``ctx.strategy.policy`` decides whether
+  branches that trade safety for time are eligible, for both alike.
 * ``compute_params`` / ``request_sp`` — ``cost = cps * (age + cTime)``: the discomfort
   accumulated by completion, with ``cTime`` and ``endPose`` from the plan upTsk would make
   from the state asked about (:mod:`planners.estimates`), timed with ``ctx.motion``;
@@ -175,12 +178,8 @@ class PddlTaskType(TaskType):
     def suspension_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], Branch]:
         """genSusp: the world at interruption, the suspension goal and the branch that chose it."""
         world = self._world(ctx)
-        b = Bindings(ctx.args, world)
-        branch = self._branch(self.spec.suspension, b, world, ctx)
-        goal = b.literals(branch.goal)
-        if "suspension_goal" in self.hooks:
-            goal = [tuple(g) for g in self.hooks["suspension_goal"](ctx, world, goal)]
-        return world, goal, branch
+        branch, b = self.branch(ctx, world)
+        return world, b.literals(branch.goal), branch
 
     def suspension_facts(self, ctx: TaskContext, world: WorldState) -> list[Literal]:
         """genSusp's extra init facts: the request's and ``task.py``'s (e.g. carry_object's
@@ -216,8 +215,7 @@ class PddlTaskType(TaskType):
     def static_suspension(self, ctx: TaskContext) -> StagePlan:
         """The decision list ``exeSusp`` (eq. 47): the first branch whose condition holds."""
         world = self._world(ctx)
-        b = Bindings(ctx.args, world)
-        branch = self._branch(self.spec.static_suspension, b, world, ctx)
+        branch, b = self.branch(ctx, world)
         travel = travel_table(world, ctx.motion, self.spec.travel_s)
         stages = self.builder.from_templates(branch.stages, b, travel, ctx.suspended)
         return StagePlan(stages, Purpose.GEN_SUSP, strategy="static", sim_time=self.spec.static_time_s,
@@ -230,13 +228,24 @@ class PddlTaskType(TaskType):
             raise PlanningFailed("error", f"{self.name}: needs a WorldState, got {type(ctx.world).__name__}")
         return ctx.world
 
-    def _branch(self, branches: tuple[Branch, ...], b: Bindings, world: WorldState, ctx: TaskContext) -> Branch:
+    def branch(self, ctx: TaskContext, world: WorldState) -> tuple[Branch, Bindings]:
+        """The suspension branch both strategies pursue (eq. 47), with ``when``'s ``?vars`` bound.
+
+        The first branch whose ``when`` holds in the world at interruption; a
+        ``conditional`` branch only under ``ctx.strategy.policy == "conditional"`` and
+        when the expected interruption (``ctx.memory["interruption_s"]``; unknown = long)
+        is at most its ``max_interruption_s``."""
         expected = ctx.memory.get(INTERRUPTION_KEY)
         length = math.inf if expected is None else float(expected)
-        for br in branches:
-            if length >= br.min_interruption_s and holds(world.facts, b.literals(br.when)):
-                return br
-        return branches[-1]
+        base = Bindings(ctx.args, world)
+        for br in self.spec.suspension:
+            if br.policy == "conditional" and (ctx.strategy.policy != "conditional"
+                                               or br.max_interruption_s is None or length > br.max_interruption_s):
+                continue
+            bound = base.match(br.when, world.facts)
+            if bound is not None:
+                return br, bound
+        return self.spec.suspension[-1], base
 
     def problem_text(self, ctx: TaskContext, world: WorldState, goal: list[Literal],
                      extra: list[Literal]) -> tuple[PddlText, frozenset[Literal], dict[tuple[str, str], float]]:

@@ -46,13 +46,18 @@ def place_of(world: WorldState, name: str) -> str | None:
 
 
 class Bindings:
-    """Resolves the tokens of ``task.toml``: ``$arg``, ``$robot``, ``$at:x``; others are literal."""
+    """Resolves the tokens of ``task.toml``: ``$arg``, ``$robot``, ``$at:x``, and ``?x`` once a
+    suspension branch's ``when`` bound it (:meth:`match`); others are literal."""
 
-    def __init__(self, args: Mapping[str, Any], world: WorldState | None) -> None:
+    def __init__(self, args: Mapping[str, Any], world: WorldState | None,
+                 variables: Mapping[str, str] | None = None) -> None:
         self.args = args
         self.world = world
+        self.vars = dict(variables or {})
 
     def token(self, tok: str) -> str:
+        if tok.startswith("?"):
+            return self.vars.get(tok, tok)
         if not tok.startswith("$"):
             return tok
         key = tok[1:]
@@ -71,6 +76,46 @@ class Bindings:
 
     def literals(self, lits: Sequence[Literal]) -> list[Literal]:
         return [tuple(self.token(t) for t in lit) for lit in lits]
+
+    def _distance(self, env: Mapping[str, str]) -> float:
+        """How far the things ``env`` names are from the robot (straight line; 0 without poses)."""
+        if self.world is None:
+            return 0.0
+        robot = self.world.poses.get(robot_name(self.world))
+        if robot is None:
+            return 0.0
+        return sum(math.dist(robot[:2], self.world.poses[v][:2]) for v in env.values() if v in self.world.poses)
+
+    def match(self, when: Sequence[Literal], facts: frozenset[tuple[str, ...]]) -> Bindings | None:
+        """These bindings extended by the first assignment of ``when``'s ``?vars`` under which
+        every literal holds — candidates nearest the robot first (straight line), then by
+        name — or None if none does.  A negated literal
+        holds when no fact matches it."""
+        def solve(k: int, env: dict[str, str]) -> dict[str, str] | None:
+            if k == len(when):
+                return env
+            lit = tuple(self.token(t) if not t.startswith("?") else env.get(t, t) for t in when[k])
+            negated = lit[0] == "not"
+            atom = lit[1:] if negated else lit
+            found = []
+            for f in sorted(facts):
+                if len(f) != len(atom) or f[0] != atom[0]:
+                    continue
+                new = dict(env)
+                if all((new.setdefault(a, v) == v) if a.startswith("?") else a == v
+                       for a, v in zip(atom[1:], f[1:], strict=True)):
+                    found.append(new)
+            if negated:
+                return solve(k + 1, env) if not found else None
+            found.sort(key=lambda e: (self._distance(e), sorted(e.items())))
+            for new in found:
+                done = solve(k + 1, new)
+                if done is not None:
+                    return done
+            return None
+
+        env = solve(0, dict(self.vars))
+        return None if env is None else Bindings(self.args, self.world, env)
 
 
 class StageBuilder:

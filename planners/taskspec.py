@@ -1,7 +1,9 @@
 """``task.toml``: the declarative part of a task folder, read into frozen dataclasses.
 
-Every fault is a :class:`~planners.checks.DefinitionError` naming ``task.toml`` and the
-key at fault.  The format is documented, with an example, in ``docs/domains.md``.
+It is read strictly with :mod:`tasker.reader`: every fault (an unknown key or table
+such as ``kindd`` or ``[shedule]`` included) is a :class:`~planners.checks.DefinitionError`
+naming ``task.toml``, the line, the field and what was expected, with a "did you mean".
+The format is documented, with an example, in ``docs/domains.md``.
 Literals are lists of strings, like the world's facts: ``["at", "$person", "$destination"]``,
 negated as ``["not", "following", "$person"]``; ``$name`` is a request argument,
 ``$robot`` the robot, ``$at:name`` the place where ``name`` is; ``?param`` (in
@@ -10,17 +12,18 @@ negated as ``["not", "following", "$person"]``; ``$name`` is a request argument,
 
 from __future__ import annotations
 
-import math
-import tomllib
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from planners.checks import DefinitionError
+from tasker import reader
 from tasker.errors import ConfigError
+from tasker.meaning import BINDING_KINDS, ROLES, Binding, Hazard, Meaning, People
 from tasker.stage import StageKind
-from tasker.task import ArgSpec
+from tasker.task import POLICIES, ArgSpec
 
 SKILLS = ("navigate", "say", "manipulate", "wait")
 """Skills the core agent offers (the contract with ``robot/``)."""
@@ -52,14 +55,20 @@ class StageTemplate:
 
 @dataclass(frozen=True, slots=True)
 class Branch:
-    """One branch of a decision list: ``when`` all literals hold (and the interruption is
-    at least ``min_interruption_s`` long), use ``goal`` (planned) or ``stages`` (static)."""
+    """One branch of the suspension decision list (eq. 47), shared by both strategies.
+
+    It applies when every ``when`` literal holds (``?vars`` are bound by the first match,
+    in sorted order, and may be used in ``goal`` and ``stages``); ``planned`` plans to
+    ``goal``, ``static`` runs ``stages`` — the load check proves the stages reach the goal.
+    A ``policy = "conditional"`` branch trades safety for time: it is eligible only under
+    that policy and when the expected interruption is at most ``max_interruption_s``."""
 
     when: tuple[Literal, ...] = ()
-    min_interruption_s: float = 0.0
     goal: tuple[Literal, ...] = ()
     stages: tuple[StageTemplate, ...] = ()
     label: str = ""
+    policy: str = "strict"
+    max_interruption_s: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -87,7 +96,6 @@ class TaskSpec:
     suspension: tuple[Branch, ...]
     actions: Mapping[str, ActionSpec]
     static_update: tuple[StageTemplate, ...]
-    static_suspension: tuple[Branch, ...]
     cps: float
     travel_s: float
     planning_time_s: float
@@ -95,169 +103,274 @@ class TaskSpec:
     timeout_s: float = 10.0
     example: ExampleWorld | None = None
     hooks: Mapping[str, Any] = field(default_factory=dict)
+    hazards: tuple[Hazard, ...] = ()
+    people: People | None = None
+    bindings: tuple[RawBinding, ...] = ()
+    lines: Mapping[str, int | None] = field(default_factory=dict)
+    """Where each checked field is written (``"hazards[0].fact"`` -> line), for later checks."""
+
+    @property
+    def toml(self) -> Path:
+        return self.folder / "task.toml"
+
+    def error(self, fieldname: str, message: str) -> DefinitionError:
+        """A fault found after reading (against the domain), located like the reader's own."""
+        return DefinitionError(self.toml, f"{fieldname}: {message}", self.lines.get(fieldname))
+
+
+@dataclass(frozen=True, slots=True)
+class RawBinding:
+    """A ``[[bindings]]`` entry as written; the loader adds the object types from the domain."""
+
+    kind: str
+    fact: Literal
+    object: str
+    state: str = "on"
+    otherwise: str = "off"
+
+    def resolve(self, types: tuple[str, ...]) -> Binding:
+        return Binding(self.kind, self.fact, self.object, types, self.state, self.otherwise)
+
+
+def meaning_of(spec: TaskSpec, bindings: tuple[Binding, ...]) -> Meaning:
+    """The :class:`~tasker.meaning.Meaning` a task type exposes."""
+    return Meaning(spec.hazards, spec.people, bindings)
 
 
 class _Reader:
-    """Typed access to a TOML table with errors that name the file and the key."""
+    """Reads ``task.toml`` through :class:`tasker.reader.Table`; remembers field lines."""
 
     def __init__(self, file: Path) -> None:
         self.file = file
+        self.lines: dict[str, int | None] = {}
 
-    def fail(self, key: str, reason: str) -> DefinitionError:
-        return DefinitionError(self.file, f"[{key}] {reason}")
+    def fail(self, t: reader.Table, key: str | int | None, reason: str) -> DefinitionError:
+        return _definition(t.error(key, reason))
 
-    def table(self, data: Mapping[str, Any], key: str, where: str, required: bool = False) -> dict[str, Any]:
-        value = data.get(key)
-        if value is None:
-            if required:
-                raise self.fail(where, f"missing table {key!r}")
-            return {}
-        if not isinstance(value, dict):
-            raise self.fail(where, f"{key!r} must be a table")
-        return value
+    def note(self, t: reader.Table, key: str | int | None = None) -> str:
+        name = t.field(key)
+        self.lines[name] = t.line(key)
+        return name
 
-    def number(self, data: Mapping[str, Any], key: str, where: str, default: float) -> float:
-        value = data.get(key, default)
-        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) or value < 0:
-            raise self.fail(where, f"{key!r} must be a finite number >= 0, got {value!r}")
-        return float(value)
-
-    def literals(self, value: Any, where: str) -> tuple[Literal, ...]:
+    def literals(self, t: reader.Table, key: str, default: Any = None) -> tuple[Literal, ...]:
+        value = t.raw(key, [] if default is None else default)
+        self.note(t, key)
         if not isinstance(value, list):
-            raise self.fail(where, f"expected a list of literals such as [[\"at\", \"$x\", \"$place\"]], got {value!r}")
+            raise self.fail(t, key, 'expected a list of literals such as [["at", "$x", "$place"]], '
+                                    f"got {value!r}")
         out: list[Literal] = []
         for lit in value:
-            if not isinstance(lit, list) or not lit or not all(isinstance(s, str) and s for s in lit):
-                raise self.fail(where, f"a literal is a non-empty list of strings, got {lit!r}")
-            if lit[0] == "not" and len(lit) < 2:
-                raise self.fail(where, f"'not' needs a predicate: {lit!r}")
-            out.append(tuple(lit))
+            out.append(self.literal(t, key, lit))
         return tuple(out)
 
-    def templates(self, value: Any, where: str) -> tuple[StageTemplate, ...]:
+    def literal(self, t: reader.Table, key: str, lit: Any) -> Literal:
+        if not isinstance(lit, list) or not lit or not all(isinstance(s, str) and s for s in lit):
+            raise self.fail(t, key, f"a literal is a non-empty list of strings, got {lit!r}")
+        if lit[0] == "not" and len(lit) < 2:
+            raise self.fail(t, key, f"'not' needs a predicate: {lit!r}")
+        return tuple(lit)
+
+    def templates(self, t: reader.Table, key: str) -> tuple[StageTemplate, ...]:
+        value = t.raw(key, [])
+        self.note(t, key)
         if not isinstance(value, list):
-            raise self.fail(where, "stages must be a list of {action = ..., args = [...]} tables")
+            raise self.fail(t, key, "stages must be a list of {action = ..., args = [...]} tables")
         out = []
-        for st in value:
-            if not isinstance(st, dict) or not isinstance(st.get("action"), str):
-                raise self.fail(where, f"a stage needs an 'action' string, got {st!r}")
-            args = st.get("args", [])
+        for i, raw in enumerate(value):
+            if not isinstance(raw, dict):
+                raise self.fail(t, key, f"a stage is a table {{action = ..., args = [...]}}, got {raw!r}")
+            st = reader.Table(self.file, raw, (*t.path, key, i), t._index)
+            action = st.string("action")
+            args = st.raw("args", [])
             if not isinstance(args, list) or not all(isinstance(a, str) for a in args):
-                raise self.fail(where, f"stage {st['action']!r}: 'args' must be a list of strings")
-            sus = st.get("suspended")
-            if sus is not None and not isinstance(sus, str):
-                raise self.fail(where, f"stage {st['action']!r}: 'suspended' must be an action name")
-            out.append(StageTemplate(st["action"], tuple(args), sus))
+                raise self.fail(st, "args", f"stage {action!r}: expected a list of strings")
+            sus = st.string("suspended", None)
+            st.done()
+            out.append(StageTemplate(action, tuple(args), sus))
         return tuple(out)
 
-    def branches(self, value: Any, where: str, static: bool) -> tuple[Branch, ...]:
-        if not isinstance(value, list):
-            raise self.fail(where, "must be an array of tables ([[...]])")
-        out = []
-        for k, b in enumerate(value):
-            w = f"{where}[{k}]"
-            if not isinstance(b, dict):
-                raise self.fail(w, "must be a table")
-            when = self.literals(b.get("when", []), w)
-            mi = self.number(b, "min_interruption_s", w, 0.0)
-            goal = () if static else self.literals(b.get("goal", []), w)
-            stages = self.templates(b.get("stages", []), w) if static else ()
-            out.append(Branch(when, mi, goal, stages, str(b.get("label", ""))))
-        if not out or out[-1].when or out[-1].min_interruption_s:
-            raise self.fail(where, "the last branch must have no 'when' (the default case)")
+    def branches(self, t: reader.Table, key: str) -> tuple[Branch, ...]:
+        if key not in t:
+            out = [Branch()]
+        else:
+            out = []
+            for b in t.tables(key):
+                policy = b.string("policy", "strict", choices=POLICIES)
+                limit = b.number("max_interruption_s", None, min=0)
+                if (policy == "conditional") != (limit is not None):
+                    raise self.fail(b, "max_interruption_s" if limit is not None else "policy",
+                                    'a branch that trades safety for time has policy = "conditional" and '
+                                    "max_interruption_s (the longest interruption it accepts), and only such a branch")
+                out.append(Branch(self.literals(b, "when"), self.literals(b, "goal"), self.templates(b, "stages"),
+                                  b.string("label", "", empty=True), policy,
+                                  None if limit is None else float(limit)))
+                self.note(b)
+                b.done()
+            if not out:
+                raise self.fail(t, key, "needs at least one branch (the default case, with no 'when')")
+        last = out[-1]
+        if last.when or last.policy != "strict":
+            raise self.fail(t, key, "the last branch must have no 'when' and the strict policy (the default case)")
         return tuple(out)
 
 
-def _action(r: _Reader, name: str, a: Any) -> ActionSpec:
-    where = f"actions.{name}"
-    if not isinstance(a, dict):
-        raise r.fail(where, "must be a table")
-    skill = a.get("skill")
-    if skill not in SKILLS:
-        raise r.fail(where, f"'skill' must be one of {list(SKILLS)}, got {skill!r}")
+def _definition(exc: reader.InputError) -> DefinitionError:
+    return DefinitionError(exc.file, f"{exc.field}: {exc.message}" if exc.field else exc.message, exc.line)
+
+
+@contextmanager
+def _as_definition_error() -> Iterator[None]:
     try:
-        kind = StageKind(a.get("kind", "suspendable"))
-    except ValueError:
-        raise r.fail(where, f"'kind' must be 'suspendable' or 'blocking', got {a.get('kind')!r}") from None
-    travel = a.get("travel")
+        yield
+    except reader.InputError as exc:
+        raise _definition(exc) from None
+
+
+def _action(r: _Reader, a: reader.Table, name: str) -> ActionSpec:
+    skill = a.string("skill", choices=SKILLS)
+    kind = StageKind(a.string("kind", "suspendable", choices=[k.value for k in StageKind]))
+    travel = a.raw("travel", None)
     if travel is not None and (not isinstance(travel, list) or len(travel) != 2
                                or not all(isinstance(t, str) and t.startswith("?") for t in travel)):
-        raise r.fail(where, f"'travel' must be two parameters [\"?from\", \"?to\"], got {travel!r}")
-    duration = r.number(a, "duration", where, 0.0) if "duration" in a else None
-    for key in ("to", "text"):
-        if key in a and not isinstance(a[key], str):
-            raise r.fail(where, f"{key!r} must be a string")
-    if skill == "navigate" and "to" not in a:
-        raise r.fail(where, "a navigate action needs 'to' (the parameter naming its target)")
-    return ActionSpec(name, skill, kind, duration, tuple(travel) if travel else None, a.get("to"), a.get("text"))
+        raise r.fail(a, "travel", f"expected two parameters [\"?from\", \"?to\"], got {travel!r}")
+    duration = a.number("duration", None, min=0)
+    to = a.string("to", None)
+    text = a.string("text", None)
+    r.note(a)
+    a.done()
+    if skill == "navigate" and to is None:
+        raise r.fail(a, None, "a navigate action needs 'to' (the parameter naming its target)")
+    return ActionSpec(name, skill, kind, None if duration is None else float(duration),
+                      tuple(travel) if travel else None, to, text)
 
 
-def _args(r: _Reader, raw: Any) -> tuple[ArgSpec, ...]:
-    if not isinstance(raw, list):
-        raise r.fail("args", "must be an array of tables ([[args]])")
+def _args(r: _Reader, top: reader.Table) -> tuple[ArgSpec, ...]:
     out = []
-    for k, a in enumerate(raw):
-        if not isinstance(a, dict) or "name" not in a:
-            raise r.fail(f"args[{k}]", "needs a 'name'")
+    for a in top.tables("args", []):
+        name = a.string("name")
         try:
-            out.append(ArgSpec(name=a["name"], type=a.get("type", "str"), required=a.get("required", True),
-                               default=a.get("default"), help=a.get("help", ""),
-                               choices=tuple(a["choices"]) if "choices" in a else None))
+            out.append(ArgSpec(name=name, type=a.string("type", "str"), required=a.boolean("required", True),
+                               default=a.raw("default", None), help=a.string("help", "", empty=True),
+                               choices=tuple(a.raw("choices")) if "choices" in a else None))
         except (ConfigError, TypeError) as exc:
-            raise r.fail(f"args[{k}]", str(exc)) from None
+            raise r.fail(a, None, str(exc)) from None
+        a.done()
     return tuple(out)
 
 
-def _example(r: _Reader, ex: dict[str, Any]) -> ExampleWorld | None:
-    if not ex:
+def _example(r: _Reader, top: reader.Table) -> ExampleWorld | None:
+    if "example" not in top:
         return None
+    ex = top.table("example")
     poses = {}
-    for name, p in r.table(ex, "poses", "example").items():
+    for name, p in ex.table("poses", {}).items():
         if not isinstance(p, list) or len(p) not in (2, 3) or not all(isinstance(v, int | float) for v in p):
-            raise r.fail("example.poses", f"{name}: a pose is [x, y] or [x, y, yaw], got {p!r}")
+            raise r.fail(ex.table("poses"), name, f"a pose is [x, y] or [x, y, yaw], got {p!r}")
         poses[name] = (float(p[0]), float(p[1]), float(p[2]) if len(p) == 3 else 0.0)
-    objects = r.table(ex, "objects", "example", required=True)
+    objects_t = ex.table("objects")
+    objects = dict(objects_t.items())
     if not all(isinstance(v, str) for v in objects.values()):
-        raise r.fail("example.objects", "maps object names to type names (strings)")
-    facts = r.literals(ex.get("facts", []), "example.facts")
-    return ExampleWorld(r.table(ex, "args", "example"), objects, facts, poses)
+        raise r.fail(ex, "objects", "maps object names to type names (strings)")
+    facts = r.literals(ex, "facts")
+    args = dict(ex.table("args", {}).items())
+    ex.done()
+    return ExampleWorld(args, objects, facts, poses)
+
+
+def _hazards(r: _Reader, top: reader.Table) -> tuple[Hazard, ...]:
+    out = []
+    for h in top.tables("hazards", []):
+        name = h.string("name")
+        fact_value = h.raw("fact")
+        r.note(h, "fact")
+        fact = r.literal(h, "fact", fact_value)
+        if fact[0] == "not":
+            raise r.fail(h, "fact", f"a hazard is a fact that holds (no 'not'), got {list(fact)}")
+        budget = h.number("budget_s", min=0)
+        severity = h.number("severity", 1.0, min=0)
+        try:
+            out.append(Hazard(name, fact, float(budget), float(severity), h.string("label", "", empty=True)))
+        except ValueError as exc:
+            raise r.fail(h, "name", str(exc)) from None
+        h.done()
+    names = [x.name for x in out]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise r.fail(top, "hazards", f"duplicate hazard name(s) {dup}")
+    return tuple(out)
+
+
+def _people(r: _Reader, top: reader.Table) -> People | None:
+    if "people" not in top:
+        return None
+    p = top.table("people")
+    person = p.string("person")
+    r.note(p, "person")
+    roles = {role: r.literals(p, role) for role in ROLES if role in p}
+    p.done()
+    return People(person, roles)
+
+
+def _bindings(r: _Reader, top: reader.Table) -> tuple[RawBinding, ...]:
+    out = []
+    for b in top.tables("bindings", []):
+        kind = b.string("kind", choices=BINDING_KINDS)
+        fact = r.literal(b, "fact", b.raw("fact"))
+        r.note(b, "fact")
+        variables = [tok for tok in fact[1:] if tok.startswith("?")]
+        if fact[0] == "not" or len(variables) != len(fact) - 1 or not variables:
+            raise r.fail(b, "fact", f"a binding is a fact whose arguments are all ?variables, got {list(fact)}")
+        obj = b.string("object", variables[-1])
+        if obj not in variables:
+            raise r.fail(b, "object", f"expected one of the fact's variables {variables}, got {obj!r}"
+                                      f"{reader.suggest(obj, variables)}")
+        state = b.string("state", "on") if kind == "device" else "on"
+        otherwise = b.string("otherwise", "off") if kind == "device" else "off"
+        b.done()
+        out.append(RawBinding(kind, fact, obj, state, otherwise))
+    return tuple(out)
 
 
 def read_task_toml(path: Path) -> TaskSpec:
     """Read and check one ``task.toml`` (the PDDL is checked by :mod:`planners.pddl_task`)."""
     r = _Reader(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise DefinitionError(path, "no such file") from None
-    except tomllib.TOMLDecodeError as exc:
-        line = int(exc.args[0].rsplit("line ", 1)[1].split(",")[0]) if "line " in str(exc) else None
-        raise DefinitionError(path, f"TOML syntax error: {exc}", line) from None
-    task = r.table(data, "task", "task", required=True)
-    name = task.get("name")
-    if not isinstance(name, str) or not name.isidentifier():
-        raise r.fail("task", f"'name' must be an identifier, got {name!r}")
-    problem = r.table(data, "problem", "problem", required=True)
-    raw_actions = r.table(data, "actions", "actions", required=True)
-    static = r.table(data, "static", "static", required=True)
-    schedule = r.table(data, "schedule", "schedule")
-    return TaskSpec(
-        folder=path.parent,
-        name=name,
-        description=str(task.get("description", "")),
-        domain_file=path.parent / str(task.get("domain", "domain.pddl")),
-        args=_args(r, data.get("args", [])),
-        goal=r.literals(problem.get("goal", []), "problem.goal"),
-        facts=r.literals(problem.get("facts", []), "problem.facts"),
-        suspended_facts=r.literals(problem.get("suspended_facts", []), "problem.suspended_facts"),
-        suspension=r.branches(data.get("suspension", [{}]), "suspension", static=False),
-        actions={n: _action(r, n, a) for n, a in raw_actions.items()},
-        static_update=r.templates(static.get("update", []), "static.update"),
-        static_suspension=r.branches(static.get("suspension", [{}]), "static.suspension", static=True),
-        cps=r.number(schedule, "cps", "schedule", 1.0),
-        travel_s=r.number(schedule, "travel_s", "schedule", 10.0),
-        planning_time_s=r.number(task, "planning_time_s", "task", 0.5),
-        static_time_s=r.number(task, "static_time_s", "task", 0.05),
-        timeout_s=r.number(task, "timeout_s", "task", 10.0),
-        example=_example(r, r.table(data, "example", "example")),
-    )
+    with _as_definition_error():
+        top = reader.load(path)
+        task = top.table("task")
+        name = task.string("name")
+        if not name.isidentifier():
+            raise r.fail(task, "name", f"'name' must be an identifier, got {name!r}")
+        description = task.string("description", "", empty=True)
+        domain = task.string("domain", "domain.pddl")
+        planning_time_s = task.number("planning_time_s", 0.5, min=0)
+        static_time_s = task.number("static_time_s", 0.05, min=0)
+        timeout_s = task.number("timeout_s", 10.0, min=0)
+        task.done()
+        problem = top.table("problem")
+        goal = r.literals(problem, "goal")
+        facts = r.literals(problem, "facts")
+        suspended_facts = r.literals(problem, "suspended_facts")
+        problem.done()
+        actions_t = top.table("actions")
+        actions = {n: _action(r, actions_t.table(n), n) for n in actions_t.keys()}
+        actions_t.done()
+        static = top.table("static")
+        static_update = r.templates(static, "update")
+        if "suspension" in static:
+            raise r.fail(static, "suspension", "[[static.suspension]] is gone: each [[suspension]] branch now has "
+                                               "both `goal` (planned) and `stages` (static), see docs/domains.md")
+        static.done()
+        schedule = top.table("schedule", {})
+        cps = schedule.number("cps", 1.0, min=0)
+        travel_s = schedule.number("travel_s", 10.0, min=0)
+        schedule.done()
+        spec = TaskSpec(
+            folder=path.parent, name=name, description=description, domain_file=path.parent / domain,
+            args=_args(r, top), goal=goal, facts=facts, suspended_facts=suspended_facts,
+            suspension=r.branches(top, "suspension"), actions=actions, static_update=static_update,
+            cps=float(cps), travel_s=float(travel_s), planning_time_s=float(planning_time_s),
+            static_time_s=float(static_time_s), timeout_s=float(timeout_s), example=_example(r, top),
+            hazards=_hazards(r, top), people=_people(r, top), bindings=_bindings(r, top), lines=r.lines,
+        )
+        top.done()
+    return spec

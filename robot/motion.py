@@ -409,17 +409,24 @@ class MotionEstimator:
         """
         scene = self.planner.scene
         d = scene.people[person]
-        best: tuple[Pose, MotionEstimate] | None = None
+        cands = []
         for k in range(APPROACH_DIRECTIONS):
             a = 2 * math.pi * k / APPROACH_DIRECTIONS
             gx, gy = d.x + APPROACH * math.cos(a), d.y + APPROACH * math.sin(a)
-            if not scene.free(gx, gy, ignore=(person,)):
-                continue
-            goal = (gx, gy, math.atan2(d.y - gy, d.x - gx))
+            if scene.free(gx, gy, ignore=(person,)):
+                # the straight-line drive time bounds the travel time from below (the profile
+                # is concave, turns cost >= 0), so candidates are tried nearest first and
+                # the search stops once no farther one can beat the best
+                bound = self.limits.drive_time(math.hypot(gx - start[0], gy - start[1]))
+                cands.append((bound, k, (gx, gy, math.atan2(d.y - gy, d.x - gx))))
+        best: tuple[float, int, Pose, MotionEstimate] | None = None
+        for bound, k, goal in sorted(cands):
+            if best is not None and bound > best[0]:
+                break
             est = self._estimate(self.planner, start, goal)
-            if est.reachable and (best is None or est.time_s < best[1].time_s):
-                best = (goal, est)
-        return best if best is not None else (None, UNREACHABLE)
+            if est.reachable and (best is None or (est.time_s, k) < (best[0], best[1])):
+                best = (est.time_s, k, goal, est)
+        return (best[2], best[3]) if best is not None else (None, UNREACHABLE)
 
     def table(self, poses: list[Pose] | tuple[Pose, ...]) -> np.ndarray:
         """Seconds from every pose to every other: an ``(n, n)`` matrix, ``inf`` if unreachable.

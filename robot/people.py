@@ -4,15 +4,18 @@ Each person is moved kinematically on the simulation clock (deterministic, no
 randomness).  What a person does in a step, in order of precedence:
 
 1. **fallen** people lie still;
-2. ``("told_to_wait", NAME)`` in the symbolic state: stand still;
-3. ``("following", NAME)``: walk along the robot's trail and stop ``FOLLOW_GAP``
-   metres (along the trail) behind the robot — the trail keeps them off walls;
+2. :attr:`Person.waiting` (the person was told to wait): stand still;
+3. :attr:`Person.following` (the person follows the robot): walk along the robot's
+   trail and stop ``FOLLOW_GAP`` metres (along the trail) behind the robot — the trail
+   keeps them off walls;
 4. otherwise the **script**: ``walk`` waypoints ``(t, x, y)`` say where the person is
    at time ``t``; the person heads for the scripted position of *now* at their walking
    speed, so after a reaction ends they walk back onto the script instead of jumping.
 
 Posture changes come from the script's ``events`` ``(t, posture)`` or from
-:meth:`Person.set_posture`.
+:meth:`Person.set_posture`.  ``waiting`` and ``following`` are set by the world from the
+facts a task folder binds to them (``robot.sim.Simulation.bind``): people react to
+what they were told, never to a task's predicate names.
 """
 
 from __future__ import annotations
@@ -37,6 +40,8 @@ class Person:
         self.posture = spec.posture
         self._event = 0
         self._trail: list[tuple[float, float]] = []
+        self.following = False
+        self.waiting = False
 
     @property
     def pose(self) -> Pose:
@@ -92,17 +97,16 @@ class Person:
             break
 
     def step(self, t: float, dt: float, facts: frozenset[Fact] | set[Fact], robot: tuple[float, float]) -> None:
-        """Move the person from ``t - dt`` to ``t``."""
+        """Move the person from ``t - dt`` to ``t`` (``facts`` is not read: reactions are flags)."""
         events = self.spec.events
         while self._event < len(events) and events[self._event][0] <= t:
             self.posture = events[self._event][1]
             self._event += 1
-        following = ("following", self.name) in facts
-        if not following:
+        if not self.following:
             self._trail = []
-        if self.posture == "fallen" or ("told_to_wait", self.name) in facts:
+        if self.posture == "fallen" or self.waiting:
             return
-        if following:
+        if self.following:
             self._follow(robot, dt)
             return
         target = self.scripted(t)

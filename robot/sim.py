@@ -10,10 +10,15 @@ planner and the symbolic state, and steps them together on the simulated clock:
   :mod:`robot.skills`; :meth:`poll` advances the world to ``now`` first, so the
   simulation also works when nobody else calls :meth:`advance`.
 
-The symbolic state starts from the world file's facts, device states
-(``("state", device, value)``) and ``("at", "robot", place)`` when the robot starts on
-a place; skills change it through their stage's ``add``/``delete`` lists.  Postures are
-physical and reported as ``("posture", person, posture)``.
+The symbolic state starts from the world file's facts, ``("at", device, place)`` and
+``("at", "robot", place)`` when the robot starts on a place; skills change it through
+their stage's ``add``/``delete`` lists.  The world keeps **one** state: a fact a task
+folder *binds* to physical state (:class:`tasker.meaning.Binding`, given with
+:meth:`Simulation.bind`) — a device's state, a door open, an object held, a person
+following or waiting — is never stored: :meth:`Simulation.apply` changes the device,
+the door, the grip or the person, and :meth:`Simulation.snapshot` derives the fact from
+it.  The world names no task's predicate.  Device states are reported as
+``("state", device, value)``, postures as ``("posture", person, posture)``.
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ from robot.scene import Scene, segments_clear
 from robot.skills import SKILLS, Skill
 from robot.spec import WorldSpec, load_world
 from robot.tiago import robot_dimensions
+from tasker.meaning import Binding
 from tasker.protocols import RUNNING, SkillState, SkillStatus, failed
 from tasker.stage import Stage
 from tasker.world import Fact, Pose, WorldState
@@ -64,12 +70,14 @@ class Simulation:
         self.mj = MjApartment(self.spec)
         self.time = 0.0
         self.facts: set[Fact] = set(self.spec.facts)
-        self.facts |= {("state", d.name, d.state) for d in self.spec.devices.values()}
-        # devices are where their place is; a cooker that is on is ("cooker_on", name) for the domains
+        # devices are where their place is
         self.facts |= {("at", d.name, d.place) for d in self.spec.devices.values()}
-        self.facts |= {("cooker_on", d.name) for d in self.spec.devices.values() if d.type == "cooker"
-                       and d.state == "on"}
-        self.facts |= {("open", n) for n, d in self.spec.doors.items() if d.open}
+        # physical state: the one copy; bound facts are derived from it (see bind)
+        self.device_state: dict[str, str] = {n: d.state for n, d in sorted(self.spec.devices.items())}
+        self.door_open: dict[str, bool] = {n: bool(d.open) for n, d in sorted(self.spec.doors.items())}
+        self.held: set[str] = set()
+        self.bindings: tuple[Binding, ...] = ()
+        self.version = 0  # bumped whenever the symbolic or bound state changes
         x, y, _ = self.spec.robot.pose
         for name, (px, py, _) in sorted(self.spec.places.items()):
             if math.hypot(px - x, py - y) < AT_TOLERANCE and not any(f[:2] == ("at", "robot") for f in self.facts):
@@ -188,8 +196,77 @@ class Simulation:
 
     def set_door(self, name: str, is_open: bool) -> None:
         """Open or close a door: the scene (and so every cached estimate) and MuJoCo follow."""
+        self.door_open[name] = bool(is_open)
+        self.version += 1
         self.scene.set_door(name, is_open)
         self.mj.set_door(name, is_open)
+
+    def set_device(self, name: str, state: str) -> None:
+        """Switch a device (``"on"``, ``"off"``, ...): the one place its state is kept."""
+        if name not in self.device_state:
+            raise KeyError(f"no device {name!r}; known: {sorted(self.device_state)}")
+        self.device_state[name] = str(state)
+        self.version += 1
+
+    # ---- bindings: facts that are physical state -------------------------------------
+    def bind(self, bindings: Iterable[Binding]) -> None:
+        """Say which facts are physical state (the task folders' ``[[bindings]]``).
+
+        Facts of the world file that a binding covers move into the physical state."""
+        self.bindings = tuple(dict.fromkeys(bindings))
+        stored = sorted(f for f in self.facts if self._binding(f) is not None)
+        self.facts -= set(stored)
+        for f in stored:
+            self._set_bound(f, True)
+        self.version += 1
+
+    def _binding(self, fact: Fact) -> tuple[Binding, str] | None:
+        """The binding that covers a ground fact, with the physical thing it is about."""
+        kinds: dict[str, set[str]] = {"device": set(self.device_state), "door": set(self.door_open),
+                                      "held": set(self.spec.objects), "follower": set(self.people.by_name),
+                                      "waiting": set(self.people.by_name)}
+        for b in self.bindings:
+            obj = b.object_of(fact)
+            if obj is not None and obj in kinds[b.kind] and (not b.types or self._type(obj) in b.types):
+                return b, obj
+        return None
+
+    def _type(self, name: str) -> str:
+        return self.objects().get(name, "")
+
+    def _set_bound(self, fact: Fact, value: bool) -> bool:
+        hit = self._binding(fact)
+        if hit is None:
+            return False
+        b, obj = hit
+        if b.kind == "device":
+            self.set_device(obj, b.state if value else b.otherwise)
+        elif b.kind == "door":
+            self.set_door(obj, value)
+        elif b.kind == "held":
+            (self.held.add if value else self.held.discard)(obj)
+        elif b.kind == "follower":
+            self.people[obj].following = value
+        else:
+            self.people[obj].waiting = value
+        return True
+
+    def _bound_facts(self) -> set[Fact]:
+        out: set[Fact] = set()
+        objects = self.objects()
+        for b in self.bindings:
+            if b.kind == "device":
+                things = [n for n, v in self.device_state.items() if v == b.state]
+            elif b.kind == "door":
+                things = [n for n, v in self.door_open.items() if v]
+            elif b.kind == "held":
+                things = sorted(self.held)
+            elif b.kind == "follower":
+                things = [p.name for p in self.people if p.following]
+            else:
+                things = [p.name for p in self.people if p.waiting]
+            out |= {b.ground(n, "robot") for n in things if not b.types or objects.get(n) in b.types}
+        return out
 
     def snapshot(self) -> WorldState:
         """The world as task hooks see it: symbolic facts plus the facts read off the physics.
@@ -210,10 +287,18 @@ class Simulation:
         robot_place = self.nearest_place(rx, ry)
         facts.add(("at", "robot", robot_place))
         for p in self.people:
-            with_robot = ("following", p.name) in self.facts or math.hypot(p.x - rx, p.y - ry) <= TOGETHER
+            with_robot = p.following or math.hypot(p.x - rx, p.y - ry) <= TOGETHER
             facts.add(("at", p.name, robot_place if with_robot else self.person_place(p.x, p.y)))
             if p.posture == "fallen":
                 facts.add(("fallen", p.name))
+        facts |= {("state", n, v) for n, v in self.device_state.items()}
+        facts |= self._bound_facts()
+        for name in sorted(self.spec.objects):  # an object is posed at its place, or with the robot holding it
+            place = next((f[2] for f in facts if f[0] == "at" and len(f) == 3 and f[1] == name), None)
+            if name in self.held:
+                poses[name] = poses["robot"]
+            elif place is not None and place in self.spec.places:
+                poses[name] = self.spec.places[place]
         return WorldState(frozenset(facts | self.people.facts()), poses, self.objects(), self.time)
 
     def person_place(self, x: float, y: float) -> str:
@@ -257,11 +342,10 @@ class Simulation:
         """Change the symbolic state: ``delete`` first, then ``add`` (lists of ground facts)."""
         removed: list[Fact] = [tuple(f) for f in delete]
         added: list[Fact] = [tuple(f) for f in add]
-        self.facts -= set(removed)
-        self.facts |= set(added)
-        for fact, is_open in [(f, False) for f in removed] + [(f, True) for f in added]:
-            if fact[0] == "open" and len(fact) == 2 and fact[1] in self.spec.doors:
-                self.set_door(fact[1], is_open)  # the physical door follows the symbolic one
+        for fact, value in [(f, False) for f in removed] + [(f, True) for f in added]:
+            if not self._set_bound(fact, value):  # bound facts change the physical state, not a copy
+                (self.facts.add if value else self.facts.discard)(fact)
+        self.version += 1
 
     # ---- CoreAgent -------------------------------------------------------------------
     def begin(self, agent: str, stage: Stage, now: float) -> None:

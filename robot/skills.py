@@ -54,6 +54,8 @@ class SkillHost(Protocol):
     def objects(self) -> Mapping[str, str]: ...
 
 BLOCK_TIMEOUT = 5.0  # seconds a blocked path is retried before the skill fails
+STALL_TIMEOUT = 2 * BLOCK_TIMEOUT  # seconds without moving STALL_MOVE metres before the skill gives up
+STALL_MOVE = 0.1
 CHECK_PERIOD = 0.2  # seconds between checks of the path ahead
 
 
@@ -104,6 +106,7 @@ class Navigate(Skill):
         self.blocked_since: float | None = None
         self.next_check = now
         self.stopping = False
+        self.mark = (now, sim.robot_pose()[:2])  # last time and place the base made progress
         why = self._replan()
         if why:
             self.result = failed(why)
@@ -179,7 +182,20 @@ class Navigate(Skill):
         cmd = f.command(x, y, yaw, dt)
         if f.done and self.blocked_since is None and not self.stopping and self.result is RUNNING:
             self.result = SUCCEEDED
+        elif self.result is RUNNING and not self.stopping:
+            self._watch_progress(now, x, y)
         return cmd
+
+    def _watch_progress(self, now: float, x: float, y: float) -> None:
+        """A navigation that re-plans paths it cannot drive (a person beside a doorway the
+        planner squeezes past, say) would wait forever: fail once the base has not moved
+        ``STALL_MOVE`` metres for ``STALL_TIMEOUT`` seconds, so the task ends with its reason."""
+        since, (mx, my) = self.mark
+        if math.hypot(x - mx, y - my) >= STALL_MOVE:
+            self.mark = (now, (x, y))
+        elif now - since > STALL_TIMEOUT:
+            self.result = failed(f"no progress toward {self.target!r} for {STALL_TIMEOUT:g} s "
+                                 f"(stuck at ({x:.2f}, {y:.2f}))")
 
     def stop(self, now: float) -> None:
         """Brake to a standstill at the acceleration limits (the physics loop keeps braking)."""

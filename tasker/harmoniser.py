@@ -88,7 +88,11 @@ AgentFactory = Callable[[str, Request, float, Callable[[DynamicAgent], None]], D
 
 
 class TaskHarmoniser:
-    """The robot's task harmoniser.  ``exe_da``, ``irr_da`` and ``idle_da`` are its roles."""
+    """The robot's task harmoniser.  ``exe_da``, ``irr_da`` and ``idle_da`` are its roles.
+
+    ``hazard_waiting`` (default off) selects hazard-aware waiting, one factor of the
+    static-versus-planned sweep (``docs/sweeps.md``); it is stored for the behaviour that uses it.
+    """
 
     def __init__(
         self,
@@ -99,6 +103,7 @@ class TaskHarmoniser:
         mode: Mode = Mode.IT,
         s_freq: float = 1.0,
         guard: OscillationGuard | None = OscillationGuard(),
+        hazard_waiting: bool = False,
     ) -> None:
         if not isinstance(s_freq, int | float) or s_freq <= 0:
             raise ConfigError(f"sFreq must be a positive number of Hz, got {s_freq!r}")
@@ -106,6 +111,7 @@ class TaskHarmoniser:
         self.mode = Mode(mode)
         self.s_freq = float(s_freq)
         self.guard = guard  # None: no oscillation guard
+        self.hazard_waiting = bool(hazard_waiting)  # hazard-aware waiting, a sweep factor (stored only for now)
         self._became: dict[str, list[float]] = {}  # when each agent became exeDA since the last new request
         self._factory = agent_factory
         self._trace = trace

@@ -39,6 +39,7 @@ class SimulationLoop:
     """Builds the harmoniser and its agents and steps them on one simulated clock.
 
     ``strategies`` maps a task type to its :class:`Strategy`; others use ``strategy``.
+    ``hazard_waiting`` switches hazard-aware waiting on (passed to the harmoniser).
     """
 
     def __init__(
@@ -58,6 +59,7 @@ class SimulationLoop:
         motion: Any = None,
         resolution: float = 0.001,
         horizon: float = 24 * 3600.0,
+        hazard_waiting: bool = False,
     ) -> None:
         if not (isinstance(resolution, int | float) and 0 < resolution <= 1):
             raise ConfigError(f"resolution must be in (0, 1] seconds, got {resolution!r}")
@@ -72,8 +74,10 @@ class SimulationLoop:
         self.motion = motion
         self.resolution = float(resolution)
         self.horizon = float(horizon)
+        # hazard-aware waiting (a sweep factor): stored here and on the harmoniser, which implements it
+        self.hazard_waiting = bool(hazard_waiting)
         self.harmoniser = TaskHarmoniser(scheduler, self._make_agent, trace=self.trace, mode=Mode(mode),
-                                         s_freq=s_freq)
+                                         s_freq=s_freq, hazard_waiting=self.hazard_waiting)
         self._heap: list[tuple[int, int, int, Any]] = []
         self._seq = itertools.count()
         self._tick = 0
@@ -82,6 +86,7 @@ class SimulationLoop:
         self._started = False
         self.aborted: str | None = None  # why the run was aborted, if it was
         self.all_agents: list[DynamicAgent] = []  # every agent created, ended ones included
+        self.observers: list[Callable[[float], None]] = []  # called after each tick, e.g. tasker.meaning.Monitor
 
     # -- time ---------------------------------------------------------------------------------
 
@@ -257,4 +262,6 @@ class SimulationLoop:
                     timer = True
                     self._push(tick + max(1, round(1.0 / (harm.s_freq * self.resolution))), _TIMER, None)
             harm.step(now, timer)
+            for observe in self.observers:
+                observe(now)
         return self.trace

@@ -34,8 +34,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tasker.errors import BadRequest, ConfigError
+from tasker.meaning import NO_MEANING, Meaning
 from tasker.messages import CompletionCost, CostParams, ScheduleParams, SPRequest
 from tasker.stage import Purpose, Stage, StagePlan
+
+POLICIES = ("strict", "conditional")
+"""Suspension policies (:attr:`Strategy.policy`)."""
 
 _ARG_TYPES: dict[str, type] = {"str": str, "float": float, "int": int, "bool": bool, "pose": tuple}
 
@@ -89,15 +93,22 @@ class Strategy:
 
     Each is ``"planned"`` (call a planner on the world as it is) or ``"static"``
     (the task's template ``exeTsk``, Alg. 3, and decision-tree ``exeSusp``, eq. 47).
+    Both pursue the same suspension goal.  ``policy`` is a separate factor applied to
+    both: ``"strict"`` always reaches the safe state; ``"conditional"`` also allows the
+    branches a task declares as trading safety for time (e.g. leave the cooker on for a
+    short interruption).
     """
 
     update: str = "planned"
     suspension: str = "planned"
+    policy: str = "strict"
 
     def __post_init__(self) -> None:
         for name in ("update", "suspension"):
             if getattr(self, name) not in ("planned", "static"):
                 raise ConfigError(f"Strategy.{name} must be 'planned' or 'static', got {getattr(self, name)!r}")
+        if self.policy not in POLICIES:
+            raise ConfigError(f"Strategy.policy must be one of {list(POLICIES)}, got {self.policy!r}")
 
 
 @dataclass(slots=True)
@@ -158,12 +169,15 @@ class TaskType:
 
     Subclasses set :attr:`name`, :attr:`arg_specs` and :attr:`description`, and
     override hooks.  One instance serves every agent of the type, so per-agent state
-    belongs in ``ctx.memory``, never on ``self``.
+    belongs in ``ctx.memory``, never on ``self``.  :attr:`meaning` declares what the
+    task means for safety and people (hazards, roles, physical bindings; see
+    :mod:`tasker.meaning`): the trace and the metrics read it, never the task's name.
     """
 
     name: str = ""
     description: str = ""
     arg_specs: tuple[ArgSpec, ...] = ()
+    meaning: Meaning = NO_MEANING
 
     # -- framework-owned ------------------------------------------------------------
 

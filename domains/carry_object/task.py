@@ -1,4 +1,7 @@
-"""Problem-builder hooks of carry_object: passages without doors, and doors to close."""
+"""Problem-builder hook of carry_object: passages without doors.
+
+Closing the doors on a suspension is declared in ``task.toml`` (``[[suspension]]``), so the
+static and the planned strategy pursue the same goal."""
 
 from __future__ import annotations
 
@@ -16,8 +19,3 @@ def extra_facts(ctx: TaskContext, world: WorldState) -> Iterable[Fact]:
         for b in places:
             if a != b and (a, b) not in doors:
                 yield ("free_passage", a, b)
-
-
-def suspension_goal(ctx: TaskContext, world: WorldState, goal: list[tuple[str, ...]]) -> list[tuple[str, ...]]:
-    """Whatever the branch asks, plus: every door left open is closed."""
-    return list(goal) + [("not", "open", f[1]) for f in world.matching("open") if len(f) == 2]

@@ -12,7 +12,9 @@ from planners.planner import Planner
 from planners.taskspec import Branch
 from tasker.errors import PlanningFailed
 from tasker.stage import Purpose
-from tests.domains.conftest import apply, make_ctx, steps
+from tasker.task import Strategy
+from tasker.world import WorldState
+from tests.domains.conftest import apply, make_ctx
 
 
 def test_static_update_is_the_template(task: PddlTaskType) -> None:
@@ -121,17 +123,28 @@ def test_carry_suspension_places_safely_and_closes_door(tasks: dict[str, PddlTas
     assert ("surface", place.args[2]) in ctx.world.facts  # only ever put down on a surface
 
 
-def test_cook_suspension_depends_on_interruption_length(tasks: dict[str, PddlTaskType]) -> None:
+@pytest.mark.parametrize("strategy", ["planned", "static"])
+def test_cook_suspension_policy_is_the_same_factor_for_both_strategies(tasks: dict[str, PddlTaskType],
+                                                                        strategy: str) -> None:
+    """strict: the cooker goes off whatever the interruption; conditional: a short
+    interruption leaves it on — for the planned and the static strategy alike."""
     t = tasks["cook"]
     ctx = make_ctx(t)
     exe = t.update_task(ctx)
     k = [s.action for s in exe.stages].index("cook_food")  # cooker on, pan on it
     world = apply(ctx.world, exe.stages[:k])
-    long_ctx, short_ctx = make_ctx(t, world=world), make_ctx(t, world=world)
-    short_ctx.memory[INTERRUPTION_KEY] = 10.0
-    assert steps(t.generate_suspension(long_ctx).stages) == [("turn_off", "robot", "stove", "kitchen")]
-    assert t.generate_suspension(short_ctx).stages == ()
+
+    def susp(policy: str, expected: float | None, w: WorldState = world) -> list[str]:
+        c = make_ctx(t, strategy=strategy, world=w)
+        c.strategy = Strategy(strategy, strategy, policy)
+        if expected is not None:
+            c.memory[INTERRUPTION_KEY] = expected
+        return [s.action for s in t.generate_suspension(c).stages]
+
+    assert susp("strict", 10.0) == susp("strict", None) == ["turn_off"]
+    assert susp("conditional", None) == ["turn_off"] and susp("conditional", 10.0) == []
     k = [s.action for s in exe.stages].index("put_down")  # hot pan held
-    held = make_ctx(t, world=apply(ctx.world, exe.stages[:k]))
-    held.memory[INTERRUPTION_KEY] = 10.0
-    assert [s.action for s in t.generate_suspension(held).stages] == ["put_down"]
+    held = apply(ctx.world, exe.stages[:k])
+    off = ["turn_off"] if ("cooker_on", "stove") in held.facts else []
+    assert susp("strict", 10.0, held) == ["put_down", *off]
+    assert susp("conditional", 10.0, held) == ["put_down"]

@@ -254,3 +254,21 @@ def test_help_and_a_warm_plan_stay_clear_of_heavy_imports(tmp_path: Path) -> Non
     mods = _modules_after(plan, tmp_path)
     assert "planners.fd" in mods and "fast_downward.translate.main" in mods
     assert not {m for m in mods if m.split(".")[0] in ("unified_planning", "ConfigSpace", "up_fast_downward")}
+
+
+def test_sweep_jobs_carry_absolute_task_paths(tmp_path: Path, files: dict[str, str],
+                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    import experiments.sweep
+
+    assert main(["new", "mine", str(tmp_path / "tasks" / "mine")]) == 0
+    seen: list[Any] = []
+
+    def fake(spec: Any, db: str, **_: object) -> Any:
+        seen.append(spec)
+        return SimpleNamespace(total=0, skipped=0, ran=0, ok=0, errors=0, wall=0.0, backend="local")
+
+    monkeypatch.setattr(experiments.sweep, "run_sweep", fake)
+    monkeypatch.chdir(tmp_path)
+    assert main(["sweep", files["spec"], "--db", files["db"], "--path", "tasks"]) == 0
+    jobs = seen[0].jobs()
+    assert jobs and all(j.task_paths == (str((tmp_path / "tasks").resolve()),) for j in jobs)

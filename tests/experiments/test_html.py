@@ -104,7 +104,22 @@ def test_world_slider_follows_the_trajectory(events: list[dict[str, Any]]) -> No
     assert "peter (fallen)" in last["data"][2]["text"]
     assert "device_on cooker (d1)" in last["layout"]["title"]["text"]
     assert "hazards on: none" in frames[0]["layout"]["title"]["text"]
-    assert [t["name"] for t in fig["data"]][2:] == [t["name"] for t in last["data"]]  # frames update traces 2-4
+    assert [t["name"] for t in fig["data"]][3:] == [t["name"] for t in last["data"]]  # frames update traces 3-5
+    susp = next(t for t in fig["data"] if t["name"] == "robot at susp")
+    n_susp = sum(1 for e in events if e["event"] == "command" and e["flag"] == "susp")
+    assert len(susp["x"]) == n_susp and list(susp["text"])[0].startswith("susp d")
+
+
+def test_recorded_trajectory_of_the_robot_recorder_is_read(tmp_path: Path) -> None:
+    lines = [{"format": "tasker-trajectory/1", "world": "paper", "rate_hz": 10.0,
+              "fields": {"robot": ["x", "y", "yaw"], "people": ["x", "y", "yaw", "posture"]}},
+             {"t": 0.0, "robot": [1.0, 2.0, 0.5], "people": {"peter": [3.0, 4.0, 0.0, "standing"]}},
+             {"t": 0.1, "mark": "manipulated", "object": "pan", "action": "pick_pan", "at": [1.0, 2.0]},
+             {"t": 0.1, "robot": [1.5, 2.0, 0.5], "people": {"peter": [3.0, 4.0, 0.0, "fallen"]}}]
+    (tmp_path / "trajectory.jsonl").write_text("".join(json.dumps(r) + "\n" for r in lines))
+    assert report_html.read_trajectory(tmp_path) == (
+        [(0.0, 1.0, 2.0, 0.5), (0.1, 1.5, 2.0, 0.5)],
+        {"peter": [(0.0, 3.0, 4.0, "standing"), (0.1, 3.0, 4.0, "fallen")]})
 
 
 @pytest.mark.parametrize("kind", ["jsonl", "csv"])

@@ -46,6 +46,13 @@ class Build:
         return self.add(t, "stage", agent=agent, fsm=fsm, index=0, action=action, args=list(args),
                         kind="suspendable", status=status)
 
+    def hazard(self, t: float, agent: str | None, hazard: str, status: str, *args: str,
+               budget_s: float = 0.0) -> Build:
+        return self.add(t, "hazard", agent=agent, hazard=hazard, args=list(args), status=status, budget_s=budget_s)
+
+    def role(self, t: float, agent: str, role: str, status: str, person: str) -> Build:
+        return self.add(t, "role", agent=agent, role=role, person=person, status=status)
+
     def end(self, t: float, agent: str, cause: str = "finished", reason: str = "finished") -> Build:
         self.go(t, agent, "exeTsk", "end")
         return self.add(t, "end", agent=agent, task_type="cook", reason=reason, cause=cause)
@@ -92,43 +99,60 @@ def test_a_susp_followed_by_a_start_of_the_same_agent_is_no_switch() -> None:
 
 def test_cooker_left_on_through_a_switch_is_unattended_until_resumed() -> None:
     b = Build().request(0, "d1").go(0, "d1", "initComm", "compSP", "upTsk", "exeTsk")
-    b.stage(5, "d1", "turn_on", "done", "robot", "stove", "kitchen")
+    b.hazard(5, "d1", "cooker_on", "on", "stove", budget_s=10.0)
     b.go(8, "d1", "exeTsk", "genSusp", "exeSusp").go(10, "d1", "exeSusp", "wait")
-    b.go(25, "d1", "wait", "upTsk", "exeTsk").stage(30, "d1", "turn_off", "done", "robot", "stove", "kitchen")
+    b.go(25, "d1", "wait", "upTsk", "exeTsk").hazard(30, "d1", "cooker_on", "off", "stove", budget_s=10.0)
     m = metrics.compute(b.end(31, "d1").events)["safety"]
     cooker = m["hazards"]["cooker_on"]
     assert cooker["active_s"] == 25.0 and cooker["unattended_s"] == 15.0
+    assert cooker["longest_unattended_s"] == 15.0 and cooker["budget_s"] == 10.0
+    assert cooker["overruns"] == 1 and cooker["overrun_s"] == 5.0  # 15 s unattended against a 10 s budget
     assert cooker["at_switch"] == 1 and cooker["active_at_end"] == 0
-    assert m["cooker_unattended_s"] == 15.0
+    assert m["unattended_s"] == 15.0 and m["budget_overruns"] == 1
     assert m["violations_at_switch"] == 1
     assert m["switches_into_wait"] == [{"t": 10.0, "agent": "d1", "hazards": ["cooker_on(stove)"]}]
 
 
+def test_a_hazard_turned_off_in_the_instant_of_the_switch_is_not_left_behind() -> None:
+    b = Build().request(0, "d1").go(0, "d1", "initComm", "compSP", "upTsk", "exeTsk")
+    b.hazard(1, "d1", "held", "on", "robot", "vase")
+    b.go(3, "d1", "exeTsk", "genSusp", "exeSusp").go(4, "d1", "exeSusp", "wait")
+    b.hazard(4, "d1", "held", "off", "robot", "vase")  # the monitor writes edges after the tick's transitions
+    assert metrics.compute(b.events)["safety"]["violations_at_switch"] == 0
+
+
 def test_a_cooker_never_turned_off_counts_until_the_end_of_the_trace() -> None:
     b = Build().request(0, "d1").go(0, "d1", "initComm", "compSP", "upTsk", "exeTsk")
-    b.stage(2, "d1", "turn_on", "done", "robot", "stove", "kitchen")
+    b.hazard(2, "d1", "cooker_on", "on", "stove", budget_s=60.0)
     b.end(4, "d1", cause="failed", reason="stage cook_food failed").add(10, "run", status="horizon reached", active=[])
     m = metrics.compute(b.events)
-    assert m["safety"]["hazards"]["cooker_on"] == {"episodes": 1, "active_s": 8.0, "unattended_s": 6.0,
-                                                   "at_switch": 0, "active_at_end": 1}
+    assert m["safety"]["hazards"]["cooker_on"] == {
+        "episodes": 1, "budget_s": 60.0, "active_s": 8.0, "unattended_s": 6.0, "longest_unattended_s": 6.0,
+        "overruns": 0, "overrun_s": 0.0, "at_switch": 0, "active_at_end": 1, "unowned": 0}
     assert m["totals"]["failed"] == 1 and m["totals"]["by_cause"] == {"failed": 1}
     assert m["totals"]["failure_reasons"] == ["d1: stage cook_food failed"]
     assert m["run"]["horizon_reached"] is True
 
 
+def test_a_hazard_nobody_owns_is_counted_apart() -> None:
+    b = Build().hazard(0, None, "door_open", "on", "door1").request(1, "d1").end(5, "d1")
+    s = metrics.compute(b.events)["safety"]
+    assert s["unowned_hazards"] == 1 and s["unattended_s"] == 0.0 and s["hazards"]["door_open"]["unowned"] == 1
+
+
 def test_held_object_open_door_and_follower_at_a_switch() -> None:
     b = Build().request(0, "d1", "carry_object", item="vase").go(0, "d1", "initComm", "compSP", "upTsk", "exeTsk")
-    b.stage(1, "d1", "open_door", "done", "robot", "door1", "hall")
-    b.stage(2, "d1", "pick", "done", "robot", "vase", "kitchen")
+    b.hazard(1, "d1", "door_open", "on", "door1").hazard(2, "d1", "object_held", "on", "robot", "vase")
     b.request(2, "d2", "guide_human", person="john").go(2, "d2", "initComm", "compSP")
+    b.role(2, "d2", "waiting", "on", "john")
     b.go(3, "d1", "exeTsk", "genSusp", "exeSusp").go(4, "d1", "exeSusp", "wait")
-    b.go(4, "d2", "compSP", "upTsk", "exeTsk").stage(6, "d2", "greet", "done", "robot", "john", "hall")
-    b.stage(7, "d2", "ask_to_follow", "done", "robot", "john", "hall")
+    b.go(4, "d2", "compSP", "upTsk", "exeTsk").role(6, "d2", "waiting", "off", "john")
+    b.hazard(7, "d2", "person_following", "on", "john").role(7, "d2", "following", "on", "john")
     b.go(9, "d2", "exeTsk", "genSusp", "exeSusp").go(9, "d2", "exeSusp", "wait")
     m = metrics.compute(b.events)
     s = m["safety"]
-    assert s["objects_held_at_switch"] == 1 and s["doors_open_at_switch"] == 1
-    assert s["people_following_at_switch"] == 1
+    assert s["hazards"]["object_held"]["at_switch"] == 1 and s["hazards"]["door_open"]["at_switch"] == 1
+    assert s["hazards"]["person_following"]["at_switch"] == 1
     assert s["violations_at_switch"] == 3  # d1: vase + door; d2: john
     assert s["hazards_active_at_switch"] == 2 + 3  # d2's switch also sees d1's leftovers
     people = m["people"]["people"]["d2"]
@@ -137,30 +161,31 @@ def test_held_object_open_door_and_follower_at_a_switch() -> None:
     assert people["following_s"] == 2.0  # asked to follow at 7 -> end of trace at 9
 
 
-def test_people_wait_again_after_ask_to_wait_until_greeted_again() -> None:
-    b = Build().request(0, "d1", "guide_human", person="ann").go(0, "d1", "initComm", "compSP", "upTsk", "exeTsk")
-    b.stage(3, "d1", "greet", "done", "r", "ann", "hall").stage(4, "d1", "ask_to_follow", "done", "r", "ann", "hall")
-    b.stage(10, "d1", "ask_to_wait", "done", "r", "ann", "hall", fsm="exeSusp")
-    b.stage(20, "d1", "greet_and_apologise", "done", "r", "ann", "hall")
-    b.stage(21, "d1", "ask_to_follow", "done", "r", "ann", "hall")
-    b.stage(30, "d1", "say_goodbye", "done", "r", "ann", "k")
-    m = metrics.compute(b.end(30, "d1").events)
-    assert m["people"]["people"]["d1"]["waiting_s"] == 3.0 + 10.0
-    assert m["people"]["people"]["d1"]["following_s"] == 6.0 + 9.0
-    assert m["people"]["people_following_s"] == 15.0
-    assert m["safety"]["hazards"]["person_following"]["episodes"] == 2
+def test_people_waiting_following_and_time_to_help() -> None:
+    b = Build().request(0, "d1", "guide_human", person="ann").role(0, "d1", "waiting", "on", "ann")
+    b.role(3, "d1", "waiting", "off", "ann").role(4, "d1", "following", "on", "ann")
+    b.role(10, "d1", "following", "off", "ann").role(10, "d1", "waiting", "on", "ann")
+    b.role(10, "d1", "told_to_wait", "on", "ann")
+    b.role(21, "d1", "waiting", "off", "ann").role(21, "d1", "told_to_wait", "off", "ann")
+    b.role(21, "d1", "following", "on", "ann").role(30, "d1", "following", "off", "ann")
+    b.request(5, "d2", "human_fell", person="bob").role(5, "d2", "needs_help", "on", "bob")
+    b.role(5, "d2", "waiting", "on", "bob").role(12, "d2", "waiting", "off", "bob")
+    b.role(17, "d2", "helped", "on", "bob")
+    m = metrics.compute(b.events)["people"]
+    assert m["people"]["d1"]["waiting_s"] == 3.0 + 11.0 and m["people"]["d1"]["told_to_wait_s"] == 11.0
+    assert m["people"]["d1"]["following_s"] == 6.0 + 9.0 and m["people_following_s"] == 15.0
+    assert m["people"]["d2"]["time_to_help_s"] == 12.0 and m["needing_help"] == 1 and m["not_helped"] == 0
+    assert m["time_to_help_s"] == {"mean": 12.0, "max": 12.0}
 
 
-def test_hazards_of_failed_stages_do_not_change() -> None:
-    b = Build().request(0, "d1").stage(1, "d1", "turn_on", "failed", "r", "stove", "k")
-    assert metrics.compute(b.events)["safety"]["hazards"]["cooker_on"]["episodes"] == 0
-
-
-def test_every_hazard_rule_names_a_known_hazard_and_a_stage_status() -> None:
-    for rule in metrics.HAZARDS:
-        assert rule.hazard in metrics.HAZARD_KINDS
-        assert rule.status in ("begin", "done")
-    assert len({(r.action, r.status) for r in metrics.HAZARDS}) == len(metrics.HAZARDS)
+def test_metrics_name_no_task_action_or_predicate() -> None:
+    """The hazard and people collectors read declared names from the trace: a hazard of a
+    made-up task is measured like any other."""
+    b = Build().request(0, "d1", "juggle").go(0, "d1", "initComm", "compSP", "upTsk", "exeTsk")
+    b.hazard(1, "d1", "balls_in_the_air", "on", "ball3", budget_s=2.0).go(2, "d1", "exeTsk", "genSusp", "exeSusp")
+    b.go(2, "d1", "exeSusp", "wait").hazard(7, "d1", "balls_in_the_air", "off", "ball3", budget_s=2.0)
+    s = metrics.compute(b.events)["safety"]
+    assert s["hazards"]["balls_in_the_air"]["unattended_s"] == 5.0 and s["budget_overruns"] == 1
 
 
 def test_empty_trace() -> None:
@@ -176,9 +201,8 @@ def test_demo_scenario(demo: Trace) -> None:
     assert m["switching"]["switches"] == 1 and m["totals"]["suspensions"] == 1
     assert m["decisions"]["decisions"] == len(demo.of("decision"))
     assert m["tasks"]["d1"]["suspensions"] == 1
-    # the guide's suspension asked the person to wait: nobody follows through the switch
-    assert m["safety"]["people_following_at_switch"] == 0
-    assert m["people"]["people"]["d1"]["following_s"] > 0
+    # synthetic runs have no world: no hazard or role edges (docs/metrics.md says so)
+    assert m["safety"]["hazards"] == {} and m["people"]["people"] == {}
 
 
 def test_deterministic_and_json_ready(demo: Trace) -> None:

@@ -84,7 +84,7 @@ HAND = [
     ev(10, "request", agent="d2", task_type="fall", args={"deadline": 50.0, "death_at": 950.0}),
     ev(10, "command", agent="d1", flag="susp"),
     ev(10, "transition", agent="d1", **{"from": "exeTsk", "to": "genSusp"}),
-    ev(11, "plan", agent="d1", purpose="genSusp", stages=[{"action": "ask_to_wait"}]),
+    ev(11, "plan", agent="d1", purpose="genSusp", stages=[{"action": "ask_to_stay"}]),
     ev(11, "transition", agent="d1", **{"from": "genSusp", "to": "exeSusp"}),
     ev(15, "transition", agent="d1", **{"from": "exeSusp", "to": "wait"}),
     ev(15, "command", agent="d2", flag="start"),

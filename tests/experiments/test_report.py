@@ -28,12 +28,13 @@ def rows() -> list[RunRow]:
     out = []
     for seed in range(5):
         out += [
-            _row("a", seed, STATIC, totals={"duration_s": {"mean": 10.0 + seed}, "failed": 0},
+            _row("a", seed, STATIC, totals={"duration_s": {"mean": 10.0 + seed}, "failed": 0}, x_s=10.0 + seed,
                  people={"people_waiting_s": 20.0 + seed}),
-            _row("a", seed, PLANNED, totals={"duration_s": {"mean": 8.0 + seed}, "failed": 0},
+            _row("a", seed, PLANNED, totals={"duration_s": {"mean": 8.0 + seed}, "failed": 0}, x_s=8.0 + seed,
                  people={"people_waiting_s": 20.0 + seed}),
-            _row("b", seed, STATIC, totals={"duration_s": {"mean": 5.0}, "failed": 0}),
-            _row("b", seed, PLANNED, totals={"duration_s": {"mean": 6.0 + 0.1 * seed}, "failed": 0}),
+            _row("b", seed, STATIC, totals={"duration_s": {"mean": 5.0}, "failed": 0}, x_s=5.0),
+            _row("b", seed, PLANNED, totals={"duration_s": {"mean": 6.0 + 0.1 * seed}, "failed": 0},
+                 x_s=6.0 + 0.1 * seed),
         ]
     return out
 
@@ -51,14 +52,14 @@ def test_estimate_is_the_student_t_interval() -> None:
 def test_numeric_metrics_flatten_and_skip_what_is_not_a_number() -> None:
     flat = numeric_metrics({"totals": {"failed": 1, "duration_s": {"mean": 2.5}}, "run": {"seed": 3, "ok": True},
                             "note": "hello", "list": [1, 2], "inf_metric": "inf", "tasks": {"d1": {"x": 1}}})
-    assert flat == {"totals.failed": 1.0, "totals.duration_s.mean": 2.5, "run.ok": 1.0, "inf_metric": math.inf}
+    assert flat == {"totals.failed": 1.0, "run.ok": 1.0, "inf_metric": math.inf, "derived.finished_tasks": 0.0}
 
 
 def test_summaries_per_strategy_pooled_and_per_scenario(rows: list[RunRow]) -> None:
     by = {(s.scenario, s.strategy, s.metric): s.estimate for s in summarise(rows)}
-    assert by[(ALL, STATIC, "totals.duration_s.mean")].n == 10
-    assert by[("a", PLANNED, "totals.duration_s.mean")].mean == pytest.approx(10.0)
-    assert by[("b", STATIC, "totals.duration_s.mean")].half == 0.0
+    assert by[(ALL, STATIC, "x_s")].n == 10  # pooled rows are descriptive only, never compared
+    assert by[("a", PLANNED, "x_s")].mean == pytest.approx(10.0)
+    assert by[("b", STATIC, "x_s")].half == 0.0
     assert (ALL, STATIC, "people.people_waiting_s") in by and ("b", STATIC, "people.people_waiting_s") not in by
     assert by[(ALL, STATIC, "people.people_waiting_s")].n == 5  # missing in b: left out, not zero
 
@@ -69,34 +70,100 @@ def test_direction_of_better() -> None:
     assert not report.higher_is_better("safety.violations_at_switch")
 
 
-def test_comparisons_pair_strategies_that_differ_only_in_planned_vs_static() -> None:
-    labels = [STATIC, PLANNED, "update=planned,suspension=planned", "update=planned,suspension=static,scheduler=x"]
+def test_comparisons_pair_strategies_that_differ_in_one_factor() -> None:
+    labels = [STATIC, PLANNED, "update=planned,suspension=planned", "update=planned,suspension=static,scheduler=x",
+              "update=static,suspension=planned,policy=conditional", "update=static,suspension=planned,policy=strict",
+              "update=static,suspension=planned,policy=strict,hazard_waiting=on",
+              "update=static,suspension=planned,policy=strict,hazard_waiting=off"]
     assert sorted(comparisons(labels)) == [
+        ("hazard_waiting", "update=static,suspension=planned,policy=strict,hazard_waiting=on",
+         "update=static,suspension=planned,policy=strict,hazard_waiting=off"),
+        ("policy", "update=static,suspension=planned,policy=conditional",
+         "update=static,suspension=planned,policy=strict"),
         ("suspension", PLANNED, STATIC),
         ("update", "update=planned,suspension=planned", PLANNED),
-        ("update+suspension", "update=planned,suspension=planned", STATIC),
     ]
 
 
-def test_paired_counts_wins_ties_losses_per_scenario(rows: list[RunRow]) -> None:
+def test_holm_against_a_hand_computed_example() -> None:
+    # sorted: 0.005*4 = 0.02, 0.01*3 = 0.03, 0.03*2 = 0.06, 0.04*1 = 0.04 -> kept monotone at 0.06
+    adjusted = report.holm([0.01, 0.04, 0.03, 0.005, math.nan])
+    assert adjusted[:4] == [pytest.approx(0.03), pytest.approx(0.06), pytest.approx(0.06), pytest.approx(0.02)]
+    assert math.isnan(adjusted[4])  # no test, not in the family
+    assert report.holm([0.5, 0.9]) == [pytest.approx(1.0), pytest.approx(1.0)]  # capped at 1
+
+
+def test_paired_is_per_scenario_never_pooled_and_holm_corrected(rows: list[RunRow]) -> None:
     pairs = {(p.scenario, p.metric): p for p in paired(rows)}
-    a = pairs[("a", "totals.duration_s.mean")]
+    assert not any(sc == ALL for sc, _ in pairs)  # opposite effects in a and b are never pooled
+    assert ("a", "totals.duration_s.mean") not in pairs  # replaced by the finished-only duration
+    a = pairs[("a", "x_s")]
     assert (a.wins, a.ties, a.losses, a.diff.mean, a.diff.n) == (5, 0, 0, pytest.approx(-2.0), 5)
-    assert report._verdict(a) == "planned better"
-    b = pairs[("b", "totals.duration_s.mean")]
-    assert (b.wins, b.ties, b.losses) == (0, 0, 5)
-    assert report._verdict(b) == "static better"
-    pooled = pairs[(ALL, "totals.duration_s.mean")]
-    assert (pooled.wins, pooled.losses, pooled.diff.n) == (5, 5, 10)
-    failed = pairs[(ALL, "totals.failed")]
-    assert (failed.ties, report._verdict(failed)) == (10, "identical")
-    assert pairs[(ALL, "people.people_waiting_s")].diff.n == 5  # only where both runs have it
+    assert report._verdict(a) == "suspension=planned better"
+    b = pairs[("b", "x_s")]
+    assert (b.wins, b.ties, b.losses) == (0, 0, 5) and report._verdict(b) == "suspension=static better"
+    tests = [p for p in pairs.values() if not math.isnan(p.p)]
+    assert [p.p_holm for p in tests] == pytest.approx(report.holm([p.p for p in tests]))
+    assert all(p.p_holm >= p.p for p in tests)
+    failed = pairs[("a", "totals.failed")]
+    assert (failed.ties, report._verdict(failed)) == (5, "identical")
+
+
+def test_paired_p_is_the_paired_t_test() -> None:
+    d = [1.0, 2.0, 0.5, 3.0, -0.2]
+    assert report.paired_p(d) == pytest.approx(stats.ttest_1samp(d, 0.0).pvalue)
+    assert report.paired_p([1.0, 1.0]) == 0.0 and math.isnan(report.paired_p([0.0, 0.0]))
+
+
+def test_constant_metrics_are_dropped_with_a_note(tmp_path: Path, rows: list[RunRow]) -> None:
+    const = [RunRow(r.scenario, r.seed, r.strategy, r.status, r.record, {**r.metrics, "resumption_s": 2.0})
+             for r in rows]
+    assert report.constant_metrics(const)["resumption_s"] == 2.0
+    analysis = report.analyse(const)
+    assert "resumption_s" not in {s.metric for s in analysis.summaries}
+    assert "resumption_s" not in {p.metric for p in analysis.pairs}
+    assert "`resumption_s` = 2" in report.markdown(analysis)
+
+
+def test_non_finite_values_are_counted_and_shown(rows: list[RunRow]) -> None:
+    bad = [RunRow(r.scenario, r.seed, r.strategy, r.status, r.record,
+                  {**r.metrics, "y_s": "inf" if (r.seed, r.strategy) == (0, PLANNED) else float(r.seed)})
+           for r in rows]
+    by = {(s.scenario, s.strategy, s.metric): s for s in summarise(bad)}
+    assert (by[("a", PLANNED, "y_s")].nonfinite, by[("a", PLANNED, "y_s")].estimate.n) == (1, 4)
+    pairs = {(p.scenario, p.metric): p for p in paired(bad)}
+    assert (pairs[("a", "y_s")].nonfinite, pairs[("a", "y_s")].diff.n) == (1, 4)
+    assert "1 non-finite" in report.markdown(report.analyse(bad))
+
+
+def test_failed_and_unfinished_tasks_are_out_of_the_duration_mean_and_counted() -> None:
+    m = {"tasks": {"a": {"cause": "finished", "duration_s": 10.0}, "b": {"cause": "failed", "duration_s": 1.0},
+                   "c": {"cause": None, "duration_s": None}},
+         "totals": {"failed": 1, "unfinished": 1, "duration_s": {"mean": 5.5}}}
+    flat = numeric_metrics(m)
+    assert flat["derived.finished_duration_s.mean"] == 10.0 and "totals.duration_s.mean" not in flat
+    rows = [RunRow("s", 1, STATIC, Status.OK, {}, m), RunRow("s", 2, STATIC, Status.ERROR, {}, {}, error="x: crash"),
+            RunRow("s", 3, STATIC, Status.ERROR, {}, {}, error="PlanningFailed: unsolvable")]
+    md = report.markdown(report.analyse(rows))
+    assert "3 runs: 1 ok, 1 infeasible, 1 failed" in md
+    assert f"| s | {STATIC} | 1 | 1 | 1 | 1 | 1 |" in md
+
+
+def test_primary_outcome_reads_configured_paths(tmp_path: Path) -> None:
+    rows = [RunRow("s", seed, st, Status.OK, {}, {"safety": {"unattended_s": h}, "people": {"time_to_help_s":
+                                                                                              {"mean": w}}})
+            for seed in range(4) for st, h, w in ((STATIC, 10.0 + seed, 30.0), (PLANNED, 1.0, 40.0 + seed))]
+    cells = report.primary_cells(rows, report.PrimaryOutcome())
+    assert cells[("s", STATIC)][0].mean == pytest.approx(11.5) and cells[("s", PLANNED)][1].mean == 41.5
+    custom = report.PrimaryOutcome(hazard=("people.time_to_help_s.mean",), help=("safety.unattended_s",))
+    assert report.primary_cells(rows, custom)[("s", STATIC)][0].mean == 30.0
+    assert report.plot_frontier(rows, custom, tmp_path) == tmp_path / "primary_frontier.png"
 
 
 def test_errors_and_unpaired_runs_are_left_out_of_the_comparison(rows: list[RunRow]) -> None:
     extra = [RunRow("a", 9, PLANNED, Status.ERROR, {}, {}, error="Boom: no plan"), _row("a", 8, STATIC, x=1.0)]
     pairs = {(p.scenario, p.metric): p for p in paired(rows + extra)}
-    assert pairs[("a", "totals.duration_s.mean")].diff.n == 5
+    assert pairs[("a", "x_s")].diff.n == 5
     assert ("a", "x") not in pairs
 
 
@@ -108,21 +175,16 @@ def test_report_files(tmp_path: Path, rows: list[RunRow]) -> None:
         store.add(RunRow("b", 9, PLANNED, Status.ERROR, {}, {}, error="PlanningFailed: unsolvable\ntraceback"))
     files = build_report(db, tmp_path / "out")
     md = files.markdown.read_text()
-    lines = md.splitlines()
-    assert sum(line.startswith(f"| {STATIC} |") for line in lines) == 3  # all, a, b
-    assert sum(line.startswith(f"| {PLANNED} |") for line in lines) == 3
-    assert "totals.duration_s.mean" in md and "± " in md
-    assert "| b | 9 | update=static,suspension=planned | PlanningFailed: unsolvable |" in md
-    assert "| a | 5/0/0 planned |" in md and "| b | 0/0/5 static |" in md  # where planned wins, where not
-    assert "| totals.duration_s.mean | lower | -0.4 ± 1.209 (10) | 5/0/5 | no significant difference |" in md
+    assert "| b | 9 | update=static,suspension=planned | infeasible | PlanningFailed: unsolvable |" in md
+    assert "p (Holm)" in md and "## Primary outcome" in md
     with files.summary_csv.open() as f:
         summary = list(csv.DictReader(f))
     assert {r["scenario"] for r in summary} == {ALL, "a", "b"}
-    assert all(float(r["ci_low"]) <= float(r["mean"]) <= float(r["ci_high"]) for r in summary)
     with files.paired_csv.open() as f:
-        assert {r["dimension"] for r in csv.DictReader(f)} == {"suspension"}
+        scopes = {(r["dimension"], r["scenario"]) for r in csv.DictReader(f)}
+    assert scopes == {("suspension", "a"), ("suspension", "b")}
     names = {p.name for p in files.plots}
-    assert "totals.duration_s.mean.png" in names and any(n.startswith("paired_") for n in names)
+    assert "primary_frontier.png" in names and any(n.startswith("paired_") for n in names)
 
 
 def test_report_of_a_missing_database_is_an_error(tmp_path: Path) -> None:
@@ -133,15 +195,12 @@ def test_report_of_a_missing_database_is_an_error(tmp_path: Path) -> None:
 def test_host_dependent_metrics_are_reported_without_a_verdict(tmp_path: Path, rows: list[RunRow]) -> None:
     timed = [RunRow(r.scenario, r.seed, r.strategy, r.status, r.record,
                     {**r.metrics, "wall_time_s": 2.0 + r.seed if r.strategy == PLANNED else 1.0 + r.seed,
-                     "real_time_factor": 30.0})
+                     "real_time_factor": 30.0 + r.seed})
              for r in rows]
     pairs = {(p.scenario, p.metric): p for p in paired(timed)}
-    wall = pairs[(ALL, "wall_time_s")]
-    assert wall.diff.mean == pytest.approx(1.0) and report.host_dependent("wall_time_s")
+    wall = pairs[("a", "wall_time_s")]
+    assert wall.diff.mean == pytest.approx(1.0) and report.host_dependent("wall_time_s") and math.isnan(wall.p)
     assert report._verdict(wall) == "host-dependent: no verdict" and wall.better == "–"
-    md = report.markdown(timed, summarise(timed), list(pairs.values()))
-    assert "| wall_time_s | – | 1 ± 0 (10) | – | host-dependent: no verdict |" in md
-    assert "static better" not in [line for line in md.splitlines() if "wall_time_s" in line][-1]
     db = tmp_path / "r.db"
     with ResultStore(db) as store:
         for row in timed:
@@ -149,7 +208,7 @@ def test_host_dependent_metrics_are_reported_without_a_verdict(tmp_path: Path, r
     files = build_report(db, tmp_path / "out")
     with files.paired_csv.open() as f:
         flags = {r["metric"]: r["host_dependent"] for r in csv.DictReader(f)}
-    assert flags["wall_time_s"] == "1" and flags["real_time_factor"] == "1" and flags["totals.failed"] == "0"
+    assert flags["wall_time_s"] == "1" and flags["real_time_factor"] == "1" and flags["x_s"] == "0"
     assert files.html is not None
     page = files.html.read_text()
     assert "<table>" in page and "host-dependent: no verdict" in page and 'id="metric-0"' in page

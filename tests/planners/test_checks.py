@@ -68,8 +68,9 @@ def test_malformed_input_is_refused_with_file_and_line(name: str, tmp_path: Path
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_plan_command_exits_2_without_traceback(name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     d, p, fault, _, _ = _write(tmp_path, name)
-    assert main(["plan", str(d), str(p)]) == 2
+    assert main(["plan", str(d), str(p), "--timeout", "10"]) == 2
     out = capsys.readouterr()
+    assert out.err.startswith("tasker plan: error: ")
     assert fault in out.err and "Traceback" not in out.err + out.out
 
 

@@ -296,3 +296,14 @@ def test_paper_scenario_trace_does_not_depend_on_what_earlier_runs_cached() -> N
     runs = [run_scenario(scn, pictures=False).trace.events for _ in range(2)]
     assert any(e["event"] == "decision" and e.get("rule") == "cost" for e in runs[0])
     assert [json.dumps(e, sort_keys=True) for e in runs[0]] == [json.dumps(e, sort_keys=True) for e in runs[1]]
+
+
+def test_static_strategy_asked_from_elsewhere_applies_the_decision_list(tasks: dict[str, PddlTaskType]) -> None:
+    task = tasks["guide_human"]
+    ctx = make_ctx(task, strategy="static")
+    full = task.update_task(ctx)
+    ctx.world = advance(ctx.world, full.stages[:3])  # John follows; eq. 47 says: ask him to wait
+    ctx.plan, ctx.stage_index, ctx.stage_started, ctx.now = full, 3, 0.0, 0.0
+    est = estimator_for(task).estimate(ctx, ctx.world.poses["bedroom"])
+    assert est.source is Source.TEMPLATE
+    assert [s[0] for s in est.steps] == ["approach", "greet_and_apologise", "ask_to_follow", "guide", "say_goodbye"]

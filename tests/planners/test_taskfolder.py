@@ -29,8 +29,9 @@ def _edit(path: Path, old: str, new: str) -> None:
 
 TOML_CASES = [
     ('skill = "say"\nkind = "blocking"\ntext = "Hello {h}', 'skill = "talk"\nkind = "blocking"\ntext = "Hello {h}',
-     "'skill' must be one of"),
-    ('[actions.say_goodbye]\nskill = "say"\n', '[actions.say_goodbye]\nskill = "say"\nkind = "sometimes"\n', "'kind'"),
+     "actions.greet.skill: expected one of ['navigate', 'say', 'manipulate', 'wait'], got 'talk'"),
+    ('[actions.say_goodbye]\nskill = "say"\n', '[actions.say_goodbye]\nskill = "say"\nkind = "sometimes"\n',
+     "actions.say_goodbye.kind: expected one of"),
     ('["not", "told_to_wait", "$person"]]', '["not", "told_to", "$person"]]', "unknown predicate 'told_to'"),
     ('goal = [["at", "$person", "$destination"]', 'goal = [["at", "$person"]', "takes 2 argument(s)"),
     ('{ action = "say_goodbye", args = ["$robot", "$person", "$destination"] }',
@@ -42,8 +43,32 @@ TOML_CASES = [
     ('travel = ["?from", "?to"]', 'travel = ["?from", "?nowhere"]', "?nowhere is not a parameter"),
     ('[[suspension]]\nlabel = "save"\ngoal = []', '[[suspension]]\nlabel = "save"\nwhen = [["greeted", "$person"]]\n'
      'goal = []', "the last branch must have no 'when'"),
+    ('when = [["greeted", "$person"]]\ngoal = [["told_to_wait", "$person"]]',
+     'when = [["greeted", "$person"]]\ngoal = [["told_to_wait", "?who"]]', "suspension[1]: ?who is not bound"),
     ('name = "guide_human"', 'name = "guide human"', "'name' must be an identifier"),
-    ('[task]', '[task', "TOML syntax error"),
+    # the strict reader: unknown keys and tables are errors with the line and a did-you-mean
+    ('[actions.say_goodbye]\nskill = "say"\n', '[actions.say_goodbye]\nskill = "say"\nkindd = "blocking"\n',
+     "actions.say_goodbye.kindd: unknown key 'kindd'; did you mean 'kind'?"),
+    ('[schedule]', '[shedule]', "shedule: unknown key 'shedule'; did you mean 'schedule'?"),
+    # static and planned pursue the same goal: the branch's stages must reach it
+    ('stages = [{ action = "ask_to_wait", args = ["$robot", "$person", "$at:robot"] }]', 'stages = []',
+     "suspension[0]: static and planned must pursue the same goal"),
+    ('label = "save"\ngoal = []', 'label = "save"\npolicy = "conditional"\ngoal = []',
+     "suspension[2].policy: a branch"),
+    ('[static]', '[[static.suspension]]\nstages = []\n\n[static]', "[[static.suspension]] is gone"),
+    ('budget_s = 0', 'budget = 0', "hazards[0].budget_s: missing (required)"),
+    ('fact = ["following", "$person"]\nbudget_s', 'fact = ["folowing", "$person"]\nbudget_s',
+     "hazards[0].fact: unknown predicate 'folowing'; did you mean 'following'?"),
+    ('fact = ["following", "$person"]\nbudget_s', 'fact = ["following", "$person", "$robot"]\nbudget_s',
+     "hazards[0].fact: 'following' takes 1 argument(s), got 2"),
+    ('fact = ["following", "$person"]\nbudget_s', 'fact = ["following", "$persn"]\nbudget_s',
+     "hazards[0].fact: unknown request argument '$persn'; did you mean '$person'?"),
+    ('person = "person"     #', 'person = "who"     #', "people.person: no request argument 'who'"),
+    ('told_to_wait = [["told_to_wait", "$person"]]', 'told_to_wait = [["told", "$person"]]',
+     "people.told_to_wait: unknown predicate 'told'"),
+    ('kind = "waiting"', 'kind = "sleeping"', "bindings[1].kind: expected one of"),
+    ('fact = ["told_to_wait", "?h"]', 'fact = ["told_to_wait", "$person"]', "bindings[1].fact: a binding is a fact"),
+    ('[task]', '[task', "not valid TOML"),
 ]
 
 
@@ -54,6 +79,28 @@ def test_bad_task_toml(old: str, new: str, fragment: str, tmp_path: Path) -> Non
     with pytest.raises(DefinitionError) as info:
         load_task(folder)
     assert info.value.file.endswith("task.toml") and fragment in str(info.value)
+
+
+def test_strict_reader_names_the_line(tmp_path: Path) -> None:
+    folder = _copy(tmp_path)
+    _edit(folder / "task.toml", '[actions.say_goodbye]\nskill = "say"\n',
+          '[actions.say_goodbye]\nskill = "say"\nkindd = "blocking"\n')
+    line = folder.joinpath("task.toml").read_text().splitlines().index('kindd = "blocking"') + 1
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder)
+    assert info.value.line == line and f"task.toml:{line}: " in str(info.value)
+    assert "valid keys: duration, kind, skill, text, to, travel" in str(info.value)
+
+
+def test_a_bad_task_toml_is_one_line_and_exit_2_from_the_cli(tmp_path: Path,
+                                                             capsys: pytest.CaptureFixture[str]) -> None:
+    from experiments.cli import main
+
+    folder = _copy(tmp_path)
+    _edit(folder / "task.toml", '[schedule]', '[shedule]')
+    assert main(["domains", "--path", str(folder)]) == 2
+    err = capsys.readouterr().err
+    assert "did you mean 'schedule'?" in err and "Traceback" not in err
 
 
 def test_bad_domain_in_folder_names_domain(tmp_path: Path) -> None:

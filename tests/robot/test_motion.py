@@ -139,3 +139,14 @@ def test_table_is_one_search_per_source(paper) -> None:
     table = motion.table(poses)
     assert motion.planner.searches - before <= 2 * len(poses)  # door layer, and people where they are in the way
     assert table[0, 1] == motion.estimate(poses[0], poses[1]).time_s
+
+
+def test_travel_matrix_and_seed_checks_fire() -> None:
+    from robot.motion import TravelMatrix
+    from robot.roadmap import ompl_seed
+
+    with pytest.raises(ValueError, match="2 labels need 2 poses"):
+        TravelMatrix("paper", 1, ("a", "b"), ((0.0, 0.0, 0.0),), np.zeros((2, 2)), np.zeros((2, 2)))
+    with pytest.raises(ValueError, match="seed must be >= 0"):
+        ompl_seed(-1)
+    assert ompl_seed(0) == 1 and ompl_seed(1) == 2

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from robot.sim import Simulation
+from tasker.meaning import Binding
 from tasker.protocols import CoreAgent, SkillState, World
 from tasker.stage import Stage
 from tasker.world import WorldState
@@ -72,6 +73,7 @@ def test_person_asked_to_follow_ends_near_the_destination(paper) -> None:
     sim = Simulation(paper)
     status, now = run(sim, nav("john", add=[["met", "robot", "john"]]), 0.0)
     assert status.state is SkillState.SUCCEEDED and sim.snapshot().holds("met", "robot", "john")
+    sim.bind([Binding("follower", ("following", "?h"), "?h", ("person",))])
     sim.apply(add=[["following", "john"]])
     status, now = run(sim, nav("john_destination"), now)
     assert status.state is SkillState.SUCCEEDED
@@ -83,13 +85,27 @@ def test_person_asked_to_follow_ends_near_the_destination(paper) -> None:
 def test_told_to_wait_stops_a_walking_person(paper) -> None:
     sim = Simulation(paper)
     sim.advance(20.0)
+    sim.bind([Binding("waiting", ("told_to_wait", "?h"), "?h")])
     sim.apply(add=[["told_to_wait", "john"]])
+    assert sim.people["john"].waiting and ("told_to_wait", "john") not in sim.facts
     here = sim.people["john"].pose
     sim.advance(30.0)
     assert sim.people["john"].pose == here
     sim.apply(delete=[["told_to_wait", "john"]])
     sim.advance(35.0)
     assert sim.people["john"].pose != here
+
+
+def test_a_bound_device_has_one_state(paper) -> None:
+    """The fact a task folder binds to a device is derived from the device, never stored twice."""
+    sim = Simulation(paper)
+    sim.bind([Binding("device", ("heating", "?c"), "?c", ("cooker",), state="on", otherwise="off")])
+    assert not sim.snapshot().holds("heating", "cooker") and sim.snapshot().holds("state", "cooker", "off")
+    sim.apply(add=[["heating", "cooker"]])  # a stage switches it on: the device follows
+    assert sim.device_state["cooker"] == "on" and sim.snapshot().holds("heating", "cooker")
+    sim.set_device("cooker", "off")  # a person switches it off: the fact follows
+    assert not sim.snapshot().holds("heating", "cooker") and sim.snapshot().holds("state", "cooker", "off")
+    assert not any(f[0] == "heating" for f in sim.facts)
 
 
 def test_timed_skills_apply_effects_and_fail_cleanly(flat) -> None:
