@@ -44,13 +44,15 @@ def _scenario(hysteresis: float, variant: int | None, scenario: str = "paper") -
 def run_one(job: tuple[float, int | None, str]) -> list[dict[str, Any]]:
     """Run the scenario (``variant`` None: as shipped) with ``hysteresis`` and check Appendix B."""
     from experiments import appendix_b
-    from experiments.runner import RunAborted, run_scenario
+    from experiments.runner import RunAborted, RunResult, run_scenario
 
     hysteresis, variant, scenario = job
     scn = _scenario(hysteresis, variant, scenario)
     try:
         events = list(run_scenario(scn, seed=scn.seed, pictures=False).trace.events)
-    except RunAborted as exc:
+    except RunAborted as exc:  # the trace so far still says which steps happened
+        if not isinstance(exc.result, RunResult):
+            raise
         events = list(exc.result.trace.events)
     return [{"name": s.name, "ok": s.ok, "t": s.t, "c_switch": s.c_switch, "c_wait": s.c_wait,
              "margin": s.margin, "detail": s.detail} for s in appendix_b.check(events)]

@@ -122,7 +122,7 @@ def walk(stages: Sequence[Stage], start: Pose | None, world: WorldState | None, 
                 return math.inf, None
             total += float(est.time_s)
             pose = est.end_pose or target
-            if world.objects.get(str(s.data.get("to"))) == PERSON_TYPE:
+            if world is not None and world.objects.get(str(s.data.get("to"))) == PERSON_TYPE:
                 # the robot is now with this person: the next leg starts where they stand, so
                 # the motion model does not route around them (a guided person follows the
                 # robot, anyone else stays behind it), as the navigate skill finds on the spot

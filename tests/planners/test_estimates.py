@@ -307,3 +307,21 @@ def test_static_strategy_asked_from_elsewhere_applies_the_decision_list(tasks: d
     est = estimator_for(task).estimate(ctx, ctx.world.poses["bedroom"])
     assert est.source is Source.TEMPLATE
     assert [s[0] for s in est.steps] == ["approach", "greet_and_apologise", "ask_to_follow", "guide", "say_goodbye"]
+
+
+def test_a_guide_plan_never_moves_with_another_tasks_person(tasks: dict[str, PddlTaskType]) -> None:
+    """While another task guides Alice, John's plan gets the robot to John by approaching him,
+    not by 'guiding' Alice there (found in the paper run: guide John's estimate walked Alice
+    to the hall).  Every step of John's plan is about John."""
+    task = tasks["guide_human"]
+    ctx0 = make_ctx(task)
+    world = ctx0.world
+    assert isinstance(world, WorldState)
+    world = world.updated([("at", "alice", "livingroom"), ("greeted", "alice"), ("following", "alice")],
+                          [("at", "alice", "bedroom")])
+    poses = dict(world.poses)
+    poses["alice"] = poses["livingroom"]
+    world = WorldState(world.facts, poses, world.objects, world.time)
+    for suspended in (False, True):
+        est = estimator_for(task).estimate(make_ctx(task, world=world, suspended=suspended))
+        assert est.steps and all("alice" not in step[1:] for step in est.steps), est.steps
