@@ -88,6 +88,20 @@ def _switch(events: Sequence[Event], after: float, dac: str, exe: str, rule: str
     return d, _first(events, num(d["t"]), event="command", agent=dac, flag="start")
 
 
+def _closest(events: Sequence[Event], after: float, dac: str, exe: str) -> Event | None:
+    """The finite cost comparison of ``dac`` over ``exe`` at or after ``after`` with the lowest
+    ``c_switch / c_wait`` (the one that came closest to switching), or None."""
+    best: tuple[float, float] | None = None
+    found = None
+    for e in events:
+        if (e.get("event") == "decision" and e.get("rule") == "cost" and e.get("dac") == dac
+                and e.get("exeDA") == exe and num(e.get("t")) >= after):
+            cs, cw = num(e.get("c_switch")), num(e.get("c_wait"))
+            if math.isfinite(cs) and math.isfinite(cw) and cw > 0 and (best is None or (cs / cw, num(e["t"])) < best):
+                best, found = (cs / cw, num(e["t"])), e
+    return found
+
+
 def _compared(d: Event | None) -> tuple[bool, float | None, float | None, str]:
     """Is ``d`` a finite cost comparison that switched, and its numbers."""
     if d is None:
@@ -97,6 +111,12 @@ def _compared(d: Event | None) -> tuple[bool, float | None, float | None, str]:
     ok = finite and cs < (h if math.isfinite(h) else 1.0) * cw
     return ok, cs, cw, f"c_switch={_fmt(cs)} < {_fmt(h)}·c_wait={_fmt(cw)}" if ok else \
         f"not a finite comparison won: c_switch={_fmt(cs)}, c_wait={_fmt(cw)}"
+
+
+def _last_stage(events: Sequence[Event], agent: str, before: float) -> Event | None:
+    """``agent``'s last ``exeTsk`` stage event at or before ``before``."""
+    return next((e for e in reversed(events) if e.get("event") == "stage" and e.get("agent") == agent
+                 and e.get("fsm") == "exeTsk" and num(e.get("t")) <= before), None)
 
 
 def _role_at(events: Sequence[Event], t: float, agent: str, role: str) -> bool:
@@ -153,6 +173,8 @@ def check(events: Sequence[Event]) -> list[Step]:
 
     # 3. John walked: d1's cTime fell since it lost the robot, and that wins the comparison
     d, s = _switch(events, t, "d1", "d2", "cost")
+    if d is None:  # it did not happen: show the comparison that came closest, and how far it was
+        d = _closest(events, t, "d1", "d2")
     won, cs, cw, why = _compared(d)
     before = num(d2_dec.get("cTime_exeDA")) if d2_dec else math.nan
     after = num(d.get("cTime_dac")) if d else math.nan
@@ -163,10 +185,11 @@ def check(events: Sequence[Event]) -> list[Step]:
                         and e.get("purpose") == "upTsk" and num(e["t"]) >= num(s["t"])), None)
     apologies = _apologies(events, "d1")
     apologises = resumed is not None and any(st.get("action") in apologies for st in resumed.get("stages", ()))
+    where = "" if s is not None or d is None else f"no switch; closest at t={_fmt(num(d['t']))}: "
     steps.append(Step("John walked toward his destination: guide John (d1) takes back over",
                       s is not None and won and cheaper and apologises, num(s["t"]) if s else None,
-                      f"{why}; d1 cTime {_fmt(before)} -> {_fmt(after)} s; resumes with greet_and_apologise: "
-                      f"{apologises}", cs, cw))
+                      f"{where}{why}; d1 cTime {_fmt(before)} s when suspended, {_fmt(after)} s at this decision; "
+                      f"resumes with the apology {sorted(apologies)}: {apologises}", cs, cw))
     t = num(s["t"]) if s else t
 
     # 4. Peter fell preempts by class while John follows the robot; John is asked to wait
@@ -178,10 +201,13 @@ def check(events: Sequence[Event]) -> list[Step]:
         following = _role_at(events, num(d["t"]), "d1", "following")
         told = next((e for e in events if e.get("event") == "role" and num(e["t"]) >= num(d["t"])
                      and e.get("agent") == "d1" and e.get("role") == "told_to_wait" and e.get("status") == "on"), None)
+    stage = _last_stage(events, "d1", num(d["t"])) if d is not None else None
     ok = s is not None and following and told is not None and num(told["t"]) <= num(s["t"])
     steps.append(Step("Peter fell (d3) preempts guide John at once while John is guided; John is asked to wait",
                       ok, num(s["t"]) if s else None,
-                      f"John following d1 at the decision: {following}; told to wait at {told['t'] if told else None}"))
+                      f"John following d1 at the decision: {following} (d1's stage: "
+                      f"{stage.get('action') if stage else None} {stage.get('status') if stage else None}); "
+                      f"told to wait at {told['t'] if told else None}"))
     t = num(s["t"]) if s else t
 
     # 5. Sara fell wins the comparison: her task is the shorter one
