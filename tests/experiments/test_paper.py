@@ -39,7 +39,7 @@ def checked(paper_run: Path) -> dict[float, list[dict[str, Any]]]:
     shipped = appendix_b.check(read(paper_run / "trace.jsonl"))
     as_dicts = [{"ok": s.ok, "t": s.t, "c_switch": s.c_switch, "c_wait": s.c_wait, "detail": s.detail,
                  "name": s.name} for s in shipped]
-    return {0.9: as_dicts, 1.0: run_one((1.0, None, "paper"))}
+    return {0.9: as_dicts, 1.0: run_one((1.0, None, "paper"))["steps"]}
 
 
 def _events(change: Callable[[scenarios.RobotScenario], scenarios.RobotScenario]) -> list[appendix_b.Event]:
