@@ -113,3 +113,26 @@ def test_counterfactual_peter_stays_down_so_his_task_does_not_end_from_wait() ->
     end = next(e for e in events if e["event"] == "end" and e.get("agent") == "d3")
     assert end["cause"] == "finished", end
     assert not appendix_b.check(events)[5].ok
+
+
+def test_the_checker_survives_inf_and_never_credits_a_non_finite_comparison(paper_run: Path) -> None:
+    events = [dict(e) for e in read(paper_run / "trace.jsonl")]
+    assert appendix_b.check(events)[1].ok
+    # the deciding comparison of step 2, with an infinite side as the trace writes it
+    d = next(e for e in events if e["event"] == "decision" and e.get("dac") == "d2" and e.get("switch"))
+    d["c_wait"] = "inf"
+    step = appendix_b.check(events)[1]
+    assert not step.ok and step.margin is None and "inf" in step.detail
+    # every number of the trace may be non-finite or missing: the checker still answers
+    broken = [{**e, **{k: "inf" for k in ("c_switch", "c_wait", "cTime_dac", "cTime_exeDA") if k in e}}
+              for e in events]
+    assert len(appendix_b.check(broken)) == 7
+
+
+def test_the_report_replaces_only_its_block() -> None:
+    from experiments.paper_report import BEGIN, END, splice
+
+    text = f"# title\n\nprose\n\n{BEGIN}\nold\n{END}\n\nmore prose\n"
+    out = splice(text, f"{BEGIN}\nnew\n{END}\n")
+    assert out == f"# title\n\nprose\n\n{BEGIN}\nnew\n{END}\n\nmore prose\n"
+    assert splice("no markers\n", f"{BEGIN}\nx\n{END}\n").endswith(f"\n\n{BEGIN}\nx\n{END}\n")
