@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import json
 import math
 import sys
 from collections.abc import Sequence
@@ -173,6 +174,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--variants", type=int, default=50, help="randomised variants per hysteresis (default 50)")
     p.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
     p.add_argument("--out", type=Path, help="Markdown file whose generated block to replace")
+    p.add_argument("--json", type=Path, help="also write every run's checked steps and predictions here (JSON)")
     p.add_argument("--scenario", default="paper", help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     if args.variants < 0:
@@ -191,6 +193,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     command = f"python -m experiments.paper_report --variants {args.variants}" + (
         f" --out {args.out}" if args.out else "")
     block = render(shipped, variants, args.variants, command)
+    if args.json is not None:
+        runs = [{"hysteresis": h, "variant": v, **r} for (h, v, _), r in zip(jobs, results, strict=True)]
+        args.json.write_text(json.dumps(runs, indent=1, default=str) + "\n")
     if args.out is None:
         sys.stdout.write(block)
     else:
