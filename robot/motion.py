@@ -101,6 +101,7 @@ RING = 16  # milestones around a person in the way
 SNAP_STEP = 0.01  # metres between the rings searched for a free start
 SNAP_REACH = 0.6  # metres: a start deeper in collision than this is not snapped
 RING_SLACK = 0.005  # metres a ring's chords keep outside the person's clearance
+TABLE_AFTER = 32  # door-layer searches under one set of closed doors before its all-pairs table pays
 
 
 class BasePlanner:
@@ -126,7 +127,7 @@ class BasePlanner:
     """
 
     def __init__(self, spec: WorldSpec, scene: Scene, seed: int = 1, milestones: int | None = None,
-                 cache_size: int = 4096) -> None:
+                 cache_size: int = 4096, table_after: int | None = TABLE_AFTER) -> None:
         self.scene = scene
         self.roadmap = Roadmap.for_world(spec, scene, seed, milestones)
         self._cache: OrderedDict[tuple[object, ...], tuple[Point, ...] | None] = OrderedDict()
@@ -135,6 +136,9 @@ class BasePlanner:
         self._disc_masks: OrderedDict[Disc, np.ndarray] = OrderedDict()
         self._rings: OrderedDict[tuple[Disc, tuple[str, ...]], tuple[np.ndarray, np.ndarray]] = OrderedDict()
         self._trees: OrderedDict[tuple[object, ...], tuple[np.ndarray, np.ndarray, np.ndarray]] = OrderedDict()
+        self._graphs: OrderedDict[Layer, tuple[np.ndarray, np.ndarray, np.ndarray, csr_matrix]] = OrderedDict()
+        self._door_searches: dict[tuple[str, ...], int] = {}  # door-layer searches per set of closed doors
+        self.table_after = table_after
         self.searches = 0  # Dijkstra runs so far (benchmarks and tests read it)
         self._boxes_key: tuple[str, ...] | None = None
         self._all_boxes = np.zeros((0, 4))
@@ -231,6 +235,25 @@ class BasePlanner:
     # ---- search ------------------------------------------------------------------------
     def _graph(self, layer: Layer) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Nodes, undirected edges and lengths of the roadmap as ``layer`` leaves it."""
+        return self._layer_graph(layer)[:3]
+
+    def _layer_graph(self, layer: Layer) -> tuple[np.ndarray, np.ndarray, np.ndarray, csr_matrix]:
+        """:meth:`_graph`'s nodes, edges and lengths, and the layer's sparse matrix with one
+        extra, empty row for a start (cached per layer: it depends on nothing else)."""
+        if layer in self._graphs:
+            self._graphs.move_to_end(layer)
+            return self._graphs[layer]
+        nodes, edges, lengths = self._build_graph(layer)
+        n = len(nodes)
+        matrix = csr_matrix((np.concatenate([lengths, lengths]),
+                             (np.concatenate([edges[:, 0], edges[:, 1]]), np.concatenate([edges[:, 1], edges[:, 0]]))),
+                            shape=(n + 1, n + 1))
+        self._graphs[layer] = (nodes, edges, lengths, matrix)
+        if len(self._graphs) > 32:
+            self._graphs.popitem(last=False)
+        return self._graphs[layer]
+
+    def _build_graph(self, layer: Layer) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         doors, discs = layer
         rm = self.roadmap
         blocked = self._door_mask(doors).copy()
@@ -279,23 +302,70 @@ class BasePlanner:
         return cand[ok], d[cand[ok]], direct
 
     def _tree(self, s: Point, layer: Layer) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Distances and predecessors from ``s`` over ``layer``'s graph (cached), and its nodes."""
+        """Distances and predecessors from ``s`` over ``layer``'s graph (cached), and its nodes.
+
+        The door layer, once searched from ``table_after`` starts under the same closed doors,
+        is read off the roadmap's all-pairs table for those doors (:meth:`_from_table`): a new
+        start then costs its links and a minimum over the table, not a search.  The people
+        layer is searched (scipy Dijkstra) over its cached graph plus the start's links.
+        """
         key = (s, layer)
         if key in self._trees:
             self._trees.move_to_end(key)
             return self._trees[key]
-        nodes, edges, lengths = self._graph(layer)
-        n = len(nodes)
-        si, sd, _ = self._links(s, nodes, layer[1])
-        rows = np.concatenate([edges[:, 0], edges[:, 1], np.full(len(si), n)])
-        cols = np.concatenate([edges[:, 1], edges[:, 0], si])
-        graph = csr_matrix((np.concatenate([lengths, lengths, sd + 1e-9]), (rows, cols)), shape=(n + 1, n + 1))
-        dist, pred = dijkstra(graph, directed=True, indices=n, return_predecessors=True)
-        self.searches += 1
-        self._trees[key] = (dist, pred, nodes)
+        doors, discs = layer
+        if not discs and self._use_table(doors):
+            nodes = self.roadmap.nodes
+            si, sd, _ = self._links(s, nodes, discs)
+            tree = self._from_table(si, sd, doors)
+        else:
+            nodes, _, _, base = self._layer_graph(layer)
+            n = len(nodes)
+            si, sd, _ = self._links(s, nodes, discs)
+            # the layer's matrix with its empty last row (the start's) filled in with the links
+            indptr = base.indptr.copy()
+            indptr[-1] += len(si)
+            graph = csr_matrix((np.concatenate([base.data, sd + 1e-9]), np.concatenate([base.indices, si]), indptr),
+                               shape=(n + 1, n + 1))
+            dist, pred = dijkstra(graph, directed=True, indices=n, return_predecessors=True)
+            self.searches += 1
+            self._door_searches[doors] = self._door_searches.get(doors, 0) + (not discs)
+            tree = (dist, pred, nodes)
+        self._trees[key] = tree
         if len(self._trees) > 512:
             self._trees.popitem(last=False)
-        return self._trees[key]
+        return tree
+
+    def _use_table(self, doors: tuple[str, ...]) -> bool:
+        return self.table_after is not None and self._door_searches.get(doors, 0) >= self.table_after
+
+    def _from_table(self, si: np.ndarray, sd: np.ndarray,
+                    doors: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The door layer's search tree from a start linked to nodes ``si`` at distances ``sd``,
+        read off the all-pairs table of ``doors`` (:meth:`Roadmap.all_pairs
+        <robot.roadmap.Roadmap.all_pairs>`); the start is node ``n``, as in a search.
+
+        Node ``v``'s distance is the least ``sd[i] + table[si[i], v]``, its predecessor the
+        table's on the way from that best linked node ``b``.  That predecessor ``u`` is on a
+        shortest route from the start too (its distance is at most the one through ``b`` and
+        at least ``dist[v] - |uv|``), so walking predecessors back gives a shortest route that
+        ends at a linked node whose best way is its own link, whose predecessor is the start.
+        """
+        nodes = self.roadmap.nodes
+        n = len(nodes)
+        dist = np.full(n + 1, math.inf)
+        pred = np.full(n + 1, -9999, dtype=np.int32)
+        dist[n] = 0.0
+        if len(si):
+            table, tpred = self.roadmap.all_pairs(self._door_mask(doors))
+            total = (sd + 1e-9)[:, None] + table[si]
+            best = np.argmin(total, axis=0)
+            cols = np.arange(n)
+            dist[:n] = total[best, cols]
+            pred[:n] = tpred[si[best], cols]
+            own = si[best[si]] == si  # linked nodes best reached by their own link
+            pred[si[own]] = n
+        return dist, pred, nodes
 
     def _shortcut(self, pts: list[Point], discs: tuple[Disc, ...]) -> list[Point]:
         """The shortest chain through ``pts`` whose links are all collision-free."""

@@ -172,6 +172,7 @@ class Roadmap:
                                   np.concatenate([self.edges[:, 1], self.edges[:, 0]]))), shape=(n, n))
         self.stats = RoadmapStats(n, len(self.edges), seed, "ompl.geometric.PRM", ompl_n,
                                   int((~ok).sum()))
+        self._tables: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
 
     def _visibility(self, scene: Scene) -> np.ndarray:
         """Edges between every pair of corner and added nodes that see each other (static layer)."""
@@ -209,6 +210,25 @@ class Roadmap:
         idx = np.argpartition(d, min(k, len(d) - 1))[:k]
         idx = idx[np.argsort(d[idx])]
         return idx, d[idx]
+
+    def all_pairs(self, blocked: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Shortest distances and predecessors between all nodes over the roadmap less the
+        ``blocked`` edges (scipy Dijkstra from every node), cached per mask: one table per set
+        of closed doors, shared by every planner over this roadmap.  ``pred[i, j]`` is ``j``'s
+        predecessor on a shortest path from ``i`` (negative for ``i`` itself and unreachable)."""
+        key = np.packbits(blocked).tobytes()
+        if key not in self._tables:
+            from scipy.sparse.csgraph import dijkstra
+
+            e, w = self.edges[~blocked], self.lengths[~blocked]
+            n = len(self.nodes)
+            g = csr_matrix((np.concatenate([w, w]), (np.concatenate([e[:, 0], e[:, 1]]),
+                                                     np.concatenate([e[:, 1], e[:, 0]]))), shape=(n, n))
+            dist, pred = dijkstra(g, directed=True, return_predecessors=True)
+            if len(self._tables) >= 4:
+                self._tables.pop(next(iter(self._tables)))
+            self._tables[key] = (dist, pred)
+        return self._tables[key]
 
     def box_blocked(self, boxes: np.ndarray, radius: float) -> np.ndarray:
         """Mask of edges that pass closer than ``radius`` to any of ``boxes`` (closed doors)."""
