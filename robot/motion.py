@@ -137,11 +137,20 @@ class BasePlanner:
         self._rings: OrderedDict[tuple[Disc, tuple[str, ...]], tuple[np.ndarray, np.ndarray]] = OrderedDict()
         self._trees: OrderedDict[tuple[object, ...], tuple[np.ndarray, np.ndarray, np.ndarray]] = OrderedDict()
         self._graphs: OrderedDict[Layer, tuple[np.ndarray, np.ndarray, np.ndarray, csr_matrix]] = OrderedDict()
+        self._starts: OrderedDict[tuple[Point, tuple[str, ...]], tuple[np.ndarray, np.ndarray]] = OrderedDict()
         self._door_searches: dict[tuple[str, ...], int] = {}  # door-layer searches per set of closed doors
         self.table_after = table_after
         self.searches = 0  # Dijkstra runs so far (benchmarks and tests read it)
         self._boxes_key: tuple[str, ...] | None = None
         self._all_boxes = np.zeros((0, 4))
+
+    def forget_starts(self) -> None:
+        """Drop every per-start result (search trees, start links, answers), keeping what
+        depends on the scene alone (layer graphs, door tables): the next query from any start
+        is planned as from a new one (benchmarks measure new-source queries this way)."""
+        self._trees.clear()
+        self._starts.clear()
+        self._cache.clear()
 
     # ---- the scene, by layer -----------------------------------------------------------
     def _doors(self) -> tuple[str, ...]:
@@ -302,70 +311,66 @@ class BasePlanner:
         return cand[ok], d[cand[ok]], direct
 
     def _tree(self, s: Point, layer: Layer) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Distances and predecessors from ``s`` over ``layer``'s graph (cached), and its nodes.
-
-        The door layer, once searched from ``table_after`` starts under the same closed doors,
-        is read off the roadmap's all-pairs table for those doors (:meth:`_from_table`): a new
-        start then costs its links and a minimum over the table, not a search.  The people
-        layer is searched (scipy Dijkstra) over its cached graph plus the start's links.
-        """
+        """Distances and predecessors from ``s`` over ``layer``'s graph (cached), and its nodes:
+        a scipy Dijkstra over the layer's cached graph plus the start's links."""
         key = (s, layer)
         if key in self._trees:
             self._trees.move_to_end(key)
             return self._trees[key]
         doors, discs = layer
-        if not discs and self._use_table(doors):
-            nodes = self.roadmap.nodes
-            si, sd, _ = self._links(s, nodes, discs)
-            tree = self._from_table(si, sd, doors)
-        else:
-            nodes, _, _, base = self._layer_graph(layer)
-            n = len(nodes)
-            si, sd, _ = self._links(s, nodes, discs)
-            # the layer's matrix with its empty last row (the start's) filled in with the links
-            indptr = base.indptr.copy()
-            indptr[-1] += len(si)
-            graph = csr_matrix((np.concatenate([base.data, sd + 1e-9]), np.concatenate([base.indices, si]), indptr),
-                               shape=(n + 1, n + 1))
-            dist, pred = dijkstra(graph, directed=True, indices=n, return_predecessors=True)
-            self.searches += 1
-            self._door_searches[doors] = self._door_searches.get(doors, 0) + (not discs)
-            tree = (dist, pred, nodes)
-        self._trees[key] = tree
+        nodes, _, _, base = self._layer_graph(layer)
+        n = len(nodes)
+        si, sd, _ = self._links(s, nodes, discs)
+        # the layer's matrix with its empty last row (the start's) filled in with the links
+        indptr = base.indptr.copy()
+        indptr[-1] += len(si)
+        graph = csr_matrix((np.concatenate([base.data, sd + 1e-9]), np.concatenate([base.indices, si]), indptr),
+                           shape=(n + 1, n + 1))
+        dist, pred = dijkstra(graph, directed=True, indices=n, return_predecessors=True)
+        self.searches += 1
+        if not discs:
+            self._door_searches[doors] = self._door_searches.get(doors, 0) + 1
+        self._trees[key] = (dist, pred, nodes)
         if len(self._trees) > 512:
             self._trees.popitem(last=False)
-        return tree
+        return self._trees[key]
 
-    def _use_table(self, doors: tuple[str, ...]) -> bool:
-        return self.table_after is not None and self._door_searches.get(doors, 0) >= self.table_after
+    def _use_table(self, layer: Layer) -> bool:
+        """Is ``layer`` the door layer, searched often enough under its closed doors that
+        their all-pairs table (built once, shared by every planner of the roadmap) pays?"""
+        return (not layer[1] and self.table_after is not None
+                and self._door_searches.get(layer[0], 0) >= self.table_after)
 
-    def _from_table(self, si: np.ndarray, sd: np.ndarray,
-                    doors: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The door layer's search tree from a start linked to nodes ``si`` at distances ``sd``,
-        read off the all-pairs table of ``doors`` (:meth:`Roadmap.all_pairs
-        <robot.roadmap.Roadmap.all_pairs>`); the start is node ``n``, as in a search.
+    def _start_links(self, s: Point, doors: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """The roadmap nodes start ``s`` links to on the door layer, and their distances (cached)."""
+        key = (s, doors)
+        if key not in self._starts:
+            si, sd, _ = self._links(s, self.roadmap.nodes, ())
+            self._starts[key] = (si, sd)
+            if len(self._starts) > 512:
+                self._starts.popitem(last=False)
+        self._starts.move_to_end(key)
+        return self._starts[key]
 
-        Node ``v``'s distance is the least ``sd[i] + table[si[i], v]``, its predecessor the
-        table's on the way from that best linked node ``b``.  That predecessor ``u`` is on a
-        shortest route from the start too (its distance is at most the one through ``b`` and
-        at least ``dist[v] - |uv|``), so walking predecessors back gives a shortest route that
-        ends at a linked node whose best way is its own link, whose predecessor is the start.
-        """
-        nodes = self.roadmap.nodes
-        n = len(nodes)
-        dist = np.full(n + 1, math.inf)
-        pred = np.full(n + 1, -9999, dtype=np.int32)
-        dist[n] = 0.0
-        if len(si):
-            table, tpred = self.roadmap.all_pairs(self._door_mask(doors))
-            total = (sd + 1e-9)[:, None] + table[si]
-            best = np.argmin(total, axis=0)
-            cols = np.arange(n)
-            dist[:n] = total[best, cols]
-            pred[:n] = tpred[si[best], cols]
-            own = si[best[si]] == si  # linked nodes best reached by their own link
-            pred[si[own]] = n
-        return dist, pred, nodes
+    def _table_route(self, s: Point, doors: tuple[str, ...], gi: np.ndarray, gd: np.ndarray) -> list[int] | None:
+        """The door layer's shortest route of roadmap nodes from start ``s`` to one of the goal's
+        links ``gi`` (at ``gd``), read off the all-pairs table of ``doors`` instead of searched:
+        the least ``link(s, a) + table[a, b] + link(b, goal)`` over the start's links ``a`` and
+        the goal's ``b``, then ``table``'s predecessors from ``b`` back to ``a``.  The same
+        length as :meth:`_tree`'s search (which adds the same 1e-9 to each start link)."""
+        si, sd = self._start_links(s, doors)
+        if not len(si):
+            return None
+        table, pred = self.roadmap.all_pairs(self._door_mask(doors))
+        total = (sd + 1e-9)[:, None] + table[np.ix_(si, gi)] + gd[None, :]
+        i, j = np.unravel_index(int(np.argmin(total)), total.shape)
+        if not math.isfinite(total[i, j]):
+            return None
+        a, row = int(si[i]), pred[si[i]]
+        route = [int(gi[j])]
+        while route[-1] != a:
+            route.append(int(row[route[-1]]))
+        return route[::-1]
 
     def _shortcut(self, pts: list[Point], discs: tuple[Disc, ...]) -> list[Point]:
         """The shortest chain through ``pts`` whose links are all collision-free."""
@@ -421,21 +426,31 @@ class BasePlanner:
         head = (s0,) if s != s0 else ()
         if math.hypot(g[0] - s[0], g[1] - s[1]) < 1e-6:
             return (*head, s, g)
-        dist, pred, nodes = self._tree(s, layer)
-        gi, gd, direct = self._links(g, nodes, discs, also=s, goal=True)
-        if direct:
-            return (*head, s, g)
-        if not len(gi):
-            return None
-        total = dist[gi] + gd
-        b = int(np.argmin(total))
-        if not math.isfinite(total[b]):
-            return None
-        route = [int(gi[b])]
-        n = len(nodes)
-        while route[-1] != n:
-            route.append(int(pred[route[-1]]))
-        pts = [s] + [(float(x), float(y)) for x, y in nodes[route[-2::-1]]] + [g]
+        if self._use_table(layer):
+            nodes = self.roadmap.nodes
+            gi, gd, direct = self._links(g, nodes, discs, also=s, goal=True)
+            if direct:
+                return (*head, s, g)
+            route = self._table_route(s, layer[0], gi, gd) if len(gi) else None
+            if route is None:
+                return None
+        else:
+            dist, pred, nodes = self._tree(s, layer)
+            gi, gd, direct = self._links(g, nodes, discs, also=s, goal=True)
+            if direct:
+                return (*head, s, g)
+            if not len(gi):
+                return None
+            total = dist[gi] + gd
+            b = int(np.argmin(total))
+            if not math.isfinite(total[b]):
+                return None
+            route = [int(gi[b])]
+            n = len(nodes)
+            while route[-1] != n:
+                route.append(int(pred[route[-1]]))
+            route = route[-2::-1]
+        pts = [s] + [(float(x), float(y)) for x, y in nodes[route]] + [g]
         return (*head, *self._shortcut(pts, discs))
 
     def plan(self, start: Point, goal: Point) -> tuple[Point, ...] | None:
