@@ -9,9 +9,10 @@
    ``navigate`` skill checks paths with: a path may leave a person's clearance or
    stop inside it, never enter it);
 2. a Dijkstra search (scipy) from the start over the roadmap less the edges closed
-   doors block; if its path is clear of people it is the answer, otherwise a second
-   search over the roadmap less the edges people block, plus rings of milestones
-   around them;
+   doors block — or, once a set of closed doors has been searched from ``TABLE_AFTER``
+   starts, a look-up in the all-pairs table of those doors; if its path is clear of
+   people it is the answer, otherwise a search over the roadmap less the edges people
+   block, plus rings of milestones around them;
 3. the route is shortened: the shortest chain of mutually visible route points.
 
 :class:`MotionEstimator` implements :class:`tasker.world.MotionModel`: time comes from
@@ -101,7 +102,12 @@ RING = 16  # milestones around a person in the way
 SNAP_STEP = 0.01  # metres between the rings searched for a free start
 SNAP_REACH = 0.6  # metres: a start deeper in collision than this is not snapped
 RING_SLACK = 0.005  # metres a ring's chords keep outside the person's clearance
-TABLE_AFTER = 32  # door-layer searches under one set of closed doors before its all-pairs table pays
+# Door-layer searches under one set of closed doors before their all-pairs table is built:
+# the table (paper apartment: ~0.5 s) costs a few hundred searches (~1-2 ms each), so it is
+# built only once that many were run (ski rental: never more than twice the better choice).
+# A scenario run searches few starts (places repeat, answers are cached; the paper scenario
+# and the bench's 1-hour day each stay well under 256) and does not pay for it.
+TABLE_AFTER = 256
 
 
 class BasePlanner:
@@ -112,7 +118,10 @@ class BasePlanner:
 
     1. the **door layer** (walls, furniture, closed doors): a Dijkstra tree from the
        start over the roadmap less the edges closed doors block, cached by
-       (start, closed doors); the goal is linked to it, the route shortened;
+       (start, closed doors); the goal is linked to it, the route shortened.  After
+       ``table_after`` such searches under one set of closed doors, the roadmap's
+       all-pairs table for them is built once and new starts read their route off it
+       (:meth:`_table_route`, same lengths); ``table_after=None`` always searches;
     2. if that path is clear of people, it is the answer (people only add constraints,
        so it is still the shortest);
     3. otherwise the **people layer**: the roadmap less the edges people block, plus a
