@@ -37,6 +37,7 @@ from scipy import stats
 
 from experiments import days as day_pipeline
 from experiments import protocol as protocols
+from tasker.errors import ConfigError
 from tasker.trace import number
 
 OSCILLATION_SWITCHES = 3
@@ -180,7 +181,8 @@ def run_days(protocol: str | Path, days: int, names: Sequence[str], *, first_see
             if r.get("backend", "synthetic") == backend:
                 done[r["scheduler"], r["seed"]] = r
     jobs = [(str(protocol), seed, name, backend, None if keep is None else str(keep / name / str(seed)))
-            for name in names for seed in range(first_seed, first_seed + days) if (name, seed) not in done]
+            for seed in range(first_seed, first_seed + days) for name in names if (name, seed) not in done]
+    # seed-major: a run stopped early leaves every scheduler with (nearly) as many days
     results = [done[n, s] for n in names for s in range(first_seed, first_seed + days) if (n, s) in done]
 
     def record(r: dict[str, Any]) -> None:
@@ -309,57 +311,37 @@ def table(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead",
     return "\n".join(line for line in out if line is not None).lstrip("\n") + "\n"
 
 
-EXAMPLES = """\
-examples:
-  tasker day --protocol tabsa --days 100 --out out/day
-  tasker day --protocol tabsa-short --backend robot --days 20 --out out/day-robot --resume"""
-
-
-def add_arguments(ap: argparse.ArgumentParser) -> None:
-    ap.add_argument("--protocol", default="tabsa",
-                    help=f"a registered protocol ({', '.join(day_pipeline.names())}) or a protocol file (.toml)")
-    ap.add_argument("--backend", default="synthetic", choices=day_pipeline.BACKENDS)
-    ap.add_argument("--days", type=int, default=100)
-    ap.add_argument("--first-seed", type=int, default=1)
-    ap.add_argument("--schedulers", nargs="+", default=["lookahead", "alg2", "simple", "simple2", "distance"])
-    ap.add_argument("--workers", type=int, default=None,
-                    help="local processes (default: 2 synthetic, 1 robot: a robot day is long, keep it in one)")
-    ap.add_argument("--resume", action="store_true", help="keep OUT/days.jsonl and run only the days it lacks")
-    ap.add_argument("--keep-runs", action="store_true", help="keep each day's files in OUT/runs/SCHEDULER/SEED")
-    ap.add_argument("--out", required=True, type=Path)
+from experiments.day_cli import add_arguments  # noqa: E402  (the options live with the light CLI module)
 
 
 def run(a: argparse.Namespace) -> int:
-    """Run the days, write ``days.jsonl`` and ``table.md``; print the table.  Exit 2 on bad input."""
+    """Run the days, write ``days.jsonl`` and ``table.md``; print the table.
+
+    Bad input raises :class:`tasker.cliargs.UsageError` (or the protocol's
+    :class:`tasker.reader.InputError`) before the first day runs."""
     from tasker import schedulers
-    from tasker.errors import TaskerError
+    from tasker.cliargs import UsageError
+    from tasker.reader import suggest
 
     unknown = [n for n in a.schedulers if n not in schedulers.names()]
     if unknown:
-        from tasker.reader import suggest
-
-        print(f"error: unknown scheduler {unknown[0]!r}{suggest(unknown[0], schedulers.names())}; "
-              f"known: {', '.join(schedulers.names())}", file=sys.stderr)
-        return 2
+        raise UsageError("--schedulers", f"unknown scheduler {unknown[0]!r}{suggest(unknown[0], schedulers.names())}; "
+                                         f"known: {', '.join(schedulers.names())}")
     if a.days < 1:
-        print(f"error: --days: expected >= 1, got {a.days}", file=sys.stderr)
-        return 2
-    workers = a.workers if a.workers is not None else (2 if a.backend == "synthetic" else 1)
-    a.out.mkdir(parents=True, exist_ok=True)
-    log = a.out / "days.jsonl"
-    if not a.resume and log.exists():
-        log.unlink()
+        raise UsageError("--days", f"expected >= 1, got {a.days}")
     try:
         proto = day_pipeline.load(a.protocol)
-        if a.backend == "robot" and proto.robot is None:
-            print(f"error: {proto.source}: no [robot_backend]: this protocol runs on the synthetic backend only",
-                  file=sys.stderr)
-            return 2
-        results = run_days(a.protocol, a.days, a.schedulers, first_seed=a.first_seed, workers=workers,
-                           backend=a.backend, log=log, keep=a.out / "runs" if a.keep_runs else None)
-    except TaskerError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    except ConfigError as exc:
+        raise UsageError("--protocol", str(exc)) from exc
+    if a.backend == "robot" and proto.robot is None:
+        raise UsageError("--backend", f"{proto.source} has no [robot_backend]: it runs on the synthetic backend only")
+    workers = a.workers if a.workers is not None else (2 if a.backend == "synthetic" else 1)
+    log = a.out / "days.jsonl"
+    a.out.mkdir(parents=True, exist_ok=True)
+    if not a.resume and log.exists():
+        log.unlink()
+    results = run_days(a.protocol, a.days, a.schedulers, first_seed=a.first_seed, workers=workers,
+                       backend=a.backend, log=log, keep=a.out / "runs" if a.keep_runs else None)
     backend = "" if a.backend == "synthetic" else f" --backend {a.backend}"
     cmd = (f"python -m experiments.dayreport --protocol {a.protocol}{backend} --days {a.days} "
            f"--first-seed {a.first_seed} --schedulers {' '.join(a.schedulers)} --out {a.out}")
@@ -370,19 +352,19 @@ def run(a: argparse.Namespace) -> int:
     return 0
 
 
-def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    """``tasker day``: the same as ``python -m experiments.dayreport``."""
-    p = sub.add_parser("day", help="run a day protocol: N days x schedulers on a backend, and its table",
-                       description=__doc__.splitlines()[0], epilog=EXAMPLES)
-    add_arguments(p)
-    p.set_defaults(func=run)
-
-
 def main(argv: Sequence[str] | None = None) -> int:
+    from experiments.day_cli import EXAMPLES
+
     ap = argparse.ArgumentParser(prog="python -m experiments.dayreport", description=__doc__.splitlines()[0],
                                  epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_arguments(ap)
-    return run(ap.parse_args(argv))
+    from tasker.errors import TaskerError
+
+    try:
+        return run(ap.parse_args(argv))
+    except TaskerError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":
