@@ -93,3 +93,21 @@ def test_every_scheduler_runs_every_task_type_robot(tiny_protocol: protocol.Prot
     m = dayreport.run_day(tiny_protocol.source, 1, name, "robot")
     assert {t: v["completed"] for t, v in m["per_type"].items()} == {"transport": 1, "fall": 1, "pick_place": 1}
     assert m["dead_falls"] == 0 and m["travel_m"] > 0
+
+
+@pytest.mark.parametrize("name", ["tabsa", "tabsa-short"])
+def test_every_spot_and_place_of_the_robot_world_is_clear(name: str) -> None:
+    """People stand 0.3 m and the robot's places 0.4 m clear of every wall and piece of furniture."""
+    from robot.spec import load_world
+
+    proto = days.load(name)
+    assert proto.robot is not None
+    world = load_world(proto.robot.world)
+    boxes = [o.box for o in world.obstacles]
+
+    def clearance(x: float, y: float) -> float:
+        return min(((max(b[0] - x, 0.0, x - b[2])) ** 2 + (max(b[1] - y, 0.0, y - b[3])) ** 2) ** 0.5 for b in boxes)
+
+    assert all(clearance(*s) >= 0.3 for spots in proto.robot.spots.values() for s in spots)
+    assert all(clearance(p[0], p[1]) >= 0.4 for p in world.places.values())
+    assert set(proto.robot.places.values()) <= set(world.places)
