@@ -64,6 +64,7 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
     kind: dict[str, str] = {}
     args: dict[str, Mapping[str, Any]] = {}
     finished: dict[str, float] = {}
+    failed: set[str] = set()
     starts: dict[str, list[float]] = {}
     interruptions: dict[str, int] = {}
     suspensions = 0
@@ -77,6 +78,8 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
             args[e["agent"]] = e["args"]
         elif ev == "end" and e.get("cause") == "finished":
             finished[e["agent"]] = e["t"]
+        elif ev == "end" and e.get("cause") == "failed":  # a plan or a skill failed: not the scheduler's choice
+            failed.add(e["agent"])
         elif ev == "command" and e.get("flag") == "start":
             starts.setdefault(e["agent"], []).append(e["t"])
         elif ev == "transition":
@@ -99,7 +102,7 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
         done = [a for a in agents if a in finished]
         gaps = [finished[a] - number(args[a]["deadline"]) for a in done if args[a].get("deadline") is not None]
         n_int = sum(interruptions.get(a, 0) for a in agents)
-        per_type[t] = {"requested": len(agents), "completed": len(done),
+        per_type[t] = {"requested": len(agents), "completed": len(done), "failed": sum(a in failed for a in agents),
                        "completion_minus_deadline_s": _mean(gaps), "lateness_s": sum(max(0.0, g) for g in gaps),
                        "late": sum(1 for g in gaps if g > 0), "interruptions": n_int,
                        "interruptions_per_task": n_int / len(agents) if agents else None}
@@ -117,7 +120,7 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
         ending = "all done" if len(finished) == len(kind) else "time ran out"
     all_gaps = [finished[a] - number(args[a]["deadline"]) for a in finished if args[a].get("deadline") is not None]
     return {
-        "requested": len(kind), "completed": len(finished),
+        "requested": len(kind), "completed": len(finished), "failed": len(failed),
         "completion_minus_deadline_s": _mean(all_gaps), "lateness_s": sum(max(0.0, g) for g in all_gaps),
         "dead_falls": len(dead), "first_death_t": first_death,
         "interruptions": sum(interruptions.values()), "suspensions": suspensions,
