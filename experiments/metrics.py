@@ -18,6 +18,7 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any, Protocol
 
+from experiments.calibration import CalibrationCollector
 from tasker.meaning import CMD_STATES as CMD
 from tasker.trace import read
 
@@ -349,7 +350,8 @@ class RunCollector:
 def collectors() -> dict[str, Collector]:
     """A fresh set of collectors, keyed by the section of :func:`compute`'s result they fill."""
     return {"run": RunCollector(), "tasks": TaskCollector(), "switching": SwitchCollector(),
-            "decisions": DecisionCollector(), "safety": HazardCollector(), "people": PeopleCollector()}
+            "decisions": DecisionCollector(), "safety": HazardCollector(), "people": PeopleCollector(),
+            "calibration": CalibrationCollector()}
 
 
 def _clean(value: Any) -> Any:
