@@ -402,8 +402,9 @@ def render(rows: Sequence[RunRow], command: str) -> str:
     pairs, every, constant = tested_pairs(rows)
     versions = sorted({str(r.record.get("tasker_version", "?")) for r in ok})
     out = ["# Static versus planned suspension: results", "",
-           "Regenerate (the sweep resumes: only runs missing from the database are run; one worker, about 30 "
-           "minutes on one free core):", "", "```bash", command, "```", "",
+           "Regenerate (the sweep resumes: only runs missing from the database are run, on one worker; the runs "
+           f"below took {_fmt(math.fsum(r.wall or 0.0 for r in rows) / 60)} minutes of worker wall time on a "
+           "shared machine):", "", "```bash", command, "```", "",
            DECLARATION.rstrip(), "",
            "## The runs", "",
            f"{len(rows)} runs ({len(ok)} ok): {len(scenarios)} scenarios × {len({r.seed for r in rows})} seeds × "
