@@ -99,3 +99,15 @@ def test_main_reports_what_the_database_holds(rows: list[RunRow], tmp_path: Path
     text = md.read_text(encoding="utf-8")
     assert "4 runs (4 ok)" in text and "--no-run" not in text.split("```")[1]
     assert results.main(["--spec", str(spec), "--db", str(db), "--seeds", "3", "--no-run"]) == 2
+
+
+def test_the_shipped_factorial_spec_is_the_declared_design() -> None:
+    from experiments.sweep import load_spec
+
+    spec = load_spec(Path(results.ROOT) / results.SPEC)
+    assert {Strategy.parse(s.label) for s in spec.strategies} == {Strategy.parse(s) for s in STRATEGIES}
+    assert [Path(s).stem for s in spec.scenarios] == ["household", "carry", "paper", "compound"]
+    assert set(spec.variants) == set(spec.scenarios)  # every scenario has its interruption grid
+    for grid in spec.variants.values():  # the first three seeds put the interruption in every stratum
+        assert sorted(grid.stratum(seed) for seed in spec.seeds[:3]) == \
+            sorted(grid.stratum(k) for k in range(grid.strata))
