@@ -8,6 +8,15 @@
    than linear (ratio per agent <= 1).  Target: <= 1 ms at 1,000 agents.
 2. Real-time factor of the simulation loop on 50 synthetic tasks with every rate at
    10 Hz (sFreq, repRate, taskExeRate, SPupRate).  Target: >= 1,000x real time.
+3. At the scale of a day (issue 12): the tick with 10,000 waiting agents (target <= 1 ms),
+   and the loop over 100, 300 and 1,000 synthetic tasks, rates at 1 Hz (as in the
+   scenarios), at two loads: a task every 60 s (the robot keeps up: a queue forms and
+   drains, as in a day) and every 10 s (overload: the queue grows all run long).
+   Baseline, measured in the same run: the 100-task loop's wall time per task.  Under a
+   steady load, growth must stay linear (wall per task at n / at 100 <= 1.5) and 1,000
+   tasks run >= 1,000x real time.  Under overload, every waiting agent reports at
+   ``repRate`` (Alg. 1), so reports grow with queue length x time, i.e. quadratically in
+   n: that case is printed, not held to the target.
 """
 
 from __future__ import annotations
@@ -65,6 +74,23 @@ def real_time_factor(n_tasks: int = 50, hz: float = 10.0) -> tuple[float, float,
     return sim / wall, sim, wall
 
 
+def queue_factor(n_tasks: int, every: float) -> tuple[float, float, float]:
+    """(real-time factor, simulated s, wall s) of ``n_tasks`` tasks arriving every ``every`` s,
+    each ~45 s of work plus travel."""
+    tasks = [SyntheticTask("guide", _stages(), weight=1.0),
+             SyntheticTask("fell", [Stage("approach", duration=15.0), Stage("check", duration=5.0)], weight=3.0)]
+    loop = SimulationLoop(TaskStore(tasks), schedulers.create("alg2", classes=[["fell"], ["guide"]], hysteresis=0.9),
+                          core=TimedExecutor(seed=1, jitter=0.2), s_freq=1.0, rates=Rates(1.0, 10.0, 1.0), seed=1)
+    for i in range(n_tasks):
+        loop.request(i * every, "fell" if i % 5 == 4 else "guide", {"site": [float(i % 7), float(i % 3)]})
+    t0 = time.perf_counter()
+    trace = loop.run()
+    wall = time.perf_counter() - t0
+    assert len(trace.of("end")) == n_tasks
+    sim = trace.events[-1]["t"]
+    return sim / wall, sim, wall
+
+
 def main() -> None:
     print("harmonisation tick (Alg. 2 compare), median of 200")
     base = tick_cost(10)
@@ -76,6 +102,24 @@ def main() -> None:
     rtf, sim, wall = real_time_factor()
     print(f"loop, 50 synthetic tasks at 10 Hz: {sim:.0f} s simulated in {wall:.2f} s wall = "
           f"{rtf:,.0f}x real time (target >= 1,000x) {'OK' if rtf >= 1000 else 'BELOW TARGET'}")
+    big = tick_cost(10_000, repeats=20)
+    print(f"  10000 waiting agents: {big * 1e3:8.3f} ms   x{big / base:6.1f} vs 10 agents   "
+          f"growth/linear = {(big / base) / 1000:4.2f}   {'OK' if big <= 1e-3 else 'ABOVE 1 ms TARGET'}")
+    for every, held in ((60.0, True), (10.0, False)):
+        print(f"loop, a task every {every:.0f} s (~45 s of work each; rates 1 Hz)"
+              + ("" if held else ": overload, printed only"))
+        per_task0 = None
+        sizes = (100, 300, 1000) if held else (100, 300)
+        for n in sizes:
+            rtf, sim, wall = queue_factor(n, every)
+            per_task = wall / n
+            per_task0 = per_task0 or per_task
+            growth = per_task / per_task0
+            verdict = ("" if not held else
+                       f"({'linear' if growth <= 1.5 else 'SUPERLINEAR'})"
+                       + ("" if n < 1000 else (" OK" if rtf >= 1000 else " BELOW 1,000x TARGET")))
+            print(f"  {n:5d} tasks: {sim:9.0f} s simulated in {wall:6.2f} s = {rtf:8,.0f}x real time   "
+                  f"wall/task x{growth:4.2f} vs 100 tasks {verdict}")
 
 
 if __name__ == "__main__":

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from tasker.errors import TaskerError
-from tasker.trace import number
+from tasker.trace import number, read
 
 PROBLEMS = "problems"
 INDEX = "index.json"
@@ -165,14 +165,10 @@ def load_trace(run_dir: Path) -> list[dict[str, Any]]:
     path = run_dir / "trace.jsonl"
     if not path.is_file():
         return []
-    out = []
-    for i, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
-        if line.strip():
-            try:
-                out.append(json.loads(line))
-            except json.JSONDecodeError as exc:
-                raise ExplainError(f"{path}:{i}: not valid JSON: {exc.msg}") from None
-    return out
+    try:
+        return read(path)
+    except ValueError as exc:
+        raise ExplainError(str(exc)) from None
 
 
 def moved(events: Iterable[Mapping[str, Any]], agent: str, until: float | None = None) -> list[Mapping[str, Any]]:

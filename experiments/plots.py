@@ -136,14 +136,15 @@ def _with_gaps(costs: list[Event]) -> tuple[list[float], list[Event | None]]:
 
 def hazard_spans(events: Sequence[Event], t_end: float) -> list[tuple[str, str, float, float]]:
     """(agent, hazard label, start, end) from ``hazard`` events (``status`` on/off); a hazard
-    still on at the end of the trace lasts until ``t_end``."""
+    still on at the end of the trace lasts until ``t_end``; one no agent owns (``agent: null``,
+    e.g. a door open in the world file) is labelled ``unowned``."""
     spans: list[tuple[str, str, float, float]] = []
     on: dict[tuple[str, str], float] = {}
     for e in events:
         if e["event"] != "hazard":
             continue
         label = " ".join([str(e.get("hazard", "?")), *(str(a) for a in e.get("args") or [])])
-        key = (str(e.get("agent", "?")), label)
+        key = (str(e.get("agent") or "unowned"), label)
         if e.get("status") == "on":
             on.setdefault(key, float(e["t"]))
         elif key in on:

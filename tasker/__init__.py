@@ -10,8 +10,8 @@ plug in through :mod:`tasker.protocols` and :mod:`tasker.task` hooks.
 from __future__ import annotations
 
 from tasker.agent import DynamicAgent, Rates
-from tasker.errors import BadRequest, ConfigError, PlanningFailed, TaskerError, UnknownName
-from tasker.harmoniser import Mode, Request, TaskHarmoniser
+from tasker.errors import BadRequest, ConfigError, PlanningFailed, RunAborted, TaskerError, UnknownName
+from tasker.harmoniser import Mode, OscillationGuard, Request, TaskHarmoniser
 from tasker.loop import SimulationLoop
 from tasker.messages import (
     SP_COMPLETION,
@@ -34,8 +34,9 @@ __version__ = "0.1.0"
 
 __all__ = [
     "SP_COMPLETION", "ArgSpec", "BadRequest", "Command", "CompletionCost", "ConfigError", "CostParams",
-    "DynamicAgent", "Flag", "FsmState", "Mode", "PlanningFailed", "Purpose", "Rates", "Report", "Request",
-    "Requester", "SPRequest", "ScheduleParams", "SimulationLoop", "Stage", "StageKind", "StagePlan",
+    "DynamicAgent", "Flag", "FsmState", "Mode", "OscillationGuard", "PlanningFailed", "Purpose", "Rates",
+    "Report", "Request",
+    "Requester", "RunAborted", "SPRequest", "ScheduleParams", "SimulationLoop", "Stage", "StageKind", "StagePlan",
     "Strategy", "TaskContext", "TaskHarmoniser", "TaskStore", "TaskType", "TaskerError", "Trace",
     "UnknownName", "__version__",
 ]

@@ -20,11 +20,13 @@ import re
 import sys
 import tempfile
 import traceback
+import warnings
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any, NoReturn
 
 from tasker.errors import TaskerError, UnknownName
+from tasker.reader import InputWarning
 
 EXIT_OK = 0
 """The command did what it was asked."""
@@ -183,7 +185,18 @@ def run_handler(handler: Callable[[argparse.Namespace], Any], args: argparse.Nam
     command = getattr(args, "command", None) or "?"
     verbose = int(getattr(args, "verbose", 0) or 0)
     try:
-        return int(handler(args))
+        with warnings.catch_warnings():
+            default = warnings.showwarning
+
+            def show(message: Warning | str, category: type[Warning], *rest: Any, **kw: Any) -> None:
+                if issubclass(category, InputWarning):  # valid but doubtful input: one line, our format
+                    if not getattr(args, "quiet", False):
+                        print(f"tasker {command}: warning: {message}", file=sys.stderr)
+                else:
+                    default(message, category, *rest, **kw)
+
+            warnings.showwarning = show
+            return int(handler(args))
     except KeyboardInterrupt:
         print(f"tasker {command}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

@@ -14,7 +14,7 @@ def test_bundled_task_types_register() -> None:
     assert store.names() == ["carry_object", "cook", "guide_human", "human_fell"]
     assert store.validate("guide_human", {"person": "john", "destination": "kitchen"}) == {
         "person": "john", "destination": "kitchen"}
-    assert store.validate("cook", {}) == {"pan": "pan", "cooker": "stove"}
+    assert store.validate("cook", {}) == {"pan": "pan", "cooker": "cooker"}
     with pytest.raises(BadRequest, match="missing required argument 'destination'"):
         store.validate("guide_human", {"person": "john"})
     with pytest.raises(BadRequest, match="unknown argument"):

@@ -145,6 +145,6 @@ def test_cook_suspension_policy_is_the_same_factor_for_both_strategies(tasks: di
     assert susp("conditional", None) == ["turn_off"] and susp("conditional", 10.0) == []
     k = [s.action for s in exe.stages].index("put_down")  # hot pan held
     held = apply(ctx.world, exe.stages[:k])
-    off = ["turn_off"] if ("cooker_on", "stove") in held.facts else []
+    off = ["turn_off"] if ("cooker_on", "cooker") in held.facts else []
     assert susp("strict", 10.0, held) == ["put_down", *off]
     assert susp("conditional", 10.0, held) == ["put_down"]

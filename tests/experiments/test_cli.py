@@ -272,3 +272,17 @@ def test_sweep_jobs_carry_absolute_task_paths(tmp_path: Path, files: dict[str, s
     assert main(["sweep", files["spec"], "--db", files["db"], "--path", "tasks"]) == 0
     jobs = seen[0].jobs()
     assert jobs and all(j.task_paths == (str((tmp_path / "tasks").resolve()),) for j in jobs)
+
+
+def test_doubtful_input_is_one_warning_line_in_the_cli_format(tmp_path: Path,
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
+    scn = tmp_path / "late.toml"
+    scn.write_text('kind = "synthetic"\nname = "late"\n[settings]\nhorizon = 20.0\n'
+                   '[tasks.t]\nstages = [{ action = "a", duration = 1.0 }]\n'
+                   '[[requests]]\nt = 0.0\ntask = "t"\n[[requests]]\nt = 100.0\ntask = "t"\n')
+    assert main(["run", str(scn), "--out", str(tmp_path / "out")]) == 0
+    err = capsys.readouterr().err
+    assert f"tasker run: warning: {scn}:" in err and "after the horizon" in err
+    assert "InputWarning" not in err
+    assert main(["run", str(scn), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    assert "warning" not in capsys.readouterr().err

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import pytest
@@ -42,15 +41,13 @@ def test_unknown_planner_lists_known() -> None:
         Planner("no-such-planner")
 
 
-def test_cache_hit_is_fast_and_marked() -> None:
+def test_cache_hit_is_marked_and_counted() -> None:
     planner = Planner()
     text = PddlText(DOMAIN, problem_text())
     first = planner.solve(text)
     assert not first.cached
-    t0 = time.perf_counter()
     again = planner.solve(PddlText(DOMAIN, problem_text()))
-    elapsed = time.perf_counter() - t0
-    assert again.cached and again.plan == first.plan and elapsed <= 1e-3
+    assert again.cached and again.plan == first.plan  # how fast a hit is: benchmarks/bench_planner.py
     assert planner.hits == 1 and planner.misses == 1
 
 
@@ -68,9 +65,8 @@ def test_up_problem_repeat_is_cached(pddl_files: tuple[Path, Path]) -> None:
     _, _, problem = load_problem(*pddl_files)
     planner = Planner()
     planner.solve(problem)
-    t0 = time.perf_counter()
     assert planner.solve(problem).cached
-    assert time.perf_counter() - t0 <= 1e-3
+    assert planner.hits == 1 and planner.misses == 1
 
 
 def test_timeouts_are_not_cached() -> None:
