@@ -37,13 +37,15 @@ from experiments.report import (
     paired,
 )
 from experiments.store import ResultStore, RunRow, Status
-from experiments.sweep import Strategy, load_spec, run_sweep
+from experiments.sweep import Strategy, SweepSpec, load_spec, run_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = "experiments/sweeps/factorial.toml"
 DB = "out/factorial.db"
 OUT = "out/factorial-report"
 MARKDOWN = "docs/results.md"
+NOTES = "experiments/sweeps/factorial-notes.md"
+"""Hand-written notes from reading the traces, included verbatim after the generated findings (no numbers)."""
 
 PRIMARY = PrimaryOutcome()
 HAZARD, HELP = PRIMARY.hazard[0], PRIMARY.help[0]
@@ -278,6 +280,12 @@ def _findings(rows: Sequence[RunRow], pairs: Sequence[Paired], every: Sequence[P
                 helps.append(f"{LABELS[p.metric]} ({ctx})")
             elif v == "baseline better":
                 hurts.append(f"{LABELS[p.metric]} ({ctx})")
+        worse = [w for w in worse_outcomes(rows) if w[0] == sc]
+        if worse:
+            n_planned = sum(1 for r in rows if r.scenario == sc and r.status is Status.OK
+                            and _factors(r.strategy).get("suspension") == "planned")
+            out.append(f"  * planned left more people never helped, or failed more tasks, than static in "
+                       f"{len(worse)} of {n_planned} planned runs — see *Where planned was less safe* below.")
         less_safe = [p for p in mine if p.metric == HAZARD and p.losses > 0]
         if helps:
             out.append(f"  * planning the suspension **helps** (Holm-significant): {', '.join(helps)}.")
@@ -291,8 +299,7 @@ def _findings(rows: Sequence[RunRow], pairs: Sequence[Paired], every: Sequence[P
                        + "; ".join(f"{p.losses} of {p.diff.n} seeds ({_cell(p.treatment, without='suspension')})"
                                    for p in less_safe) + " — see *Where planned was less safe* below.")
         else:
-            out.append("  * planned was never less safe than static here (no seed where its hazard-unattended "
-                       "time was longer).")
+            out.append("  * planned never left hazards unattended longer than static here (in no seed).")
     out.append("")
     hw = [p for p in every if p.dimension == "hazard_waiting" and not host_dependent(p.metric)]
     if hw and all(p.wins == p.losses == 0 for p in hw):
@@ -305,6 +312,43 @@ def _findings(rows: Sequence[RunRow], pairs: Sequence[Paired], every: Sequence[P
     elif hw:
         out += ["Hazard-aware waiting changed some runs: its paired effects are in the tables below.", ""]
     return out
+
+
+def worse_outcomes(rows: Sequence[RunRow]) -> list[tuple[str, str, int, dict[str, float], dict[str, float], str]]:
+    """Every (scenario, planned cell, seed) where planned suspension left more people never helped or more
+    tasks failed than static in the same variant: ``(scenario, label, seed, planned, static, reasons)``."""
+    by = {(r.scenario, r.strategy, r.seed): r for r in rows if r.status is Status.OK}
+    out = []
+    for (sc, st, seed), r in sorted(by.items()):
+        if _factors(st).get("suspension") != "planned":
+            continue
+        base = Strategy(**{**dict(Strategy.parse(st).items()), "suspension": "static"}).label
+        b = by.get((sc, base, seed))
+        if b is None:
+            continue
+        m, bm = numeric_metrics(r.metrics), numeric_metrics(b.metrics)
+        keys = ("people.not_helped", "totals.failed")
+        if any(m.get(k, 0.0) > bm.get(k, 0.0) for k in keys):
+            totals = r.metrics.get("totals", {})
+            reasons = totals.get("failure_reasons", []) if isinstance(totals, dict) else []
+            out.append((sc, st, seed, {k: m.get(k, 0.0) for k in keys}, {k: bm.get(k, 0.0) for k in keys},
+                        "; ".join(str(x) for x in reasons)))
+    return out
+
+
+def _worse_outcomes(rows: Sequence[RunRow]) -> list[str]:
+    worse = worse_outcomes(rows)
+    if not worse:
+        return ["In no scenario, context or seed did planned suspension leave more people unhelped or fail more "
+                "tasks than static.", ""]
+    body = [[_name(sc), _cell(st, without="suspension"), str(seed),
+             f"{b['people.not_helped']:.0f} / {b['totals.failed']:.0f}",
+             f"{m['people.not_helped']:.0f} / {m['totals.failed']:.0f}", why[:300]]
+            for sc, st, seed, m, b, why in worse]
+    return ["Seeds where planned suspension left more people never helped, or failed more tasks, than static in "
+            "the same variant (the time-to-help means above leave such people out: they were never helped):", "",
+            *_table(["scenario", "policy/hazard waiting", "seed", "static: never helped / failed",
+                     "planned: never helped / failed", "planned's failure reasons"], body)]
 
 
 def _household_check(rows: Sequence[RunRow], scenarios: Sequence[str]) -> list[str]:
@@ -348,13 +392,13 @@ def _less_safe(rows: Sequence[RunRow], scenarios: Sequence[str]) -> list[str]:
             lines.append([_name(sc), _cell(st, without="suspension"), str(seed), _fmt(b[HAZARD]), _fmt(m[HAZARD]),
                           ", ".join(grew) or "–"])
     out = ["## Where planned was less safe", ""]
+    out += _worse_outcomes(rows)
     if not lines:
         return out + ["In no scenario, context or seed did planned suspension leave hazards unattended longer "
                       "than static.", ""]
     out += ["Each seed where planned suspension left hazards unattended longer than static in the same "
-            "variant, with the hazards whose unattended time grew (replay one with `tasker run SCENARIO "
-            "--randomize --seed N --suspension planned`, with the variant's interruption grid applied by the "
-            "sweep).", ""]
+            "variant, with the hazards whose unattended time grew. Replay one, with every output of `tasker run`: "
+            "`python -m experiments.results --replay SCENARIO SEED planned/POLICY/WAITING --out out/replay`.", ""]
     return out + _table(["scenario", "policy/hazard waiting", "seed", "static (s)", "planned (s)", "hazards"], lines)
 
 
@@ -391,7 +435,7 @@ def _calibration(rows: Sequence[RunRow], scenarios: Sequence[str]) -> list[str]:
                          "interruptions underestimated", "censored"], body)
 
 
-def render(rows: Sequence[RunRow], command: str) -> str:
+def render(rows: Sequence[RunRow], command: str, notes: str = "") -> str:
     """``docs/results.md`` from the stored runs (deterministic: same rows, same text)."""
     import tasker
 
@@ -419,6 +463,8 @@ def render(rows: Sequence[RunRow], command: str) -> str:
                     f" (and {len(constant) - len(shown)} more, listed in the report)" if len(constant) > len(shown)
                     else "") + ".", ""]
     out += _findings(rows, pairs, every, scenarios)
+    if notes.strip():
+        out += [notes.strip(), ""]
     out += ["## Primary outcome per cell", "",
             "Mean ± 95 % CI (runs) of each coordinate; the frontier is `out/factorial-report/plots/"
             "primary_frontier.png`.", ""]
@@ -439,6 +485,32 @@ def render(rows: Sequence[RunRow], command: str) -> str:
     return "\n".join(out).rstrip() + "\n"
 
 
+def replay(spec: SweepSpec, scenario: str, seed: str, cell: str, *, out: Path) -> int:
+    """Run the job ``(scenario, seed, cell)`` of ``spec`` again — the same variant, interruption grid
+    included — and write every output of ``tasker run`` into ``out``."""
+    from experiments.runner import run_scenario
+
+    by_name = {_name(sc): sc for sc in spec.scenarios}
+    if scenario not in by_name:
+        print(f"python -m experiments.results: --replay: no scenario {scenario!r} in the spec "
+              f"(scenarios: {', '.join(sorted(by_name))})", file=sys.stderr)
+        return 2
+    jobs = {(str(j.seed), _cell(j.strategy.label)): j for j in spec.jobs() if j.scenario == by_name[scenario]}
+    job = jobs.get((seed, cell))
+    if job is None:
+        cells = sorted({c for _, c in jobs})
+        print(f"python -m experiments.results: --replay: no job {scenario} seed {seed} cell {cell!r} "
+              f"(seeds: {', '.join(sorted({s for s, _ in jobs}, key=int))}; cells: {', '.join(cells)})",
+              file=sys.stderr)
+        return 2
+    st = job.strategy
+    run_scenario(job.source, seed=job.seed, update=st.update, suspension=st.suspension, scheduler=st.scheduler,
+                 randomize=True, task_paths=job.task_paths, policy=st.policy, hazard_waiting=st.hazard_waiting,
+                 interruption=job.interruption, out=out)
+    print(f"wrote {out}/ ({scenario}, seed {seed}, {st.label})")
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m experiments.results", description=__doc__.splitlines()[0])
     ap.add_argument("--spec", default=SPEC, help=f"sweep spec (default {SPEC})")
@@ -448,6 +520,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
     ap.add_argument("--seeds", type=int, default=None, metavar="N",
                     help="only the spec's first N seeds (a smaller run for a busy machine)")
+    ap.add_argument("--replay", nargs=3, metavar=("SCENARIO", "SEED", "CELL"), default=None,
+                    help="run one job of the spec again with every output (trace, report.html, plots) into --out: "
+                         "SCENARIO as in the tables (e.g. compound), SEED, CELL as suspension/policy/hazard waiting "
+                         "(e.g. planned/strict/off)")
     ap.add_argument("--no-run", action="store_true", help="do not run missing jobs; report what the database holds")
     args = ap.parse_args(argv)
     from tasker.reader import InputError
@@ -457,6 +533,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except InputError as exc:
         print(f"python -m experiments.results: {exc}", file=sys.stderr)
         return 2
+    if args.replay is not None:
+        return replay(spec, *args.replay, out=Path(args.out))
     if args.seeds is not None:
         if not 1 <= args.seeds <= len(spec.seeds):
             print(f"python -m experiments.results: --seeds: expected 1..{len(spec.seeds)}, got {args.seeds}",
@@ -472,7 +550,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         rows = [r for r in store.rows() if (r.scenario, r.seed, r.strategy) in keys]
     command = " ".join(["python -m experiments.results", *(a for a in (argv if argv is not None else sys.argv[1:])
                                                           if a != "--no-run")]).strip()
-    Path(args.markdown).write_text(render(rows, command), encoding="utf-8")
+    notes = ROOT / NOTES
+    text = render(rows, command, notes.read_text(encoding="utf-8") if notes.is_file() else "")
+    Path(args.markdown).write_text(text, encoding="utf-8")
     print(f"wrote {args.markdown} ({len(rows)} runs) and {args.out}/")
     return 0
 

@@ -62,13 +62,30 @@ def test_document_is_deterministic_and_says_what_the_runs_show(rows: list[RunRow
     # the seed where planned was less safe is named, with the hazard that grew
     assert "| hh | conditional/off | 2 | 22 | 32 | cooker_on |" in text
     assert "| hh | conditional/on | 2 | 22 | 32 | cooker_on |" in text
-    assert "planned was never less safe than static here" in text  # cr
+    assert "planned never left hazards unattended longer than static here" in text  # cr
     # time to help: planned better by 5 s in every seed of hh
     assert "-5 ± 0 (n 4), 4/0/0" in text
     # hazard_waiting identical in every pair
     assert "Hazard-aware waiting had no effect in these runs" in text
     # the errored run is counted as infeasible, apart from the ok runs
     assert "| cr | static/strict/off | 4 | 1 | 0 |" in text
+
+
+def test_a_person_planned_left_unhelped_is_named_with_the_reasons(rows: list[RunRow]) -> None:
+    label = Strategy(update="planned", suspension="planned", policy="strict", hazard_waiting=False).label
+    worse = [RunRow(r.scenario, r.seed, r.strategy, r.status, r.record,
+                    {**r.metrics, "people": {"time_to_help_s": {"mean": None}, "not_helped": 1},
+                     "totals": {"failed": 1, "unfinished": 0, "failure_reasons": ["d2: stuck in the doorway"]}})
+             if (r.scenario, r.seed, r.strategy) == ("cr", 3, label) else r for r in rows]
+    assert [(sc, seed) for sc, _, seed, *_ in results.worse_outcomes(worse)] == [("cr", 3)]
+    text = results.render(worse, "cmd")
+    assert "| cr | strict/off | 3 | 0 / 0 | 1 / 1 | d2: stuck in the doorway |" in text
+    assert "planned left more people never helped, or failed more tasks, than static in 1 of 16" in text
+
+
+def test_notes_are_included_verbatim_after_the_findings(rows: list[RunRow]) -> None:
+    text = results.render(rows, "cmd", notes="## Reading the traces (by hand)\n\n* a note\n")
+    assert text.index("## What it shows") < text.index("* a note") < text.index("## Primary outcome per cell")
 
 
 def test_a_factor_with_an_effect_is_not_called_a_no_op(rows: list[RunRow]) -> None:
