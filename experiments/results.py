@@ -66,6 +66,10 @@ LABELS = {
     "unfinished tasks",
 }
 
+AFTER_END = "safety.after_end_s"
+"""Shown beside the hazard coordinate, descriptive only (not in Holm's family): unattended time no suspension
+or waiting could attend to, because the hazard's task had ended."""
+
 FACTOR_ORDER = ("suspension", "policy", "hazard_waiting")
 
 DECLARATION = """\
@@ -213,11 +217,12 @@ def _primary_table(rows: Sequence[RunRow], sc: str, strategies: Sequence[str]) -
         h, hn = _values(rows, sc, st, HAZARD)
         w, wn = _values(rows, sc, st, HELP)
         o, _ = _values(rows, sc, st, "safety.budget_overruns")
+        a, _ = _values(rows, sc, st, AFTER_END)
         body.append([_cell(st), _ci(estimate(h)) + (f", {hn} non-finite" if hn else ""),
-                     _ci(estimate(w)) + (f", {wn} non-finite" if wn else ""),
+                     _ci(estimate(a)) if a else "not measured", _ci(estimate(w)) + (f", {wn} non-finite" if wn else ""),
                      f"{sum(1 for v in o if v > 0)} of {len(o)}"])
-    return _table(["suspension/policy/hazard waiting", "hazard unattended (s)", "time to help (s)",
-                   "runs with a budget overrun"], body)
+    return _table(["suspension/policy/hazard waiting", "hazard unattended (s)",
+                   "of which after its task ended (s)", "time to help (s)", "runs with a budget overrun"], body)
 
 
 def _p(p: float) -> str:
@@ -466,8 +471,9 @@ def render(rows: Sequence[RunRow], command: str, notes: str = "") -> str:
     if notes.strip():
         out += [notes.strip(), ""]
     out += ["## Primary outcome per cell", "",
-            "Mean ± 95 % CI (runs) of each coordinate; the frontier is `out/factorial-report/plots/"
-            "primary_frontier.png`.", ""]
+            "Mean ± 95 % CI (runs) of each coordinate, and the part of the hazard time that came after the "
+            "hazard's task had ended (`safety.after_end_s`, descriptive, not tested); the frontier is "
+            "`out/factorial-report/plots/primary_frontier.png`.", ""]
     for sc in scenarios:
         out += [f"### {_name(sc)}", "", *_primary_table(rows, sc, strategies)]
     out += _less_safe(rows, scenarios)
