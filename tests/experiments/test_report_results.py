@@ -128,3 +128,14 @@ def test_the_shipped_factorial_spec_is_the_declared_design() -> None:
     for grid in spec.variants.values():  # the first three seeds put the interruption in every stratum
         assert sorted(grid.stratum(seed) for seed in spec.seeds[:3]) == \
             sorted(grid.stratum(k) for k in range(grid.strata))
+
+
+def test_replay_refuses_a_job_the_spec_does_not_have(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = str(Path(results.ROOT) / results.SPEC)
+    assert results.main(["--spec", spec, "--replay", "kitchen", "1", "planned/strict/off", "--out",
+                         str(tmp_path)]) == 2
+    assert "no scenario 'kitchen'" in capsys.readouterr().err
+    assert results.main(["--spec", spec, "--replay", "carry", "1", "planned/strict/of", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "no job carry seed 1 cell 'planned/strict/of'" in err and "planned/strict/off" in err
+    assert not any(tmp_path.iterdir())
