@@ -11,7 +11,8 @@ Two estimates steer harmonisation and can be checked against what happened:
   realised duration is not that of the task the estimate was about.
 * **An interruption's expected length** — the ``expected_s`` of a ``susp`` command.  The
   realised interruption runs from the agent entering ``wait`` after that suspension to its
-  next ``start``.  An interruption that never ends in a ``start`` (the task ended while
+  next ``start`` — a ``start`` with ``secure`` (hazard-aware waiting: it reaches its safe
+  state and waits again) does not end it.  An interruption that never ends in a ``start`` (the task ended while
   waiting, or the run stopped) is *censored*: counted, never compared.
 
 A non-finite estimate (``"inf"`` in the trace) is counted, never averaged.  Like every
@@ -79,7 +80,9 @@ class CalibrationCollector:
                 self._open[agent]["wait_t"] = t
         elif kind == "command" and agent in self.task_type:
             flag = e.get("flag")
-            if flag == "start":
+            if flag == "start" and e.get("secure"):
+                pass  # hazard-aware waiting: it secures its hazard and waits again — not a (re)start of the task
+            elif flag == "start":
                 if agent not in self.first_start:
                     predicted = _num(e["predicted_s"]) if "predicted_s" in e else None
                     self.first_start[agent] = (t, predicted)

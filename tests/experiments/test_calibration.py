@@ -100,3 +100,17 @@ def test_infinite_expected_interruption_is_counted_apart() -> None:
     sus = metrics.compute(events)["calibration"]["interruptions"]
     assert sus["nonfinite"] == 1 and sus["compared"] == 0
     assert sus["list"][0]["expected_s"] == "inf"  # JSON-ready, as in the trace
+
+
+def test_securing_while_waiting_does_not_end_the_interruption() -> None:
+    """Hazard-aware waiting: d1 secures its hazard from wait (48-52) and waits again; its interruption
+    still runs from 32 to its real resumption at 82, and the securing counts as time owning the robot."""
+    events = trace()
+    at = next(i for i, e in enumerate(events) if e["t"] >= 48.0)
+    events[at:at] = [ev(48.0, "command", agent="d1", flag="start", secure=True),
+                     *go(48.0, "d1", "wait", "genSusp", "exeSusp"), *go(52.0, "d1", "exeSusp", "wait")]
+    cal = metrics.compute(events)["calibration"]
+    (row,) = cal["interruptions"]["list"]
+    assert row["outcome"] == "resumed" and row["realised_s"] == pytest.approx(50.0)
+    d1 = next(r for r in cal["estimates"]["tasks"] if r["agent"] == "d1")
+    assert d1["executing_s"] == pytest.approx(104.0) and d1["predicted_s"] == 100.0
