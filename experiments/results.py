@@ -307,15 +307,22 @@ def _findings(rows: Sequence[RunRow], pairs: Sequence[Paired], every: Sequence[P
             out.append("  * planned never left hazards unattended longer than static here (in no seed).")
     out.append("")
     hw = [p for p in every if p.dimension == "hazard_waiting" and not host_dependent(p.metric)]
+    on_runs = [numeric_metrics(r.metrics) for r in rows
+               if r.status is Status.OK and _factors(r.strategy).get("hazard_waiting") == "on"]
+    secured = [sum(v for k, v in f.items() if k.startswith("decisions.decisions_by.") and k.endswith("/secure"))
+               for f in on_runs]
+    acts = (f"With it on, the harmoniser made {sum(secured):.0f} securing decisions (`decision` rule `secure`) in "
+            f"{sum(1 for x in secured if x > 0)} of {len(on_runs)} runs.")
     if hw and all(p.wins == p.losses == 0 for p in hw):
-        out += ["**Hazard-aware waiting had no effect in these runs**: on and off gave identical values of every "
+        out += ["**Hazard-aware waiting changed nothing in these runs**: on and off gave identical values of every "
                 f"metric in every one of the {len({(p.scenario, p.treatment) for p in hw})} paired cells "
-                "(scenario × context). In the code that ran, `hazard_waiting` is only stored by the harmoniser; "
-                "hazard-aware waiting is being implemented by another engineer. Re-run this command after "
-                "merging it, with a fresh database (`--db`, or delete the old one): the sweep resumes, so it would "
-                "otherwise keep the runs of the old code.", ""]
+                f"(scenario × context). {acts}"
+                + (" No waiting task's hazard came near its budget in these variants, or hazard-aware waiting was "
+                   "not active in the code that ran (it was implemented by another engineer while this experiment "
+                   "was set up); the budget overruns in the primary tables are then hazards no waiting can attend "
+                   "to (`safety.after_end_s`: their task had ended)." if sum(secured) == 0 else ""), ""]
     elif hw:
-        out += ["Hazard-aware waiting changed some runs: its paired effects are in the tables below.", ""]
+        out += [f"Hazard-aware waiting changed some runs: its paired effects are in the tables below. {acts}", ""]
     return out
 
 

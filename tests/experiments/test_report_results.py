@@ -66,7 +66,8 @@ def test_document_is_deterministic_and_says_what_the_runs_show(rows: list[RunRow
     # time to help: planned better by 5 s in every seed of hh
     assert "-5 ± 0 (n 4), 4/0/0" in text
     # hazard_waiting identical in every pair
-    assert "Hazard-aware waiting had no effect in these runs" in text
+    assert "Hazard-aware waiting changed nothing in these runs" in text
+    assert "the harmoniser made 0 securing decisions" in text
     # the errored run is counted as infeasible, apart from the ok runs
     assert "| cr | static/strict/off | 4 | 1 | 0 |" in text
 
@@ -93,7 +94,7 @@ def test_a_factor_with_an_effect_is_not_called_a_no_op(rows: list[RunRow]) -> No
                       {**r.metrics, "people": {"time_to_help_s": {"mean": 50.0 + r.seed}, "not_helped": 0}})
                if r.status is Status.OK and "hazard_waiting=on" in r.strategy else r for r in rows]
     text = results.render(changed, "cmd")
-    assert "Hazard-aware waiting had no effect" not in text
+    assert "Hazard-aware waiting changed nothing" not in text
     assert "### hazard waiting — hh" in text
 
 
