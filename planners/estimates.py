@@ -58,6 +58,8 @@ if TYPE_CHECKING:
 
 NAVIGATE = "navigate"
 """The skill whose stages are timed with the motion model (others by their duration)."""
+PERSON_TYPE = "person"
+"""The object type of people: a leg to one ends where they stand (see :func:`walk`)."""
 
 Travel = dict[tuple[str, str], float]
 
@@ -103,7 +105,9 @@ def walk(stages: Sequence[Stage], start: Pose | None, world: WorldState | None, 
     A ``navigate`` stage whose target has a pose in ``world`` is timed by ``motion`` from
     the pose reached so far (with ``estimate_ignoring_doors`` when ``through_door`` says
     the leg crosses a door the plan opens, as :func:`~planners.problem.travel_table`
-    does); any other stage takes its duration.  ``elapsed`` seconds of the first stage
+    does); after a leg to a person, the next leg starts where that person stands (the
+    robot is with them: the person it guides is no obstacle on their own guide); any
+    other stage takes its duration.  ``elapsed`` seconds of the first stage
     have already run (a navigate leg is re-timed from ``start`` instead).
     """
     pose = start
@@ -118,6 +122,11 @@ def walk(stages: Sequence[Stage], start: Pose | None, world: WorldState | None, 
                 return math.inf, None
             total += float(est.time_s)
             pose = est.end_pose or target
+            if world is not None and world.objects.get(str(s.data.get("to"))) == PERSON_TYPE:
+                # the robot is now with this person: the next leg starts where they stand, so
+                # the motion model does not route around them (a guided person follows the
+                # robot, anyone else stays behind it), as the navigate skill finds on the spot
+                pose = (float(target[0]), float(target[1]), float(pose[2]))
         else:
             total += max(0.0, s.duration - elapsed) if k == 0 else s.duration
             pose = target or pose

@@ -382,7 +382,14 @@ class BasePlanner:
         # the door-layer path may start with a snap off a jamb; people judge it as driven
         if self.scene.people_clear(pts[:-1], pts[1:], discs, goal=g).all():
             return path
-        return self._cached((s, g, doors, discs))
+        path = self._cached((s, g, doors, discs))
+        if path is None:
+            # no way that leaves the people the robot is beside without coming closer (a
+            # place between two people): pass them, as Scene.path_clear allows
+            away = tuple(d for d in discs if not self.scene.holds(d, s))
+            if len(away) < len(discs):
+                path = self._cached((s, g, doors, away))
+        return path
 
     def _cached(self, key: tuple[Point, Point, tuple[str, ...], tuple[Disc, ...]]) -> tuple[Point, ...] | None:
         if key in self._cache:

@@ -158,9 +158,12 @@ class Navigate(Skill):
         # Whoever follows the robot was planned around but is not checked against: they walk
         # its trail, up to it, and would otherwise make it re-plan at each of their steps.
         followers = tuple(p.name for p in self.sim.people if p.following)
+        scene = self.sim.scene
         pts = np.asarray(ahead)
-        return not self.sim.scene.segments_free(pts[:-1], pts[1:], static=False, goal=ahead[-1],
-                                                slack=TRACKING_SLACK, ignore=followers).all()
+        if len(scene.closed_doors()) and not scene.segments_free(pts[:-1], pts[1:], static=False,
+                                                                 ignore=tuple(scene.people)).all():
+            return True  # a door closed across the way
+        return not scene.path_clear(ahead, slack=TRACKING_SLACK, ignore=followers)
 
     def control(self, now: float, dt: float) -> Command:
         f = self.follower
