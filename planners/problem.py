@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import unified_planning as up
 
@@ -135,7 +136,30 @@ def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float)
                 out[a, b] = float(estimate(world.poses[a], world.poses[b]).time_s)
             else:
                 out[a, b] = float(travel_s)
+    _from_robot(world, motion, out, through_door, ignoring_doors)
     return out
+
+
+def _from_robot(world: WorldState, motion: MotionModel | None, out: dict[tuple[str, str], float],
+                through_door: set[tuple[str, str]], ignoring_doors: Callable[..., Any] | None) -> None:
+    """Legs leaving the robot's place start where the robot *is*, not at the place's pose.
+
+    The robot's ``at`` fact is its nearest place, which may be metres away (a navigation
+    interrupted between places); timing its first leg from the place's pose can price a
+    direct leg through people standing *there* and make the planner detour through another
+    place, while the robot itself is already past them.
+    """
+    robots = sorted(n for n, t in world.objects.items() if t == "robot")
+    here = world.poses.get(robots[0]) if robots and motion is not None else None
+    at = [f[2] for f in world.facts if len(f) == 3 and f[0] == "at" and robots and f[1] == robots[0]]
+    if here is None or len(at) != 1 or motion is None:
+        return
+    a = at[0]
+    for b in sorted(n for n, t in world.objects.items() if t == PLACE_TYPE):
+        if b == a or b not in world.poses:
+            continue
+        estimate = ignoring_doors if ((a, b) in through_door and ignoring_doors is not None) else motion.estimate
+        out[a, b] = float(estimate(here, world.poses[b]).time_s)
 
 
 def _atom(fact: Iterable[str]) -> str:

@@ -192,6 +192,27 @@ class Scene:
         """Is ``point`` inside person ``d``'s clearance (the robot there would touch them)?"""
         return math.hypot(point[0] - d.x, point[1] - d.y) < self.clearance(d)
 
+    def beside(self, point: tuple[float, float]) -> tuple[str, ...]:
+        """People whose clearance holds ``point`` (by name)."""
+        return tuple(d.name for d in self.discs() if self.holds(d, point))
+
+    def path_clear(self, points: list[tuple[float, float]] | np.ndarray, slack: float = 0.0,
+                   ignore: tuple[str, ...] = ()) -> bool:
+        """Is the polyline ``points`` clear of people (less ``ignore``), driven from its first
+        point to its last?  What the ``navigate`` skill asks of the path ahead, from the
+        base's true pose.  People the robot is beside at either end do not block it (it is
+        leaving them, or stopping beside them); the planner prefers a path that leaves
+        them without coming closer (:meth:`people_clear`), and every path it returns
+        passes this test.
+        """
+        pts = np.asarray(points, float).reshape(-1, 2)
+        if len(pts) < 2:
+            return True
+        start, goal = (float(pts[0, 0]), float(pts[0, 1])), (float(pts[-1, 0]), float(pts[-1, 1]))
+        skip = set(ignore) | set(self.beside(start))
+        discs = [d for d in self.discs() if d.name not in skip]
+        return bool(self.people_clear(pts[:-1], pts[1:], discs, goal=goal, slack=slack).all())
+
     def people_clear(self, a: np.ndarray, b: np.ndarray, discs: tuple[Disc, ...] | list[Disc] | None = None,
                      leaving: bool = True, goal: tuple[float, float] | None = None,
                      slack: float = 0.0) -> np.ndarray:

@@ -147,9 +147,10 @@ def suspend_estimate(agent: DynamicAgent, now: float, expected_s: float | None =
     In ``exeTsk``: what is left of a blocking stage and the blocking stages after it
     (eq. 25), then its suspension at the first suspendable stage (own policy, the
     interruption expected to last ``expected_s``), or nothing more if no suspendable
-    stage is left (it ends instead).  In ``upTsk``: the planning time left, then the same
-    from the first stage.  In ``genSusp``/``exeSusp``: what is left of the suspension.
-    0 outside ``cmd``.
+    stage is left (it ends instead) — or, if longer, the same from the start of its next
+    blocking run, which it may enter right after this estimate.  In ``upTsk``: the
+    planning time left, then the same from the first stage.  In ``genSusp``/``exeSusp``:
+    what is left of the suspension.  0 outside ``cmd``.
     """
     if agent.ended:
         raise AgentEnded(agent.id, agent.end_reason or "ended")
@@ -165,25 +166,38 @@ def suspend_estimate(agent: DynamicAgent, now: float, expected_s: float | None =
         stages, index, left = runner.plan.stages, runner.index, 0.0
     else:
         return 0.0
-    left += _stages_left(agent, now, stages, index, lambda s: s.blocking)
-    # the suspension happens at the first suspendable stage (eq. 26); none left: the task ends instead
+    policy = agent.ctx.strategy.policy
+    estimate = left + _from(agent, now, stages, index, policy, expected_s)
+    # the agent may enter its next blocking run just after this estimate: that run is the worst case
+    # until the next estimate (re-made whenever the agent moves on), so the lead covers it already
+    nxt = next((j for j in range(index + 1, len(stages)) if stages[j].blocking and not stages[j - 1].blocking), None)
+    if nxt is not None:
+        estimate = max(estimate, _from(agent, now, stages, nxt, policy, expected_s, whole=True))
+    return estimate
+
+
+def _from(agent: DynamicAgent, now: float, stages: Sequence[Stage], index: int, policy: str,
+          expected_s: float | None, whole: bool = False) -> float:
+    """Suspending from stage ``index``: its blocking run (eq. 25), then the suspension at the first
+    suspendable stage (eq. 26) — none left: the task ends instead.  ``whole``: the run not yet begun."""
+    left = _stages_left(agent, now, stages, index, lambda s: s.blocking, whole)
     at = next((s for s in stages[index:] if not s.blocking), None)
     if at is None:
         return left
-    return left + suspension_estimate(agent, now, agent.ctx.strategy.policy, at, expected_s)
+    return left + suspension_estimate(agent, now, policy, at, expected_s)
 
 
 def _stages_left(agent: DynamicAgent, now: float, stages: Sequence[Stage], index: int,
-                 take: Callable[[Stage], bool]) -> float:
+                 take: Callable[[Stage], bool], whole: bool = False) -> float:
     """Durations of ``stages`` from ``index`` while ``take`` holds; of a running stage of
-    ``exeTsk``, what is left of it."""
+    ``exeTsk``, what is left of it (unless ``whole``)."""
     total = 0.0
     started = agent.ctx.stage_started
     for i in range(index, len(stages)):
         if not take(stages[i]):
             break
         d = stages[i].duration
-        if i == index and started is not None and agent.state is S.EXE_TSK:
+        if i == index and not whole and started is not None and agent.state is S.EXE_TSK:
             d = max(0.0, d - (now - started))
         total += d
     return total

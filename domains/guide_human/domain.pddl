@@ -39,7 +39,7 @@
 
   (:action guide
     :parameters (?r - robot ?h - person ?from ?to - place)
-    :precondition (and (at ?r ?from) (at ?h ?from) (following ?h) (connected ?from ?to))
+    :precondition (and (target ?h) (at ?r ?from) (at ?h ?from) (following ?h) (connected ?from ?to))
     :effect (and (not (at ?r ?from)) (at ?r ?to) (not (at ?h ?from)) (at ?h ?to)
                  (increase (total-cost) (travel-time ?from ?to))))
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import replace
+from typing import Any
 
 import pytest
 
@@ -307,3 +308,77 @@ def test_static_strategy_asked_from_elsewhere_applies_the_decision_list(tasks: d
     est = estimator_for(task).estimate(ctx, ctx.world.poses["bedroom"])
     assert est.source is Source.TEMPLATE
     assert [s[0] for s in est.steps] == ["approach", "greet_and_apologise", "ask_to_follow", "guide", "say_goodbye"]
+
+
+def test_a_guide_plan_never_moves_with_another_tasks_person(tasks: dict[str, PddlTaskType]) -> None:
+    """While another task guides Alice, John's plan gets the robot to John by approaching him,
+    not by 'guiding' Alice there (found in the paper run: guide John's estimate walked Alice
+    to the hall).  Every step of John's plan is about John."""
+    task = tasks["guide_human"]
+    ctx0 = make_ctx(task)
+    world = ctx0.world
+    assert isinstance(world, WorldState)
+    world = world.updated([("at", "alice", "livingroom"), ("greeted", "alice"), ("following", "alice")],
+                          [("at", "alice", "bedroom")])
+    poses = dict(world.poses)
+    poses["alice"] = poses["livingroom"]
+    world = WorldState(world.facts, poses, world.objects, world.time)
+    for suspended in (False, True):
+        est = estimator_for(task).estimate(make_ctx(task, world=world, suspended=suspended))
+        assert est.steps and all("alice" not in step[1:] for step in est.steps), est.steps
+
+
+def test_the_robots_first_leg_is_timed_from_where_it_is_not_from_its_place() -> None:
+    """The robot's ``at`` fact is its nearest place, possibly metres away (a navigation cut
+    between places).  upTsk's travel table times legs leaving that place from the robot's
+    real pose: timed from the place's pose, a direct leg was priced through people standing
+    there and the plan detoured (session-1 paper scenario, Alice sent to John's destination:
+    without it guide Alice was predicted 21.6 s and took 88.6 s)."""
+    from planners.problem import travel_table
+
+    objects = {"robot": "robot", "a": "place", "b": "place", "c": "place"}
+    poses = {"a": (0.0, 0.0, 0.0), "b": (10.0, 0.0, 0.0), "c": (0.0, 10.0, 0.0), "robot": (6.0, 0.0, 0.0)}
+    world = WorldState(frozenset({("at", "robot", "a")}), poses, objects)
+    motion = StraightLineMotion()
+    table = travel_table(world, motion, 12.0)
+    assert table["a", "b"] == pytest.approx(motion.estimate(poses["robot"], poses["b"]).time_s)
+    assert table["a", "c"] == pytest.approx(motion.estimate(poses["robot"], poses["c"]).time_s)
+    assert table["b", "c"] == pytest.approx(motion.estimate(poses["b"], poses["c"]).time_s)  # other legs as before
+
+
+def test_after_a_leg_to_a_person_the_next_leg_starts_where_they_stand() -> None:
+    """The robot stops ``APPROACH`` metres short of a person, who then follows it: the next leg
+    is timed from the person's position, so the live motion model does not route around the
+    very person being guided (session-1 paper scenario: without it guide Alice was predicted
+    43 s and took 99 s)."""
+    starts: list[Pose] = []
+
+    class Recording(StraightLineMotion):
+        def estimate(self, start: Pose, goal: Pose) -> Any:
+            starts.append(start)
+            est = super().estimate(start, goal)
+            # stop 1 m short, like an approach pose
+            d = math.dist(start[:2], goal[:2])
+            k = max(0.0, (d - 1.0) / d) if d > 0 else 0.0
+            end = (start[0] + k * (goal[0] - start[0]), start[1] + k * (goal[1] - start[1]), 0.0)
+            return replace(est, end_pose=end)
+
+    objects = {"robot": "robot", "john": "person", "dest": "place"}
+    poses = {"robot": (0.0, 0.0, 0.0), "john": (5.0, 0.0, 0.0), "dest": (5.0, 5.0, 0.0)}
+    world = WorldState(frozenset(), poses, objects)
+    stages = [Stage("approach", ("robot", "john"), skill="navigate", data={"to": "john"}),
+              Stage("guide", ("robot", "john", "dest"), skill="navigate", data={"to": "dest"})]
+    walk(stages, poses["robot"], world, Recording())
+    assert [s[:2] for s in starts] == [(0.0, 0.0), (5.0, 0.0)]
+
+
+def test_a_plan_estimated_across_a_closed_door_opens_it() -> None:
+    """The reference table keeps closed doors closed (but for door_between pairs, which the
+    plan may open): carry's first estimate is a plan through the door it opens, and finite."""
+    from experiments import scenario as scenarios
+    from experiments.runner import build_robot
+
+    loop, _ = build_robot(scenarios.load(scenarios.resolve("carry")), seed=1)
+    trace = loop.run(until=0.5)
+    start = next(e for e in trace.events if e["event"] == "command" and e["flag"] == "start")
+    assert isinstance(start["predicted_s"], float) and math.isfinite(start["predicted_s"])

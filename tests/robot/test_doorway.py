@@ -36,8 +36,7 @@ def _doorway_scene(paper: WorldSpec):  # type: ignore[no-untyped-def]
 
 def _skill_accepts(scene: Scene, start: tuple[float, float], path: tuple[tuple[float, float], ...]) -> bool:
     """What Navigate._path_ahead_blocked asks before the first leg: from the true pose on."""
-    pts = np.asarray([start, *path[1:]])
-    return bool(scene.segments_free(pts[:-1], pts[1:], static=False, goal=path[-1]).all())
+    return scene.path_clear([start, *path[1:]])
 
 
 def test_the_doorway_start_is_where_the_old_models_disagreed(paper) -> None:
@@ -146,3 +145,18 @@ def test_navigate_retries_a_failed_replan_once_the_doorway_clears(paper) -> None
             blocked |= sim.planner.plan(sim.robot_pose()[:2], paper.places["bedroom"][:2]) is None
     assert blocked  # the doorway really was shut while Peter stood in it
     assert status.state is SkillState.SUCCEEDED, status
+
+
+def test_a_start_between_two_people_is_left_by_passing_one(paper) -> None:
+    """The hall place with Sara fallen south-west of it and John standing north-east (a
+    randomised paper run): no way leaves both without coming closer to one, so the planner
+    passes the one the robot is beside — as the skill's check allows — rather than
+    calling every place unreachable from there."""
+    motion = motion_model(paper, people=False)
+    scene = motion.planner.scene
+    scene.set_person("sara", 5.473, 3.453, "fallen")
+    scene.set_person("john", 6.452, 4.308, "standing")
+    start = paper.places["hall"]
+    assert set(scene.beside(start[:2])) == {"sara", "john"}
+    est = motion.estimate(start, paper.places["john_destination"])
+    assert est.reachable and _skill_accepts(scene, start[:2], est.path)

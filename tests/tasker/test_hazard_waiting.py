@@ -266,8 +266,12 @@ def test_suspend_estimate_counts_the_blocking_stages_left() -> None:
                          suspension={"bake": [st("tidy", 9.0)], "serve": [st("tidy", 4.0)]})
     loop = SimulationLoop(TaskStore([task]), schedulers.create("fifo"), core=EffectExecutor(world))
     loop.request(0.0, "bake")
-    loop.run(until=12.0)
+    loop.run(until=1.0)
     [agent] = loop.all_agents
+    assert agent.progress == (FsmState.EXE_TSK, 0)
+    # in prep (suspendable, nothing to do on suspension) it may enter bake right after: the worst case
+    assert agent.suspend_estimate(1.0) == pytest.approx(30.0 + 3.0 + 4.0)
+    loop.run(until=12.0)
     assert agent.state is FsmState.EXE_TSK and agent.progress == (FsmState.EXE_TSK, 1)
     started = agent.ctx.stage_started
     assert started is not None
