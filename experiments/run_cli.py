@@ -52,7 +52,14 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
                    help="genSusp strategy for every task (default: the scenario's)")
     p.add_argument("--update", choices=("static", "planned"), default=None,
                    help="upTsk strategy for every task (default: the scenario's)")
-    p.add_argument("--scheduler", default=None, help="schedule algorithm: alg2, priority, fifo, sjf, srtf, edf")
+    p.add_argument("--scheduler", default=None,
+                   help="schedule algorithm (tasker.schedulers: alg2, lookahead, priority, fifo, sjf, srtf, edf, "
+                        "simple, simple2, distance)")
+    p.add_argument("--policy", choices=("strict", "conditional"), default=None,
+                   help="suspension policy for both strategies: conditional branches (e.g. leave the cooker on for "
+                        "a short interruption) are eligible only under 'conditional' (default: the scenario's)")
+    p.add_argument("--hazard-waiting", action="store_true",
+                   help="a waiting task secures its declared hazard before its budget runs out (docs/model.md)")
     p.add_argument("--mode", choices=("IT", "CT"), default=None, help="interruptible or constant-task harmonisation")
     p.add_argument("--randomize", action="store_true", help="draw a randomised variant of the scenario from --seed")
     p.add_argument("--no-pictures", action="store_true", help="skip the PNG figures")
@@ -80,7 +87,8 @@ def _run(args: argparse.Namespace) -> int:
     result = run_scenario(path, seed=args.seed, update=args.update, suspension=args.suspension,
                           scheduler=args.scheduler, mode=args.mode, out=out, randomize=args.randomize,
                           progress=show_progress(args), pictures=not args.no_pictures,
-                          task_paths=tuple(paths))
+                          task_paths=tuple(paths), policy=args.policy,
+                          hazard_waiting=args.hazard_waiting)
     ends = result.trace.of("end")
     causes: dict[str, int] = {}
     for e in ends:

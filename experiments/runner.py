@@ -98,6 +98,7 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
                       lambda: sim.snapshot().facts, task_types=store.names(),
                       version=lambda: (sim.time, sim.version))
     loop.observers.append(monitor.observe)
+    loop.harmoniser.hazards = monitor.active  # hazard-aware waiting learns of hazards from the monitor
     requester = Requester(store, loop.harmoniser, "scenario")
     for a in scn.actions:
         loop.at(a.t, _action(loop, sim, requester, a, scn))

@@ -1,5 +1,7 @@
 """Command-line subcommands of ``tasker`` for worlds: ``world`` and ``cost``.
 
+``world --json`` prints :func:`robot.describe.describe_world`.
+
 ``register(subparsers)`` adds them to an :mod:`argparse` parser; each handler returns
 the exit status.  ``cost`` answers the travel-time matrix of every given place or
 point in one process; it exits 0 when every pair is reachable, 1 when one is not and
@@ -78,15 +80,9 @@ def _world(args: argparse.Namespace) -> int:
 
         draw_world(spec, writable_file(args.out, "--out"))
     if args.json:
-        doc: dict[str, Any] = {
-            "name": spec.name,
-            "places": {n: list(p) for n, p in spec.places.items()},
-            "bounds": [list(spec.bounds[0]), list(spec.bounds[1])],
-            "people": {n: {"pose": list(p.pose), "posture": p.posture} for n, p in spec.people.items()},
-            "doors": {n: d.open for n, d in spec.doors.items()},
-            "devices": {n: {"type": d.type, "place": d.place, "state": d.state} for n, d in spec.devices.items()},
-        }
-        print(json.dumps(doc, indent=2))
+        from robot.describe import describe_world
+
+        print(json.dumps(describe_world(spec, None if args.no_roadmap else args.seed), indent=2))
     elif not args.out:
         print(f"{spec.name}: {spec.description}")
         print(f"  bounds {spec.bounds}, {len(spec.rooms)} rooms, {len(spec.obstacles)} obstacles, "
@@ -134,11 +130,15 @@ def register(subparsers: Any) -> None:
         "world", help="show a world: places, people; draw it",
         description="Load and check a world (a shipped name or a .toml file); print its places and people, "
                     "as text or JSON, and draw it from above.",
-        epilog="examples:\n  tasker world paper\n  tasker world flat --json\n"
+        epilog="examples:\n  tasker world paper\n  tasker world flat --json\n  tasker world paper --json --no-roadmap\n"
                "  tasker world my_flat.toml --out flat.png")
     p.add_argument("world", metavar="WORLD", help="a shipped world name (paper, flat) or a .toml path")
     p.add_argument("--out", metavar="PNG", help="write a top-down picture")
-    p.add_argument("--json", action="store_true", help="print places, bounds and people as JSON")
+    p.add_argument("--json", action="store_true",
+                   help="print the whole world as JSON (format tasker.world/1, see docs/robot.md): places, rooms, "
+                        "doors, devices, people, objects and the roadmap's statistics")
+    p.add_argument("--seed", type=seed, default=1, help="roadmap seed for --json, 0 <= N < 2**32 (default 1)")
+    p.add_argument("--no-roadmap", action="store_true", help="with --json: leave the roadmap out (no OMPL run)")
     p.set_defaults(func=_world)
     c = subparsers.add_parser(
         "cost", help="travel times of the robot between places (a matrix, one call)",

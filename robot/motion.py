@@ -3,21 +3,25 @@
 :class:`BasePlanner` answers "how does the base get from here to there" on the
 :class:`~robot.roadmap.Roadmap` grown once by OMPL:
 
-1. start and goal are linked to their nearest visible roadmap nodes (exact tests,
-   people standing at the start or goal are ignored: the robot is beside them);
-2. if nothing dynamic (closed door, person) blocks a roadmap edge, the best route is
-   a look-up in the all-pairs table; otherwise a Dijkstra search (scipy) runs on the
-   roadmap less its blocked edges;
+1. a start in collision is snapped off it; start and goal are linked to their nearest
+   visible roadmap nodes (exact tests; people judged by
+   :meth:`Scene.people_clear <robot.scene.Scene.people_clear>`, the rule the
+   ``navigate`` skill checks paths with: a path may leave a person's clearance or
+   stop inside it, never enter it);
+2. a Dijkstra search (scipy) from the start over the roadmap less the edges closed
+   doors block; if its path is clear of people it is the answer, otherwise a second
+   search over the roadmap less the edges people block, plus rings of milestones
+   around them;
 3. the route is shortened: the shortest chain of mutually visible route points.
 
 :class:`MotionEstimator` implements :class:`tasker.world.MotionModel`: time comes from
 :class:`DriveLimits` with the same stop–turn–drive profile the controller executes
 (:mod:`robot.control`), so estimates match what MuJoCo takes.
 
-**Caching.**  Results are cached by (start, goal, ``Scene.version``).  The version
-changes whenever a door opens or closes or a person moves or changes posture, so a
-cached answer can never describe a scene that no longer exists; the roadmap itself
-covers only walls and furniture and never needs rebuilding.
+**Caching.**  Results and search trees are cached by exactly what they depend on
+(start, goal, closed doors, people), so a cached answer can never describe a scene
+that no longer exists; the roadmap itself covers only walls and furniture and never
+needs rebuilding.
 """
 
 from __future__ import annotations
@@ -31,7 +35,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from robot.roadmap import Roadmap, heading, path_length
-from robot.scene import Disc, Scene, point_box_distance, point_segment_distance, segments_clear
+from robot.scene import Disc, Scene, point_box_distance, segments_clear
 from robot.spec import RobotSpec, WorldSpec
 from tasker.world import UNREACHABLE, MotionEstimate, Pose
 
@@ -96,6 +100,7 @@ Layer = tuple[tuple[str, ...], tuple[Disc, ...]]  # closed doors, people in the 
 RING = 16  # milestones around a person in the way
 SNAP_STEP = 0.01  # metres between the rings searched for a free start
 SNAP_REACH = 0.6  # metres: a start deeper in collision than this is not snapped
+RING_SLACK = 0.005  # metres a ring's chords keep outside the person's clearance
 
 
 class BasePlanner:
@@ -111,10 +116,13 @@ class BasePlanner:
        so it is still the shortest);
     3. otherwise the **people layer**: the roadmap less the edges people block, plus a
        ring of milestones around each person in the way (so the path hugs them), searched
-       from the start and cached by (start, closed doors, people in the way).
+       from the start and cached by (start, closed doors, people).
 
-    A start in collision (braked next to a door jamb, pushed against a wall) is snapped
-    to the nearest free point first; the path then starts with that short move.
+    People are judged by :meth:`Scene.people_clear <robot.scene.Scene.people_clear>`,
+    the rule the ``navigate`` skill checks the path ahead with, so every path returned
+    is one the skill drives.  A start in collision (braked next to a door jamb, pushed
+    against a wall) is snapped to the nearest free point first (:meth:`snap`); the
+    path then starts with that short move.
     """
 
     def __init__(self, spec: WorldSpec, scene: Scene, seed: int = 1, milestones: int | None = None,
@@ -143,8 +151,15 @@ class BasePlanner:
             self._all_boxes = np.vstack([self.scene.static, self.scene.closed_doors()])
         return self._all_boxes
 
-    def _free_segments(self, a: np.ndarray, b: np.ndarray, discs: tuple[Disc, ...]) -> np.ndarray:
-        """Which segments are clear of the bounds, walls, furniture, closed doors and ``discs``."""
+    def _free_segments(self, a: np.ndarray, b: np.ndarray, discs: tuple[Disc, ...], leaving: bool = True,
+                       goal: Point | None = None) -> np.ndarray:
+        """Which segments are clear of the bounds, walls, furniture, closed doors and ``discs``.
+
+        People by :meth:`Scene.people_clear <robot.scene.Scene.people_clear>` — the very
+        rule the ``navigate`` skill checks the path ahead with: segments of a path, driven
+        from ``a`` to ``b`` (``leaving``), stopping at ``goal``; roadmap edges, which are
+        searched both ways, with ``leaving=False``.
+        """
         scene, r = self.scene, self.scene.radius
         a, b = np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2)
         lo, hi = np.minimum(a, b), np.maximum(a, b)
@@ -152,12 +167,16 @@ class BasePlanner:
         ok &= hi[:, 1] <= scene.ymax - r
         ok &= segments_clear(a, b, self._boxes(), r)
         if discs and ok.any():
-            px, py = np.array([d.x for d in discs]), np.array([d.y for d in discs])
-            rr = np.array([d.r for d in discs]) + r
-            ok &= (point_segment_distance(px, py, a, b) >= rr[None, :]).all(axis=1)
+            idx = np.flatnonzero(ok)
+            ok[idx] = scene.people_clear(a[idx], b[idx], discs, leaving=leaving, goal=goal)
         return ok
 
-    def _free_points(self, pts: np.ndarray, discs: tuple[Disc, ...]) -> np.ndarray:
+    def _free_points(self, pts: np.ndarray) -> np.ndarray:
+        """Which points the robot may stand on: clear of bounds, walls, furniture, closed doors.
+
+        People never make a point invalid: the robot may be beside them already, or stop
+        next to them; :meth:`_free_segments` keeps it from driving deeper.
+        """
         scene, r = self.scene, self.scene.radius
         x, y = pts[:, 0], pts[:, 1]
         ok = (x >= scene.xmin + r) & (x <= scene.xmax - r) & (y >= scene.ymin + r) & (y <= scene.ymax - r)
@@ -165,8 +184,6 @@ class BasePlanner:
             ok &= point_box_distance(x, y, scene.static).min(axis=1) >= r
         if len(scene.closed_doors()):
             ok &= point_box_distance(x, y, scene.closed_doors()).min(axis=1) >= r
-        for d in discs:
-            ok &= np.hypot(x - d.x, y - d.y) >= d.r + r
         return ok
 
     def _door_mask(self, doors: tuple[str, ...]) -> np.ndarray:
@@ -177,7 +194,7 @@ class BasePlanner:
 
     def _disc_mask(self, d: Disc) -> np.ndarray:
         if d not in self._disc_masks:
-            self._disc_masks[d] = self.roadmap.disc_blocked(d.x, d.y, d.r + self.scene.radius)
+            self._disc_masks[d] = self.roadmap.disc_blocked(d.x, d.y, self.scene.clearance(d))
             if len(self._disc_masks) > 256:
                 self._disc_masks.popitem(last=False)
         return self._disc_masks[d]
@@ -187,10 +204,10 @@ class BasePlanner:
         ``-1 - ring index``), clear of walls, furniture and closed doors."""
         key = (d, doors)
         if key not in self._rings:
-            radius = (d.r + self.scene.radius) / math.cos(math.pi / RING) + 0.005
+            radius = self.scene.clearance(d) / math.cos(math.pi / RING) + RING_SLACK
             ang = 2 * math.pi * np.arange(RING) / RING
             pts = np.stack([d.x + radius * np.cos(ang), d.y + radius * np.sin(ang)], axis=1)
-            keep = self._free_points(pts, ())
+            keep = self._free_points(pts)
             pts = pts[keep]
             local = np.flatnonzero(keep)
             rm = self.roadmap
@@ -205,7 +222,7 @@ class BasePlanner:
                 b_idx += [int(n) for n in near]
             a_arr, b_arr = np.array(a_idx, dtype=int), np.array(b_idx, dtype=int)
             ends = np.where(b_arr[:, None] >= 0, rm.nodes[np.maximum(b_arr, 0)], pts[-1 - np.minimum(b_arr, -1)])
-            ok = self._free_segments(pts[a_arr], ends, ()) if len(a_arr) else np.zeros(0, dtype=bool)
+            ok = self._free_segments(pts[a_arr], ends, (), leaving=False) if len(a_arr) else np.zeros(0, dtype=bool)
             self._rings[key] = (pts, np.stack([a_arr[ok], b_arr[ok]], axis=1).reshape(-1, 2))
             if len(self._rings) > 256:
                 self._rings.popitem(last=False)
@@ -234,17 +251,19 @@ class BasePlanner:
         all_edges = np.vstack(edges)
         if len(discs) and len(all_edges) > len(edges[0]):
             ring_part = all_edges[len(edges[0]):]
-            others = [d for d in discs]
-            ok = self._free_segments(all_nodes[ring_part[:, 0]], all_nodes[ring_part[:, 1]], tuple(others))
+            ok = self._free_segments(all_nodes[ring_part[:, 0]], all_nodes[ring_part[:, 1]], discs, leaving=False)
             all_edges = np.vstack([edges[0], ring_part[ok]])
         lengths = np.hypot(*(all_nodes[all_edges[:, 0]] - all_nodes[all_edges[:, 1]]).T)
         return all_nodes, all_edges, lengths
 
     def _links(self, p: Point, nodes: np.ndarray, discs: tuple[Disc, ...], k: int = 16,
-               also: Point | None = None) -> tuple[np.ndarray, np.ndarray, bool]:
+               also: Point | None = None, goal: bool = False) -> tuple[np.ndarray, np.ndarray, bool]:
         """Nodes visible from ``p`` among its ``k`` nearest and the nearest 24 milestones within
         3 m that are not OMPL samples (corners, doors, places, rings), with distances; and
-        whether ``p`` sees ``also`` directly (one vectorised test for all)."""
+        whether ``p`` sees ``also`` directly (one vectorised test for all).
+
+        ``p`` is the path's start (segments ``p → node``), or with ``goal`` its goal
+        (segments ``node → p`` and ``also → p``): people are judged in driving order."""
         d = np.hypot(nodes[:, 0] - p[0], nodes[:, 1] - p[1])
         first = int(self.roadmap.corner_nodes[0]) if len(self.roadmap.corner_nodes) else len(self.roadmap.nodes)
         near = np.argpartition(d, min(k, len(d) - 1))[:k]
@@ -253,7 +272,8 @@ class BasePlanner:
             special = special[np.argsort(d[special], kind="stable")[:24]]
         cand = np.unique(np.concatenate([near, special]))
         ends = nodes[cand] if also is None else np.vstack([nodes[cand], [also]])
-        ok = self._free_segments(np.repeat([p], len(ends), axis=0), ends, discs)
+        here = np.repeat([p], len(ends), axis=0)
+        ok = self._free_segments(ends, here, discs, goal=p) if goal else self._free_segments(here, ends, discs)
         direct = bool(ok[-1]) if also is not None else False
         ok = ok[: len(cand)]
         return cand[ok], d[cand[ok]], direct
@@ -285,7 +305,7 @@ class BasePlanner:
         P = np.asarray(pts)
         ii, jj = np.triu_indices(n, 1)
         free = np.zeros((n, n), dtype=bool)
-        free[ii, jj] = self._free_segments(P[ii], P[jj], discs)
+        free[ii, jj] = self._free_segments(P[ii], P[jj], discs, goal=pts[-1])
         free[np.arange(n - 1), np.arange(1, n)] = True  # route links are valid by construction
         seg = np.hypot(*(P[None, :, :] - P[:, None, :]).transpose(2, 0, 1))
         best = np.full(n, math.inf)
@@ -301,20 +321,27 @@ class BasePlanner:
         return [pts[k] for k in reversed(out)]
 
     def snap(self, p: Point, discs: tuple[Disc, ...] = ()) -> Point | None:
-        """The nearest free point to ``p`` (``p`` itself when free), within ``SNAP_REACH``."""
-        if self._free_points(np.array([p]), discs)[0]:
+        """The nearest point to ``p`` the robot may stand on (``p`` itself when it may), within
+        ``SNAP_REACH``, reached from ``p`` without coming closer to any of ``discs`` than it is
+        (:meth:`Scene.people_clear <robot.scene.Scene.people_clear>`): a start braked against a
+        door jamb is moved off it, a start beside a person stays where it is."""
+        if self._free_points(np.array([p]))[0]:
             return p
         radii = np.arange(1, int(SNAP_REACH / SNAP_STEP) + 1) * SNAP_STEP
         ang = 2 * math.pi * np.arange(32) / 32
-        pts = np.stack([p[0] + np.outer(radii, np.cos(ang)).ravel(), p[1] + np.outer(radii, np.sin(ang)).ravel()], 1)
-        ok = np.flatnonzero(self._free_points(pts, discs))
+        # rounded first, then tested: a snapped start must be free as it is returned
+        pts = np.round(np.stack([p[0] + np.outer(radii, np.cos(ang)).ravel(),
+                                 p[1] + np.outer(radii, np.sin(ang)).ravel()], 1), 4)
+        ok = np.flatnonzero(self._free_points(pts))
+        if len(ok) and discs:
+            ok = ok[self.scene.people_clear(np.repeat([p], len(ok), axis=0), pts[ok], discs)]
         if not len(ok):
             return None
-        return (round(float(pts[ok[0], 0]), 4), round(float(pts[ok[0], 1]), 4))
+        return (float(pts[ok[0], 0]), float(pts[ok[0], 1]))
 
     def _query(self, s: Point, g: Point, layer: Layer) -> tuple[Point, ...] | None:
         discs = layer[1]
-        if not self._free_points(np.array([g]), discs)[0]:
+        if not self._free_points(np.array([g]))[0]:
             return None
         s0 = s
         snapped = self.snap(s, discs)
@@ -325,7 +352,7 @@ class BasePlanner:
         if math.hypot(g[0] - s[0], g[1] - s[1]) < 1e-6:
             return (*head, s, g)
         dist, pred, nodes = self._tree(s, layer)
-        gi, gd, direct = self._links(g, nodes, discs, also=s)
+        gi, gd, direct = self._links(g, nodes, discs, also=s, goal=True)
         if direct:
             return (*head, s, g)
         if not len(gi):
@@ -346,15 +373,23 @@ class BasePlanner:
         s = (round(float(start[0]), 4), round(float(start[1]), 4))
         g = (round(float(goal[0]), 4), round(float(goal[1]), 4))
         doors = self._doors()
-        ignore = self.scene.blocking_discs([s, g])
-        discs = tuple(self.scene.discs(ignore))
+        # people the goal is beside do not block the way to it (Scene.people_clear)
+        discs = tuple(d for d in self.scene.discs() if not self.scene.holds(d, g))
         path = self._cached((s, g, doors, ()))
         if path is None or not discs:
             return path
         pts = np.asarray(path)
-        if self._free_segments(pts[:-1], pts[1:], discs).all():
+        # the door-layer path may start with a snap off a jamb; people judge it as driven
+        if self.scene.people_clear(pts[:-1], pts[1:], discs, goal=g).all():
             return path
-        return self._cached((s, g, doors, discs))
+        path = self._cached((s, g, doors, discs))
+        if path is None:
+            # no way that leaves the people the robot is beside without coming closer (a
+            # place between two people): pass them, as Scene.path_clear allows
+            away = tuple(d for d in discs if not self.scene.holds(d, s))
+            if len(away) < len(discs):
+                path = self._cached((s, g, doors, away))
+        return path
 
     def _cached(self, key: tuple[Point, Point, tuple[str, ...], tuple[Disc, ...]]) -> tuple[Point, ...] | None:
         if key in self._cache:

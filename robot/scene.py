@@ -24,6 +24,7 @@ import numpy as np
 from robot.spec import Box, WorldSpec
 
 PERSON_RADIUS = {"standing": 0.25, "sitting": 0.35, "fallen": 0.6}
+PEOPLE_TOLERANCE = 1e-3  # metres of slack: planned paths are rounded to 0.1 mm, the skill checks from the true pose
 
 
 @dataclass(frozen=True, slots=True)
@@ -183,13 +184,73 @@ class Scene:
                 return False
         return True
 
-    def blocking_discs(self, points: list[tuple[float, float]]) -> tuple[str, ...]:
-        """People whose disc overlaps the robot at any of ``points`` (the robot is beside them)."""
-        out = []
-        for d in self.discs():
-            if any(math.hypot(px - d.x, py - d.y) < d.r + self.radius for px, py in points):
-                out.append(d.name)
-        return tuple(out)
+    def clearance(self, d: Disc) -> float:
+        """How close the robot's centre may come to person ``d``'s centre: their radius plus its."""
+        return d.r + self.radius
+
+    def holds(self, d: Disc, point: tuple[float, float]) -> bool:
+        """Is ``point`` inside person ``d``'s clearance (the robot there would touch them)?"""
+        return math.hypot(point[0] - d.x, point[1] - d.y) < self.clearance(d)
+
+    def beside(self, point: tuple[float, float]) -> tuple[str, ...]:
+        """People whose clearance holds ``point`` (by name)."""
+        return tuple(d.name for d in self.discs() if self.holds(d, point))
+
+    def path_clear(self, points: list[tuple[float, float]] | np.ndarray, slack: float = 0.0,
+                   ignore: tuple[str, ...] = ()) -> bool:
+        """Is the polyline ``points`` clear of people (less ``ignore``), driven from its first
+        point to its last?  What the ``navigate`` skill asks of the path ahead, from the
+        base's true pose.  People the robot is beside at either end do not block it (it is
+        leaving them, or stopping beside them); the planner prefers a path that leaves
+        them without coming closer (:meth:`people_clear`), and every path it returns
+        passes this test.
+        """
+        pts = np.asarray(points, float).reshape(-1, 2)
+        if len(pts) < 2:
+            return True
+        start, goal = (float(pts[0, 0]), float(pts[0, 1])), (float(pts[-1, 0]), float(pts[-1, 1]))
+        skip = set(ignore) | set(self.beside(start))
+        discs = [d for d in self.discs() if d.name not in skip]
+        return bool(self.people_clear(pts[:-1], pts[1:], discs, goal=goal, slack=slack).all())
+
+    def people_clear(self, a: np.ndarray, b: np.ndarray, discs: tuple[Disc, ...] | list[Disc] | None = None,
+                     leaving: bool = True, goal: tuple[float, float] | None = None,
+                     slack: float = 0.0) -> np.ndarray:
+        """**The** definition of "a person blocks this segment", used by the base planner,
+        the ``navigate`` skill's check of the path ahead and the snapping of a start alike,
+        so that a path the planner returns is one the skill drives.
+
+        Segment ``a[i]→b[i]`` is blocked by a person when it comes closer to their centre
+        than :meth:`clearance` — except that
+
+        * the robot may already be closer (a person walked up to it, it braked beside
+          them): with ``leaving``, a segment that starts inside a clearance is clear as
+          long as it never comes closer than its start, so the robot can always back
+          away, and a path never *enters* a clearance on its way;
+        * the robot may be sent next to someone (0.9 m from a fallen person, to a place
+          a person stands on): people whose clearance holds ``goal`` do not block the
+          path to it — they are who the robot is going to stop beside.
+
+        Without ``leaving`` (the undirected roadmap edges) a segment is blocked whenever
+        it comes closer than the clearance.  ``discs`` defaults to everyone in the scene.
+        ``slack`` metres closer are tolerated: the planner plans with none; the skill,
+        which checks from the base's true pose (a waypoint counts as reached within a
+        couple of centimetres), with a little, so that it accepts every path the planner
+        returns as the base really drives it.
+        """
+        a, b = np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2)
+        ok = np.ones(len(a), dtype=bool)
+        discs = self.discs() if discs is None else list(discs)
+        if goal is not None:
+            discs = [d for d in discs if not self.holds(d, goal)]
+        if not discs or not len(a):
+            return ok
+        px, py = np.array([d.x for d in discs]), np.array([d.y for d in discs])
+        limit = np.broadcast_to(np.array([self.clearance(d) for d in discs])[None, :], (len(a), len(discs)))
+        if leaving:
+            limit = np.minimum(limit, np.hypot(a[:, :1] - px[None, :], a[:, 1:] - py[None, :]))
+        near = point_segment_distance(px, py, a, b) < limit - (PEOPLE_TOLERANCE + slack)
+        return np.asarray(~near.any(axis=1), dtype=bool)
 
     def free(self, x: float, y: float, ignore: tuple[str, ...] = ()) -> bool:
         """Static and dynamic layers: walls, furniture, closed doors, people (less ``ignore``)."""
@@ -201,8 +262,14 @@ class Scene:
         return all(math.hypot(x - d.x, y - d.y) >= d.r + self.radius for d in self.discs(ignore))
 
     def segments_free(self, a: np.ndarray, b: np.ndarray, dynamic: bool = True, static: bool = True,
+                      goal: tuple[float, float] | None = None, slack: float = 0.0,
                       ignore: tuple[str, ...] = ()) -> np.ndarray:
-        """Which segments ``a[i]→b[i]`` the disc robot can sweep along (exact, vectorised)."""
+        """Which segments ``a[i]→b[i]`` the disc robot can sweep along (exact, vectorised).
+
+        The dynamic layer is closed doors and people; people by :meth:`people_clear`
+        (driven from ``a`` to ``b``, stopping at ``goal``, ``slack`` metres tolerated),
+        less the people named in ``ignore``.
+        """
         a, b = np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2)
         ok = np.ones(len(a), dtype=bool)
         r = self.radius
@@ -213,10 +280,5 @@ class Scene:
             ok &= segments_clear(a, b, self.static, r)
         if dynamic:
             ok &= segments_clear(a, b, self._closed, r)
-            discs = self.discs(ignore)
-            if discs:
-                px = np.array([d.x for d in discs])
-                py = np.array([d.y for d in discs])
-                rr = np.array([d.r for d in discs]) + r
-                ok &= (point_segment_distance(px, py, a, b) >= rr[None, :]).all(axis=1)
+            ok &= self.people_clear(a, b, self.discs(ignore), goal=goal, slack=slack)
         return ok

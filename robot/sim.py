@@ -36,7 +36,7 @@ from robot.people import People, Person
 from robot.recording import PersonState, Recorder
 from robot.scene import Scene, segments_clear
 from robot.skills import SKILLS, Skill
-from robot.spec import WorldSpec, load_world
+from robot.spec import WorldSpec, load_world, room_of
 from robot.tiago import robot_dimensions
 from tasker.meaning import Binding
 from tasker.protocols import RUNNING, SkillState, SkillStatus, failed
@@ -313,11 +313,8 @@ class Simulation:
         return self.place_of(x, y, self.spec.places)
 
     def room_of(self, x: float, y: float) -> str | None:
-        """The smallest room whose box holds ``(x, y)`` (ties by name), or None."""
-        rooms = [(b[2] - b[0]) * (b[3] - b[1]) for b in self.spec.rooms.values()]
-        inside = [(area, n) for area, (n, b) in zip(rooms, self.spec.rooms.items(), strict=True)
-                  if b[0] <= x <= b[2] and b[1] <= y <= b[3]]
-        return min(inside)[1] if inside else None
+        """The smallest room whose box holds ``(x, y)`` (ties by name), or None (:func:`robot.spec.room_of`)."""
+        return room_of(self.spec, x, y)
 
     def place_of(self, x: float, y: float, spots: Mapping[str, Pose]) -> str:
         """The nearest of ``spots`` that is not behind a wall (ties broken by name).

@@ -57,6 +57,10 @@ BLOCK_TIMEOUT = 5.0  # seconds a blocked path is retried before the skill fails
 STALL_TIMEOUT = 2 * BLOCK_TIMEOUT  # seconds without moving STALL_MOVE metres before the skill gives up
 STALL_MOVE = 0.1
 CHECK_PERIOD = 0.2  # seconds between checks of the path ahead
+# metres closer to a person than planned that the check of the path ahead tolerates: the
+# follower counts a waypoint reached within POS_TOL and drives on from where it really is,
+# and keeps to a leg within about a centimetre
+TRACKING_SLACK = PathFollower.POS_TOL + 0.01
 
 
 class Skill:
@@ -150,10 +154,16 @@ class Navigate(Skill):
         ahead = [(x, y)] + f.path[f.leg + 1 :]
         if len(ahead) < 2:
             return False
+        # people by the planner's own rule (Scene.people_clear): what it plans, this accepts.
+        # Whoever follows the robot was planned around but is not checked against: they walk
+        # its trail, up to it, and would otherwise make it re-plan at each of their steps.
+        followers = tuple(p.name for p in self.sim.people if p.following)
         scene = self.sim.scene
-        ignore = scene.blocking_discs([(x, y), ahead[-1]])
         pts = np.asarray(ahead)
-        return not scene.segments_free(pts[:-1], pts[1:], static=False, ignore=ignore).all()
+        if len(scene.closed_doors()) and not scene.segments_free(pts[:-1], pts[1:], static=False,
+                                                                 ignore=tuple(scene.people)).all():
+            return True  # a door closed across the way
+        return not scene.path_clear(ahead, slack=TRACKING_SLACK, ignore=followers)
 
     def control(self, now: float, dt: float) -> Command:
         f = self.follower
@@ -167,7 +177,9 @@ class Navigate(Skill):
             self.next_check = now + CHECK_PERIOD
             moved = (self.person_at is not None and isinstance(self.target, str)
                      and math.dist(self.person_at, self.sim.people[self.target].pose[:2]) > 0.5)
-            if moved or self._path_ahead_blocked():
+            # a failed re-plan left the base braked: retry at every check until it works or
+            # BLOCK_TIMEOUT passes, even if the old path ahead has since cleared
+            if moved or self.blocked_since is not None or self._path_ahead_blocked():
                 why = self._replan()
                 f = self.follower
                 assert f is not None  # _replan installs a new follower or keeps the old one, never clears it

@@ -222,6 +222,13 @@ def read_world(top: Table, source: str) -> WorldSpec:
     return spec
 
 
+def room_of(spec: WorldSpec, x: float, y: float) -> str | None:
+    """The smallest room whose box holds ``(x, y)`` (ties by name), or None."""
+    inside = [((b[2] - b[0]) * (b[3] - b[1]), n) for n, b in spec.rooms.items()
+              if b[0] <= x <= b[2] and b[1] <= y <= b[3]]
+    return min(inside)[1] if inside else None
+
+
 def point_problem(spec: WorldSpec, x: float, y: float) -> str | None:
     """Why ``(x, y)`` is not a point in the world's free space (outside the bounds, inside a
     wall or furniture), or ``None``."""

@@ -16,6 +16,10 @@ reaches the next suspendable stage.  ``term`` while in ``cmd`` is handled as a s
 suspension followed by ``end`` (a task is never dropped mid-manoeuvre); so is the
 task's own ``ic_term`` (``check_terminate``) while it executes.
 
+Hazard-aware waiting (``docs/model.md``): a ``start`` whose data has ``secure`` makes a
+waiting agent *secure* its hazard — ``wait --secure--> genSusp``, the suspension of the
+``strict`` policy, ``exeSusp``, then ``wait`` again — instead of resuming its task.
+
 The agent never names a target state: it fires events through the one FSM table of
 :mod:`tasker.fsm`, whose guards it evaluates.  Every call into a task hook or the core
 agent is contained (:meth:`DynamicAgent.step`): an exception ends this task only.
@@ -26,10 +30,10 @@ from __future__ import annotations
 import math
 import traceback
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
-from tasker import fsm
+from tasker import fsm, securing
 from tasker.errors import AgentEnded, ConfigError, FSMError, InvariantViolation, PlanningFailed, WorldError
 from tasker.messages import Command, Flag, FsmState, Report, ScheduleParams, SPRequest
 from tasker.protocols import CoreAgent, SkillState
@@ -112,6 +116,7 @@ class DynamicAgent:
         self._ack = 0
         self._pending_start = False
         self._pending_susp = False
+        self._pending_secure = False  # the pending start asks to secure (hazard-aware waiting)
         self._pending_term: tuple[str, str] | None = None  # (reason, cause: "term" or "self")
         self._runner: StageRunner | None = None
         self._ready_at = 0.0  # end of a planning hook's simulated time
@@ -181,6 +186,19 @@ class DynamicAgent:
             self._fail(now, exc)
             raise AgentEnded(self.id, self.end_reason or "error") from exc
 
+    @property
+    def progress(self) -> tuple[FsmState, int]:
+        """Where the agent is: its state and the index of its current stage (estimates change with it)."""
+        return self.state, self._runner.index if self._runner is not None else -1
+
+    def secure_estimate(self, now: float) -> float:
+        """Seconds until this waiting agent, asked to secure now, is safe (:func:`tasker.securing.secure_estimate`)."""
+        return securing.secure_estimate(self, now)
+
+    def suspend_estimate(self, now: float, expected_s: float | None = None) -> float:
+        """Seconds until this agent, sent ``susp`` now, waits (:func:`tasker.securing.suspend_estimate`)."""
+        return securing.suspend_estimate(self, now, expected_s)
+
     def abort(self, now: float, reason: str) -> None:
         """End at once with cause ``error`` (the run is aborted): stop the running stage, guarded."""
         if self.state is not S.END:
@@ -223,6 +241,7 @@ class DynamicAgent:
             self._ack = cmd.seq
             if cmd.flag is Flag.START:
                 self._pending_start = True
+                self._pending_secure = bool(cmd.data.get("secure"))
             elif cmd.flag is Flag.SUSP:
                 self._pending_susp = True
                 if "expected_s" in cmd.data:  # how long the interruption is expected to last
@@ -248,7 +267,11 @@ class DynamicAgent:
         if self._pending_start:
             self._pending_start = False
             self._pending_susp = False  # a susp that reached a non-executing agent is void
-            self._start_up_tsk(now)
+            if self._pending_secure and self.state is S.WAIT:
+                self._start_secure(now)
+            else:
+                self._pending_secure = False
+                self._start_up_tsk(now)
             return
         self._pending_susp = False
         why = self.task.check_terminate(self.ctx)
@@ -376,6 +399,31 @@ class DynamicAgent:
         except PlanningFailed as exc:
             self._end(now, f"genSusp {exc.status}: {exc}", cause="failed", event="plan_failed")
             return
+        self._run_suspension(now, plan)
+
+    def _start_secure(self, now: float) -> None:
+        """Hazard-aware waiting: from ``wait``, reach the ``strict`` policy's safe state, then wait again.
+
+        The same hook as any suspension (``generate_suspension``), asked under the
+        ``strict`` policy: whatever a ``conditional`` branch left unsafe for a short
+        interruption is made safe now that the interruption has lasted.
+        """
+        self._pending_secure = False
+        self.ctx.terminating = False
+        self._fire("secure", now)
+        self._refresh(now)
+        strategy = self.ctx.strategy
+        self.ctx.strategy = replace(strategy, policy="strict")
+        try:
+            plan = self.task.generate_suspension(self.ctx)
+        except PlanningFailed as exc:
+            self._end(now, f"genSusp (secure) {exc.status}: {exc}", cause="failed", event="plan_failed")
+            return
+        finally:
+            self.ctx.strategy = strategy
+        self._run_suspension(now, plan)
+
+    def _run_suspension(self, now: float, plan: StagePlan) -> None:
         self._emit_plan(now, plan)
         self._runner = StageRunner(plan)
         self._ready_at = now + plan.sim_time

@@ -109,11 +109,15 @@ TRANSITIONS: tuple[Transition, ...] = (
     Transition(S.EXE_SUSP, "stage_failed", S.END, condition="stage failed"),
     Transition(S.WAIT, "start", S.UP_TSK, condition="ic_start"),
     Transition(S.WAIT, "term", S.END, condition="ic_term"),
+    # not in Fig. 5: hazard-aware waiting (docs/model.md) lets a waiting task secure its hazard,
+    # then exeSusp --finished--> wait as after any suspension
+    Transition(S.WAIT, "secure", S.GEN_SUSP, condition="secure: a hazard's budget runs out"),
 ) + tuple(
     Transition(s, "error", S.END, condition="exception in a hook, a skill or the planner")
     for s in FsmState if s is not S.END
 )
-"""Every transition of Fig. 5, plus ``error`` from every state (a raising hook ends its task)."""
+"""Every transition of Fig. 5, plus ``error`` from every state (a raising hook ends its task) and
+``wait --secure--> genSusp`` (hazard-aware waiting, a departure documented in ``docs/model.md``)."""
 
 GUARDS: tuple[str, ...] = tuple(sorted({t.guard for t in TRANSITIONS if t.guard is not None}))
 """Guard names a runner must evaluate."""

@@ -23,6 +23,14 @@ the executing task for nothing —, and once per switch rather than on every
 iteration; and ``pf_switchDA`` also runs while the executing agent is suspending,
 so that if ``irrDA`` ends meanwhile the suspended agent still leaves ``exeDA``
 (eq. 36 would never trigger it again: found by the property test).
+
+**Hazard-aware waiting** (``hazard_waiting=True`` and a ``hazards`` source, e.g.
+:meth:`tasker.meaning.Monitor.active`), not in the paper: at each ``timer(sFreq)``
+the harmoniser checks every waiting agent whose hazard holds and is unattended; when
+the budget left is no more than the time to secure it (:class:`tasker.securing.HazardWatch`),
+it makes that agent ``irrDA`` whatever the scheduler says — the executing agent is
+suspended safely the normal way — and starts it with ``secure``: the agent reaches
+its ``strict`` safe state and waits again (``docs/model.md``).
 """
 
 from __future__ import annotations
@@ -37,9 +45,10 @@ from tasker.agent import DynamicAgent
 from tasker.errors import AgentEnded, ConfigError, InvariantViolation, TaskerError, WorldError
 from tasker.messages import Command, Flag, FsmState, ScheduleParams, SPRequest
 from tasker.schedulers.base import Candidate, Scheduler, ScheduleView
+from tasker.securing import HazardSource, HazardWatch
 from tasker.trace import Trace
 
-_TRACED = frozenset({"by", "expected_s", "predicted_s"})
+_TRACED = frozenset({"by", "expected_s", "predicted_s", "secure"})
 """Command data copied into the ``command`` trace event."""
 
 
@@ -87,11 +96,23 @@ class OscillationGuard:
 AgentFactory = Callable[[str, Request, float, Callable[[DynamicAgent], None]], DynamicAgent]
 
 
+@dataclass(slots=True)
+class _Securing:
+    """The agent chosen to secure its hazard, its estimated time to secure, and the ``start`` it was sent."""
+
+    agent: str
+    secure_s: float
+    seq: int | None = None
+
+
 class TaskHarmoniser:
     """The robot's task harmoniser.  ``exe_da``, ``irr_da`` and ``idle_da`` are its roles.
 
     ``hazard_waiting`` (default off) selects hazard-aware waiting, one factor of the
-    static-versus-planned sweep (``docs/sweeps.md``); it is stored for the behaviour that uses it.
+    static-versus-planned sweep (``docs/model.md``): with a ``hazards`` source (set
+    here or later as :attr:`hazards`), a waiting agent secures its hazard before the
+    hazard's budget runs out (module docstring).  ``secure_margin_s`` is the slack
+    added to the estimated time to secure.
     """
 
     def __init__(
@@ -104,6 +125,8 @@ class TaskHarmoniser:
         s_freq: float = 1.0,
         guard: OscillationGuard | None = OscillationGuard(),
         hazard_waiting: bool = False,
+        hazards: HazardSource | None = None,
+        secure_margin_s: float = 5.0,
     ) -> None:
         if not isinstance(s_freq, int | float) or s_freq <= 0:
             raise ConfigError(f"sFreq must be a positive number of Hz, got {s_freq!r}")
@@ -111,7 +134,10 @@ class TaskHarmoniser:
         self.mode = Mode(mode)
         self.s_freq = float(s_freq)
         self.guard = guard  # None: no oscillation guard
-        self.hazard_waiting = bool(hazard_waiting)  # hazard-aware waiting, a sweep factor (stored only for now)
+        self.hazard_waiting = bool(hazard_waiting)  # hazard-aware waiting, a sweep factor
+        self.hazards = hazards  # where hazard-aware waiting learns of hazards (None: it has nothing to watch)
+        self.watch = HazardWatch(secure_margin_s, 1.0 / self.s_freq)  # hazard-aware waiting's memory
+        self._securing: _Securing | None = None
         self._became: dict[str, list[float]] = {}  # when each agent became exeDA since the last new request
         self._factory = agent_factory
         self._trace = trace
@@ -182,13 +208,15 @@ class TaskHarmoniser:
         term_event = bool(self._ended)
         if term_event:
             self._remove_ended()
+        if timer and self.hazard_waiting and self.hazards is not None and self._securing is None:
+            self._watch_hazards(now)
         shdl_event = (self.exe_da is None and self.irr_da is None and bool(self._idle)) or self._new_data
         self._new_data = False
-        if (timer or shdl_event) and self.irr_da is None:
+        if (timer or shdl_event) and self.irr_da is None and self._securing is None:
             if self.exe_da is None or (self.mode is Mode.IT and self.scheduler.preemptive):
                 self._pf_schedule(now)
         suspending = self.exe_da is not None and self.exe_da in self._susp_seq
-        if self.irr_da is not None or term_event or suspending:
+        if self.irr_da is not None or term_event or suspending or self._securing is not None:
             self._pf_switch_da(now)
             if self.exe_da is None and self.irr_da is None and self._idle:  # freed: shdl_event at once
                 self._pf_schedule(now)
@@ -226,6 +254,9 @@ class TaskHarmoniser:
                 self.exe_da = None
             if self.irr_da == agent_id:
                 self.irr_da = None
+            if self._securing is not None and self._securing.agent == agent_id:
+                self._trace.emit(self.now, "secure", agent=agent_id, status="ended")
+                self._securing = None
         self._ended.clear()
         self._roles_dirty = True
 
@@ -288,7 +319,13 @@ class TaskHarmoniser:
     def _pf_switch_da(self, now: float) -> None:
         """Alg. 1."""
         exe = self.exe_da
-        if exe is not None:
+        securing = self._securing
+        if exe is not None and securing is not None and securing.agent == exe:
+            report = self.agents[exe].report
+            assert report is not None
+            if report.fsm_state is FsmState.WAIT and securing.seq is not None and report.ack >= securing.seq:
+                self._secure_done(now, exe)  # secured and waiting again: back to idleDA
+        elif exe is not None:
             report = self.agents[exe].report
             assert report is not None
             state = report.fsm_state
@@ -305,9 +342,52 @@ class TaskHarmoniser:
             if self._in_cmd:
                 raise InvariantViolation(f"about to start {self.irr_da} while {sorted(self._in_cmd)} is in cmd")
             self.exe_da, self.irr_da = self.irr_da, None  # lines 10-11
-            self._became.setdefault(self.exe_da, []).append(now)
-            self._send(self.exe_da, Flag.START, self._start_data(self.exe_da))  # line 12
+            if securing is not None and securing.agent == self.exe_da:  # not a resumption: not in the guard's count
+                securing.seq = self._send(self.exe_da, Flag.START, {"secure": True})
+            else:
+                self._became.setdefault(self.exe_da, []).append(now)
+                self._send(self.exe_da, Flag.START, self._start_data(self.exe_da))  # line 12
             self._roles_dirty = True
+
+    # -- hazard-aware waiting ----------------------------------------------------------------
+
+    def _watch_hazards(self, now: float) -> None:
+        """Hazard-aware waiting: if a waiting agent must secure its hazard now, make it ``irrDA``."""
+        assert self.hazards is not None
+        waiting = {a: da for a in self._idle if (da := self.agents.get(a)) is not None and not da.ended
+                   and da.report is not None and da.report.fsm_state is FsmState.WAIT}
+        if not waiting:
+            return
+        exe = self.agents.get(self.exe_da) if self.exe_da is not None else None
+        try:
+            due = self.watch.due(now, self.hazards(), waiting, exe, self._order)
+        except AgentEnded:
+            self._remove_ended()
+            return
+        if due is None:
+            return
+        agent, hz = due.agent, due.hazard
+        self._securing = _Securing(agent, due.secure_s)
+        self._trace.emit(now, "decision", algorithm=self.scheduler.name, rule="secure", dac=agent,
+                         exeDA=self.exe_da, switch=True, hazard=str(hz.name), args=list(hz.fact[1:]),
+                         remaining_s=due.remaining_s, secure_s=due.secure_s, suspend_s=due.suspend_s,
+                         margin_s=self.watch.margin_s + self.watch.period_s)
+        self._trace.emit(now, "secure", agent=agent, status="start",
+                         hazards=[{"hazard": e[1], "args": list(e[2][1:])} for e in due.episodes])
+        if self.irr_da is not None:  # a switch already under way: the hazard goes first
+            self._idle[self.irr_da] = None
+        del self._idle[agent]
+        self._idle = dict.fromkeys(sorted(self._idle, key=lambda a: self._order.get(a, 0)))
+        self.irr_da = agent
+        self._roles_dirty = True
+
+    def _secure_done(self, now: float, agent: str) -> None:
+        self._trace.emit(now, "secure", agent=agent, status="done")
+        self._securing = None
+        self._idle[agent] = None
+        self._idle = dict.fromkeys(sorted(self._idle, key=lambda a: self._order.get(a, 0)))
+        self.exe_da = None
+        self._roles_dirty = True
 
     # -- agents' side -----------------------------------------------------------------------
 
@@ -338,6 +418,9 @@ class TaskHarmoniser:
         task's suspension may depend on it (a cooker left on for a short interruption).
         """
         data: dict[str, Any] = {"by": replacement}
+        if self._securing is not None and self._securing.agent == replacement:
+            data["expected_s"] = self._securing.secure_s  # it secures its hazard, then waits again
+            return data
         c_time = self._c_time(replacement)
         if c_time is None:
             return data
@@ -373,6 +456,8 @@ class TaskHarmoniser:
             if len(self._in_cmd) > 1:
                 raise InvariantViolation(f"agents {sorted(self._in_cmd)} are in cmd at once")
         else:
+            if agent.id in self._in_cmd:
+                self.watch.left_cmd[agent.id] = self.now  # its hazards are unattended from now on
             self._in_cmd.discard(agent.id)
         if report.fsm_state is FsmState.END:
             self._ended.append(agent.id)

@@ -25,7 +25,7 @@ from typing import Any
 
 from tasker.agent import DynamicAgent, Rates
 from tasker.errors import ConfigError, RunAborted, WorldError
-from tasker.harmoniser import Mode, Request, TaskHarmoniser
+from tasker.harmoniser import HazardSource, Mode, Request, TaskHarmoniser
 from tasker.protocols import CoreAgent, World
 from tasker.schedulers.base import Scheduler
 from tasker.store import TaskStore
@@ -39,7 +39,9 @@ class SimulationLoop:
     """Builds the harmoniser and its agents and steps them on one simulated clock.
 
     ``strategies`` maps a task type to its :class:`Strategy`; others use ``strategy``.
-    ``hazard_waiting`` switches hazard-aware waiting on (passed to the harmoniser).
+    ``hazard_waiting`` switches hazard-aware waiting on and ``hazards`` says which hazards
+    hold (both passed to the harmoniser; ``hazards`` may also be set later on
+    ``harmoniser.hazards``, e.g. to a :meth:`tasker.meaning.Monitor.active` built on this loop).
     """
 
     def __init__(
@@ -60,6 +62,7 @@ class SimulationLoop:
         resolution: float = 0.001,
         horizon: float = 24 * 3600.0,
         hazard_waiting: bool = False,
+        hazards: HazardSource | None = None,
     ) -> None:
         if not (isinstance(resolution, int | float) and 0 < resolution <= 1):
             raise ConfigError(f"resolution must be in (0, 1] seconds, got {resolution!r}")
@@ -77,7 +80,7 @@ class SimulationLoop:
         # hazard-aware waiting (a sweep factor): stored here and on the harmoniser, which implements it
         self.hazard_waiting = bool(hazard_waiting)
         self.harmoniser = TaskHarmoniser(scheduler, self._make_agent, trace=self.trace, mode=Mode(mode),
-                                         s_freq=s_freq, hazard_waiting=self.hazard_waiting)
+                                         s_freq=s_freq, hazard_waiting=self.hazard_waiting, hazards=hazards)
         self._heap: list[tuple[int, int, int, Any]] = []
         self._seq = itertools.count()
         self._tick = 0

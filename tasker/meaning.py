@@ -129,6 +129,20 @@ class Meaning:
 NO_MEANING = Meaning()
 
 
+@dataclass(frozen=True, slots=True)
+class ActiveHazard:
+    """A hazard that holds now: whose it is, which one, since when (simulated s), and its budget.
+
+    What :meth:`Monitor.active` gives the harmoniser for hazard-aware waiting
+    (:class:`tasker.harmoniser.TaskHarmoniser`).  ``agent`` is None for a hazard nobody owns."""
+
+    agent: str | None
+    name: str
+    fact: Fact
+    budget_s: float
+    since: float
+
+
 # -- patterns ---------------------------------------------------------------------------
 
 
@@ -216,6 +230,7 @@ class Monitor:
         self._robot = robot
         self._last: tuple[frozenset[Fact], tuple[tuple[str, bool], ...]] | None = None
         self.hazards: dict[tuple[str | None, str, Fact], Hazard] = {}
+        self._since: dict[tuple[str | None, str, Fact], float] = {}  # when each active hazard went on
         self.roles: dict[tuple[str, str], str] = {}
         self._done_in_tick: list[str] = []
         self._live: set[str] = set()
@@ -263,10 +278,20 @@ class Monitor:
                 for f in matches(atom, facts):
                     found[(self._owner(hz, task_type, f, members, made_by), hz.name, f)] = hz
         for key in sorted(set(self.hazards) - set(found), key=_order):
+            self._since.pop(key, None)
             self._emit_hazard(now, key, self.hazards.pop(key), "off")
         for key in sorted(set(found) - set(self.hazards), key=_order):
             self.hazards[key] = found[key]
+            self._since[key] = now
             self._emit_hazard(now, key, found[key], "on")
+
+    def active(self) -> tuple[ActiveHazard, ...]:
+        """The hazards that hold now (as of the last :meth:`observe`), in the trace's order.
+
+        A callable the runner gives the harmoniser (``TaskHarmoniser.hazards``): the model
+        learns of hazards through it, never from a task's name."""
+        return tuple(ActiveHazard(key[0], key[1], key[2], self.hazards[key].budget_s, self._since[key])
+                     for key in sorted(self.hazards, key=_order))
 
     def _owner(self, hz: Hazard, task_type: str, fact: Fact, members: list[Any], made_by: list[str]) -> str | None:
         """For a pattern without ``$args``: who already owns it, the agent whose stage made it

@@ -16,7 +16,7 @@ from typing import IO, Any
 
 EVENTS = (
     "run", "request", "rejected", "transition", "command", "roles", "decision", "plan",
-    "stage", "params", "mode", "change", "world", "hazard", "role", "end",
+    "stage", "params", "mode", "change", "world", "hazard", "role", "secure", "end",
 )
 
 

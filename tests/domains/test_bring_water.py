@@ -14,18 +14,11 @@ from planners.bundled import ENV_VAR
 
 FOLDER = Path(__file__).parent / "fixtures" / "bring_water"
 
-# Found when merging the world's shortest paths: the robot, sent from the kitchen to the living
-# room while Alice sits by one door and John stands by the other, re-plans a path through the
-# hall doorway it cannot drive past John and is then stranded there (no path to Peter).
-pytestmark = pytest.mark.xfail(strict=False, reason="robot stranded in the living/hall doorway beside John "
-                                                    "(robot/motion.py vs the skill's path check); being fixed")
-
-
-@pytest.fixture(scope="module")
-def run() -> object:
+@pytest.fixture(scope="module", params=["static", "planned"])
+def run(request: pytest.FixtureRequest) -> object:
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv(ENV_VAR, str(FOLDER))
-        return run_scenario(FOLDER / "scenario.toml", suspension="static", pictures=False)
+        return run_scenario(FOLDER / "scenario.toml", suspension=request.param, pictures=False)
 
 
 def test_it_runs_to_the_end(run) -> None:  # type: ignore[no-untyped-def]
@@ -39,7 +32,11 @@ def test_its_hazards_and_person_are_in_the_trace(run) -> None:  # type: ignore[n
     waiting = run.trace.of("role", agent="d1", role="waiting")
     assert waiting[0]["person"] == "sara" and waiting[0]["status"] == "on"
     susp = run.trace.of("plan", agent="d1", purpose="genSusp")[0]
-    assert [s["action"] for s in susp["stages"]] == ["navigate", "put_on_table"]  # on a table, not the floor
+    actions = [s["action"] for s in susp["stages"]]
+    if run.trace.of("run")[0]["suspension"] == "static":  # the folder's rule: put it on a table
+        assert actions == ["navigate", "put_on_table"]
+    else:  # planned to the same goal (hand empty, glass not on the floor): a table, or Sara herself
+        assert actions[0] == "navigate" and actions[-1] in ("put_on_table", "serve")
     assert not run.trace.of("hazard", hazard="glass_on_floor")
 
 

@@ -286,3 +286,10 @@ def test_doubtful_input_is_one_warning_line_in_the_cli_format(tmp_path: Path,
     assert "InputWarning" not in err
     assert main(["run", str(scn), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     assert "warning" not in capsys.readouterr().err
+
+
+def test_run_takes_the_policy_and_hazard_waiting_factors(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    assert main(["run", "synthetic_demo", "--out", str(out), "--hazard-waiting", "--no-pictures", "--quiet"]) == 0
+    assert json.loads((out / "run.json").read_text())["settings"]["hazard_waiting"] is True
+    assert main(["run", "synthetic_demo", "--policy", "lenient", "--out", str(out)]) == 2

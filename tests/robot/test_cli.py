@@ -8,16 +8,65 @@ from pathlib import Path
 import pytest
 
 from experiments.cli import main as cli
+from robot.spec import load_world, shipped_worlds
 
 
 def test_world_json_and_picture(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     png = tmp_path / "paper.png"
     assert cli(["world", "paper", "--json", "--out", str(png)]) == 0
     doc = json.loads(capsys.readouterr().out)
-    assert doc["bounds"] == [[0.0, 0.0], [12.0, 8.0]]
-    assert doc["places"]["hall"] == [6.0, 4.0, 1.5708]
+    assert doc["format"] == "tasker.world/1" and doc["bounds"] == [[0.0, 0.0], [12.0, 8.0]]
+    assert doc["places"]["hall"] == {"pose": [6.0, 4.0, 1.5708], "room": "hall"}
     assert set(doc["people"]) == {"john", "alice", "peter", "sara"}
     assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize("world", shipped_worlds())
+def test_world_json_describes_every_part_of_the_world(world: str, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = load_world(world)
+    assert cli(["world", world, "--json"]) == 0
+    out = capsys.readouterr().out
+    doc = json.loads(out)
+    assert list(doc["places"]) == list(spec.places)  # every place, in the file's order
+    for name, place in doc["places"].items():
+        assert place["pose"] == list(spec.places[name]) and place["room"] in spec.rooms
+        assert name in doc["rooms"][place["room"]]["places"]
+    assert set(doc["rooms"]) == set(spec.rooms) and set(doc["devices"]) == set(spec.devices)
+    assert set(doc["people"]) == set(spec.people) and doc["objects"] == dict(spec.objects)
+    for name, door in doc["doors"].items():
+        assert door["open"] == spec.doors[name].open and len(door["rooms"]) == 2
+        assert all(name in doc["rooms"][r]["doors"] for r in door["rooms"] if r is not None)
+    assert len(doc["walls"]) == sum(o.kind == "wall" for o in spec.obstacles)
+    assert doc["robot"]["pose"] == list(spec.robot.pose) and doc["robot"]["room"] in spec.rooms
+    rm = doc["roadmap"]
+    assert rm["nodes"] > rm["ompl_milestones"] > 0 and rm["edges"] > rm["nodes"] and rm["components"] >= 1
+    assert cli(["world", world, "--json"]) == 0
+    assert capsys.readouterr().out == out  # the same world, the same bytes
+
+
+def test_world_json_roadmap_is_optional_and_seeded(capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli(["world", "flat", "--json", "--no-roadmap"]) == 0
+    assert "roadmap" not in json.loads(capsys.readouterr().out)
+    assert cli(["world", "flat", "--json", "--seed", "4"]) == 0
+    rm = json.loads(capsys.readouterr().out)["roadmap"]
+    assert rm["seed"] == 4 and rm["places_unlinked"] == ["storage"]  # flat's storage is walled off
+    assert cli(["world", "flat", "--json", "--seed", "-1"]) == 2
+    assert "--seed" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("text", "expected"), [
+    ('name = "x"\nbounds = [[0, 0], [5, 5]]\nwals = []\n', ":3: wals: unknown key 'wals'; did you mean 'walls'?"),
+    ('name = "x"\nbounds = [[0, 0], [5, 5]\n', ":3: not valid TOML"),
+    ('name = "x"\nbounds = [[0, 0], [5, 5]]\n[places]\nhall = [1, 2]\n', ":4: places.hall: expected [x, y, yaw]"),
+])
+def test_world_json_bad_world_file_is_one_clear_line(tmp_path: Path, text: str, expected: str,
+                                                     capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text)
+    assert cli(["world", str(bad), "--json"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and "Traceback" not in captured.err
+    assert captured.err.startswith(f"tasker world: error: {bad}{expected}"), captured.err
 
 
 def test_cost_exit_statuses(capsys: pytest.CaptureFixture[str]) -> None:
