@@ -29,6 +29,7 @@ SUBCOMMAND_MODULES = (
     "planners.cli",           # plan, domains, fsm, new
     "robot.cli",              # world, cost
     "experiments.explain",    # explain
+    "experiments.day_cli",    # day
     # Add a subcommand here: a module with ``register(subparsers)`` (e.g. explain, an HTML report).
 )
 """Modules that add subcommands, in the order ``tasker --help`` lists them."""

@@ -5,15 +5,20 @@ metrics — tasks completed per type, completion minus deadline, falls that died
 interruptions per type and per task, oscillation, how the day ended — plus ours:
 suspensions (interruptions that needed an ``exeSusp``), time spent suspending,
 switches, and for whole-queue schedulers the longest queue ordered and the decisions
-whose search hit its budget.  Abandonment and travel distance need the robot's path (robot backend) and
-are not computed here.
+whose search hit its budget.  On the robot backend, :mod:`experiments.pathmetrics` adds
+abandonment and travel distance from the recorded trajectory.
 
-:func:`run_days` runs N days x schedulers in local processes and :func:`table` writes the
-Markdown table with 95 % confidence intervals and paired comparisons of ``lookahead``
-against each baseline (Wilcoxon signed-rank over days, Holm-corrected)::
+:func:`run_days` runs N days x schedulers on a backend (days made by
+:func:`experiments.days.make`) and :func:`table` writes the Markdown table with 95 %
+confidence intervals and paired comparisons of ``lookahead`` against each baseline
+(Wilcoxon signed-rank over days, Holm-corrected)::
 
-    python -m experiments.dayreport --protocol experiments/protocols/tabsa.toml --days 100 \\
+    python -m experiments.dayreport --protocol tabsa --days 100 \\
         --schedulers lookahead alg2 simple simple2 distance --out out/day
+    python -m experiments.dayreport --protocol tabsa-short --backend robot --days 20 --out out/day-robot
+
+``tasker day`` is the same command.  Each day's metrics are appended to
+``OUT/days.jsonl`` as the day ends, so ``--resume`` goes on where a stopped run stopped.
 """
 
 from __future__ import annotations
@@ -30,7 +35,9 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
+from experiments import days as day_pipeline
 from experiments import protocol as protocols
+from tasker.errors import ConfigError
 from tasker.trace import number
 
 OSCILLATION_SWITCHES = 3
@@ -40,8 +47,12 @@ ENDINGS = ("all done", "a fall died", "oscillation", "time ran out")
 
 # -- one day -----------------------------------------------------------------------------------------
 
-def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = None) -> dict[str, Any]:
+def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = None,
+                kinds: Mapping[str, str] | None = None) -> dict[str, Any]:
     """The protocol metrics of one day's trace (see the module docstring and ``docs/benchmark.md``).
+
+    ``kinds`` maps a trace's task type to the protocol's task type (the robot backend runs
+    task folders under their own names); per-type metrics are keyed by the protocol's.
 
     ``day_end`` is when the day stops (default: the time of the last event).  A fall is
     dead when it was not finished by its request's ``death_at`` and that time falls
@@ -53,6 +64,7 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
     kind: dict[str, str] = {}
     args: dict[str, Mapping[str, Any]] = {}
     finished: dict[str, float] = {}
+    failed: set[str] = set()
     starts: dict[str, list[float]] = {}
     interruptions: dict[str, int] = {}
     suspensions = 0
@@ -62,9 +74,12 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
     for e in events:
         ev = e["event"]
         if ev == "request":
-            kind[e["agent"]], args[e["agent"]] = e["task_type"], e["args"]
+            kind[e["agent"]] = (kinds or {}).get(e["task_type"], e["task_type"])
+            args[e["agent"]] = e["args"]
         elif ev == "end" and e.get("cause") == "finished":
             finished[e["agent"]] = e["t"]
+        elif ev == "end" and e.get("cause") == "failed":  # a plan or a skill failed: not the scheduler's choice
+            failed.add(e["agent"])
         elif ev == "command" and e.get("flag") == "start":
             starts.setdefault(e["agent"], []).append(e["t"])
         elif ev == "transition":
@@ -87,7 +102,7 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
         done = [a for a in agents if a in finished]
         gaps = [finished[a] - number(args[a]["deadline"]) for a in done if args[a].get("deadline") is not None]
         n_int = sum(interruptions.get(a, 0) for a in agents)
-        per_type[t] = {"requested": len(agents), "completed": len(done),
+        per_type[t] = {"requested": len(agents), "completed": len(done), "failed": sum(a in failed for a in agents),
                        "completion_minus_deadline_s": _mean(gaps), "lateness_s": sum(max(0.0, g) for g in gaps),
                        "late": sum(1 for g in gaps if g > 0), "interruptions": n_int,
                        "interruptions_per_task": n_int / len(agents) if agents else None}
@@ -105,7 +120,7 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
         ending = "all done" if len(finished) == len(kind) else "time ran out"
     all_gaps = [finished[a] - number(args[a]["deadline"]) for a in finished if args[a].get("deadline") is not None]
     return {
-        "requested": len(kind), "completed": len(finished),
+        "requested": len(kind), "completed": len(finished), "failed": len(failed),
         "completion_minus_deadline_s": _mean(all_gaps), "lateness_s": sum(max(0.0, g) for g in all_gaps),
         "dead_falls": len(dead), "first_death_t": first_death,
         "interruptions": sum(interruptions.values()), "suspensions": suspensions,
@@ -129,36 +144,63 @@ def _oscillation(starts: Mapping[str, list[float]]) -> float | None:
 
 # -- many days -----------------------------------------------------------------------------------------
 
-def scheduler_options(proto: protocols.Protocol, name: str) -> dict[str, Any]:
-    """Options each scheduler gets from the protocol: what it can know of the day's task types."""
-    if name == "alg2":  # priority classes, highest first
-        prios = sorted({s.priority for s in proto.tasks.values()}, reverse=True)
-        return {"classes": [[k for k, s in proto.tasks.items() if s.priority == p] for p in prios]}
-    if name == "lookahead":
-        budgets = {k: s.death_after_s for k, s in proto.tasks.items() if s.death_after_s is not None}
-        penalty = max((s.suspend_s for s in proto.tasks.values()), default=0.0) + proto.planning_time_s
-        return {"switch_penalty_s": penalty, "budgets": budgets}
-    return {}
+def scheduler_options(proto: protocols.Protocol, name: str, backend: str = "synthetic") -> dict[str, Any]:
+    """Options each scheduler gets from the protocol (:func:`experiments.days.scheduler_options`)."""
+    return day_pipeline.scheduler_options(proto, name, backend)
 
 
-def run_day(protocol_path: str, seed: int, scheduler: str) -> dict[str, Any]:
-    """One day under one scheduler: its metrics (a top-level function, so processes can run it)."""
-    proto = protocols.load(protocol_path)
-    loop = protocols.build_day(proto, seed, scheduler, scheduler_options(proto, scheduler))
-    trace = loop.run()
-    return {"scheduler": scheduler, "seed": seed, **day_metrics(trace.events, day_end=proto.length_s)}
+def run_day(protocol: str, seed: int, scheduler: str, backend: str = "synthetic",
+            keep: str | None = None) -> dict[str, Any]:
+    """One day under one scheduler: its metrics (a top-level function, so processes can run it).
+
+    ``keep``: a folder to keep the run's files in (trace; robot: trajectory, run.json)."""
+    day = day_pipeline.make(protocol, seed, backend=backend, scheduler=scheduler)
+    run = day.run(out=keep)
+    proto = day.protocol
+    kinds = {v: k for k, v in day_pipeline.task_names(proto, backend).items()}
+    out = {"scheduler": scheduler, "seed": seed, "backend": backend,
+           **day_metrics(run.events, day_end=proto.length_s, kinds=kinds)}
+    if backend == "robot":
+        from experiments.pathmetrics import path_metrics
+
+        out |= path_metrics(run.events, run.samples)
+        out["wall_time_s"] = run.record.get("wall_time_s")  # not in the table: how long the day took here
+    return out
 
 
-def run_days(protocol_path: str | Path, days: int, names: Sequence[str], *, first_seed: int = 1,
-             workers: int = 2) -> list[dict[str, Any]]:
-    """Every (day, scheduler) pair, in ``workers`` local processes; results sorted by scheduler then seed."""
-    protocols.load(protocol_path)  # a bad protocol fails here, once, with its file and line
-    jobs = [(str(protocol_path), seed, name) for name in names for seed in range(first_seed, first_seed + days)]
-    if workers <= 1:
-        results = [run_day(*j) for j in jobs]
+def run_days(protocol: str | Path, days: int, names: Sequence[str], *, first_seed: int = 1,
+             workers: int = 2, backend: str = "synthetic", log: Path | None = None,
+             keep: Path | None = None) -> list[dict[str, Any]]:
+    """Every (day, scheduler) pair; results sorted by scheduler then seed.
+
+    ``workers`` local processes (1: in this process).  ``log``: a JSON-lines file each
+    result is appended to as it ends; results already there (same backend, scheduler and
+    seed) are not run again.  ``keep``: keep each run's files in ``keep/SCHEDULER/SEED``."""
+    day_pipeline.load(protocol)  # a bad protocol fails here, once, with its file and line
+    done: dict[tuple[str, int], dict[str, Any]] = {}
+    if log is not None and log.is_file():
+        for line in log.read_text(encoding="utf-8").splitlines():
+            r = json.loads(line)
+            if r.get("backend", "synthetic") == backend:
+                done[r["scheduler"], r["seed"]] = r
+    jobs = [(str(protocol), seed, name, backend, None if keep is None else str(keep / name / str(seed)))
+            for seed in range(first_seed, first_seed + days) for name in names if (name, seed) not in done]
+    # seed-major: a run stopped early leaves every scheduler with (nearly) as many days
+    results = [done[n, s] for n in names for s in range(first_seed, first_seed + days) if (n, s) in done]
+
+    def record(r: dict[str, Any]) -> None:
+        results.append(r)
+        if log is not None:
+            with log.open("a", encoding="utf-8") as f:
+                f.write(json.dumps(r, sort_keys=True) + "\n")
+
+    if workers <= 1 or len(jobs) <= 1:
+        for j in jobs:
+            record(run_day(*j))
     else:
         with ProcessPoolExecutor(max_workers=workers) as pool:
-            results = list(pool.map(run_day, *zip(*jobs, strict=True), chunksize=8))
+            for r in pool.map(run_day, *zip(*jobs, strict=True), chunksize=8 if backend == "synthetic" else 1):
+                record(r)
     order = {n: k for k, n in enumerate(names)}
     return sorted(results, key=lambda r: (order[r["scheduler"]], r["seed"]))
 
@@ -196,6 +238,9 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
         ("suspensions with exeSusp (ours)", "suspensions", lambda r: r["suspensions"]),
         ("time suspending (s, ours)", "susp_time", lambda r: r["suspension_time_s"]),
         ("switches (ours)", "switches", lambda r: r["switches"]),
+        ("abandonments (robot leaves a fallen person's 2 m circle)", "abandonments", lambda r: r.get("abandonments")),
+        ("falls abandoned at least once", "abandoned", lambda r: r.get("abandoned_falls")),
+        ("travel distance (m)", "travel", lambda r: r.get("travel_m")),
         ("longest queue ordered (lookahead)", "longest", lambda r: r["longest_order"] or None),
         ("decisions not proven optimal (lookahead)", "anytime", lambda r: r["anytime_decisions"] if r["longest_order"]
          else None),
@@ -203,7 +248,7 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
     return rows
 
 
-PAIRED = ("dead", "lateness", "gap", "completed", "interruptions")
+PAIRED = ("dead", "abandonments", "lateness", "gap", "completed", "interruptions", "travel")
 
 
 def holm(pvalues: Sequence[float]) -> list[float]:
@@ -238,7 +283,8 @@ def table(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead",
         for n in names:
             vals = [v for v in (get(r) for r in by[n]) if v is not None]
             cells.append(_fmt(*_ci(vals)) if vals else "–")
-        out.append(f"| {label} | " + " | ".join(cells) + " |")
+        if any(c != "–" for c in cells):  # e.g. path metrics exist only on the robot backend
+            out.append(f"| {label} | " + " | ".join(cells) + " |")
     out += ["", "How the days ended (TaBSA's first stopping condition; the day is run to its end):", "",
             "| ending | " + " | ".join(names) + " |", "|---|" + "---|" * len(names)]
     for ending in ENDINGS:
@@ -258,6 +304,8 @@ def table(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead",
                 ref = {r["seed"]: get(r) for r in by[reference]}
                 pairs = [(ref[r["seed"]], get(r)) for r in by[n] if ref.get(r["seed"]) is not None
                          and get(r) is not None]
+                if not pairs:
+                    continue
                 diff = np.array([a - b for a, b in pairs], dtype=float)
                 tests.append((label, n, diff, _wilcoxon(diff)))
         adjusted = holm([p for *_, p in tests])
@@ -266,43 +314,60 @@ def table(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead",
     return "\n".join(line for line in out if line is not None).lstrip("\n") + "\n"
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m experiments.dayreport", description=__doc__.splitlines()[0])
-    ap.add_argument("--protocol", default="experiments/protocols/tabsa.toml")
-    ap.add_argument("--days", type=int, default=100)
-    ap.add_argument("--first-seed", type=int, default=1)
-    ap.add_argument("--schedulers", nargs="+", default=["lookahead", "alg2", "simple", "simple2", "distance"])
-    ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--out", required=True, type=Path)
-    a = ap.parse_args(argv)
+from experiments.day_cli import add_arguments  # noqa: E402  (the options live with the light CLI module)
+
+
+def run(a: argparse.Namespace) -> int:
+    """Run the days, write ``days.jsonl`` and ``table.md``; print the table.
+
+    Bad input raises :class:`tasker.cliargs.UsageError` (or the protocol's
+    :class:`tasker.reader.InputError`) before the first day runs."""
     from tasker import schedulers
-    from tasker.errors import TaskerError
+    from tasker.cliargs import UsageError
+    from tasker.reader import suggest
 
     unknown = [n for n in a.schedulers if n not in schedulers.names()]
     if unknown:
-        from tasker.reader import suggest
-
-        print(f"error: unknown scheduler {unknown[0]!r}{suggest(unknown[0], schedulers.names())}; "
-              f"known: {', '.join(schedulers.names())}", file=sys.stderr)
-        return 2
+        raise UsageError("--schedulers", f"unknown scheduler {unknown[0]!r}{suggest(unknown[0], schedulers.names())}; "
+                                         f"known: {', '.join(schedulers.names())}")
     if a.days < 1:
-        print(f"error: --days: expected >= 1, got {a.days}", file=sys.stderr)
-        return 2
+        raise UsageError("--days", f"expected >= 1, got {a.days}")
     try:
-        results = run_days(a.protocol, a.days, a.schedulers, first_seed=a.first_seed, workers=a.workers)
-    except TaskerError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+        proto = day_pipeline.load(a.protocol)
+    except ConfigError as exc:
+        raise UsageError("--protocol", str(exc)) from exc
+    if a.backend == "robot" and proto.robot is None:
+        raise UsageError("--backend", f"{proto.source} has no [robot_backend]: it runs on the synthetic backend only")
+    workers = a.workers if a.workers is not None else (2 if a.backend == "synthetic" else 1)
+    log = a.out / "days.jsonl"
     a.out.mkdir(parents=True, exist_ok=True)
-    with (a.out / "days.jsonl").open("w", encoding="utf-8") as f:
-        for r in results:
-            f.write(json.dumps(r, sort_keys=True) + "\n")
-    cmd = (f"python -m experiments.dayreport --protocol {a.protocol} --days {a.days} --first-seed {a.first_seed} "
-           f"--schedulers {' '.join(a.schedulers)} --out {a.out}")
-    text = table(results, title=f"{Path(a.protocol).stem}: seeds {a.first_seed}–{a.first_seed + a.days - 1}")
+    if not a.resume and log.exists():
+        log.unlink()
+    results = run_days(a.protocol, a.days, a.schedulers, first_seed=a.first_seed, workers=workers,
+                       backend=a.backend, log=log, keep=a.out / "runs" if a.keep_runs else None)
+    backend = "" if a.backend == "synthetic" else f" --backend {a.backend}"
+    cmd = (f"python -m experiments.dayreport --protocol {a.protocol}{backend} --days {a.days} "
+           f"--first-seed {a.first_seed} --schedulers {' '.join(a.schedulers)} --out {a.out}")
+    title = f"{proto.name} ({a.backend} backend): seeds {a.first_seed}–{a.first_seed + a.days - 1}"
+    text = table(results, title=title)
     (a.out / "table.md").write_text(text + f"\nGenerated by `{cmd}`.\n", encoding="utf-8")
     print(text)
     return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    from experiments.day_cli import EXAMPLES
+
+    ap = argparse.ArgumentParser(prog="python -m experiments.dayreport", description=__doc__.splitlines()[0],
+                                 epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_arguments(ap)
+    from tasker.errors import TaskerError
+
+    try:
+        return run(ap.parse_args(argv))
+    except TaskerError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any, Protocol
 
+from experiments.calibration import CalibrationCollector
 from tasker.meaning import CMD_STATES as CMD
 from tasker.trace import read
 
@@ -204,6 +205,8 @@ class HazardCollector:
             before = h["stretch"]
             h["stretch"] += dt
             h["unattended_s"] += dt
+            if self.state.get(h["agent"]) == "end":  # left behind by a task that has ended
+                h["after_end_s"] += dt
             h["longest_unattended_s"] = max(h["longest_unattended_s"], h["stretch"])
             over = h["stretch"] - max(h["budget_s"], before)
             if over > 0:
@@ -242,7 +245,7 @@ class HazardCollector:
                 self.active[key] = {"hazard": e["hazard"], "args": list(key[2]), "agent": agent,
                                     "budget_s": float(e.get("budget_s", 0.0)), "severity": e.get("severity", 1.0),
                                     "start": self.t, "unattended_s": 0.0, "longest_unattended_s": 0.0,
-                                    "stretch": 0.0, "overruns": 0, "overrun_s": 0.0}
+                                    "stretch": 0.0, "overruns": 0, "overrun_s": 0.0, "after_end_s": 0.0}
             elif e["status"] == "off" and key in self.active:
                 self._close(key)
 
@@ -263,6 +266,7 @@ class HazardCollector:
                         "longest_unattended_s": max((h["longest_unattended_s"] for h in mine), default=0.0),
                         "overruns": sum(h["overruns"] for h in mine),
                         "overrun_s": math.fsum(h["overrun_s"] for h in mine),
+                        "after_end_s": math.fsum(h["after_end_s"] for h in mine),
                         "at_switch": sum(1 for s in self.at_switch for hz, _ in s["own"] if hz == k),
                         "active_at_end": sum(1 for h in open_now if h["hazard"] == k and h["agent"] is not None),
                         "unowned": sum(1 for h in episodes if h["hazard"] == k and h["agent"] is None)}
@@ -276,6 +280,7 @@ class HazardCollector:
             "longest_unattended_s": max((h["longest_unattended_s"] for h in owned), default=0.0),
             "budget_overruns": sum(h["overruns"] for h in owned),
             "overrun_s": math.fsum(h["overrun_s"] for h in owned),
+            "after_end_s": math.fsum(h["after_end_s"] for h in owned),
             "unowned_hazards": len(episodes) - len(owned),
         }
 
@@ -349,7 +354,8 @@ class RunCollector:
 def collectors() -> dict[str, Collector]:
     """A fresh set of collectors, keyed by the section of :func:`compute`'s result they fill."""
     return {"run": RunCollector(), "tasks": TaskCollector(), "switching": SwitchCollector(),
-            "decisions": DecisionCollector(), "safety": HazardCollector(), "people": PeopleCollector()}
+            "decisions": DecisionCollector(), "safety": HazardCollector(), "people": PeopleCollector(),
+            "calibration": CalibrationCollector()}
 
 
 def _clean(value: Any) -> Any:

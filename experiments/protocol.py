@@ -23,13 +23,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from experiments import synthetic
 from experiments.actions import TimedAction
 from experiments.synthetic import SyntheticScenario
 from tasker.agent import Rates
 from tasker.loop import SimulationLoop
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
-from tasker.reader import Table
+from tasker.reader import Table, check_name, suggest
 from tasker.reader import load as read_table
 from tasker.stage import Purpose, Stage, StageKind, StagePlan
 from tasker.synthetic import SyntheticTask
@@ -62,6 +61,40 @@ class TaskSpec:
 
 
 @dataclass(frozen=True)
+class RobotTask:
+    """How one protocol task type runs on the robot backend: a task folder and its arguments.
+
+    ``args`` values may use ``$site`` and ``$dest`` (the world places of the request's
+    sites), ``$person`` (a person of the world, one per request, scripted to be at the
+    site) and ``$object`` (an object of ``object_type`` put at the site for this request).
+    ``posture``: the person takes it at the call (e.g. ``fallen``) and stands up again at
+    the request's ``death_at``.
+    """
+
+    kind: str
+    task: str
+    args: dict[str, str]
+    object_type: str | None = None
+    posture: str | None = None
+
+
+@dataclass(frozen=True)
+class RobotBackend:
+    """The robot backend of a protocol: the world, where each site is in it, the task folders.
+
+    ``spots``: per site, where its people stand, in order of preference: a request's
+    person takes the first spot no one else holds then (an escorted person holds theirs
+    for the rest of the day, a fallen person until taken away)."""
+
+    world: str
+    places: dict[str, str]
+    spots: dict[str, tuple[Pose, ...]]
+    tasks: dict[str, RobotTask]
+    lead_s: float
+    task_exe_rate: float
+
+
+@dataclass(frozen=True)
 class Protocol:
     """A checked day protocol."""
 
@@ -76,6 +109,7 @@ class Protocol:
     sites: dict[str, Pose]
     last_call_s: float
     tasks: dict[str, TaskSpec]
+    robot: RobotBackend | None = None
 
     @property
     def death_after_s(self) -> float | None:
@@ -147,17 +181,76 @@ def load(path: str | Path) -> Protocol:
     tasks: dict[str, TaskSpec] = {}
     for kind in tasks_t.keys():
         if kind not in KINDS:
-            from tasker.reader import suggest
-
             raise tasks_t.error(kind, f"unknown task type {kind!r}{suggest(kind, KINDS)} (known: {', '.join(KINDS)})")
         tasks[kind] = _task(tasks_t.table(kind), kind)
     if not tasks:
         raise tasks_t.error(None, f"expected at least one of {', '.join(KINDS)}")
     tasks_t.done()
+    backend = _robot_backend(top.table("robot_backend"), Path(path), sites, tasks) if "robot_backend" in top else None
     top.done()
     return Protocol(name=top.data["name"], source=str(path), start=start, length_s=length, step_s=step,
                     robot_speed=speed, start_site=start_site, planning_time_s=planning, sites=sites,
-                    last_call_s=last_call, tasks=tasks)
+                    last_call_s=last_call, tasks=tasks, robot=backend)
+
+
+_VARIABLES = ("$site", "$dest", "$person", "$object")
+
+
+def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str, TaskSpec]) -> RobotBackend:
+    """``[robot_backend]``: the world file (relative to the protocol), sites, task folders."""
+    world = t.string("world")
+    world_file = path.parent / world
+    if not world_file.is_file():
+        raise t.error("world", f"no world file {world_file} (a .toml file relative to the protocol)")
+    lead = t.number("lead_s", 120.0, positive=True)
+    exe_rate = t.number("task_exe_rate", 10.0, positive=True)
+    sites_t = t.table("sites")
+    places: dict[str, str] = {}
+    spots: dict[str, tuple[Pose, ...]] = {}
+    for name, _ in sites_t.items():
+        check_name(sites_t, name, name, sorted(sites), "site of [apartment.sites]")
+        st = sites_t.table(name)
+        places[name] = st.string("place")
+        raw = st.raw("spots")
+        if not isinstance(raw, list) or not raw:
+            raise st.error("spots", f"expected a list of [x, y] where the site's people stand, got {raw!r}")
+        spots[name] = tuple(_pose(st, "spots", v) for v in raw)
+        st.done()
+    missing = sorted(set(sites) - set(places))
+    if missing:
+        raise sites_t.error(None, f"every site needs its place and spot in the world; missing: {', '.join(missing)}")
+    sites_t.done()
+    tasks_t = t.table("tasks")
+    out: dict[str, RobotTask] = {}
+    for kind, _ in tasks_t.items():
+        check_name(tasks_t, kind, kind, sorted(tasks), "task type of [tasks]")
+        tt = tasks_t.table(kind)
+        args_t = tt.table("args")
+        args = {k: str(args_t.string(k)) for k, _ in args_t.items()}
+        for k, v in args.items():
+            if v.startswith("$") and v not in _VARIABLES:
+                raise args_t.error(k, f"unknown variable {v!r}{_suggest(v)} (known: {', '.join(_VARIABLES)})")
+        args_t.done()
+        obj = tt.string("object_type", None)
+        if "$object" in args.values() and obj is None:
+            raise tt.error("object_type", "required when an argument is $object (the type of the object to create)")
+        posture = tt.string("posture", None, choices=("fallen", "sitting", "standing"))
+        if posture is not None and "$person" not in args.values():
+            raise tt.error("posture", "needs a $person argument (whose posture changes)")
+        out[kind] = RobotTask(kind, str(tt.string("task")), args, obj, posture)
+        tt.done()
+    missing = sorted(set(tasks) - set(out))
+    if missing:
+        raise tasks_t.error(None, "every task type of [tasks] needs its task folder here; "
+                                  f"missing: {', '.join(missing)}")
+    tasks_t.done()
+    t.done()
+    return RobotBackend(world=str(world_file.resolve()), places=places, spots=spots, tasks=out, lead_s=lead,
+                        task_exe_rate=exe_rate)
+
+
+def _suggest(value: str) -> str:
+    return suggest(value, _VARIABLES)
 
 
 # -- the day's task types --------------------------------------------------------------------------
@@ -285,38 +378,73 @@ def task_types(protocol: Protocol) -> tuple[DayTask, ...]:
     return tuple(DayTask(spec, protocol.robot_speed, protocol.planning_time_s) for spec in protocol.tasks.values())
 
 
-def generate(protocol: Protocol, seed: int, *, scheduler: str = "alg2",
-             scheduler_options: dict[str, Any] | None = None) -> SyntheticScenario:
-    """One day of ``protocol`` drawn from ``seed``: the same seed gives the same day.
+@dataclass(frozen=True)
+class DayRequest:
+    """One request of a drawn day, before any backend gives it a form.
 
-    Each task type draws its own stream (``random.Random(f"{name}:{seed}:{kind}")``),
-    so adding a type to a protocol leaves the other types' draws unchanged.
+    ``site`` and ``dest`` are site names of the protocol; ``deadline`` and ``death_at``
+    absolute seconds; ``work`` (falls) and ``walk_speed`` (transports) as drawn.
+    """
+
+    t: float
+    kind: str
+    site: str
+    dest: str
+    deadline: float
+    priority: int
+    weight: float
+    work: float | None = None
+    walk_speed: float | None = None
+    death_at: float | None = None
+
+
+def draw(protocol: Protocol, seed: int) -> tuple[DayRequest, ...]:
+    """The requests of day ``seed``, in call order: the same seed gives the same day.
+
+    Each task type draws its own stream (``random.Random(f"{name}:{seed}:{kind}")``), so
+    adding a type to a protocol leaves the other types' draws unchanged.  Both backends
+    are built from this one draw (:mod:`experiments.days`).
     """
     sites = sorted(protocol.sites)
-    requests: list[tuple[float, int, str, dict[str, Any]]] = []
+    requests: list[tuple[float, int, DayRequest]] = []
     for kind, spec in protocol.tasks.items():
         rng = random.Random(f"{protocol.name}:{seed}:{kind}")
         for _ in range(spec.count):
             call = round(rng.uniform(0.0, protocol.last_call_s), 1)
             deadline = round(call + rng.uniform(*spec.deadline_s), 1)
             a, b = rng.sample(sites, 2)
-            args: dict[str, Any] = {"site": list(protocol.sites[a]), "deadline": deadline, "priority": spec.priority,
-                                    "weight": spec.weight}
+            extra: dict[str, Any] = {}
             if kind == "transport":
-                args["dest"] = list(protocol.sites[b])
-                args["walk_speed"] = round(rng.uniform(*spec.person_speed), 3)
+                extra["walk_speed"] = round(rng.uniform(*spec.person_speed), 3)
             elif kind == "fall":
-                args["work"] = round(rng.uniform(*spec.work_s), 1)
+                extra["work"] = round(rng.uniform(*spec.work_s), 1)
                 assert spec.death_after_s is not None
-                args["death_at"] = round(deadline + spec.death_after_s, 1)
-            else:
-                args["dest"] = list(protocol.sites[b])
-            requests.append((call, len(requests), kind, args))
+                extra["death_at"] = round(deadline + spec.death_after_s, 1)
+            requests.append((call, len(requests), DayRequest(call, kind, a, b, deadline, spec.priority, spec.weight,
+                                                             **extra)))
     requests.sort(key=lambda r: (r[0], r[1]))
-    actions = tuple(TimedAction(t, "request", {"task": kind, "args": args}) for t, _, kind, args in requests)
+    return tuple(r for *_, r in requests)
+
+
+def generate(protocol: Protocol, seed: int, *, scheduler: str = "alg2",
+             scheduler_options: dict[str, Any] | None = None) -> SyntheticScenario:
+    """Day ``seed`` of ``protocol`` (:func:`draw`) as a synthetic scenario."""
+    actions = []
+    for r in draw(protocol, seed):
+        args: dict[str, Any] = {"site": list(protocol.sites[r.site]), "deadline": r.deadline, "priority": r.priority,
+                                "weight": r.weight}
+        if r.kind == "transport":
+            args["dest"] = list(protocol.sites[r.dest])
+            args["walk_speed"] = r.walk_speed
+        elif r.kind == "fall":
+            args["work"] = r.work
+            args["death_at"] = r.death_at
+        else:
+            args["dest"] = list(protocol.sites[r.dest])
+        actions.append(TimedAction(r.t, "request", {"task": r.kind, "args": args}))
     rate = 1.0 / protocol.step_s
     return SyntheticScenario(
-        name=f"{protocol.name}-day{seed}", tasks=task_types(protocol), actions=actions, scheduler=scheduler,
+        name=f"{protocol.name}-day{seed}", tasks=task_types(protocol), actions=tuple(actions), scheduler=scheduler,
         scheduler_options=dict(scheduler_options or {}), mode="IT", s_freq=rate, rates=Rates(rate, rate, rate),
         jitter=0.0, seed=seed, horizon=protocol.length_s,
     )
@@ -324,8 +452,10 @@ def generate(protocol: Protocol, seed: int, *, scheduler: str = "alg2",
 
 def build_day(protocol: Protocol, seed: int, scheduler: str, scheduler_options: dict[str, Any] | None = None,
               ) -> SimulationLoop:
-    """A ready-to-run loop for day ``seed`` under ``scheduler``; the robot starts at ``start_site``."""
-    scn = generate(protocol, seed, scheduler=scheduler, scheduler_options=scheduler_options)
-    loop = synthetic.build(scn, seed=seed)
-    loop.core.pose = protocol.sites[protocol.start_site]  # type: ignore[union-attr]  # the TimedExecutor
+    """A ready-to-run synthetic loop for day ``seed`` under ``scheduler`` (robot at ``start_site``);
+    the same as ``experiments.days.make(protocol, seed, scheduler=...).build()``."""
+    from experiments import days
+
+    day = days.make(protocol, seed, scheduler=scheduler, scheduler_options=scheduler_options or {})
+    loop: SimulationLoop = day.build()
     return loop

@@ -54,12 +54,14 @@ class RunResult:
 def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None = None,
                 suspension: str | None = None, scheduler: str | None = None,
                 trace: Trace | None = None, task_paths: tuple[str, ...] = (), policy: str | None = None,
-                hazard_waiting: bool = False) -> tuple[SimulationLoop, Any]:
+                hazard_waiting: bool = False, request_fields: bool = False) -> tuple[SimulationLoop, Any]:
     """The loop and the simulation for a robot scenario, with every request and event scheduled.
 
     ``task_paths`` are task folders loaded besides the bundled ones and ``$TASKER_TASKS``.
     ``policy`` (default: the scenario's) reaches every task's :class:`Strategy`;
-    ``hazard_waiting`` is passed to the loop."""
+    ``hazard_waiting`` is passed to the loop; ``request_fields`` lets every task type take
+    the requests' ``deadline`` and ``priority`` (:mod:`experiments.request_fields`).
+    A ``people`` entry may set a person's ``pose``, ``walk`` and walking ``speed``."""
     from planners.bundled import task_types
     from robot.sim import Simulation
     from robot.spec import load_world
@@ -76,11 +78,18 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
                 changes["pose"] = tuple(entry["pose"])
             if "walk" in entry:
                 changes["walk"] = tuple(tuple(w) for w in entry["walk"])
+            if "speed" in entry:
+                changes["speed"] = float(entry["speed"])
             people[name] = dataclasses.replace(people[name], **changes)
         spec = dataclasses.replace(spec, people=people)
     spec = _with_objects(scn, spec)
     sim = Simulation(spec, seed=seed)
-    store = TaskStore(task_types(task_paths))
+    loaded = task_types(task_paths)
+    if request_fields:
+        from experiments.request_fields import with_request_fields
+
+        loaded = [with_request_fields(t) for t in loaded]
+    store = TaskStore(loaded)
     types = [store.get(n) for n in store.names()]
     sim.bind(b for t in types for b in t.meaning.bindings)  # the world reads the folders' bindings
     default = Strategy(update or scn.update, suspension or scn.suspension, policy or scn.policy)
@@ -133,7 +142,10 @@ def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: TimedAction
             scn: scenarios.RobotScenario) -> Callable[[], None]:
     f = a.fields
     if a.kind == "request":
-        return lambda: loop._submit(tasker.Request(f["task"], loop.store.validate(f["task"], f["args"]), "scenario"))
+        def submit() -> None:  # through the public requester, as any user's requests
+            requester.request(f["task"], f["args"])
+
+        return submit
     if a.kind == "terminate":
         return lambda: requester.terminate(f["agent"], f["reason"])
     if a.kind == "change":
@@ -161,13 +173,15 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
                  mode: str | None = None, out: Path | None = None, randomize: bool = False,
                  progress: bool = False, pictures: bool = True, task_paths: tuple[str, ...] = (),
                  policy: str | None = None, hazard_waiting: bool | None = None,
-                 interruption: scenarios.InterruptionGrid | None = None) -> RunResult:
+                 interruption: scenarios.InterruptionGrid | None = None,
+                 request_fields: bool = False) -> RunResult:
     """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced.
 
     ``task_paths``: task folders to load besides the bundled ones (``tasker run --path``).
     ``policy`` (``strict``/``conditional``) overrides the scenario's; ``hazard_waiting`` switches
     hazard-aware waiting on; ``interruption`` (with ``randomize``) places the interrupting request
-    in the seed's stratum (:class:`experiments.scenario.InterruptionGrid`)."""
+    in the seed's stratum (:class:`experiments.scenario.InterruptionGrid`); ``request_fields``: see
+    :func:`build_robot`."""
     if isinstance(source, scenarios.RobotScenario):
         kind, scn_path = "robot", Path(source.source)
     else:
@@ -189,7 +203,8 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         if mode is not None:
             scn = dataclasses.replace(scn, mode=mode)
         loop, sim = build_robot(scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler,
-                                task_paths=task_paths, policy=policy, hazard_waiting=bool(hazard_waiting))
+                                task_paths=task_paths, policy=policy, hazard_waiting=bool(hazard_waiting),
+                                request_fields=request_fields)
         spec_json = {"kind": "robot", **scn.to_json()}
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")

@@ -20,11 +20,15 @@ told to wait, the robot must come back, greet them again and apologise (Alg. 3).
   strategy, then timed by :func:`walk`.
 
 **Caching.**  Plans are cached by the symbolic problem: objects, init facts and goal,
-with travel times taken from the *reference table* — place-to-place times with doors
-open and nobody in the way (``estimate_ignoring_doors`` of ``robot``'s estimator, else
-``estimate``).  Those depend on the building only, so a person walking around never
-invalidates a cached plan, and the cached plan is a function of its key alone: the same
-state gives the same estimate whatever ran before (byte-reproducible traces).  The
+with travel times taken from the *reference table* — place-to-place times with nobody
+in the way and the doors as they are, except between places a ``door_between`` fact
+joins, which are timed with that door open (the plan decides whether to open it), as
+:func:`~planners.problem.travel_table` does (``estimate_ignoring_people`` and
+``estimate_ignoring_doors`` of ``robot``'s estimator, else ``estimate``).  Those depend
+on the building and its closed doors only, so a person walking around never invalidates
+a cached plan (and a plan never drives through a closed door it did not open), and the
+cached plan is a function of its key alone: the same state gives the same estimate
+whatever ran before (byte-reproducible traces).  The
 plan is then re-timed with the live motion model; docs/planners.md says why that is a
 fair estimate.  A leg the live model finds unreachable, or an unsolvable problem, means
 ``inf`` (no other route exists: a path planner's reachability is transitive).
@@ -342,19 +346,26 @@ class Estimator:
         return hit.steps, hit.status, ""
 
     def reference_table(self, world: WorldState, motion: Any) -> Travel:
-        """Place-to-place seconds with doors open and nobody in the way, remembered per motion model.
+        """Place-to-place seconds with nobody in the way, remembered per motion model and set
+        of closed doors: the doors as they are, except that places a ``door_between`` fact
+        joins are timed with their door open (the plan decides whether to open it).
 
-        A model without ``estimate_ignoring_doors`` is asked with ``estimate`` every time
-        (it may change); without a model or poses, the declared ``travel_s``.
+        A model without ``estimate_ignoring_people`` and ``estimate_ignoring_doors`` is asked
+        with :func:`~planners.problem.travel_table` every time (it may change); without a
+        model or poses, the declared ``travel_s``.
         """
-        ignoring: Callable[[Pose, Pose], Any] | None = getattr(motion, "estimate_ignoring_doors", None)
-        if ignoring is None:
+        as_is: Callable[[Pose, Pose], Any] | None = getattr(motion, "estimate_ignoring_people", None)
+        opened: Callable[[Pose, Pose], Any] | None = getattr(motion, "estimate_ignoring_doors", None)
+        if as_is is None or opened is None:
             return travel_table(world, motion, self.task.spec.travel_s)
         places = tuple(sorted((n, tuple(world.poses.get(n, ()))) for n, t in world.objects.items()
                               if t == PLACE_TYPE))
+        through_door = frozenset((f[2], f[3]) for f in world.matching("door_between") if len(f) == 4)
+        closed: tuple[str, ...] = tuple(getattr(motion, "closed_doors", tuple)())
+        key = (places, through_door, closed)
         with self._lock:
             ref = self._reference
-        if ref is not None and ref[0]() is motion and ref[1] == places:
+        if ref is not None and ref[0]() is motion and ref[1] == key:
             return ref[2]
         table: Travel = {}
         for a, pa in places:
@@ -362,11 +373,12 @@ class Estimator:
                 if a == b:
                     continue
                 if len(pa) >= 3 and len(pb) >= 3:
-                    table[a, b] = float(ignoring(pa, pb).time_s)  # type: ignore[arg-type]
+                    estimate = opened if (a, b) in through_door else as_is
+                    table[a, b] = float(estimate(pa, pb).time_s)  # type: ignore[arg-type]
                 else:
                     table[a, b] = float(self.task.spec.travel_s)
         try:
-            memo = (weakref.ref(motion), places, table)
+            memo = (weakref.ref(motion), key, table)
         except TypeError:  # a model that cannot be weakly referenced is simply asked again
             return table
         with self._lock:

@@ -391,6 +391,16 @@ class BasePlanner:
                 path = self._cached((s, g, doors, away))
         return path
 
+    def plan_ignoring_people(self, start: Point, goal: Point) -> tuple[Point, ...] | None:
+        """As :meth:`plan` with the doors as they are and nobody in the way."""
+        s = (round(float(start[0]), 4), round(float(start[1]), 4))
+        g = (round(float(goal[0]), 4), round(float(goal[1]), 4))
+        return self._cached((s, g, self._doors(), ()))
+
+    def closed_doors(self) -> tuple[str, ...]:
+        """The names of the doors closed now, sorted."""
+        return self._doors()
+
     def _cached(self, key: tuple[Point, Point, tuple[str, ...], tuple[Disc, ...]]) -> tuple[Point, ...] | None:
         if key in self._cache:
             self._cache.move_to_end(key)
@@ -435,6 +445,16 @@ class MotionEstimator:
         """
         return self._estimate(self.open_planner or self.planner, start, goal)
 
+    def estimate_ignoring_people(self, start: Pose, goal: Pose) -> MotionEstimate:
+        """As :meth:`estimate` with the doors as they are and nobody in the way: the
+        geometry a plan's connectivity may rely on without depending on where people stand."""
+        return self._timed(self.planner.plan_ignoring_people((start[0], start[1]), (goal[0], goal[1])),
+                           start, goal)
+
+    def closed_doors(self) -> tuple[str, ...]:
+        """The doors closed now (a key for what :meth:`estimate_ignoring_people` answers)."""
+        return self.planner.closed_doors()
+
     def approach(self, start: Pose, person: str) -> tuple[Pose | None, MotionEstimate]:
         """The cheapest reachable pose ``APPROACH`` metres from ``person``, facing them.
 
@@ -478,7 +498,9 @@ class MotionEstimator:
         return out
 
     def _estimate(self, planner: BasePlanner, start: Pose, goal: Pose) -> MotionEstimate:
-        path = planner.plan((start[0], start[1]), (goal[0], goal[1]))
+        return self._timed(planner.plan((start[0], start[1]), (goal[0], goal[1])), start, goal)
+
+    def _timed(self, path: tuple[Point, ...] | None, start: Pose, goal: Pose) -> MotionEstimate:
         if path is None:
             return UNREACHABLE
         pts = list(path)

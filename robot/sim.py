@@ -231,6 +231,15 @@ class Simulation:
                 return b, obj
         return None
 
+    def doors_closed_by(self, stage: Stage) -> tuple[str, ...]:
+        """The doors a stage closes when it succeeds: its ``delete`` facts bound to a door."""
+        out = []
+        for f in stage.data.get("delete", []):
+            hit = self._binding(tuple(str(x) for x in f))
+            if hit is not None and hit[0].kind == "door" and self.door_open.get(hit[1]):
+                out.append(hit[1])
+        return tuple(dict.fromkeys(out))
+
     def _type(self, name: str) -> str:
         return self.objects().get(name, "")
 

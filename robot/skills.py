@@ -10,7 +10,10 @@ Contract with the task types (``Stage.data``):
   exists or when people block the way for longer than ``BLOCK_TIMEOUT``.
 * ``say``: ``data["text"]``; takes ``stage.duration`` seconds.
 * ``manipulate``: takes ``stage.duration`` seconds; fails if ``data["object"]``
-  names something the world no longer has.
+  names something the world no longer has.  A manipulation that closes a door (its
+  ``delete`` list holds a fact bound to the door) while the robot stands in that doorway
+  first drives to the stage's place argument — the side the task says it acts from — so
+  the door never closes through the robot.
 * ``wait``: takes ``stage.duration`` seconds.
 
 On success the simulation applies ``data["add"]`` and ``data["delete"]``.
@@ -27,7 +30,7 @@ import numpy as np
 from robot.control import STOP, Command, PathFollower
 from robot.motion import BasePlanner, DriveLimits, MotionEstimator
 from robot.people import People
-from robot.scene import Scene
+from robot.scene import Scene, point_box_distance
 from robot.spec import WorldSpec
 from tasker.protocols import RUNNING, SUCCEEDED, SkillStatus, failed
 from tasker.stage import Stage
@@ -53,6 +56,8 @@ class SkillHost(Protocol):
 
     def objects(self) -> Mapping[str, str]: ...
 
+    def doors_closed_by(self, stage: Stage) -> tuple[str, ...]: ...
+
 BLOCK_TIMEOUT = 5.0  # seconds a blocked path is retried before the skill fails
 STALL_TIMEOUT = 2 * BLOCK_TIMEOUT  # seconds without moving STALL_MOVE metres before the skill gives up
 STALL_MOVE = 0.1
@@ -61,6 +66,7 @@ CHECK_PERIOD = 0.2  # seconds between checks of the path ahead
 # follower counts a waypoint reached within POS_TOL and drives on from where it really is,
 # and keeps to a leg within about a centimetre
 TRACKING_SLACK = PathFollower.POS_TOL + 0.01
+DOORWAY_MARGIN = 0.05  # metres beyond the robot's radius at which a door leaf would close on it
 
 
 class Skill:
@@ -89,13 +95,51 @@ class Skill:
 
 
 class Manipulate(Skill):
-    """A timed manipulation; fails at once if its object is gone."""
+    """A timed manipulation; fails at once if its object is gone.  One that closes a door
+    the robot stands in first clears the doorway (see the module's contract)."""
 
     def __init__(self, sim: SkillHost, stage: Stage, now: float) -> None:
         super().__init__(sim, stage, now)
+        self.clearing: Navigate | None = None
         obj = stage.data.get("object")
         if obj is not None and obj not in sim.objects():
             self.result = failed(f"object {obj!r} is gone")
+            return
+        place = next((a for a in stage.args if a in sim.spec.places), None)
+        if place is not None and self._in_doorway(sim.doors_closed_by(stage)):
+            self.clearing = Navigate(sim, Stage(f"clear_{stage.action}", skill="navigate", data={"to": place}), now)
+            if self.clearing.result is not RUNNING:
+                self.result = failed(f"cannot step out of the doorway to {place!r}: {self.clearing.result.reason}")
+
+    def _in_doorway(self, doors: tuple[str, ...]) -> bool:
+        if not doors:
+            return False
+        x, y, _ = self.sim.robot_pose()
+        boxes = np.asarray([self.sim.spec.doors[d].box for d in doors], dtype=float)
+        return bool(point_box_distance(np.asarray([x]), np.asarray([y]), boxes).min()
+                    < self.sim.scene.radius + DOORWAY_MARGIN)
+
+    def control(self, now: float, dt: float) -> Command:
+        c = self.clearing
+        if c is None:
+            return super().control(now, dt)
+        cmd = c.control(now, dt)
+        if c.result is SUCCEEDED and not c.braking():
+            self.clearing, self.started = None, now  # out of the doorway: the manipulation starts now
+        elif c.result is not RUNNING and c.result is not SUCCEEDED and self.result is RUNNING:
+            self.result = failed(f"could not step out of the doorway: {c.result.reason}")
+        return cmd
+
+    def stop(self, now: float) -> None:
+        if self.clearing is not None:
+            self.clearing.stop(now)
+        super().stop(now)
+
+    def quiet_until(self) -> float:
+        return -math.inf if self.clearing is not None else super().quiet_until()
+
+    def braking(self) -> bool:
+        return self.clearing is not None and self.clearing.braking()
 
 
 class Navigate(Skill):

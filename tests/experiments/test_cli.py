@@ -85,6 +85,9 @@ BAD: list[tuple[list[str], str]] = [
     (["cost", "flat", "living", "kitchen", "--seed", "-1"], "--seed"),
     (["explain", "{missing}", "--agent", "d1"], "no such run folder"),
     (["explain", "{tmp}"], "--agent"),
+    (["day", "--protocol", "tabsaa", "--out", "{tmp}/day"], "did you mean 'tabsa'"),
+    (["day", "--schedulers", "alg3", "--out", "{tmp}/day"], "did you mean 'alg2'"),
+    (["day", "--days", "0", "--out", "{tmp}/day"], "--days"),
 ]
 
 

@@ -109,6 +109,7 @@ def test_cooker_left_on_through_a_switch_is_unattended_until_resumed() -> None:
     assert cooker["overruns"] == 1 and cooker["overrun_s"] == 5.0  # 15 s unattended against a 10 s budget
     assert cooker["at_switch"] == 1 and cooker["active_at_end"] == 0
     assert m["unattended_s"] == 15.0 and m["budget_overruns"] == 1
+    assert m["after_end_s"] == 0.0  # unattended while its task waited, not after it ended
     assert m["violations_at_switch"] == 1
     assert m["switches_into_wait"] == [{"t": 10.0, "agent": "d1", "hazards": ["cooker_on(stove)"]}]
 
@@ -128,7 +129,8 @@ def test_a_cooker_never_turned_off_counts_until_the_end_of_the_trace() -> None:
     m = metrics.compute(b.events)
     assert m["safety"]["hazards"]["cooker_on"] == {
         "episodes": 1, "budget_s": 60.0, "active_s": 8.0, "unattended_s": 6.0, "longest_unattended_s": 6.0,
-        "overruns": 0, "overrun_s": 0.0, "at_switch": 0, "active_at_end": 1, "unowned": 0}
+        "overruns": 0, "overrun_s": 0.0, "after_end_s": 6.0, "at_switch": 0, "active_at_end": 1, "unowned": 0}
+    assert m["safety"]["after_end_s"] == 6.0  # every unattended second came after its task had ended
     assert m["totals"]["failed"] == 1 and m["totals"]["by_cause"] == {"failed": 1}
     assert m["totals"]["failure_reasons"] == ["d1: stage cook_food failed"]
     assert m["run"]["horizon_reached"] is True

@@ -370,3 +370,15 @@ def test_after_a_leg_to_a_person_the_next_leg_starts_where_they_stand() -> None:
               Stage("guide", ("robot", "john", "dest"), skill="navigate", data={"to": "dest"})]
     walk(stages, poses["robot"], world, Recording())
     assert [s[:2] for s in starts] == [(0.0, 0.0), (5.0, 0.0)]
+
+
+def test_a_plan_estimated_across_a_closed_door_opens_it() -> None:
+    """The reference table keeps closed doors closed (but for door_between pairs, which the
+    plan may open): carry's first estimate is a plan through the door it opens, and finite."""
+    from experiments import scenario as scenarios
+    from experiments.runner import build_robot
+
+    loop, _ = build_robot(scenarios.load(scenarios.resolve("carry")), seed=1)
+    trace = loop.run(until=0.5)
+    start = next(e for e in trace.events if e["event"] == "command" and e["flag"] == "start")
+    assert isinstance(start["predicted_s"], float) and math.isfinite(start["predicted_s"])

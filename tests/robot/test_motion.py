@@ -150,3 +150,22 @@ def test_travel_matrix_and_seed_checks_fire() -> None:
     with pytest.raises(ValueError, match="seed must be >= 0"):
         ompl_seed(-1)
     assert ompl_seed(0) == 1 and ompl_seed(1) == 2
+
+
+def test_ignoring_people_keeps_the_doors_as_they_are(flat, flat_motion) -> None:
+    """What a plan's connectivity may rely on: walls and closed doors, never where people stand."""
+    living, bedroom = flat.places["living"], flat.places["bedroom"]
+    assert flat_motion.closed_doors() == ("bedroom_door",)
+    assert not flat_motion.estimate_ignoring_people(living, bedroom).reachable  # the door is closed
+    assert flat_motion.estimate_ignoring_doors(living, bedroom).reachable
+    scene = flat_motion.planner.scene
+    kitchen = flat.places["kitchen"]
+    free = flat_motion.estimate_ignoring_people(living, kitchen)
+    before = dict(scene.people)
+    scene.set_person("bob", (living[0] + kitchen[0]) / 2, (living[1] + kitchen[1]) / 2, "fallen")
+    try:
+        assert flat_motion.estimate_ignoring_people(living, kitchen) == free
+        assert flat_motion.estimate(living, kitchen) != free
+    finally:
+        scene.remove_person("bob")
+    assert scene.people == before

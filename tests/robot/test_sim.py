@@ -135,3 +135,25 @@ def test_same_seed_same_trajectory(paper) -> None:
         trajectories.append((np.array(sim.trajectory), sim.mj.state()))
     assert np.array_equal(trajectories[0][0], trajectories[1][0])
     assert np.array_equal(trajectories[0][1], trajectories[1][1])
+
+
+def test_a_door_closed_from_the_doorway_is_closed_from_the_stage_s_side(flat) -> None:
+    """A plan may close a door while the robot stands in it (its symbolic place is already
+    one side): the skill steps out to that side first, so the leaf never closes through it."""
+    from robot.scene import point_box_distance
+
+    sim = Simulation(flat)
+    sim.bind([Binding("door", ("open", "?d"), "?d")])
+    sim.set_door("bedroom_door", True)
+    status, now = run(sim, nav([6.0, 3.5, 1.5708]), 0.0)
+    assert status.state is SkillState.SUCCEEDED
+    box = np.asarray([flat.doors["bedroom_door"].box], dtype=float)
+    x, y, _ = sim.robot_pose()
+    assert point_box_distance(np.asarray([x]), np.asarray([y]), box).min() < sim.scene.radius  # in the doorway
+    close = Stage("close_door", ("robot", "bedroom_door", "living"), skill="manipulate", duration=3.0,
+                  data={"delete": [["open", "bedroom_door"]]})
+    status, now = run(sim, close, now)
+    assert status.state is SkillState.SUCCEEDED and not sim.door_open["bedroom_door"]
+    x, y, _ = sim.robot_pose()
+    assert y < 3.45 and point_box_distance(np.asarray([x]), np.asarray([y]), box).min() >= sim.scene.radius
+    assert run(sim, nav("kitchen"), now)[0].state is SkillState.SUCCEEDED  # not walled in

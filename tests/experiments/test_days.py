@@ -1,0 +1,113 @@
+"""The one scenario pipeline: (protocol, seed, backend) → a scenario, on both backends.
+
+Robot days here are tiny (one request of each type in a few minutes) so the suite stays
+fast; the shipped protocols' days are run by ``python -m experiments.dayreport``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from experiments import dayreport, days, protocol
+from tasker import schedulers
+from tasker.errors import ConfigError
+
+PROTOCOLS = Path(__file__).resolve().parents[2] / "experiments" / "protocols"
+
+
+def tiny(tmp_path: Path) -> Path:
+    """tabsa_short with one request of each type called in the first minute, a 10-minute day."""
+    text = (PROTOCOLS / "tabsa_short.toml").read_text(encoding="utf-8")
+    text = text.replace('name = "tabsa-short"', 'name = "tiny"')
+    text = text.replace("length_s = 3600.0", "length_s = 600.0").replace("last_call_s = 2700.0", "last_call_s = 60.0")
+    text = text.replace("count = 3", "count = 1")
+    text = text.replace('world = "tabsa_apartment_short.toml"', f'world = "{PROTOCOLS / "tabsa_apartment_short.toml"}"')
+    p = tmp_path / "tiny.toml"
+    p.write_text(text, encoding="utf-8")
+    return p
+
+
+@pytest.fixture(scope="module")
+def tiny_protocol(tmp_path_factory: pytest.TempPathFactory) -> protocol.Protocol:
+    return protocol.load(tiny(tmp_path_factory.mktemp("tiny")))
+
+
+def test_protocols_are_registered_by_name() -> None:
+    assert {"tabsa", "tabsa-short"} <= set(days.names())
+    assert days.load("tabsa").name == "tabsa" and days.load("tabsa-short").name == "tabsa-short"
+    with pytest.raises(ConfigError, match="did you mean 'tabsa'"):
+        days.make("tabsaa", 1)
+    with pytest.raises(ConfigError, match="did you mean 'robot'"):
+        days.make("tabsa", 1, backend="robt")
+    with pytest.raises(ConfigError, match="did you mean 'alg2'"):
+        days.make("tabsa", 1, scheduler="alg")
+
+
+@pytest.mark.parametrize("backend", days.BACKENDS)
+def test_same_seed_same_scenario(backend: str) -> None:
+    a = days.make("tabsa", 3, backend=backend).scenario
+    b = days.make("tabsa", 3, backend=backend).scenario
+    c = days.make("tabsa", 4, backend=backend).scenario
+    assert a.actions == b.actions and a.actions != c.actions
+    if backend == "robot":
+        assert a.people == b.people and a.objects == b.objects
+
+
+def test_both_backends_are_built_from_one_draw() -> None:
+    syn = days.make("tabsa", 5).scenario
+    rob = days.make("tabsa", 5, backend="robot").scenario
+    proto = days.load("tabsa")
+    folder = days.task_names(proto, "robot")
+    syn_req = [(a.t, a.fields["task"], a.fields["args"]["deadline"]) for a in syn.actions]
+    rob_req = [(a.t, a.fields["task"], a.fields["args"]["deadline"]) for a in rob.actions if a.kind == "request"]
+    assert [(t, folder[k], d) for t, k, d in syn_req] == rob_req
+    # every request carries its deadline and priority; a fall its death time, and its person falls at the call
+    falls = [a for a in rob.actions if a.kind == "request" and a.fields["task"] == folder["fall"]]
+    assert len(falls) == 12 and all(a.fields["args"]["death_at"] == a.fields["args"]["deadline"] + 900 for a in falls)
+    postures = {(a.t, a.fields["value"][0]): a.fields["value"][1] for a in rob.actions if a.kind == "world"}
+    assert all(postures[a.t, a.fields["args"]["person"]] == "fallen" for a in falls)
+    people = [v for a in rob.actions if a.kind == "request" for v in a.fields["args"].values() if v in rob.people]
+    assert len(people) == len(set(people)) == 24  # one person per escort and per fall
+    assert len(rob.objects) == 12
+
+
+def test_a_protocol_without_a_robot_backend_says_so(tmp_path: Path) -> None:
+    text = (PROTOCOLS / "tabsa.toml").read_text(encoding="utf-8").split("[robot_backend]")[0]
+    p = tmp_path / "synthetic_only.toml"
+    p.write_text(text, encoding="utf-8")
+    with pytest.raises(ConfigError, match="no \\[robot_backend\\]"):
+        days.make(p, 1, backend="robot")
+
+
+@pytest.mark.parametrize("name", schedulers.names())
+def test_every_scheduler_runs_every_task_type_synthetic(name: str) -> None:
+    run = days.make("tabsa-short", 2, scheduler=name).run()
+    finished = {e["task_type"] for e in run.events if e["event"] == "end" and e.get("cause") == "finished"}
+    assert finished == {"transport", "fall", "pick_place"}
+
+
+@pytest.mark.parametrize("name", schedulers.names())
+def test_every_scheduler_runs_every_task_type_robot(tiny_protocol: protocol.Protocol, name: str) -> None:
+    m = dayreport.run_day(tiny_protocol.source, 1, name, "robot")
+    assert {t: v["completed"] for t, v in m["per_type"].items()} == {"transport": 1, "fall": 1, "pick_place": 1}
+    assert m["dead_falls"] == 0 and m["travel_m"] > 0
+
+
+@pytest.mark.parametrize("name", ["tabsa", "tabsa-short"])
+def test_every_spot_and_place_of_the_robot_world_is_clear(name: str) -> None:
+    """People stand 0.3 m and the robot's places 0.4 m clear of every wall and piece of furniture."""
+    from robot.spec import load_world
+
+    proto = days.load(name)
+    assert proto.robot is not None
+    world = load_world(proto.robot.world)
+    boxes = [o.box for o in world.obstacles]
+
+    def clearance(x: float, y: float) -> float:
+        return min(((max(b[0] - x, 0.0, x - b[2])) ** 2 + (max(b[1] - y, 0.0, y - b[3])) ** 2) ** 0.5 for b in boxes)
+
+    assert all(clearance(*s) >= 0.3 for spots in proto.robot.spots.values() for s in spots)
+    assert all(clearance(p[0], p[1]) >= 0.4 for p in world.places.values())
+    assert set(proto.robot.places.values()) <= set(world.places)

@@ -1,0 +1,52 @@
+"""Abandonment and travel distance on a small hand-made day, checked against values computed by hand."""
+
+from __future__ import annotations
+
+import pytest
+
+from experiments.pathmetrics import abandonments, path_metrics, travel_m
+from robot.recording import PersonState, Sample
+
+# The robot on the x axis, one sample a second; Ann lies at the origin from t = 0; Bob stands at (0, 5).
+XS = [5.0, 3.0, 1.5, 1.0, 2.5, 1.0, 1.0, 1.0, 3.0, 3.0, 3.0]
+
+
+def samples(ann_up_at: float = 99.0) -> list[Sample]:
+    return [Sample(float(t), (x, 0.0, 0.0),
+                   (PersonState("ann", 0.0, 0.0, 0.0, "fallen" if t < ann_up_at else "standing"),
+                    PersonState("bob", 0.0, 5.0, 0.0, "standing")))
+            for t, x in enumerate(XS)]
+
+
+EVENTS = [
+    {"t": 1.0, "event": "request", "agent": "d1", "task_type": "help", "args": {"person": "ann", "deadline": 9.0}},
+    {"t": 1.0, "event": "request", "agent": "d2", "task_type": "escort", "args": {"person": "bob", "to": "hall"}},
+    {"t": 7.5, "event": "end", "agent": "d1", "task_type": "help", "cause": "finished"},
+]
+
+
+def test_travel_is_the_length_of_the_sampled_path() -> None:
+    # |5-3| + |3-1.5| + |1.5-1| + |1-2.5| + |2.5-1| + 0 + 0 + |1-3| + 0 + 0
+    assert travel_m(samples()) == pytest.approx(2 + 1.5 + 0.5 + 1.5 + 1.5 + 2)
+
+
+def test_leaving_the_circle_before_helping_is_an_abandonment() -> None:
+    # from the request (t=1): 3 out, 1.5 in, 1 in, 2.5 OUT (1), 1 in, 1, 1; t=8 (3 m) is after the end at 7.5
+    assert abandonments(EVENTS, samples()) == {"d1": 1}
+    assert path_metrics(EVENTS, samples()) == {"abandonments": 1, "abandoned_falls": 1, "travel_m": 9.0}
+
+
+def test_leaving_after_helping_is_not() -> None:
+    done_early = [*EVENTS[:2], {**EVENTS[2], "t": 3.5}]  # finished before the robot left at t=4
+    assert abandonments(done_early, samples()) == {"d1": 0}
+
+
+def test_a_person_no_longer_down_ends_the_watch() -> None:
+    assert abandonments(EVENTS, samples(ann_up_at=4.0)) == {"d1": 0}  # up before the robot left
+
+
+def test_a_smaller_circle_changes_the_count() -> None:
+    # radius 1.2: in at t=3 (1.0), out at t=4 (2.5): 1; in at t=5..7: no exit before the end
+    assert abandonments(EVENTS, samples(), radius=1.2) == {"d1": 1}
+    # radius 0.9: the robot is never inside, so it never leaves
+    assert abandonments(EVENTS, samples(), radius=0.9) == {"d1": 0}
