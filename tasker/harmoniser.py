@@ -149,6 +149,11 @@ class TaskHarmoniser:
     scans, as every unindexed scheduler does: the reference computation, kept
     callable; decisions and traces are the same either way."""
 
+    scan_below: int = 32
+    """With no more waiting agents than this, a decision scans them even when
+    :attr:`incremental`: a short scan is cheaper than keeping the heap.  Reports
+    still mark their agents, so the heap is exact again as soon as it is used."""
+
     def __init__(
         self,
         scheduler: Scheduler,
@@ -302,7 +307,9 @@ class TaskHarmoniser:
         name = self.scheduler.name
         for _ in range(len(self._idle) + 2):  # each retry follows an agent that ended while asked
             exe = self._cands.get(self.exe_da) if self.exe_da is not None else None
-            index = self._candidate_index()
+            index = self._candidate_index() if len(self._idle) > self.scan_below else None
+            if index is not None:
+                index.refresh(self._cands)
             if index is not None and not index.needs_scan(self._idle):
                 lowest = index.lowest(self._idle)
                 if lowest is None:
@@ -355,8 +362,8 @@ class TaskHarmoniser:
             return None
         if self._index is None or self._index.scheduler is not self.scheduler:  # first use, or a new scheduler
             self._index = CandidateIndex(self.scheduler)
-            for cand in self._cands.values():
-                self._index.update(cand)
+            for agent in self._cands:
+                self._index.touch(agent)
         return self._index
 
     def _held(self, dac: str, exe: str, now: float) -> dict[str, Any] | None:
@@ -521,7 +528,7 @@ class TaskHarmoniser:
                              agent.ctx.request_time, self._order.get(agent.id, 0))
             self._cands[agent.id] = cand
             if self._index is not None:
-                self._index.update(cand)
+                self._index.touch(agent.id)
 
     def _emit_roles(self, now: float) -> None:
         self._roles_dirty = False

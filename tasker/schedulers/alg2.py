@@ -83,7 +83,11 @@ class Alg2(Scheduler):
         return (self.rank(c.task_type), self.cost_params(c, self.name).cost, c.order)
 
     def select_key(self, c: Candidate) -> tuple[int, float, int]:
-        return self.queue_key(c)
+        """:meth:`queue_key`, inlined: the harmoniser's index computes it for every report."""
+        p = c.params
+        if not isinstance(p, CostParams):
+            p = self.cost_params(c, self.name)  # raises the error the scan would
+        return (self._rank.get(c.task_type, self._lowest), p.cost, c.order)
 
     def schedule(self, view: ScheduleView) -> Decision:
         best: Candidate | None = view.lowest  # found by the harmoniser's index, or

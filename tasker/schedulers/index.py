@@ -5,12 +5,13 @@ key (:meth:`~tasker.schedulers.base.Scheduler.select_key`: class and cost, prior
 cTime, deadline, ...), then compare it with the executing agent.  Scanning every
 waiting agent at each decision makes one harmoniser tick O(n): 2 ms at 10,000
 waiting agents.  A key changes only when its agent's report does, so the harmoniser
-keeps the keys in a binary heap (:mod:`heapq`) updated on each report — O(log n),
-and nothing at all when the key is unchanged — and a decision reads the top.
+keeps the keys in a binary heap (:mod:`heapq`) and a decision reads the top.
 
-The heap holds every agent with a report, idle or not; the index is told nothing of
-roles.  :meth:`CandidateIndex.lowest` skips the entries that are stale (an agent
-that reported again, or ended) and sets aside the live ones that are not idle (the
+Reports only mark their agent; the marked agents are re-keyed when a decision needs
+the heap (one push each, or one ``heapify`` when most of them reported).  The heap
+holds every agent with a report, idle or not; the index is told nothing of roles.
+:meth:`CandidateIndex.lowest` skips the entries that are stale (an agent that
+reported again, or ended) and sets aside the live ones that are not idle (the
 executing agent and ``irrDA``: at most two), so a decision costs O(log n) amortised.
 Stale entries are compacted away when they outnumber the live ones.
 
@@ -26,7 +27,7 @@ reference the tests compare whole traces against.
 from __future__ import annotations
 
 import heapq
-from collections.abc import Container
+from collections.abc import Container, Mapping
 from typing import Any
 
 from tasker.schedulers.base import Candidate, Scheduler
@@ -45,7 +46,14 @@ def _usable(key: object) -> bool:
 
 
 class CandidateIndex:
-    """The agents' :meth:`Scheduler.select_key` in a heap, for one :attr:`Scheduler.indexed` scheduler."""
+    """The agents' :meth:`Scheduler.select_key` in a heap, for one :attr:`Scheduler.indexed` scheduler.
+
+    Reports only mark their agent (:meth:`touch`, O(1)); :meth:`refresh` re-keys the
+    marked agents when a decision needs the heap — one push each, or, when most
+    agents changed (every waiting agent reports on the same tick), one ``heapify``
+    of all of them — so a report costs nothing and a decision with no new report
+    costs O(log n).
+    """
 
     def __init__(self, scheduler: Scheduler) -> None:
         if not scheduler.indexed:
@@ -55,45 +63,51 @@ class CandidateIndex:
         self._heap: list[tuple[_Key, int, str]] = []
         self._live: dict[str, tuple[_Key, int]] = {}  # agent -> (key, version) of its one valid entry
         self._unkeyed: set[str] = set()  # agents whose key is not indexed: the harmoniser scans while one is idle
+        self._dirty: dict[str, None] = {}  # agents that reported since the last refresh, in report order
         self._version = 0
 
     def __len__(self) -> int:
-        """Agents indexed (with a usable key)."""
+        """Agents indexed (with a usable key), as of the last refresh."""
         return len(self._live)
 
-    def update(self, c: Candidate) -> None:
-        """``c``'s agent reported ``c``: re-key it (a push only if the key changed)."""
-        agent = c.id
-        try:
-            key = self._key(c)
-        except Exception:  # the scan will call the same key and raise it in schedule(), where errors belong
-            key = None
-        if not _usable(key):
-            self._unkeyed.add(agent)
-            self._live.pop(agent, None)
-            return
-        assert isinstance(key, tuple)
-        self._unkeyed.discard(agent)
-        old = self._live.get(agent)
-        if old is not None and old[0] == key:
-            return
-        self._version += 1
-        self._live[agent] = (key, self._version)
-        heapq.heappush(self._heap, (key, self._version, agent))
-        if len(self._heap) > 2 * len(self._live) + 64:
-            self._compact()
+    def touch(self, agent: str) -> None:
+        """``agent`` reported new parameters: re-key it at the next :meth:`refresh`."""
+        self._dirty[agent] = None
 
     def discard(self, agent: str) -> None:
         """``agent`` ended: its entries become stale."""
         self._live.pop(agent, None)
         self._unkeyed.discard(agent)
+        self._dirty.pop(agent, None)
+
+    def update(self, c: Candidate) -> None:
+        """``c``'s agent reported ``c``: re-key it now (a push only if its key changed)."""
+        self._dirty.pop(c.id, None)
+        self._rekey(c, push=True)
+
+    def refresh(self, cands: Mapping[str, Candidate]) -> None:
+        """Re-key every agent touched since the last refresh, from its latest candidate in ``cands``."""
+        dirty = self._dirty
+        if not dirty:
+            return
+        rebuild = 4 * len(dirty) > len(self._live)  # most changed: one heapify beats a push each
+        for agent in dirty:
+            c = cands.get(agent)
+            if c is not None:
+                self._rekey(c, push=not rebuild)
+            else:  # no candidate any more: as if it ended
+                self._live.pop(agent, None)
+                self._unkeyed.discard(agent)
+        dirty.clear()
+        if rebuild or len(self._heap) > 2 * len(self._live) + 64:
+            self._compact()
 
     def needs_scan(self, idle: Container[str]) -> bool:
         """True while an idle agent's key is not indexed: the decision must scan."""
         return any(a in idle for a in self._unkeyed)
 
     def lowest(self, idle: Container[str]) -> str | None:
-        """The idle agent with the lowest key, or None if no idle agent is indexed."""
+        """The idle agent with the lowest key, or None if no idle agent is indexed (call :meth:`refresh` first)."""
         heap, live = self._heap, self._live
         aside: list[tuple[_Key, int, str]] = []
         found = None
@@ -111,7 +125,28 @@ class CandidateIndex:
             heapq.heappush(heap, item)
         return found
 
+    def _rekey(self, c: Candidate, *, push: bool) -> None:
+        agent = c.id
+        try:
+            key = self._key(c)
+        except Exception:  # the scan will call the same key and raise it in schedule(), where errors belong
+            key = None
+        if not _usable(key):
+            self._unkeyed.add(agent)
+            self._live.pop(agent, None)
+            return
+        assert isinstance(key, tuple)
+        self._unkeyed.discard(agent)
+        old = self._live.get(agent)
+        if old is not None and old[0] == key:
+            return
+        self._version += 1
+        self._live[agent] = (key, self._version)
+        if push:
+            heapq.heappush(self._heap, (key, self._version, agent))
+            if len(self._heap) > 2 * len(self._live) + 64:
+                self._compact()
+
     def _compact(self) -> None:
         self._heap = [(key, version, agent) for agent, (key, version) in self._live.items()]
         heapq.heapify(self._heap)
-
