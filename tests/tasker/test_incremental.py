@@ -65,6 +65,7 @@ def test_bundled_synthetic_scenario_same_trace(scheduler: str) -> None:
     indexed, scanned, harm = both_ways(lambda: synthetic.build(scenario, seed=1, scheduler=scheduler))
     assert indexed == scanned
     assert (harm._index is not None) == harm.scheduler.indexed  # the index really ran where it could
+    assert harm._index is None or len(harm._index) == 0  # every task ended: none left in the heap
 
 
 @pytest.mark.parametrize("scheduler", schedulers.names())
