@@ -308,9 +308,7 @@ class TaskHarmoniser:
         for _ in range(len(self._idle) + 2):  # each retry follows an agent that ended while asked
             exe = self._cands.get(self.exe_da) if self.exe_da is not None else None
             index = self._candidate_index() if len(self._idle) > self.scan_below else None
-            if index is not None:
-                index.refresh(self._cands)
-            if index is not None and not index.needs_scan(self._idle):
+            if index is not None and index.ready(self._cands) and not index.needs_scan(self._idle):
                 lowest = index.lowest(self._idle)
                 if lowest is None:
                     return

@@ -37,10 +37,14 @@ _Key = tuple[Any, ...]
 
 def _usable(key: object) -> bool:
     """A key the heap can order without raising: a tuple of real numbers, none of them NaN."""
-    if not isinstance(key, tuple):
-        return False
+    if type(key) is not tuple:
+        return isinstance(key, tuple) and _usable(tuple(key))
     for x in key:
-        if not isinstance(x, int | float) or x != x:
+        t = type(x)
+        if t is float:
+            if x != x:
+                return False
+        elif t is not int and not (isinstance(x, int | float) and x == x):
             return False
     return True
 
@@ -50,9 +54,12 @@ class CandidateIndex:
 
     Reports only mark their agent (:meth:`touch`, O(1)); :meth:`refresh` re-keys the
     marked agents when a decision needs the heap — one push each, or, when most
-    agents changed (every waiting agent reports on the same tick), one ``heapify``
-    of all of them — so a report costs nothing and a decision with no new report
-    costs O(log n).
+    agents changed, one ``heapify`` of all of them — so a report costs nothing and a
+    decision with no new report costs O(log n).  When most agents reported since the
+    last decision (every waiting agent reports on the same tick), re-keying them all
+    costs more than reading them, and reports that frequent would undo it by the
+    next decision: :meth:`ready` then tells the harmoniser to scan this once, and the
+    heap is rebuilt at the first decision that follows no new report.
     """
 
     def __init__(self, scheduler: Scheduler) -> None:
@@ -64,6 +71,7 @@ class CandidateIndex:
         self._live: dict[str, tuple[_Key, int]] = {}  # agent -> (key, version) of its one valid entry
         self._unkeyed: set[str] = set()  # agents whose key is not indexed: the harmoniser scans while one is idle
         self._dirty: dict[str, None] = {}  # agents that reported since the last refresh, in report order
+        self._touched = False  # a report since the last decision
         self._version = 0
 
     def __len__(self) -> int:
@@ -73,6 +81,7 @@ class CandidateIndex:
     def touch(self, agent: str) -> None:
         """``agent`` reported new parameters: re-key it at the next :meth:`refresh`."""
         self._dirty[agent] = None
+        self._touched = True
 
     def discard(self, agent: str) -> None:
         """``agent`` ended: its entries become stale."""
@@ -85,21 +94,34 @@ class CandidateIndex:
         self._dirty.pop(c.id, None)
         self._rekey(c, push=True)
 
+    def ready(self, cands: Mapping[str, Candidate]) -> bool:
+        """At a decision: refresh the heap and return True, or return False if a scan is cheaper now.
+
+        A scan is cheaper when most agents reported since the last refresh and
+        some since the last decision (reports about as frequent as decisions).
+        """
+        touched, self._touched = self._touched, False
+        if touched and 2 * len(self._dirty) > len(self._live):
+            return False
+        self.refresh(cands)
+        return True
+
     def refresh(self, cands: Mapping[str, Candidate]) -> None:
         """Re-key every agent touched since the last refresh, from its latest candidate in ``cands``."""
         dirty = self._dirty
         if not dirty:
             return
         rebuild = 4 * len(dirty) > len(self._live)  # most changed: one heapify beats a push each
+        changed = False
         for agent in dirty:
             c = cands.get(agent)
             if c is not None:
-                self._rekey(c, push=not rebuild)
+                changed = self._rekey(c, push=not rebuild) or changed
             else:  # no candidate any more: as if it ended
                 self._live.pop(agent, None)
                 self._unkeyed.discard(agent)
         dirty.clear()
-        if rebuild or len(self._heap) > 2 * len(self._live) + 64:
+        if (rebuild and changed) or len(self._heap) > 2 * len(self._live) + 64:
             self._compact()
 
     def needs_scan(self, idle: Container[str]) -> bool:
@@ -125,7 +147,8 @@ class CandidateIndex:
             heapq.heappush(heap, item)
         return found
 
-    def _rekey(self, c: Candidate, *, push: bool) -> None:
+    def _rekey(self, c: Candidate, *, push: bool) -> bool:
+        """Re-key ``c``'s agent; True if its heap entry changed."""
         agent = c.id
         try:
             key = self._key(c)
@@ -133,19 +156,19 @@ class CandidateIndex:
             key = None
         if not _usable(key):
             self._unkeyed.add(agent)
-            self._live.pop(agent, None)
-            return
+            return self._live.pop(agent, None) is not None
         assert isinstance(key, tuple)
         self._unkeyed.discard(agent)
         old = self._live.get(agent)
         if old is not None and old[0] == key:
-            return
+            return False
         self._version += 1
         self._live[agent] = (key, self._version)
         if push:
             heapq.heappush(self._heap, (key, self._version, agent))
             if len(self._heap) > 2 * len(self._live) + 64:
                 self._compact()
+        return True
 
     def _compact(self) -> None:
         self._heap = [(key, version, agent) for agent, (key, version) in self._live.items()]

@@ -82,9 +82,20 @@ def test_an_indexed_tick_never_builds_the_candidate_list(monkeypatch: pytest.Mon
     def boom(self: _IdleCandidates) -> list[Candidate]:
         raise AssertionError("an indexed scheduler read every candidate")
 
+    served = []
+    lowest = CandidateIndex.lowest
+
+    def counted(self: CandidateIndex, idle: Any) -> str | None:
+        served.append(idle)
+        return lowest(self, idle)
+
     monkeypatch.setattr(_IdleCandidates, "_list", boom)
-    events = days.make("tabsa", 3, scheduler="alg2").build().run().events
+    monkeypatch.setattr(CandidateIndex, "lowest", counted)
+    loop = days.make("tabsa", 3, scheduler="alg2").build()
+    loop.harmoniser.scan_below = 0
+    events = loop.run().events
     assert not [e for e in events if e["event"] == "decision" and e.get("rule") == "error"]
+    assert len(served) >= 10  # the heap served decisions (the others followed reports: scanned, ``ready``)
 
 
 # -- random programs through the whole loop ------------------------------------------------------
@@ -188,9 +199,13 @@ def test_the_index_finds_what_a_scan_finds(ops: list[Any], name: str) -> None:
     cands: dict[str, Candidate] = {}
     idle: dict[str, None] = {}
 
-    def decide() -> None:
+    def decide(last: bool = False) -> None:
+        """As the harmoniser: the heap if it is ready (the last decision forces it), else the scan."""
         scan = [c for a in idle if (c := cands.get(a)) is not None]
-        index.refresh(cands)
+        if last:
+            index.refresh(cands)
+        elif not index.ready(cands):
+            return
         if index.needs_scan(idle):
             with pytest.raises(ConfigError):
                 min(scan, key=scheduler.select_key)
@@ -198,7 +213,7 @@ def test_the_index_finds_what_a_scan_finds(ops: list[Any], name: str) -> None:
         expected = min(scan, key=scheduler.select_key, default=None)
         assert index.lowest(idle) == (expected.id if expected is not None else None)
 
-    for op in ops + [("decide",)]:
+    for op in ops:
         if op[0] == "decide":
             decide()
             continue
@@ -225,6 +240,7 @@ def test_the_index_finds_what_a_scan_finds(ops: list[Any], name: str) -> None:
             idle.pop(agent, None)
         elif agent in cands:
             idle[agent] = None
+    decide(last=True)
     assert len(index._heap) <= 2 * len(index) + 65  # stale entries are compacted away
 
 
