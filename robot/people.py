@@ -13,9 +13,12 @@ randomness).  What a person does in a step, in order of precedence:
    speed, so after a reaction ends they walk back onto the script instead of jumping.
 
 Posture changes come from the script's ``events`` ``(t, posture)`` or from
-:meth:`Person.set_posture`.  ``waiting`` and ``following`` are set by the world from the
-facts a task folder binds to them (``robot.sim.Simulation.bind``): people react to
-what they were told, never to a task's predicate names.
+:meth:`Person.set_posture`; and a sitting person asked to follow the robot stands up
+first — nobody follows seated, and a standing person takes less room in a doorway
+(``robot.scene.PERSON_RADIUS``).  Scripted walks keep the script's postures.
+``waiting`` and ``following`` are set by the world from the facts a task folder binds to
+them (``robot.sim.Simulation.bind``): people react to what they were told, never to a
+task's predicate names.
 """
 
 from __future__ import annotations
@@ -107,11 +110,16 @@ class Person:
         if self.posture == "fallen" or self.waiting:
             return
         if self.following:
+            self._stand_up()
             self._follow(robot, dt)
             return
         target = self.scripted(t)
         if target is not None:
             self._walk_to(target[0], target[1], dt)
+
+    def _stand_up(self) -> None:
+        if self.posture == "sitting":
+            self.posture = "standing"
 
 
 class People:

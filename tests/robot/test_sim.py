@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from robot.scene import PERSON_RADIUS
 from robot.sim import Simulation
 from tasker.meaning import Binding
 from tasker.protocols import CoreAgent, SkillState, World
@@ -80,6 +81,20 @@ def test_person_asked_to_follow_ends_near_the_destination(paper) -> None:
     sim.advance(now + 3.0)
     john = sim.people["john"]
     assert math.dist((john.x, john.y), paper.places["john_destination"][:2]) < 1.5
+
+
+def test_a_sitting_person_asked_to_follow_stands_up(paper) -> None:
+    """Alice sits; once she follows the robot she stands, and the scene gives her a standing disc."""
+    sim = Simulation(paper)
+    assert sim.people["alice"].posture == "sitting"
+    status, now = run(sim, nav("alice", add=[["met", "robot", "alice"]]), 0.0)
+    assert status.state is SkillState.SUCCEEDED
+    sim.bind([Binding("follower", ("following", "?h"), "?h", ("person",))])
+    sim.apply(add=[["following", "alice"]])
+    sim.advance(now + 0.5)
+    assert sim.people["alice"].posture == "standing"
+    assert ("posture", "alice", "standing") in sim.snapshot().facts
+    assert sim.scene.people["alice"].r == PERSON_RADIUS["standing"]
 
 
 def test_told_to_wait_stops_a_walking_person(paper) -> None:
