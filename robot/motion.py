@@ -98,6 +98,17 @@ class DriveLimits:
 
 
 Layer = tuple[tuple[str, ...], tuple[Disc, ...]]  # closed doors, people in the way
+
+
+@dataclass(slots=True)
+class _PointMemo:
+    """What a planner knows of one point under one set of closed doors (see
+    :meth:`BasePlanner._point_memo`)."""
+
+    vis: np.ndarray  # int8 per roadmap node: 1 visible, 0 not, -1 not tested yet
+    free: bool | None = None  # may the robot stand there
+    cand: tuple[np.ndarray, np.ndarray] | None = None  # link candidates, distances to every node
+
 RING = 16  # milestones around a person in the way
 SNAP_STEP = 0.01  # metres between the rings searched for a free start
 SNAP_REACH = 0.6  # metres: a start deeper in collision than this is not snapped
@@ -146,20 +157,27 @@ class BasePlanner:
         self._rings: OrderedDict[tuple[Disc, tuple[str, ...]], tuple[np.ndarray, np.ndarray]] = OrderedDict()
         self._trees: OrderedDict[tuple[object, ...], tuple[np.ndarray, np.ndarray, np.ndarray]] = OrderedDict()
         self._graphs: OrderedDict[Layer, tuple[np.ndarray, np.ndarray, np.ndarray, csr_matrix]] = OrderedDict()
-        self._starts: OrderedDict[tuple[Point, tuple[str, ...]], tuple[np.ndarray, np.ndarray]] = OrderedDict()
         self._door_searches: dict[tuple[str, ...], int] = {}  # door-layer searches per set of closed doors
         self.table_after = table_after
         self.searches = 0  # Dijkstra runs so far (benchmarks and tests read it)
         self._boxes_key: tuple[str, ...] | None = None
         self._all_boxes = np.zeros((0, 4))
+        # visibility memos (walls, furniture, bounds, closed doors; people never): 1 free,
+        # 0 blocked, -1 not tested yet; between roadmap nodes per set of closed doors, and
+        # from a point (a start, a goal) to every roadmap node per (point, closed doors)
+        self._node_vis: OrderedDict[tuple[str, ...], np.ndarray] = OrderedDict()
+        self._point_vis: OrderedDict[tuple[Point, tuple[str, ...]], _PointMemo] = OrderedDict()
+        self._tables: dict[tuple[str, ...], tuple[np.ndarray, np.ndarray]] = {}
+        self._triu: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
 
     def forget_starts(self) -> None:
-        """Drop every per-start result (search trees, start links, answers), keeping what
-        depends on the scene alone (layer graphs, door tables): the next query from any start
-        is planned as from a new one (benchmarks measure new-source queries this way)."""
+        """Drop every per-start result (search trees, start and goal links, answers), keeping
+        what depends on the scene alone (layer graphs, door tables, visibility between roadmap
+        nodes): the next query from any start is planned as from a new one (benchmarks measure
+        new-source queries this way)."""
         self._trees.clear()
-        self._starts.clear()
         self._cache.clear()
+        self._point_vis.clear()
 
     # ---- the scene, by layer -----------------------------------------------------------
     def _doors(self) -> tuple[str, ...]:
@@ -173,6 +191,16 @@ class BasePlanner:
             self._all_boxes = np.vstack([self.scene.static, self.scene.closed_doors()])
         return self._all_boxes
 
+    def _static_free(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Which segments ``a[i]→b[i]`` are clear of the bounds, walls, furniture and closed
+        doors (exact; people are not looked at)."""
+        scene, r = self.scene, self.scene.radius
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        ok = (lo[:, 0] >= scene.xmin + r) & (hi[:, 0] <= scene.xmax - r) & (lo[:, 1] >= scene.ymin + r)
+        ok &= hi[:, 1] <= scene.ymax - r
+        ok &= segments_clear(a, b, self._boxes(), r)
+        return ok
+
     def _free_segments(self, a: np.ndarray, b: np.ndarray, discs: tuple[Disc, ...], leaving: bool = True,
                        goal: Point | None = None) -> np.ndarray:
         """Which segments are clear of the bounds, walls, furniture, closed doors and ``discs``.
@@ -182,16 +210,68 @@ class BasePlanner:
         from ``a`` to ``b`` (``leaving``), stopping at ``goal``; roadmap edges, which are
         searched both ways, with ``leaving=False``.
         """
-        scene, r = self.scene, self.scene.radius
         a, b = np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2)
-        lo, hi = np.minimum(a, b), np.maximum(a, b)
-        ok = (lo[:, 0] >= scene.xmin + r) & (hi[:, 0] <= scene.xmax - r) & (lo[:, 1] >= scene.ymin + r)
-        ok &= hi[:, 1] <= scene.ymax - r
-        ok &= segments_clear(a, b, self._boxes(), r)
+        ok = self._static_free(a, b)
+        return self._people_free(a, b, ok, discs, leaving, goal)
+
+    def _people_free(self, a: np.ndarray, b: np.ndarray, ok: np.ndarray, discs: tuple[Disc, ...],
+                     leaving: bool = True, goal: Point | None = None) -> np.ndarray:
+        """``ok`` (segments clear of everything else) less those ``discs`` block."""
         if discs and ok.any():
             idx = np.flatnonzero(ok)
-            ok[idx] = scene.people_clear(a[idx], b[idx], discs, leaving=leaving, goal=goal)
+            ok[idx] = self.scene.people_clear(a[idx], b[idx], discs, leaving=leaving, goal=goal)
         return ok
+
+    # ---- visibility memos ----------------------------------------------------------------
+    def _node_memo(self, doors: tuple[str, ...]) -> np.ndarray:
+        """Visibility between roadmap nodes under ``doors`` (``int8 (N, N)``: 1 free, 0 blocked,
+        -1 not tested), seeded with what the roadmap already knows: its edges are clear of the
+        static layer (closed doors block those in the door mask), and every pair of corner,
+        door and place nodes that is not an edge is blocked (the roadmap's visibility graph
+        tested them all)."""
+        if doors in self._node_vis:
+            self._node_vis.move_to_end(doors)
+            return self._node_vis[doors]
+        rm = self.roadmap
+        n = len(rm.nodes)
+        memo = np.full((n, n), -1, dtype=np.int8)
+        first = int(rm.corner_nodes[0]) if len(rm.corner_nodes) else n
+        memo[first:, first:] = 0
+        ok = (~self._door_mask(doors)).astype(np.int8)
+        memo[rm.edges[:, 0], rm.edges[:, 1]] = ok
+        memo[rm.edges[:, 1], rm.edges[:, 0]] = ok
+        self._node_vis[doors] = memo
+        if len(self._node_vis) > 4:
+            self._node_vis.popitem(last=False)
+        return memo
+
+    def _point_memo(self, p: Point, doors: tuple[str, ...]) -> _PointMemo:
+        """What is known of point ``p`` under ``doors``: may the robot stand there, which roadmap
+        nodes it sees, its link candidates among the roadmap nodes."""
+        key = (p, doors)
+        memo = self._point_vis.get(key)
+        if memo is None:
+            memo = _PointMemo(np.full(len(self.roadmap.nodes), -1, dtype=np.int8))
+            self._point_vis[key] = memo
+            if len(self._point_vis) > 1024:
+                self._point_vis.popitem(last=False)
+        else:
+            self._point_vis.move_to_end(key)
+        return memo
+
+    def _settle(self, doors: tuple[str, ...], p: Point, idx: np.ndarray,
+                extra: np.ndarray | None = None) -> np.ndarray:
+        """Test, in one exact vectorised call, the segments from ``p`` to the roadmap nodes
+        ``idx`` the memo does not know yet (and store the answers), and those from ``p`` to the
+        ``extra`` points (rings, a start seen from its goal), whose answers are returned."""
+        vis = self._point_memo(p, doors).vis
+        todo = idx[vis[idx] < 0]
+        ends = self.roadmap.nodes[todo] if extra is None else np.vstack([self.roadmap.nodes[todo], extra])
+        if not len(ends):
+            return np.zeros(0, dtype=bool)
+        ok = self._static_free(np.broadcast_to(np.asarray(p, dtype=float), ends.shape), ends)
+        vis[todo] = ok[: len(todo)]
+        return ok[len(todo):]
 
     def _free_points(self, pts: np.ndarray) -> np.ndarray:
         """Which points the robot may stand on: clear of bounds, walls, furniture, closed doors.
@@ -297,14 +377,14 @@ class BasePlanner:
         lengths = np.hypot(*(all_nodes[all_edges[:, 0]] - all_nodes[all_edges[:, 1]]).T)
         return all_nodes, all_edges, lengths
 
-    def _links(self, p: Point, nodes: np.ndarray, discs: tuple[Disc, ...], k: int = 16,
-               also: Point | None = None, goal: bool = False) -> tuple[np.ndarray, np.ndarray, bool]:
-        """Nodes visible from ``p`` among its ``k`` nearest and the nearest 24 milestones within
-        3 m that are not OMPL samples (corners, doors, places, rings), with distances; and
-        whether ``p`` sees ``also`` directly (one vectorised test for all).
-
-        ``p`` is the path's start (segments ``p → node``), or with ``goal`` its goal
-        (segments ``node → p`` and ``also → p``): people are judged in driving order."""
+    def _candidates(self, p: Point, nodes: np.ndarray, k: int = 16) -> tuple[np.ndarray, np.ndarray]:
+        """``p``'s link candidates among ``nodes``: its ``k`` nearest and the nearest 24 within
+        3 m that are not OMPL samples (corners, doors, places, rings), sorted; and the distances
+        from ``p`` to every node.  Memoised for the roadmap's own nodes."""
+        roadmap = nodes is self.roadmap.nodes
+        memo = self._point_memo(p, self._doors()) if roadmap and k == 16 else None
+        if memo is not None and memo.cand is not None:
+            return memo.cand
         d = np.hypot(nodes[:, 0] - p[0], nodes[:, 1] - p[1])
         first = int(self.roadmap.corner_nodes[0]) if len(self.roadmap.corner_nodes) else len(self.roadmap.nodes)
         near = np.argpartition(d, min(k, len(d) - 1))[:k]
@@ -312,12 +392,51 @@ class BasePlanner:
         if len(special) > 24:
             special = special[np.argsort(d[special], kind="stable")[:24]]
         cand = np.unique(np.concatenate([near, special]))
+        if memo is not None:
+            memo.cand = (cand, d)
+        return cand, d
+
+    def _links(self, p: Point, nodes: np.ndarray, discs: tuple[Disc, ...], k: int = 16,
+               also: Point | None = None, goal: bool = False) -> tuple[np.ndarray, np.ndarray, bool]:
+        """Nodes visible from ``p`` among its link candidates (:meth:`_candidates`), with
+        distances; and whether ``p`` sees ``also`` directly.
+
+        ``p`` is the path's start (segments ``p → node``), or with ``goal`` its goal
+        (segments ``node → p`` and ``also → p``): people are judged in driving order.  Walls,
+        furniture and closed doors come from the visibility memo, tested (all at once) only
+        where it does not know yet; people are judged afresh.
+        """
+        cand, d = self._candidates(p, nodes, k)
+        doors = self._doors()
+        n_rm = len(self.roadmap.nodes)
+        split = int(np.searchsorted(cand, n_rm))
         ends = nodes[cand] if also is None else np.vstack([nodes[cand], [also]])
-        here = np.repeat([p], len(ends), axis=0)
-        ok = self._free_segments(ends, here, discs, goal=p) if goal else self._free_segments(here, ends, discs)
+        here = np.broadcast_to(np.asarray(p, float), (len(ends), 2))
+        off = ends[split:]  # ring milestones, and ``also``: not in the memo
+        fresh = self._settle(doors, p, cand[:split], off if len(off) else None)
+        ok = np.concatenate([self._point_memo(p, doors).vis[cand[:split]] == 1, fresh])
+        if goal:
+            ok = self._people_free(ends, here, ok, discs, goal=p)
+        else:
+            ok = self._people_free(here, ends, ok, discs)
         direct = bool(ok[-1]) if also is not None else False
         ok = ok[: len(cand)]
         return cand[ok], d[cand[ok]], direct
+
+    def _point_free(self, p: Point) -> bool:
+        """May the robot stand on ``p`` (:meth:`_free_points`; memoised per point and doors)?"""
+        memo = self._point_memo(p, self._doors())
+        if memo.free is None:  # one point: plain floats beat numpy's call overhead
+            x, y = p
+            free = self.scene.static_free(x, y)
+            r2 = self.scene.radius * self.scene.radius
+            for x0, y0, x1, y1 in self.scene.closed_doors().tolist() if free else ():
+                dx = x0 - x if x < x0 else (x - x1 if x > x1 else 0.0)
+                dy = y0 - y if y < y0 else (y - y1 if y > y1 else 0.0)
+                if dx * dx + dy * dy < r2:
+                    free = False
+            memo.free = free
+        return memo.free
 
     def _tree(self, s: Point, layer: Layer) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Distances and predecessors from ``s`` over ``layer``'s graph (cached), and its nodes:
@@ -350,58 +469,130 @@ class BasePlanner:
         return (not layer[1] and self.table_after is not None
                 and self._door_searches.get(layer[0], 0) >= self.table_after)
 
-    def _start_links(self, s: Point, doors: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
-        """The roadmap nodes start ``s`` links to on the door layer, and their distances (cached)."""
-        key = (s, doors)
-        if key not in self._starts:
-            si, sd, _ = self._links(s, self.roadmap.nodes, ())
-            self._starts[key] = (si, sd)
-            if len(self._starts) > 512:
-                self._starts.popitem(last=False)
-        self._starts.move_to_end(key)
-        return self._starts[key]
+    def _door_table(self, doors: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """The roadmap's all-pairs distances and predecessors under ``doors`` (looked up once)."""
+        if doors not in self._tables:
+            self._tables[doors] = self.roadmap.all_pairs(self._door_mask(doors))
+            if len(self._tables) > 4:
+                self._tables.pop(next(iter(self._tables)))
+        return self._tables[doors]
 
-    def _table_route(self, s: Point, doors: tuple[str, ...], gi: np.ndarray, gd: np.ndarray) -> list[int] | None:
-        """The door layer's shortest route of roadmap nodes from start ``s`` to one of the goal's
-        links ``gi`` (at ``gd``), read off the all-pairs table of ``doors`` instead of searched:
-        the least ``link(s, a) + table[a, b] + link(b, goal)`` over the start's links ``a`` and
-        the goal's ``b``, then ``table``'s predecessors from ``b`` back to ``a``.  The same
-        length as :meth:`_tree`'s search (which adds the same 1e-9 to each start link)."""
-        si, sd = self._start_links(s, doors)
-        if not len(si):
+    def _table_query(self, s: Point, g: Point, doors: tuple[str, ...]) -> list[Point] | None:
+        """The door layer's shortest path, its route read off the all-pairs table of ``doors``.
+
+        The route is the least ``link(s, a) + table[a, b] + link(b, goal)`` over the start's
+        visible links ``a`` and the goal's ``b`` (the length :meth:`_tree`'s search gives, which
+        adds the same 1e-9 to each start link), then ``table``'s predecessors from ``b`` back to
+        ``a``.  One exact test covers the straight way and the links the memos do not know
+        yet, a second the shortcut's pairs they do not know.
+        """
+        nodes = self.roadmap.nodes
+        cs, ds = self._candidates(s, nodes)
+        cg, dg = self._candidates(g, nodes)
+        vs, vg = self._point_memo(s, doors).vis, self._point_memo(g, doors).vis
+        # one exact test: the straight way and every link not in the memos yet
+        us, ug = cs[vs[cs] < 0], cg[vg[cg] < 0]
+        here = np.array([s, g], dtype=float)
+        a = np.concatenate([np.zeros(len(us), dtype=int), np.ones(len(ug), dtype=int), [0]])
+        ok = self._static_free(here[a], np.vstack([nodes[us], nodes[ug], here[1:]]))
+        vs[us] = ok[: len(us)]
+        vg[ug] = ok[len(us): -1]
+        if ok[-1]:
+            return [s, g]
+        si, gi = cs[vs[cs] == 1], cg[vg[cg] == 1]
+        if not (len(si) and len(gi)):
             return None
-        table, pred = self.roadmap.all_pairs(self._door_mask(doors))
-        total = (sd + 1e-9)[:, None] + table[np.ix_(si, gi)] + gd[None, :]
-        i, j = np.unravel_index(int(np.argmin(total)), total.shape)
+        table, pred = self._door_table(doors)
+        total = (ds[si] + 1e-9)[:, None] + table[np.ix_(si, gi)] + dg[gi][None, :]
+        flat = int(np.argmin(total))
+        i, j = divmod(flat, len(gi))
         if not math.isfinite(total[i, j]):
             return None
-        a, row = int(si[i]), pred[si[i]]
-        route = [int(gi[j])]
+        pts, ids = self._route_points(s, g, nodes, self._walk(pred, int(si[i]), int(gi[j])))
+        return self._shortcut(pts, (), ids, direct=False)
+
+    @staticmethod
+    def _walk(pred: np.ndarray, a: int, b: int) -> list[int]:
+        """Roadmap nodes from ``a`` to ``b`` along the all-pairs predecessors."""
+        row = pred[a]
+        route = [b]
         while route[-1] != a:
             route.append(int(row[route[-1]]))
         return route[::-1]
 
-    def _shortcut(self, pts: list[Point], discs: tuple[Disc, ...]) -> list[Point]:
-        """The shortest chain through ``pts`` whose links are all collision-free."""
+    def _route_points(self, s: Point, g: Point, nodes: np.ndarray, route: list[int]) -> tuple[list[Point], list[int]]:
+        """The points of ``s``, the ``route`` nodes and ``g``, and which roadmap node each is
+        (``-1`` for the ends and for ring milestones)."""
+        n_rm = len(self.roadmap.nodes)
+        pts = [s] + [(float(x), float(y)) for x, y in nodes[route].tolist()] + [g]
+        return pts, [-1] + [k if k < n_rm else -1 for k in route] + [-1]
+
+    def _pairs(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Every pair ``i < j`` of ``n`` points, and which of them start at the first point or
+        end at the last (cached per ``n``)."""
+        if n not in self._triu:
+            ii, jj = np.triu_indices(n, 1)
+            self._triu[n] = (ii, jj, ii == 0, jj == n - 1)
+        return self._triu[n]
+
+    def _shortcut(self, pts: list[Point], discs: tuple[Disc, ...], ids: list[int],
+                  direct: bool | None = None) -> list[Point]:
+        """The shortest chain through ``pts`` whose links are all collision-free.
+
+        ``ids`` names the roadmap node each point is (``-1``: the start, the goal, a ring
+        milestone).  Walls, furniture and closed doors between two nodes, or between the
+        start or the goal and a node, come from the visibility memos; what they do not know
+        is tested in one call (and remembered); ``direct`` is the start–goal pair's answer if
+        known.  People are judged afresh.
+        """
         n = len(pts)
         if n <= 2:
             return pts
-        P = np.asarray(pts)
-        ii, jj = np.triu_indices(n, 1)
+        doors = self._doors()
+        P = np.asarray(pts, dtype=float)
+        idv = np.asarray(ids)
+        ii, jj, first, last = self._pairs(n)
+        node_vis = self._node_memo(doors)
+        vs, vg = self._point_memo(pts[0], doors).vis, self._point_memo(pts[-1], doors).vis
+        ni, nj = idv[ii], idv[jj]
+        ci, cj = np.maximum(ni, 0), np.maximum(nj, 0)
+        known = np.where(first, vs[cj], np.where(last, vg[ci], node_vis[ci, cj]))
+        ring = ((ni < 0) & ~first) | ((nj < 0) & ~last)  # ring milestones: never memoised
+        ring[n - 2] = True  # nor the pair (start, goal)
+        known[ring] = -1
+        known[n - 2] = -1 if direct is None else int(direct)
+        unk = np.flatnonzero(known < 0)
+        if len(unk):
+            got = self._static_free(P[ii[unk]], P[jj[unk]]).astype(np.int8)
+            known[unk] = got
+            keep = ~ring[unk]
+            f, la = first[unk] & keep, last[unk] & keep
+            mid = keep & ~f & ~la
+            vs[cj[unk[f]]] = got[f]
+            vg[ci[unk[la]]] = got[la]
+            node_vis[ci[unk[mid]], cj[unk[mid]]] = got[mid]
+            node_vis[cj[unk[mid]], ci[unk[mid]]] = got[mid]
+        ok = self._people_free(P[ii], P[jj], known == 1, discs, goal=pts[-1])
         free = np.zeros((n, n), dtype=bool)
-        free[ii, jj] = self._free_segments(P[ii], P[jj], discs, goal=pts[-1])
+        free[ii, jj] = ok
         free[np.arange(n - 1), np.arange(1, n)] = True  # route links are valid by construction
-        seg = np.hypot(*(P[None, :, :] - P[:, None, :]).transpose(2, 0, 1))
-        best = np.full(n, math.inf)
-        back = np.zeros(n, dtype=int)
+        seg = np.hypot(*(P[None, :, :] - P[:, None, :]).transpose(2, 0, 1)).tolist()
+        fr = free.tolist()
+        # the least-cost chain, first predecessor on ties; plain floats: n is small
+        best = [math.inf] * n
+        back = [0] * n
         best[0] = 0.0
         for j in range(1, n):
-            cand = np.where(free[:j, j], best[:j] + seg[:j, j], math.inf)
-            back[j] = int(np.argmin(cand))
-            best[j] = cand[back[j]]
+            bj, bi = math.inf, 0
+            for i in range(j):
+                if fr[i][j]:
+                    c = best[i] + seg[i][j]
+                    if c < bj:
+                        bj, bi = c, i
+            best[j], back[j] = bj, bi
         out = [n - 1]
         while out[-1] != 0:
-            out.append(int(back[out[-1]]))
+            out.append(back[out[-1]])
         return [pts[k] for k in reversed(out)]
 
     def snap(self, p: Point, discs: tuple[Disc, ...] = ()) -> Point | None:
@@ -409,7 +600,7 @@ class BasePlanner:
         ``SNAP_REACH``, reached from ``p`` without coming closer to any of ``discs`` than it is
         (:meth:`Scene.people_clear <robot.scene.Scene.people_clear>`): a start braked against a
         door jamb is moved off it, a start beside a person stays where it is."""
-        if self._free_points(np.array([p]))[0]:
+        if self._point_free(p):
             return p
         radii = np.arange(1, int(SNAP_REACH / SNAP_STEP) + 1) * SNAP_STEP
         ang = 2 * math.pi * np.arange(32) / 32
@@ -424,8 +615,8 @@ class BasePlanner:
         return (float(pts[ok[0], 0]), float(pts[ok[0], 1]))
 
     def _query(self, s: Point, g: Point, layer: Layer) -> tuple[Point, ...] | None:
-        discs = layer[1]
-        if not self._free_points(np.array([g]))[0]:
+        doors, discs = layer
+        if not self._point_free(g):
             return None
         s0 = s
         snapped = self.snap(s, discs)
@@ -436,31 +627,25 @@ class BasePlanner:
         if math.hypot(g[0] - s[0], g[1] - s[1]) < 1e-6:
             return (*head, s, g)
         if self._use_table(layer):
-            nodes = self.roadmap.nodes
-            gi, gd, direct = self._links(g, nodes, discs, also=s, goal=True)
-            if direct:
-                return (*head, s, g)
-            route = self._table_route(s, layer[0], gi, gd) if len(gi) else None
-            if route is None:
-                return None
-        else:
-            dist, pred, nodes = self._tree(s, layer)
-            gi, gd, direct = self._links(g, nodes, discs, also=s, goal=True)
-            if direct:
-                return (*head, s, g)
-            if not len(gi):
-                return None
-            total = dist[gi] + gd
-            b = int(np.argmin(total))
-            if not math.isfinite(total[b]):
-                return None
-            route = [int(gi[b])]
-            n = len(nodes)
-            while route[-1] != n:
-                route.append(int(pred[route[-1]]))
-            route = route[-2::-1]
-        pts = [s] + [(float(x), float(y)) for x, y in nodes[route]] + [g]
-        return (*head, *self._shortcut(pts, discs))
+            path = self._table_query(s, g, doors)
+            return None if path is None else (*head, *path)
+        nodes = self._layer_graph(layer)[0]
+        gi, gd, direct = self._links(g, nodes, discs, also=s, goal=True)
+        if direct:
+            return (*head, s, g)
+        if not len(gi):
+            return None
+        dist, pred, nodes = self._tree(s, layer)
+        total = dist[gi] + gd
+        b = int(np.argmin(total))
+        if not math.isfinite(total[b]):
+            return None
+        route = [int(gi[b])]
+        n = len(nodes)
+        while route[-1] != n:
+            route.append(int(pred[route[-1]]))
+        pts, ids = self._route_points(s, g, nodes, route[-2::-1])
+        return (*head, *self._shortcut(pts, discs, ids))
 
     def plan(self, start: Point, goal: Point) -> tuple[Point, ...] | None:
         """A collision-free polyline from ``start`` to ``goal``, or None when there is none."""

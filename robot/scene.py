@@ -101,17 +101,53 @@ def segment_box_distance(a: np.ndarray, b: np.ndarray, boxes: np.ndarray) -> np.
 
 def segments_clear(a: np.ndarray, b: np.ndarray, boxes: np.ndarray, r: float) -> np.ndarray:
     """Which segments stay at least ``r`` from every box: a cheap bounding-box filter,
-    then the exact distance for the few (segment, box) pairs that pass it."""
+    then the exact test (:func:`pairs_near`) for the few (segment, box) pairs that pass it."""
     ok = np.ones(len(a), dtype=bool)
     if not len(a) or not len(boxes):
         return ok
     lo, hi = np.minimum(a, b), np.maximum(a, b)
-    near = ((lo[:, None, 0] < boxes[None, :, 2] + r) & (hi[:, None, 0] > boxes[None, :, 0] - r)
-            & (lo[:, None, 1] < boxes[None, :, 3] + r) & (hi[:, None, 1] > boxes[None, :, 1] - r))
+    grown = boxes + np.array([-r, -r, r, r])
+    near = ((lo[:, None, 0] < grown[None, :, 2]) & (hi[:, None, 0] > grown[None, :, 0])
+            & (lo[:, None, 1] < grown[None, :, 3]) & (hi[:, None, 1] > grown[None, :, 1]))
     si, mi = np.nonzero(near)
     if len(si):
-        ok[si[pair_distance(a[si], b[si], boxes[mi]) < r]] = False
+        ok[si[pairs_near(a[si], b[si], boxes[mi], r)]] = False
     return ok
+
+
+_CORNERS = np.array([[1.0, 1.0, -1.0, -1.0], [1.0, -1.0, 1.0, -1.0]])  # (±hx, ±hy) as columns
+_DIAG_NUM = np.array([[-1.0, -1.0], [1.0, -1.0]])
+_DIAG_DEN = np.array([[1.0, 1.0], [-1.0, 1.0]])
+
+
+def pairs_near(a: np.ndarray, b: np.ndarray, boxes: np.ndarray, r: float) -> np.ndarray:
+    """Does segment ``a[i]→b[i]`` come closer than ``r`` to box ``boxes[i]``?  Element-wise,
+    exact: the same answer as ``pair_distance(a, b, boxes) < r``, in far fewer numpy calls.
+
+    The distance from the point at ``t`` on the segment to the box is convex in ``t``, linear
+    where the point faces a side, the distance to a corner where it faces a corner, and 0
+    inside.  So its least value over ``t ∈ [0, 1]`` is taken at an end, at the projection of a
+    corner, or — if the segment crosses the box — where it crosses a diagonal (a chord of a
+    rectangle crosses one of its diagonals).  Those eight parameters are evaluated at once.
+    """
+    c = (boxes[:, :2] + boxes[:, 2:]) * 0.5
+    h = (boxes[:, 2:] - boxes[:, :2]) * 0.5
+    p = a - c  # the start, box-centred
+    d = b - a
+    hr = h[:, ::-1]
+    T = np.empty((len(a), 8))
+    T[:, 0] = 0.0
+    T[:, 1] = 1.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / np.einsum("ij,ij->i", d, d)
+        # corners (±hx, ±hy): t = ((corner - p)·d) / |d|²
+        T[:, 2:6] = (-np.einsum("ij,ij->i", p, d) * inv)[:, None] + ((h * d) * inv[:, None]) @ _CORNERS
+        # diagonals through the centre along (hx, hy) and (hx, -hy): cross(p + t d, e) = 0
+        T[:, 6:8] = ((p * hr) @ _DIAG_NUM) / ((d * hr) @ _DIAG_DEN)
+    T = np.clip(np.nan_to_num(T, nan=0.0, posinf=0.0, neginf=0.0), 0.0, 1.0)
+    q = p[:, None, :] + T[:, :, None] * d[:, None, :]
+    e = np.maximum(np.abs(q) - h[:, None, :], 0.0)
+    return np.asarray((e * e).sum(axis=2).min(axis=1) < r * r)
 
 
 class Scene:
