@@ -36,7 +36,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from robot.roadmap import Roadmap, heading, path_length
-from robot.scene import Disc, Scene, point_box_distance, segments_clear
+from robot.scene import BoxSet, Disc, Scene, point_box_distance
 from robot.spec import RobotSpec, WorldSpec
 from tasker.world import UNREACHABLE, MotionEstimate, Pose
 
@@ -160,8 +160,7 @@ class BasePlanner:
         self._door_searches: dict[tuple[str, ...], int] = {}  # door-layer searches per set of closed doors
         self.table_after = table_after
         self.searches = 0  # Dijkstra runs so far (benchmarks and tests read it)
-        self._boxes_key: tuple[str, ...] | None = None
-        self._all_boxes = np.zeros((0, 4))
+        self._box_sets: dict[tuple[str, ...], BoxSet] = {}
         # visibility memos (walls, furniture, bounds, closed doors; people never): 1 free,
         # 0 blocked, -1 not tested yet; between roadmap nodes per set of closed doors, and
         # from a point (a start, a goal) to every roadmap node per (point, closed doors)
@@ -183,23 +182,24 @@ class BasePlanner:
     def _doors(self) -> tuple[str, ...]:
         return tuple(n for n, o in sorted(self.scene.door_open.items()) if not o)
 
-    def _boxes(self) -> np.ndarray:
-        """Walls, furniture and closed doors as one array (cached per set of closed doors)."""
+    def _box_set(self) -> BoxSet:
+        """What a segment of the robot's centre must keep ``radius`` from: walls, furniture,
+        closed doors, and four boxes outside the bounds (so the bounds are tested alike);
+        one per set of closed doors."""
         doors = self._doors()
-        if self._boxes_key != doors:
-            self._boxes_key = doors
-            self._all_boxes = np.vstack([self.scene.static, self.scene.closed_doors()])
-        return self._all_boxes
+        if doors not in self._box_sets:
+            sc, big = self.scene, 10.0
+            outside = np.array([[sc.xmin - big, sc.ymin - big, sc.xmin, sc.ymax + big],
+                                [sc.xmax, sc.ymin - big, sc.xmax + big, sc.ymax + big],
+                                [sc.xmin - big, sc.ymin - big, sc.xmax + big, sc.ymin],
+                                [sc.xmin - big, sc.ymax, sc.xmax + big, sc.ymax + big]])
+            self._box_sets[doors] = BoxSet(np.vstack([sc.static, sc.closed_doors(), outside]), sc.radius)
+        return self._box_sets[doors]
 
     def _static_free(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Which segments ``a[i]→b[i]`` are clear of the bounds, walls, furniture and closed
         doors (exact; people are not looked at)."""
-        scene, r = self.scene, self.scene.radius
-        lo, hi = np.minimum(a, b), np.maximum(a, b)
-        ok = (lo[:, 0] >= scene.xmin + r) & (hi[:, 0] <= scene.xmax - r) & (lo[:, 1] >= scene.ymin + r)
-        ok &= hi[:, 1] <= scene.ymax - r
-        ok &= segments_clear(a, b, self._boxes(), r)
-        return ok
+        return self._box_set().clear(a, b)
 
     def _free_segments(self, a: np.ndarray, b: np.ndarray, discs: tuple[Disc, ...], leaving: bool = True,
                        goal: Point | None = None) -> np.ndarray:

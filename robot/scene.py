@@ -102,17 +102,34 @@ def segment_box_distance(a: np.ndarray, b: np.ndarray, boxes: np.ndarray) -> np.
 def segments_clear(a: np.ndarray, b: np.ndarray, boxes: np.ndarray, r: float) -> np.ndarray:
     """Which segments stay at least ``r`` from every box: a cheap bounding-box filter,
     then the exact test (:func:`pairs_near`) for the few (segment, box) pairs that pass it."""
-    ok = np.ones(len(a), dtype=bool)
-    if not len(a) or not len(boxes):
+    return BoxSet(boxes, r).clear(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
+
+
+class BoxSet:
+    """Boxes ``(M, 4)`` and a clearance ``r``, ready for many segment tests (:meth:`clear`):
+    the boxes grown by ``r`` (the bounding-box filter), their centres and half sizes."""
+
+    __slots__ = ("boxes", "r", "r2", "grown", "centre", "half")
+
+    def __init__(self, boxes: np.ndarray, r: float) -> None:
+        self.boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
+        self.r, self.r2 = float(r), float(r) * float(r)
+        self.grown = (self.boxes + np.array([-r, -r, r, r])).T.copy()  # (4, M): x0, y0, x1, y1
+        self.centre = (self.boxes[:, :2] + self.boxes[:, 2:]) * 0.5
+        self.half = (self.boxes[:, 2:] - self.boxes[:, :2]) * 0.5
+
+    def clear(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Which segments ``a[i]→b[i]`` stay at least ``r`` from every box (exact)."""
+        ok = np.ones(len(a), dtype=bool)
+        if not len(a) or not len(self.boxes):
+            return ok
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        gx0, gy0, gx1, gy1 = self.grown
+        near = ((lo[:, 0, None] < gx1) & (hi[:, 0, None] > gx0) & (lo[:, 1, None] < gy1) & (hi[:, 1, None] > gy0))
+        si, mi = np.nonzero(near)
+        if len(si):
+            ok[si[_near(a[si], b[si], self.centre[mi], self.half[mi], self.r2)]] = False
         return ok
-    lo, hi = np.minimum(a, b), np.maximum(a, b)
-    grown = boxes + np.array([-r, -r, r, r])
-    near = ((lo[:, None, 0] < grown[None, :, 2]) & (hi[:, None, 0] > grown[None, :, 0])
-            & (lo[:, None, 1] < grown[None, :, 3]) & (hi[:, None, 1] > grown[None, :, 1]))
-    si, mi = np.nonzero(near)
-    if len(si):
-        ok[si[pairs_near(a[si], b[si], boxes[mi], r)]] = False
-    return ok
 
 
 _CORNERS = np.array([[1.0, 1.0, -1.0, -1.0], [1.0, -1.0, 1.0, -1.0]])  # (±hx, ±hy) as columns
@@ -122,7 +139,7 @@ _DIAG_DEN = np.array([[1.0, 1.0], [-1.0, 1.0]])
 
 def pairs_near(a: np.ndarray, b: np.ndarray, boxes: np.ndarray, r: float) -> np.ndarray:
     """Does segment ``a[i]→b[i]`` come closer than ``r`` to box ``boxes[i]``?  Element-wise,
-    exact: the same answer as ``pair_distance(a, b, boxes) < r``, in far fewer numpy calls.
+    exact: the answer of ``pair_distance(a, b, boxes) < r``, in far fewer numpy calls.
 
     The distance from the point at ``t`` on the segment to the box is convex in ``t``, linear
     where the point faces a side, the distance to a corner where it faces a corner, and 0
@@ -130,8 +147,12 @@ def pairs_near(a: np.ndarray, b: np.ndarray, boxes: np.ndarray, r: float) -> np.
     corner, or — if the segment crosses the box — where it crosses a diagonal (a chord of a
     rectangle crosses one of its diagonals).  Those eight parameters are evaluated at once.
     """
-    c = (boxes[:, :2] + boxes[:, 2:]) * 0.5
-    h = (boxes[:, 2:] - boxes[:, :2]) * 0.5
+    boxes = np.asarray(boxes, dtype=float)
+    return _near(a, b, (boxes[:, :2] + boxes[:, 2:]) * 0.5, (boxes[:, 2:] - boxes[:, :2]) * 0.5, r * r)
+
+
+def _near(a: np.ndarray, b: np.ndarray, c: np.ndarray, h: np.ndarray, r2: float) -> np.ndarray:
+    """:func:`pairs_near` for boxes given by centres ``c`` and half sizes ``h``."""
     p = a - c  # the start, box-centred
     d = b - a
     hr = h[:, ::-1]
@@ -144,10 +165,10 @@ def pairs_near(a: np.ndarray, b: np.ndarray, boxes: np.ndarray, r: float) -> np.
         T[:, 2:6] = (-np.einsum("ij,ij->i", p, d) * inv)[:, None] + ((h * d) * inv[:, None]) @ _CORNERS
         # diagonals through the centre along (hx, hy) and (hx, -hy): cross(p + t d, e) = 0
         T[:, 6:8] = ((p * hr) @ _DIAG_NUM) / ((d * hr) @ _DIAG_DEN)
-    T = np.clip(np.nan_to_num(T, nan=0.0, posinf=0.0, neginf=0.0), 0.0, 1.0)
+    T = np.fmin(np.fmax(T, 0.0), 1.0)  # into [0, 1]; NaN (a zero-length or parallel case) to 0
     q = p[:, None, :] + T[:, :, None] * d[:, None, :]
     e = np.maximum(np.abs(q) - h[:, None, :], 0.0)
-    return np.asarray((e * e).sum(axis=2).min(axis=1) < r * r)
+    return np.asarray((e * e).sum(axis=2).min(axis=1) < r2)
 
 
 class Scene:
