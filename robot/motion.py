@@ -228,7 +228,7 @@ class BasePlanner:
         -1 not tested), seeded with what the roadmap already knows: its edges are clear of the
         static layer (closed doors block those in the door mask), and every pair of corner,
         door and place nodes that is not an edge is blocked (the roadmap's visibility graph
-        tested them all)."""
+        tested them all); a node "sees" itself unless it stands in a closed door."""
         if doors in self._node_vis:
             self._node_vis.move_to_end(doors)
             return self._node_vis[doors]
@@ -240,6 +240,7 @@ class BasePlanner:
         ok = (~self._door_mask(doors)).astype(np.int8)
         memo[rm.edges[:, 0], rm.edges[:, 1]] = ok
         memo[rm.edges[:, 1], rm.edges[:, 0]] = ok
+        memo[np.arange(n), np.arange(n)] = self._static_free(rm.nodes, rm.nodes)  # a node in a closed door
         self._node_vis[doors] = memo
         if len(self._node_vis) > 4:
             self._node_vis.popitem(last=False)

@@ -136,3 +136,22 @@ def test_segments_clear_agrees_with_the_distance_version(paper) -> None:  # type
     got = segments_clear(a, b, scene.static, scene.radius)
     assert (got == segments_clear_by_distance(a, b, scene.static, scene.radius)).all()
     assert 0 < got.sum() < len(got)
+
+
+def test_node_memo_is_seeded_with_exact_answers(paper) -> None:  # type: ignore[no-untyped-def]
+    """What the visibility memo takes from the roadmap (its edges; corner, door and place
+    nodes that are no edge see no each other) is what the exact test says, a door closed."""
+    scene = _scene("paper", doorway=False, close_one=True, seed=2)
+    planner = BasePlanner(paper, scene)
+    doors = planner.closed_doors()
+    memo = planner._node_memo(doors)
+    rm = planner.roadmap
+    e = rm.edges
+    exact = planner._static_free(rm.nodes[e[:, 0]], rm.nodes[e[:, 1]])
+    assert (memo[e[:, 0], e[:, 1]] == exact).all() and not exact.all()  # the closed door blocks some
+    first = int(rm.corner_nodes[0])
+    rng = np.random.default_rng(3)
+    i, j = rng.integers(first, len(rm.nodes), (2, 4000))
+    known = memo[i, j] >= 0
+    assert known.all()
+    assert (memo[i, j] == planner._static_free(rm.nodes[i], rm.nodes[j])).all()
