@@ -167,7 +167,6 @@ class BasePlanner:
         self._node_vis: OrderedDict[tuple[str, ...], np.ndarray] = OrderedDict()
         self._point_vis: OrderedDict[tuple[Point, tuple[str, ...]], _PointMemo] = OrderedDict()
         self._tables: dict[tuple[str, ...], tuple[np.ndarray, np.ndarray]] = {}
-        self._triu: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
 
     def forget_starts(self) -> None:
         """Drop every per-start result (search trees, start and goal links, answers), keeping
@@ -528,14 +527,6 @@ class BasePlanner:
         pts = [s] + [(float(x), float(y)) for x, y in nodes[route].tolist()] + [g]
         return pts, [-1] + [k if k < n_rm else -1 for k in route] + [-1]
 
-    def _pairs(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Every pair ``i < j`` of ``n`` points, and which of them start at the first point or
-        end at the last (cached per ``n``)."""
-        if n not in self._triu:
-            ii, jj = np.triu_indices(n, 1)
-            self._triu[n] = (ii, jj, ii == 0, jj == n - 1)
-        return self._triu[n]
-
     def _shortcut(self, pts: list[Point], discs: tuple[Disc, ...], ids: list[int],
                   direct: bool | None = None) -> list[Point]:
         """The shortest chain through ``pts`` whose links are all collision-free.
@@ -551,34 +542,52 @@ class BasePlanner:
             return pts
         doors = self._doors()
         P = np.asarray(pts, dtype=float)
-        idv = np.asarray(ids)
-        ii, jj, first, last = self._pairs(n)
         node_vis = self._node_memo(doors)
         vs, vg = self._point_memo(pts[0], doors).vis, self._point_memo(pts[-1], doors).vis
-        ni, nj = idv[ii], idv[jj]
-        ci, cj = np.maximum(ni, 0), np.maximum(nj, 0)
-        known = np.where(first, vs[cj], np.where(last, vg[ci], node_vis[ci, cj]))
-        ring = ((ni < 0) & ~first) | ((nj < 0) & ~last)  # ring milestones: never memoised
-        ring[n - 2] = True  # nor the pair (start, goal)
-        known[ring] = -1
-        known[n - 2] = -1 if direct is None else int(direct)
-        unk = np.flatnonzero(known < 0)
-        if len(unk):
-            got = self._static_free(P[ii[unk]], P[jj[unk]]).astype(np.int8)
-            known[unk] = got
-            keep = ~ring[unk]
-            f, la = first[unk] & keep, last[unk] & keep
-            mid = keep & ~f & ~la
-            vs[cj[unk[f]]] = got[f]
-            vg[ci[unk[la]]] = got[la]
-            node_vis[ci[unk[mid]], cj[unk[mid]]] = got[mid]
-            node_vis[cj[unk[mid]], ci[unk[mid]]] = got[mid]
-        ok = self._people_free(P[ii], P[jj], known == 1, discs, goal=pts[-1])
-        free = np.zeros((n, n), dtype=bool)
-        free[ii, jj] = ok
-        free[np.arange(n - 1), np.arange(1, n)] = True  # route links are valid by construction
+        inner = np.maximum(np.asarray(ids[1:-1]), 0)
+        s_row, g_col = vs[inner].tolist(), vg[inner].tolist()
+        sub = node_vis[np.ix_(inner, inner)].tolist()
+        # what the memos know of every pair that is not a route link (those are valid by
+        # construction); plain Python: a route has a few dozen points at most
+        on = [k >= 0 for k in ids]
+        fr = [[j == i + 1 for j in range(n)] for i in range(n)]
+        clear: list[tuple[int, int]] = []
+        unknown: list[tuple[int, int]] = []
+        for i in range(n - 2):
+            for j in range(i + 2, n):
+                if i == 0:
+                    v = (-1 if direct is None else int(direct)) if j == n - 1 else (s_row[j - 1] if on[j] else -1)
+                elif j == n - 1:
+                    v = g_col[i - 1] if on[i] else -1
+                else:
+                    v = sub[i - 1][j - 1] if on[i] and on[j] else -1
+                if v < 0:
+                    unknown.append((i, j))
+                elif v:
+                    clear.append((i, j))
+        if unknown:
+            u = np.array(unknown)
+            got = self._static_free(P[u[:, 0]], P[u[:, 1]]).tolist()
+            for (i, j), v in zip(unknown, got, strict=True):
+                if v:
+                    clear.append((i, j))
+                if i == 0 and j == n - 1:
+                    continue  # the start–goal pair: not memoised
+                if i == 0:
+                    if on[j]:
+                        vs[ids[j]] = v
+                elif j == n - 1:
+                    if on[i]:
+                        vg[ids[i]] = v
+                elif on[i] and on[j]:
+                    node_vis[ids[i], ids[j]] = node_vis[ids[j], ids[i]] = v
+        if discs and clear:
+            c = np.array(clear)
+            fine = self.scene.people_clear(P[c[:, 0]], P[c[:, 1]], discs, goal=pts[-1]).tolist()
+            clear = [pair for pair, v in zip(clear, fine, strict=True) if v]
+        for i, j in clear:
+            fr[i][j] = True
         seg = np.hypot(*(P[None, :, :] - P[:, None, :]).transpose(2, 0, 1)).tolist()
-        fr = free.tolist()
         # the least-cost chain, first predecessor on ties; plain floats: n is small
         best = [math.inf] * n
         back = [0] * n
