@@ -105,6 +105,7 @@ class _PointMemo:
     """What a planner knows of one point under one set of closed doors (see
     :meth:`BasePlanner._point_memo`)."""
 
+    point: Point
     vis: np.ndarray  # int8 per roadmap node: 1 visible, 0 not, -1 not tested yet
     free: bool | None = None  # may the robot stand there
     cand: tuple[np.ndarray, np.ndarray] | None = None  # link candidates, distances to every node
@@ -161,6 +162,7 @@ class BasePlanner:
         self.table_after = table_after
         self.searches = 0  # Dijkstra runs so far (benchmarks and tests read it)
         self._box_sets: dict[tuple[str, ...], BoxSet] = {}
+        self._xy: tuple[np.ndarray, np.ndarray] | None = None  # the roadmap's node coordinates
         # visibility memos (walls, furniture, bounds, closed doors; people never): 1 free,
         # 0 blocked, -1 not tested yet; between roadmap nodes per set of closed doors, and
         # from a point (a start, a goal) to every roadmap node per (point, closed doors)
@@ -251,7 +253,7 @@ class BasePlanner:
         key = (p, doors)
         memo = self._point_vis.get(key)
         if memo is None:
-            memo = _PointMemo(np.full(len(self.roadmap.nodes), -1, dtype=np.int8))
+            memo = _PointMemo(p, np.full(len(self.roadmap.nodes), -1, dtype=np.int8))
             self._point_vis[key] = memo
             if len(self._point_vis) > 1024:
                 self._point_vis.popitem(last=False)
@@ -380,21 +382,42 @@ class BasePlanner:
     def _candidates(self, p: Point, nodes: np.ndarray, k: int = 16) -> tuple[np.ndarray, np.ndarray]:
         """``p``'s link candidates among ``nodes``: its ``k`` nearest and the nearest 24 within
         3 m that are not OMPL samples (corners, doors, places, rings), sorted; and the distances
-        from ``p`` to every node.  Memoised for the roadmap's own nodes."""
-        roadmap = nodes is self.roadmap.nodes
-        memo = self._point_memo(p, self._doors()) if roadmap and k == 16 else None
-        if memo is not None and memo.cand is not None:
-            return memo.cand
+        from ``p`` to every node.  Memoised for the roadmap's own nodes
+        (:meth:`_roadmap_candidates`, the same selection)."""
+        if nodes is self.roadmap.nodes and k == 16:
+            return self._roadmap_candidates((p,))[0]
         d = np.hypot(nodes[:, 0] - p[0], nodes[:, 1] - p[1])
         first = int(self.roadmap.corner_nodes[0]) if len(self.roadmap.corner_nodes) else len(self.roadmap.nodes)
         near = np.argpartition(d, min(k, len(d) - 1))[:k]
         special = first + np.flatnonzero(d[first:] <= 3.0)
         if len(special) > 24:
             special = special[np.argsort(d[special], kind="stable")[:24]]
-        cand = np.unique(np.concatenate([near, special]))
-        if memo is not None:
-            memo.cand = (cand, d)
-        return cand, d
+        return np.unique(np.concatenate([near, special])), d
+
+    def _roadmap_candidates(self, points: tuple[Point, ...]) -> list[tuple[np.ndarray, np.ndarray]]:
+        """:meth:`_candidates` among the roadmap's nodes for several points, those not memoised
+        yet computed together (the same selection, row by row)."""
+        memos = [self._point_memo(p, self._doors()) for p in points]
+        todo = [m for m in memos if m.cand is None]
+        if todo:
+            rm = self.roadmap
+            if self._xy is None:
+                self._xy = (rm.nodes[:, 0].copy(), rm.nodes[:, 1].copy())
+            x, y = self._xy
+            here = np.array([m.point for m in todo])
+            d = np.hypot(x[None, :] - here[:, :1], y[None, :] - here[:, 1:])
+            first = int(rm.corner_nodes[0]) if len(rm.corner_nodes) else len(rm.nodes)
+            near = np.argpartition(d, 16, axis=1)[:, :16]
+            within = d[:, first:] <= 3.0
+            pick = np.zeros(d.shape, dtype=bool)
+            pick[np.arange(len(todo))[:, None], near] = True
+            for row, m in enumerate(todo):
+                special = first + np.flatnonzero(within[row])
+                if len(special) > 24:
+                    special = special[np.argsort(d[row, special], kind="stable")[:24]]
+                pick[row, special] = True
+                m.cand = (np.flatnonzero(pick[row]), d[row])
+        return [m.cand for m in memos if m.cand is not None]
 
     def _links(self, p: Point, nodes: np.ndarray, discs: tuple[Disc, ...], k: int = 16,
                also: Point | None = None, goal: bool = False) -> tuple[np.ndarray, np.ndarray, bool]:
@@ -487,8 +510,7 @@ class BasePlanner:
         yet, a second the shortcut's pairs they do not know.
         """
         nodes = self.roadmap.nodes
-        cs, ds = self._candidates(s, nodes)
-        cg, dg = self._candidates(g, nodes)
+        (cs, ds), (cg, dg) = self._roadmap_candidates((s, g))
         vs, vg = self._point_memo(s, doors).vis, self._point_memo(g, doors).vis
         # one exact test: the straight way and every link not in the memos yet
         us, ug = cs[vs[cs] < 0], cg[vg[cg] < 0]
