@@ -108,7 +108,7 @@ class _PointMemo:
     point: Point
     vis: np.ndarray  # int8 per roadmap node: 1 visible, 0 not, -1 not tested yet
     free: bool | None = None  # may the robot stand there
-    cand: tuple[np.ndarray, np.ndarray] | None = None  # link candidates, distances to every node
+    cand: tuple[np.ndarray, np.ndarray] | None = None  # link candidates and their distances
 
 RING = 16  # milestones around a person in the way
 SNAP_STEP = 0.01  # metres between the rings searched for a free start
@@ -381,42 +381,43 @@ class BasePlanner:
 
     def _candidates(self, p: Point, nodes: np.ndarray, k: int = 16) -> tuple[np.ndarray, np.ndarray]:
         """``p``'s link candidates among ``nodes``: its ``k`` nearest and the nearest 24 within
-        3 m that are not OMPL samples (corners, doors, places, rings), sorted; and the distances
-        from ``p`` to every node.  Memoised for the roadmap's own nodes
-        (:meth:`_roadmap_candidates`, the same selection)."""
+        3 m that are not OMPL samples (corners, doors, places, rings), sorted; and their
+        distances from ``p``.  Memoised for the roadmap's own nodes (:meth:`_roadmap_candidates`)."""
         if nodes is self.roadmap.nodes and k == 16:
             return self._roadmap_candidates((p,))[0]
-        d = np.hypot(nodes[:, 0] - p[0], nodes[:, 1] - p[1])
+        return self._select(np.array([p], dtype=float), nodes[:, 0], nodes[:, 1], k)[0]
+
+    def _select(self, here: np.ndarray, x: np.ndarray, y: np.ndarray,
+                k: int = 16) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The candidates of each point of ``here`` among the nodes at ``x``, ``y``, chosen by
+        squared distance (no square roots over every node; the same order), with distances."""
+        dx, dy = x[None, :] - here[:, :1], y[None, :] - here[:, 1:]
+        d2 = dx * dx + dy * dy
         first = int(self.roadmap.corner_nodes[0]) if len(self.roadmap.corner_nodes) else len(self.roadmap.nodes)
-        near = np.argpartition(d, min(k, len(d) - 1))[:k]
-        special = first + np.flatnonzero(d[first:] <= 3.0)
-        if len(special) > 24:
-            special = special[np.argsort(d[special], kind="stable")[:24]]
-        return np.unique(np.concatenate([near, special])), d
+        near = np.argpartition(d2, min(k, d2.shape[1] - 1), axis=1)[:, :k]
+        within = d2[:, first:] <= 9.0  # within 3 m
+        pick = np.zeros(d2.shape, dtype=bool)
+        pick[np.arange(len(here))[:, None], near] = True
+        out = []
+        for row in range(len(here)):
+            special = first + np.flatnonzero(within[row])
+            if len(special) > 24:
+                special = special[np.argsort(d2[row, special], kind="stable")[:24]]
+            pick[row, special] = True
+            cand = np.flatnonzero(pick[row])
+            out.append((cand, np.hypot(x[cand] - here[row, 0], y[cand] - here[row, 1])))
+        return out
 
     def _roadmap_candidates(self, points: tuple[Point, ...]) -> list[tuple[np.ndarray, np.ndarray]]:
         """:meth:`_candidates` among the roadmap's nodes for several points, those not memoised
-        yet computed together (the same selection, row by row)."""
+        yet selected together."""
         memos = [self._point_memo(p, self._doors()) for p in points]
         todo = [m for m in memos if m.cand is None]
         if todo:
-            rm = self.roadmap
             if self._xy is None:
-                self._xy = (rm.nodes[:, 0].copy(), rm.nodes[:, 1].copy())
-            x, y = self._xy
-            here = np.array([m.point for m in todo])
-            d = np.hypot(x[None, :] - here[:, :1], y[None, :] - here[:, 1:])
-            first = int(rm.corner_nodes[0]) if len(rm.corner_nodes) else len(rm.nodes)
-            near = np.argpartition(d, 16, axis=1)[:, :16]
-            within = d[:, first:] <= 3.0
-            pick = np.zeros(d.shape, dtype=bool)
-            pick[np.arange(len(todo))[:, None], near] = True
-            for row, m in enumerate(todo):
-                special = first + np.flatnonzero(within[row])
-                if len(special) > 24:
-                    special = special[np.argsort(d[row, special], kind="stable")[:24]]
-                pick[row, special] = True
-                m.cand = (np.flatnonzero(pick[row]), d[row])
+                self._xy = (self.roadmap.nodes[:, 0].copy(), self.roadmap.nodes[:, 1].copy())
+            for m, got in zip(todo, self._select(np.array([m.point for m in todo]), *self._xy), strict=True):
+                m.cand = got
         return [m.cand for m in memos if m.cand is not None]
 
     def _links(self, p: Point, nodes: np.ndarray, discs: tuple[Disc, ...], k: int = 16,
@@ -444,7 +445,7 @@ class BasePlanner:
             ok = self._people_free(here, ends, ok, discs)
         direct = bool(ok[-1]) if also is not None else False
         ok = ok[: len(cand)]
-        return cand[ok], d[cand[ok]], direct
+        return cand[ok], d[ok], direct
 
     def _point_free(self, p: Point) -> bool:
         """May the robot stand on ``p`` (:meth:`_free_points`; memoised per point and doors)?"""
@@ -521,11 +522,12 @@ class BasePlanner:
         vg[ug] = ok[len(us): -1]
         if ok[-1]:
             return [s, g]
-        si, gi = cs[vs[cs] == 1], cg[vg[cg] == 1]
+        ks, kg = vs[cs] == 1, vg[cg] == 1
+        si, gi = cs[ks], cg[kg]
         if not (len(si) and len(gi)):
             return None
         table, pred = self._door_table(doors)
-        total = (ds[si] + 1e-9)[:, None] + table[np.ix_(si, gi)] + dg[gi][None, :]
+        total = (ds[ks] + 1e-9)[:, None] + table[np.ix_(si, gi)] + dg[kg][None, :]
         flat = int(np.argmin(total))
         i, j = divmod(flat, len(gi))
         if not math.isfinite(total[i, j]):

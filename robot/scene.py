@@ -302,6 +302,14 @@ class Scene:
             discs = [d for d in discs if not self.holds(d, goal)]
         if not discs or not len(a):
             return ok
+        # people farther from the segments' bounding box than their clearance block none of
+        # them (the limit below never exceeds the clearance): dropped before any distance
+        x0, y0 = np.minimum(a, b).min(axis=0).tolist()
+        x1, y1 = np.maximum(a, b).max(axis=0).tolist()
+        discs = [d for d in discs if math.hypot(max(x0 - d.x, 0.0, d.x - x1), max(y0 - d.y, 0.0, d.y - y1))
+                 < self.clearance(d)]
+        if not discs:
+            return ok
         px, py = np.array([d.x for d in discs]), np.array([d.y for d in discs])
         limit = np.broadcast_to(np.array([self.clearance(d) for d in discs])[None, :], (len(a), len(discs)))
         if leaving:
