@@ -175,6 +175,42 @@ def _near(a: np.ndarray, b: np.ndarray, c: np.ndarray, h: np.ndarray, r2: float)
     return np.asarray((ex * ex + ey * ey).min(axis=0) < r2)
 
 
+SMALL = 64  # (segment, person) pairs up to which people_clear works in plain floats
+
+
+def _people_clear_array(a: np.ndarray, b: np.ndarray, discs: list[Disc], radius: float, leaving: bool,
+                        tol: float) -> np.ndarray:
+    """:meth:`Scene.people_clear`'s arithmetic, vectorised over segments and people."""
+    px, py = np.array([d.x for d in discs]), np.array([d.y for d in discs])
+    limit = np.broadcast_to(np.array([d.r + radius for d in discs])[None, :], (len(a), len(discs)))
+    if leaving:
+        limit = np.minimum(limit, np.hypot(a[:, :1] - px[None, :], a[:, 1:] - py[None, :]))
+    near = point_segment_distance(px, py, a, b) < limit - tol
+    return np.asarray(~near.any(axis=1), dtype=bool)
+
+
+def _people_clear_small(a: list[list[float]], b: list[list[float]], discs: list[Disc], radius: float,
+                        leaving: bool, tol: float) -> np.ndarray:
+    """:func:`_people_clear_array`'s arithmetic, operation for operation, in plain floats: for
+    the few segments and people of a path check, cheaper than numpy's calls.  (A square root
+    may round differently in its last bit, far inside the millimetre of tolerance.)"""
+    out = []
+    for (ax, ay), (bx, by) in zip(a, b, strict=True):
+        dx, dy = bx - ax, by - ay
+        l2 = max(dx * dx + dy * dy, 1e-18)
+        clear = True
+        for d in discs:
+            limit = d.r + radius
+            if leaving:
+                limit = min(limit, math.hypot(ax - d.x, ay - d.y))
+            t = min(max(((d.x - ax) * dx + (d.y - ay) * dy) / l2, 0.0), 1.0)
+            if math.hypot(ax + t * dx - d.x, ay + t * dy - d.y) < limit - tol:
+                clear = False
+                break
+        out.append(clear)
+    return np.array(out, dtype=bool)
+
+
 class Scene:
     """The plane as the base planner sees it; a disc robot of ``radius`` metres.
 
@@ -306,6 +342,9 @@ class Scene:
             discs = [d for d in discs if not self.holds(d, goal)]
         if not discs or not len(a):
             return ok
+        tol = PEOPLE_TOLERANCE + slack
+        if len(a) * len(discs) <= SMALL:
+            return _people_clear_small(a.tolist(), b.tolist(), discs, self.radius, leaving, tol)
         # people farther from the segments' bounding box than their clearance block none of
         # them (the limit below never exceeds the clearance): dropped before any distance
         x0, y0 = np.minimum(a, b).min(axis=0).tolist()
@@ -314,12 +353,7 @@ class Scene:
                  < self.clearance(d)]
         if not discs:
             return ok
-        px, py = np.array([d.x for d in discs]), np.array([d.y for d in discs])
-        limit = np.broadcast_to(np.array([self.clearance(d) for d in discs])[None, :], (len(a), len(discs)))
-        if leaving:
-            limit = np.minimum(limit, np.hypot(a[:, :1] - px[None, :], a[:, 1:] - py[None, :]))
-        near = point_segment_distance(px, py, a, b) < limit - (PEOPLE_TOLERANCE + slack)
-        return np.asarray(~near.any(axis=1), dtype=bool)
+        return _people_clear_array(a, b, discs, self.radius, leaving, tol)
 
     def free(self, x: float, y: float, ignore: tuple[str, ...] = ()) -> bool:
         """Static and dynamic layers: walls, furniture, closed doors, people (less ``ignore``)."""

@@ -155,3 +155,22 @@ def test_node_memo_is_seeded_with_exact_answers(paper) -> None:  # type: ignore[
     known = memo[i, j] >= 0
     assert known.all()
     assert (memo[i, j] == planner._static_free(rm.nodes[i], rm.nodes[j])).all()
+
+
+@pytest.mark.parametrize("leaving", [True, False])
+def test_people_rule_in_plain_floats_is_the_array_rule(leaving: bool) -> None:
+    """Scene.people_clear answers few pairs in plain floats, many with numpy: the same rule."""
+    from robot.scene import PEOPLE_TOLERANCE, Disc, _people_clear_array, _people_clear_small
+
+    rng = np.random.default_rng(6 + leaving)
+    seen = set()
+    for _ in range(300):
+        n = int(rng.integers(1, 8))
+        a = rng.uniform(0, 4, (n, 2))
+        b = a + rng.normal(0, 1.0, (n, 2))
+        discs = [Disc(f"p{k}", *rng.uniform(0, 4, 2), float(rng.choice([0.25, 0.35, 0.6])))
+                 for k in range(int(rng.integers(1, 5)))]
+        small = _people_clear_small(a.tolist(), b.tolist(), discs, 0.35, leaving, PEOPLE_TOLERANCE)
+        assert (small == _people_clear_array(a, b, discs, 0.35, leaving, PEOPLE_TOLERANCE)).all()
+        seen |= set(small.tolist())
+    assert seen == {True, False}
