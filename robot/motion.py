@@ -162,6 +162,8 @@ class BasePlanner:
         self.table_after = table_after
         self.searches = 0  # Dijkstra runs so far (benchmarks and tests read it)
         self._box_sets: dict[tuple[str, ...], BoxSet] = {}
+        self._doors_at = -1  # the scene version _closed was read at
+        self._closed: tuple[str, ...] = ()
         self._xy: tuple[np.ndarray, np.ndarray] | None = None  # the roadmap's node coordinates
         # visibility memos (walls, furniture, bounds, closed doors; people never): 1 free,
         # 0 blocked, -1 not tested yet; between roadmap nodes per set of closed doors, and
@@ -181,7 +183,11 @@ class BasePlanner:
 
     # ---- the scene, by layer -----------------------------------------------------------
     def _doors(self) -> tuple[str, ...]:
-        return tuple(n for n, o in sorted(self.scene.door_open.items()) if not o)
+        """The closed doors, sorted (looked up again only when the scene's version moves)."""
+        if self._doors_at != self.scene.version:
+            self._closed = tuple(n for n, o in sorted(self.scene.door_open.items()) if not o)
+            self._doors_at = self.scene.version
+        return self._closed
 
     def _box_set(self) -> BoxSet:
         """What a segment of the robot's centre must keep ``radius`` from: walls, furniture,
