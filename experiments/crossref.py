@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 from experiments import fields
 from experiments.actions import TimedAction, located
+from experiments.request_fields import FIELD_NAMES, asked_for, with_request_fields
 from tasker.cliargs import TASKS_HINT
 from tasker.errors import TaskerError
 from tasker.reader import Table, check_name, suggest
@@ -107,9 +108,11 @@ def validate_request(f: Table, task: TaskType, args: Mapping[str, Any]) -> dict[
         unknown = [k for k in args if k not in known]
         at = f.table("args", {})
         if unknown:
+            fields = [n for n in FIELD_NAMES if n not in known]  # what any request may also give
+            also = f"; any request may also give {', '.join(fields)}" if fields else ""
             raise at.error(unknown[0], f"task type {task.name!r} has no argument {unknown[0]!r}"
-                                       f"{suggest(unknown[0], known)} (arguments: {', '.join(known) or 'none'})"
-                           ) from None
+                                       f"{suggest(unknown[0], [*known, *fields])} "
+                                       f"(arguments: {', '.join(known) or 'none'}{also})") from None
         bad = next((n for n in known if repr(n) in msg), None)
         raise (at.error(bad, msg) if bad else f.error("args", msg)) from None
 
@@ -297,6 +300,8 @@ def check_robot(scn: RobotScenario, top: Table, tasks: Iterable[TaskType] | None
         from planners.bundled import task_types
 
         tasks = task_types()
+    if asked_for(scn.actions):  # the file gives a deadline, priority or death time: every type takes them
+        tasks = [with_request_fields(t) for t in tasks]
     world = load_world(scn.world)
     c = _Checker(scn, top, world, {t.name: t for t in tasks})
     c.settings()

@@ -15,7 +15,7 @@ them from the schedule parameters, as with synthetic tasks.  What the task means
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 from tasker.messages import CostParams, ScheduleParams, SPRequest
@@ -28,7 +28,8 @@ FIELDS = (
     ArgSpec("death_at", "float", required=False,
             help="time the person is dead if not helped (falls; read by the day metrics, not by the task)"),
 )
-_NAMES = frozenset(f.name for f in FIELDS)
+FIELD_NAMES = tuple(f.name for f in FIELDS)
+_NAMES = frozenset(FIELD_NAMES)
 
 
 class WithRequestFields(TaskType):
@@ -81,6 +82,17 @@ class WithRequestFields(TaskType):
 
     def on_stage_done(self, ctx: TaskContext, stage: Stage) -> None:
         self.inner.on_stage_done(ctx, stage)
+
+
+def asked_for(actions: Iterable[Any]) -> bool:
+    """Whether a scenario's requests (or changes) give any of :data:`FIELDS`.
+
+    A robot scenario file that writes ``deadline = 200.0`` in a request's ``args`` gets its
+    task types wrapped (:func:`with_request_fields`) both when it is checked and when it is
+    run; a file that writes none runs its task types as they are.
+    """
+    return any(a.kind in ("request", "change") and not _NAMES.isdisjoint(a.fields.get("args") or {})
+               for a in actions)
 
 
 def with_request_fields(task: TaskType) -> TaskType:

@@ -29,6 +29,7 @@ import tasker
 from experiments import scenario as scenarios
 from experiments import synthetic
 from experiments.actions import TimedAction
+from experiments.request_fields import asked_for
 from tasker import schedulers
 from tasker.agent import Rates
 from tasker.errors import RunAborted
@@ -60,7 +61,8 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
     ``task_paths`` are task folders loaded besides the bundled ones and ``$TASKER_TASKS``.
     ``policy`` (default: the scenario's) reaches every task's :class:`Strategy`;
     ``hazard_waiting`` is passed to the loop; ``request_fields`` lets every task type take
-    the requests' ``deadline`` and ``priority`` (:mod:`experiments.request_fields`).
+    the requests' ``deadline`` and ``priority`` (:mod:`experiments.request_fields`); it is on
+    whenever the scenario's requests give one.
     A ``people`` entry may set a person's ``pose``, ``walk`` and walking ``speed``."""
     from planners.bundled import task_types
     from robot.sim import Simulation
@@ -85,7 +87,7 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
     spec = _with_objects(scn, spec)
     sim = Simulation(spec, seed=seed)
     loaded = task_types(task_paths)
-    if request_fields:
+    if request_fields or asked_for(scn.actions):
         from experiments.request_fields import with_request_fields
 
         loaded = [with_request_fields(t) for t in loaded]

@@ -107,7 +107,8 @@ class DomainModel:
 
 
 def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float) -> dict[tuple[str, str], float]:
-    """Seconds between every ordered pair of places; ``inf`` when the motion model says unreachable.
+    """Seconds between every ordered pair of places; ``inf`` when the motion model says unreachable
+    (walled off, or behind a closed door: people in the way only slow a leg, :func:`_past_people`).
 
     Without a motion model (or a pose) the declared ``travel_s`` is used, never zero.
     Pairs joined by a ``door_between`` fact are timed with the motion model's optional
@@ -137,7 +138,33 @@ def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float)
             else:
                 out[a, b] = float(travel_s)
     _from_robot(world, motion, out, through_door, ignoring_doors)
+    _past_people(world, motion, out)
     return out
+
+
+def _past_people(world: WorldState, motion: MotionModel | None, out: dict[tuple[str, str], float]) -> None:
+    """A leg unreachable only because people are in the way now is timed as if they were not.
+
+    People move: someone standing in a doorway blocks it only while they stand there, and
+    the ``navigate`` skill waits for them to clear (it fails only after making no progress
+    for a while).  Making the leg unreachable would make ``upTsk`` unsolvable — the task
+    failed — on a moment's crowding.  With a motion model's optional
+    ``estimate_ignoring_people`` (doors as they are; ``robot.motion.MotionEstimator`` has
+    it), such a leg gets the free building's time; a leg behind a closed door, or walled
+    off, stays ``inf``.
+    """
+    ignoring_people = getattr(motion, "estimate_ignoring_people", None)
+    if ignoring_people is None:
+        return
+    robots = sorted(n for n, t in world.objects.items() if t == "robot")
+    here = world.poses.get(robots[0]) if robots else None
+    at = {f[2] for f in world.facts if len(f) == 3 and f[0] == "at" and robots and f[1] == robots[0]}
+    for (a, b), secs in sorted(out.items()):
+        if math.isfinite(secs) or b not in world.poses:
+            continue
+        start = here if a in at and len(at) == 1 and here is not None else world.poses.get(a)
+        if start is not None:
+            out[a, b] = float(ignoring_people(start, world.poses[b]).time_s)
 
 
 def _from_robot(world: WorldState, motion: MotionModel | None, out: dict[tuple[str, str], float],

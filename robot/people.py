@@ -4,7 +4,8 @@ Each person is moved kinematically on the simulation clock (deterministic, no
 randomness).  What a person does in a step, in order of precedence:
 
 1. **fallen** people lie still;
-2. :attr:`Person.waiting` (the person was told to wait): stand still;
+2. :attr:`Person.waiting` (the person was told to wait): stand still — after stepping to
+   :attr:`Person.aside` if the world gave one (out of a doorway: nobody waits in one);
 3. :attr:`Person.following` (the person follows the robot): walk along the robot's
    trail and stop ``FOLLOW_GAP`` metres (along the trail) behind the robot — the trail
    keeps them off walls;
@@ -13,9 +14,12 @@ randomness).  What a person does in a step, in order of precedence:
    speed, so after a reaction ends they walk back onto the script instead of jumping.
 
 Posture changes come from the script's ``events`` ``(t, posture)`` or from
-:meth:`Person.set_posture`.  ``waiting`` and ``following`` are set by the world from the
-facts a task folder binds to them (``robot.sim.Simulation.bind``): people react to
-what they were told, never to a task's predicate names.
+:meth:`Person.set_posture`; and a sitting person asked to follow the robot stands up
+first — nobody follows seated, and a standing person takes less room in a doorway
+(``robot.scene.PERSON_RADIUS``).  Scripted walks keep the script's postures.
+``waiting`` and ``following`` are set by the world from the facts a task folder binds to
+them (``robot.sim.Simulation.bind``): people react to what they were told, never to a
+task's predicate names.
 """
 
 from __future__ import annotations
@@ -42,6 +46,7 @@ class Person:
         self._trail: list[tuple[float, float]] = []
         self.following = False
         self.waiting = False
+        self.aside: tuple[float, float] | None = None  # where a waiting person steps to first
 
     @property
     def pose(self) -> Pose:
@@ -104,14 +109,28 @@ class Person:
             self._event += 1
         if not self.following:
             self._trail = []
-        if self.posture == "fallen" or self.waiting:
+        if self.posture == "fallen":
+            return
+        if self.waiting:
+            if self.aside is not None:
+                self._walk_to(self.aside[0], self.aside[1], dt)
             return
         if self.following:
+            self._stand_up()
             self._follow(robot, dt)
             return
         target = self.scripted(t)
         if target is not None:
             self._walk_to(target[0], target[1], dt)
+
+    def stepping_aside(self) -> bool:
+        """Waiting, and not yet where :attr:`aside` says to wait."""
+        return (self.waiting and self.aside is not None and self.posture != "fallen"
+                and math.hypot(self.aside[0] - self.x, self.aside[1] - self.y) > 1e-9)
+
+    def _stand_up(self) -> None:
+        if self.posture == "sitting":
+            self.posture = "standing"
 
 
 class People:

@@ -34,7 +34,7 @@ from robot.mjworld import TIMESTEP, MjApartment
 from robot.motion import BasePlanner, DriveLimits, MotionEstimator, open_planner
 from robot.people import People, Person
 from robot.recording import PersonState, Recorder
-from robot.scene import Scene, segments_clear
+from robot.scene import PERSON_RADIUS, Scene, point_box_distance, segments_clear
 from robot.skills import SKILLS, Skill
 from robot.spec import WorldSpec, load_world, room_of
 from robot.tiago import robot_dimensions
@@ -46,6 +46,8 @@ from tasker.world import Fact, Pose, WorldState
 CONTROL_DT = 0.02  # seconds: the base controller and the people run at 50 Hz
 AT_TOLERANCE = 0.3  # metres: the robot starts "at" a place this close
 TOGETHER = 1.5  # metres: a person this close to the robot is symbolically at the robot's place
+WAIT_MARGIN = 0.05  # metres beyond a standing person's radius and the robot's width (Simulation._out_of_doorways)
+ASIDE_STEP, ASIDE_MAX, ASIDE_DIRECTIONS = 0.1, 2.0, 16  # where a person told to wait looks for a spot
 
 
 class Simulation:
@@ -119,7 +121,7 @@ class Simulation:
         """Until when person ``p`` certainly stays as they are (``self.time``: they may move now)."""
         events = p.spec.events
         nxt = events[p._event][0] if p._event < len(events) else math.inf
-        if ("following", p.name) in self.facts:
+        if ("following", p.name) in self.facts or p.stepping_aside():
             return self.time
         if p.posture == "fallen" or ("told_to_wait", p.name) in self.facts or not p.spec.walk:
             return nxt
@@ -257,8 +259,37 @@ class Simulation:
         elif b.kind == "follower":
             self.people[obj].following = value
         else:
-            self.people[obj].waiting = value
+            person = self.people[obj]
+            person.waiting = value
+            person.aside = self._out_of_doorways(person) if value else None
         return True
+
+    def _out_of_doorways(self, p: Person) -> tuple[float, float] | None:
+        """Where a standing person told to wait steps so that the robot can pass the doorway
+        they stand in or by: the nearest spot of their own room (rings of ``ASIDE_STEP``
+        metres, ``ASIDE_DIRECTIONS`` directions, east first) at least ``clear`` metres — their
+        radius, the robot's width and ``WAIT_MARGIN`` — from every door's leaf, and free of
+        walls and furniture.  None when they stand clear already, are not standing (nobody
+        sitting or lying moves aside), or no such spot lies within ``ASIDE_MAX`` metres."""
+        if p.posture != "standing" or not self.spec.doors:
+            return None
+        clear = PERSON_RADIUS["standing"] + 2 * self.scene.radius + WAIT_MARGIN
+        leaves = np.array([d.box for _, d in sorted(self.spec.doors.items())], dtype=float)
+
+        def off_doors(x: float, y: float) -> bool:
+            return bool(point_box_distance(np.array([x]), np.array([y]), leaves).min() >= clear)
+
+        if off_doors(p.x, p.y):
+            return None
+        room = room_of(self.spec, p.x, p.y)
+        for ring in range(1, round(ASIDE_MAX / ASIDE_STEP) + 1):
+            r = ring * ASIDE_STEP
+            for k in range(ASIDE_DIRECTIONS):
+                a = 2 * math.pi * k / ASIDE_DIRECTIONS
+                x, y = round(p.x + r * math.cos(a), 3), round(p.y + r * math.sin(a), 3)
+                if room_of(self.spec, x, y) == room and off_doors(x, y) and self.scene.static_free(x, y):
+                    return (x, y)
+        return None
 
     def _bound_facts(self) -> set[Fact]:
         out: set[Fact] = set()

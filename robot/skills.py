@@ -155,22 +155,30 @@ class Navigate(Skill):
         self.next_check = now
         self.stopping = False
         self.mark = (now, sim.robot_pose()[:2])  # last time and place the base made progress
-        why = self._replan()
-        if why:
-            self.result = failed(why)
+        bad = self._bad_target()
+        if bad:
+            self.result = failed(bad)
+        elif self._replan() is not None:
+            # unreachable now (people in the way, no free pose next to the person): wait for
+            # the way to clear as a navigation blocked en route does, failing after BLOCK_TIMEOUT
+            self.blocked_since = now
+
+    def _bad_target(self) -> str | None:
+        """Why ``data["to"]`` can never be reached (not a place, person or pose), else None."""
+        t = self.target
+        if isinstance(t, str):
+            return None if t in self.sim.spec.places or t in self.sim.people else f"unknown navigation target {t!r}"
+        if isinstance(t, list | tuple) and len(t) in (2, 3) and all(isinstance(v, int | float) for v in t):
+            return None
+        return f"navigate needs data['to'] = a place, a person or [x, y, yaw]; got {t!r}"
 
     def _goal(self) -> Pose | str:
         t = self.target
         sim = self.sim
         if isinstance(t, str):
-            if t in sim.spec.places:
-                return sim.spec.places[t]
-            if t in sim.people:
-                return self._approach(t)
-            return f"unknown navigation target {t!r}"
-        if isinstance(t, list | tuple) and len(t) in (2, 3) and all(isinstance(v, int | float) for v in t):
-            return (float(t[0]), float(t[1]), float(t[2]) if len(t) == 3 else math.nan)
-        return f"navigate needs data['to'] = a place, a person or [x, y, yaw]; got {t!r}"
+            return sim.spec.places[t] if t in sim.spec.places else self._approach(t)
+        assert isinstance(t, list | tuple)  # _bad_target ruled out anything else
+        return (float(t[0]), float(t[1]), float(t[2]) if len(t) == 3 else math.nan)
 
     def _approach(self, name: str) -> Pose | str:
         """The pose next to the person that the estimates use too (``MotionEstimator.approach``)."""
@@ -212,7 +220,9 @@ class Navigate(Skill):
     def control(self, now: float, dt: float) -> Command:
         f = self.follower
         if f is None:
-            return STOP
+            f = self._start_when_clear(now)
+            if f is None:
+                return STOP
         if self.result is not RUNNING:  # finished, failed or stopped: brake (a no-op once done)
             f.brake()
             x, y, yaw = self.sim.robot_pose()
@@ -241,6 +251,20 @@ class Navigate(Skill):
         elif self.result is RUNNING and not self.stopping:
             self._watch_progress(now, x, y)
         return cmd
+
+    def _start_when_clear(self, now: float) -> PathFollower | None:
+        """Blocked from the start: re-plan at every check; fail after ``BLOCK_TIMEOUT``."""
+        if self.blocked_since is None or self.result is not RUNNING or self.stopping or now < self.next_check:
+            return None
+        self.next_check = now + CHECK_PERIOD
+        why = self._replan()
+        if why is None:
+            self.blocked_since = None
+            self.mark = (now, self.sim.robot_pose()[:2])  # progress is watched from the start of the drive
+            return self.follower
+        if now - self.blocked_since > BLOCK_TIMEOUT:
+            self.result = failed(f"path to {self.target!r} blocked: {why}")
+        return None
 
     def _watch_progress(self, now: float, x: float, y: float) -> None:
         """A navigation that re-plans paths it cannot drive (a person beside a doorway the

@@ -382,3 +382,34 @@ def test_a_plan_estimated_across_a_closed_door_opens_it() -> None:
     trace = loop.run(until=0.5)
     start = next(e for e in trace.events if e["event"] == "command" and e["flag"] == "start")
     assert isinstance(start["predicted_s"], float) and math.isfinite(start["predicted_s"])
+
+
+class _Crowded:
+    """Straight lines; the bedroom is unreachable while people stand in the way, not otherwise."""
+
+    def __init__(self, bedroom: Pose) -> None:
+        self.crowded = StraightLineMotion(blocked=frozenset({bedroom}))
+        self.free = StraightLineMotion()
+
+    def estimate(self, start: Pose, goal: Pose) -> object:
+        return self.crowded.estimate(start, goal)
+
+    def estimate_ignoring_people(self, start: Pose, goal: Pose) -> object:
+        return self.free.estimate(start, goal)
+
+
+def test_people_in_the_way_slow_a_leg_but_never_cut_it(tasks: dict[str, PddlTaskType]) -> None:
+    """upTsk's travel table: a leg unreachable only because of people gets the free
+    building's time (they move; the skill waits for them), so the plan exists; a leg the
+    motion model calls unreachable with nobody in the way stays cut."""
+    from planners.problem import travel_table
+
+    ctx = make_ctx(tasks["guide_human"])
+    world = ctx.world
+    bedroom = world.poses["bedroom"]
+    table = travel_table(world, _Crowded(bedroom), 10.0)
+    free = travel_table(world, StraightLineMotion(), 10.0)
+    into = [(a, b) for (a, b) in table if b == "bedroom"]
+    assert into and all(table[k] == pytest.approx(free[k]) for k in into)
+    walled = travel_table(world, StraightLineMotion(blocked=frozenset({bedroom})), 10.0)
+    assert all(math.isinf(walled[k]) for k in into)  # no estimate_ignoring_people: nothing to fall back on

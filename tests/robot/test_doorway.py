@@ -160,3 +160,40 @@ def test_a_start_between_two_people_is_left_by_passing_one(paper) -> None:
     assert set(scene.beside(start[:2])) == {"sara", "john"}
     est = motion.estimate(start, paper.places["john_destination"])
     assert est.reachable and _skill_accepts(scene, start[:2], est.path)
+
+
+def _blocked_bedroom(paper: WorldSpec, walk: tuple[tuple[float, float, float], ...]):  # type: ignore[no-untyped-def]
+    """Peter stands in the bedroom's only door when the robot is sent there."""
+    people = {"peter": PersonSpec("peter", (7.0, 6.0, 0.0), "standing", 1.0, walk, ())}
+    sim = Simulation(dataclasses.replace(paper, people=people))
+    assert sim.planner.plan(sim.robot_pose()[:2], paper.places["bedroom"][:2]) is None  # shut at the start
+    stage = Stage("navigate", ("robot", "bedroom"), skill="navigate", data={"to": "bedroom"})
+    sim.begin("d1", stage, 0.0)
+    now, status = 0.0, sim.poll("d1", stage, 0.0)
+    while status.state is SkillState.RUNNING and now < 120.0:
+        now += 0.1
+        status = sim.poll("d1", stage, now)
+    return status, now
+
+
+def test_navigate_blocked_at_its_start_waits_for_the_way_to_clear(paper) -> None:
+    """No path when the stage begins (someone in the doorway) is not a failure yet: the skill
+    waits as it does when blocked en route, and drives once Peter walks on."""
+    status, _ = _blocked_bedroom(paper, ((0.0, 7.0, 6.0), (2.0, 7.0, 6.0), (4.0, 8.2, 7.3)))
+    assert status.state is SkillState.SUCCEEDED, status
+
+
+def test_navigate_blocked_at_its_start_fails_after_the_block_timeout(paper) -> None:
+    from robot.skills import BLOCK_TIMEOUT
+
+    status, now = _blocked_bedroom(paper, ())
+    assert status.state is SkillState.FAILED and "blocked" in status.reason
+    assert BLOCK_TIMEOUT <= now <= BLOCK_TIMEOUT + 1.0
+
+
+def test_an_unknown_target_fails_at_once(paper) -> None:
+    sim = Simulation(paper)
+    stage = Stage("navigate", ("robot", "nowhere"), skill="navigate", data={"to": "nowhere"})
+    sim.begin("d1", stage, 0.0)
+    status = sim.poll("d1", stage, 0.1)
+    assert status.state is SkillState.FAILED and "unknown navigation target 'nowhere'" in status.reason

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from robot.scene import PERSON_RADIUS
 from robot.sim import Simulation
 from tasker.meaning import Binding
 from tasker.protocols import CoreAgent, SkillState, World
@@ -82,6 +83,20 @@ def test_person_asked_to_follow_ends_near_the_destination(paper) -> None:
     assert math.dist((john.x, john.y), paper.places["john_destination"][:2]) < 1.5
 
 
+def test_a_sitting_person_asked_to_follow_stands_up(paper) -> None:
+    """Alice sits; once she follows the robot she stands, and the scene gives her a standing disc."""
+    sim = Simulation(paper)
+    assert sim.people["alice"].posture == "sitting"
+    status, now = run(sim, nav("alice", add=[["met", "robot", "alice"]]), 0.0)
+    assert status.state is SkillState.SUCCEEDED
+    sim.bind([Binding("follower", ("following", "?h"), "?h", ("person",))])
+    sim.apply(add=[["following", "alice"]])
+    sim.advance(now + 0.5)
+    assert sim.people["alice"].posture == "standing"
+    assert ("posture", "alice", "standing") in sim.snapshot().facts
+    assert sim.scene.people["alice"].r == PERSON_RADIUS["standing"]
+
+
 def test_told_to_wait_stops_a_walking_person(paper) -> None:
     sim = Simulation(paper)
     sim.advance(20.0)
@@ -94,6 +109,34 @@ def test_told_to_wait_stops_a_walking_person(paper) -> None:
     sim.apply(delete=[["told_to_wait", "john"]])
     sim.advance(35.0)
     assert sim.people["john"].pose != here
+
+
+@pytest.mark.parametrize("posture", ["standing", "sitting"])
+def test_a_person_told_to_wait_in_a_doorway_steps_out_of_it(paper, posture: str) -> None:
+    """Nobody waits standing in a doorway: told to wait there, a standing person steps to
+    the nearest spot of their room clear of every door (a sitting one stays put)."""
+    import dataclasses
+
+    from robot.roadmap import path_length
+    from robot.scene import point_box_distance
+    from robot.spec import PersonSpec, room_of
+
+    people = {"john": PersonSpec("john", (2.27, 4.96, 0.0), posture, 1.0, (), ())}  # behind the living/kitchen door
+    sim = Simulation(dataclasses.replace(paper, people=people))
+    sim.bind([Binding("waiting", ("told_to_wait", "?h"), "?h")])
+    living, kitchen = paper.places["living"][:2], paper.places["kitchen"][:2]
+    before = path_length(sim.planner.plan(living, kitchen))  # round through the hall: he is in the way
+    sim.apply(add=[["told_to_wait", "john"]])
+    sim.advance(6.0)
+    john = sim.people["john"]
+    leaves = np.array([d.box for d in paper.doors.values()])
+    gap = point_box_distance(np.array([john.x]), np.array([john.y]), leaves).min()
+    if posture == "sitting":
+        assert (john.x, john.y) == (2.27, 4.96)
+        return
+    assert gap >= PERSON_RADIUS["standing"] + 2 * sim.scene.radius
+    assert room_of(paper, john.x, john.y) == room_of(paper, 2.27, 4.96) and john.waiting
+    assert path_length(sim.planner.plan(living, kitchen)) < before - 1.0  # the door is usable again
 
 
 def test_a_bound_device_has_one_state(paper) -> None:
