@@ -522,18 +522,19 @@ class BasePlanner:
         # one exact test: the straight way and every link not in the memos yet
         us, ug = cs[vs[cs] < 0], cg[vg[cg] < 0]
         here = np.array([s, g], dtype=float)
-        a = np.concatenate([np.zeros(len(us), dtype=int), np.ones(len(ug), dtype=int), [0]])
-        ok = self._static_free(here[a], np.vstack([nodes[us], nodes[ug], here[1:]]))
-        vs[us] = ok[: len(us)]
-        vg[ug] = ok[len(us): -1]
-        if ok[-1]:
+        k = 1 + len(us)  # the straight way first, then the start's links, then the goal's
+        ok = self._static_free(np.repeat(here, [k, len(ug)], axis=0),
+                               np.concatenate([here[1:], nodes[us], nodes[ug]]))
+        vs[us] = ok[1:k]
+        vg[ug] = ok[k:]
+        if ok[0]:
             return [s, g]
         ks, kg = vs[cs] == 1, vg[cg] == 1
         si, gi = cs[ks], cg[kg]
         if not (len(si) and len(gi)):
             return None
         table, pred = self._door_table(doors)
-        total = (ds[ks] + 1e-9)[:, None] + table[np.ix_(si, gi)] + dg[kg][None, :]
+        total = (ds[ks] + 1e-9)[:, None] + table[si[:, None], gi] + dg[kg][None, :]
         flat = int(np.argmin(total))
         i, j = divmod(flat, len(gi))
         if not math.isfinite(total[i, j]):
