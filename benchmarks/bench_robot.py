@@ -127,7 +127,7 @@ def bench_queries(n: int = 60) -> None:
             m.estimate(a, b)
         base.plan(a[:2], b[:2])
     times: dict[str, list[float]] = {k: [] for k in ("new", "known", "base", "searched", "before", "before_known",
-                                                     "cold", "before_cold")}
+                                                     "cold", "before_cold", "new_door", "new_people")}
     ratios = []
     for cold in (False, True):
         for m in (ours, searched, before):
@@ -140,7 +140,9 @@ def bench_queries(n: int = 60) -> None:
                 times["before_cold"].append(_time(lambda a=a, b=b: before.estimate(a, b), cold=True))
                 continue
             est: list[Any] = []
+            searches = planner.searches
             times["new"].append(_time(lambda a=a, b=b, est=est: est.append(ours.estimate(a, b))))
+            (times["new_people"] if planner.searches > searches else times["new_door"]).append(times["new"][-1])
             times["searched"].append(_time(lambda a=a, b=b: searched.estimate(a, b)))
             times["before"].append(_time(lambda a=a, b=b: before.estimate(a, b)))
             times["known"].append(_time(lambda a=a, o=other: ours.estimate(a, o)))  # same start, new goal
@@ -162,6 +164,9 @@ def bench_queries(n: int = 60) -> None:
           f"   target <= 0.5 ms: {'OK' if mk <= 0.5 else 'MISS'}")
     print(f"  ours, new source (door table)      median {mn:6.2f} ms  p90 {p90['new']:6.2f} ms"
           f"   target <= 0.5 ms: {'OK' if mn <= 0.5 else 'MISS'}")
+    print(f"    of which the door-layer path was clear of people: {len(times['new_door'])}, median "
+          f"{med['new_door']:.2f} ms, p80 {float(np.percentile(times['new_door'], 80)) * 1e3:.2f} ms; "
+          f"people in the way (people layer searched): {len(times['new_people'])}, median {med['new_people']:.2f} ms")
     print(f"  before, known source               median {med['before_known']:6.2f} ms  p90 "
           f"{p90['before_known']:6.2f} ms   ours {med['before_known'] / mk:.1f}x faster")
     print(f"  before, new source (door table)    median {med['before']:6.2f} ms  p90 {p90['before']:6.2f} ms"
