@@ -22,7 +22,8 @@
 **Caching.**  Results and search trees are cached by exactly what they depend on
 (start, goal, closed doors, people), so a cached answer can never describe a scene
 that no longer exists; the roadmap itself covers only walls and furniture and never
-needs rebuilding.
+needs rebuilding.  Straight-line tests against walls, furniture and closed doors — what
+a query spends its time on — are made once and remembered (:mod:`robot.visibility`).
 """
 
 from __future__ import annotations
@@ -36,8 +37,9 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from robot.roadmap import Roadmap, heading, path_length
-from robot.scene import BoxSet, Disc, Scene, point_box_distance
+from robot.scene import Disc, Scene, point_box_distance
 from robot.spec import RobotSpec, WorldSpec
+from robot.visibility import Visibility
 from tasker.world import UNREACHABLE, MotionEstimate, Pose
 
 Point = tuple[float, float]
@@ -98,18 +100,6 @@ class DriveLimits:
 
 
 Layer = tuple[tuple[str, ...], tuple[Disc, ...]]  # closed doors, people in the way
-
-
-@dataclass(slots=True)
-class _PointMemo:
-    """What a planner knows of one point under one set of closed doors (see
-    :meth:`BasePlanner._point_memo`)."""
-
-    point: Point
-    vis: np.ndarray  # int8 per roadmap node: 1 visible, 0 not, -1 not tested yet
-    free: bool | None = None  # may the robot stand there
-    cand: tuple[np.ndarray, np.ndarray] | None = None  # link candidates and their distances
-
 RING = 16  # milestones around a person in the way
 SNAP_STEP = 0.01  # metres between the rings searched for a free start
 SNAP_REACH = 0.6  # metres: a start deeper in collision than this is not snapped
@@ -161,15 +151,9 @@ class BasePlanner:
         self._door_searches: dict[tuple[str, ...], int] = {}  # door-layer searches per set of closed doors
         self.table_after = table_after
         self.searches = 0  # Dijkstra runs so far (benchmarks and tests read it)
-        self._box_sets: dict[tuple[str, ...], BoxSet] = {}
         self._doors_at = -1  # the scene version _closed was read at
         self._closed: tuple[str, ...] = ()
-        self._xy: tuple[np.ndarray, np.ndarray] | None = None  # the roadmap's node coordinates
-        # visibility memos (walls, furniture, bounds, closed doors; people never): 1 free,
-        # 0 blocked, -1 not tested yet; between roadmap nodes per set of closed doors, and
-        # from a point (a start, a goal) to every roadmap node per (point, closed doors)
-        self._node_vis: OrderedDict[tuple[str, ...], np.ndarray] = OrderedDict()
-        self._point_vis: OrderedDict[tuple[Point, tuple[str, ...]], _PointMemo] = OrderedDict()
+        self.vis = Visibility(self.roadmap, scene)  # straight-line tests, memoised (never people)
         self._tables: dict[tuple[str, ...], tuple[np.ndarray, np.ndarray]] = {}
 
     def forget_starts(self) -> None:
@@ -179,7 +163,7 @@ class BasePlanner:
         new-source queries this way)."""
         self._trees.clear()
         self._cache.clear()
-        self._point_vis.clear()
+        self.vis.forget_points()
 
     # ---- the scene, by layer -----------------------------------------------------------
     def _doors(self) -> tuple[str, ...]:
@@ -189,24 +173,10 @@ class BasePlanner:
             self._doors_at = self.scene.version
         return self._closed
 
-    def _box_set(self) -> BoxSet:
-        """What a segment of the robot's centre must keep ``radius`` from: walls, furniture,
-        closed doors, and four boxes outside the bounds (so the bounds are tested alike);
-        one per set of closed doors."""
-        doors = self._doors()
-        if doors not in self._box_sets:
-            sc, big = self.scene, 10.0
-            outside = np.array([[sc.xmin - big, sc.ymin - big, sc.xmin, sc.ymax + big],
-                                [sc.xmax, sc.ymin - big, sc.xmax + big, sc.ymax + big],
-                                [sc.xmin - big, sc.ymin - big, sc.xmax + big, sc.ymin],
-                                [sc.xmin - big, sc.ymax, sc.xmax + big, sc.ymax + big]])
-            self._box_sets[doors] = BoxSet(np.vstack([sc.static, sc.closed_doors(), outside]), sc.radius)
-        return self._box_sets[doors]
-
     def _static_free(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Which segments ``a[i]→b[i]`` are clear of the bounds, walls, furniture and closed
         doors (exact; people are not looked at)."""
-        return self._box_set().clear(a, b)
+        return self.vis.free(a, b, self._doors())
 
     def _free_segments(self, a: np.ndarray, b: np.ndarray, discs: tuple[Disc, ...], leaving: bool = True,
                        goal: Point | None = None) -> np.ndarray:
@@ -229,57 +199,9 @@ class BasePlanner:
             ok[idx] = self.scene.people_clear(a[idx], b[idx], discs, leaving=leaving, goal=goal)
         return ok
 
-    # ---- visibility memos ----------------------------------------------------------------
     def _node_memo(self, doors: tuple[str, ...]) -> np.ndarray:
-        """Visibility between roadmap nodes under ``doors`` (``int8 (N, N)``: 1 free, 0 blocked,
-        -1 not tested), seeded with what the roadmap already knows: its edges are clear of the
-        static layer (closed doors block those in the door mask), and every pair of corner,
-        door and place nodes that is not an edge is blocked (the roadmap's visibility graph
-        tested them all); a node "sees" itself unless it stands in a closed door."""
-        if doors in self._node_vis:
-            self._node_vis.move_to_end(doors)
-            return self._node_vis[doors]
-        rm = self.roadmap
-        n = len(rm.nodes)
-        memo = np.full((n, n), -1, dtype=np.int8)
-        first = int(rm.corner_nodes[0]) if len(rm.corner_nodes) else n
-        memo[first:, first:] = 0
-        ok = (~self._door_mask(doors)).astype(np.int8)
-        memo[rm.edges[:, 0], rm.edges[:, 1]] = ok
-        memo[rm.edges[:, 1], rm.edges[:, 0]] = ok
-        memo[np.arange(n), np.arange(n)] = self._static_free(rm.nodes, rm.nodes)  # a node in a closed door
-        self._node_vis[doors] = memo
-        if len(self._node_vis) > 4:
-            self._node_vis.popitem(last=False)
-        return memo
-
-    def _point_memo(self, p: Point, doors: tuple[str, ...]) -> _PointMemo:
-        """What is known of point ``p`` under ``doors``: may the robot stand there, which roadmap
-        nodes it sees, its link candidates among the roadmap nodes."""
-        key = (p, doors)
-        memo = self._point_vis.get(key)
-        if memo is None:
-            memo = _PointMemo(p, np.full(len(self.roadmap.nodes), -1, dtype=np.int8))
-            self._point_vis[key] = memo
-            if len(self._point_vis) > 1024:
-                self._point_vis.popitem(last=False)
-        else:
-            self._point_vis.move_to_end(key)
-        return memo
-
-    def _settle(self, doors: tuple[str, ...], p: Point, idx: np.ndarray,
-                extra: np.ndarray | None = None) -> np.ndarray:
-        """Test, in one exact vectorised call, the segments from ``p`` to the roadmap nodes
-        ``idx`` the memo does not know yet (and store the answers), and those from ``p`` to the
-        ``extra`` points (rings, a start seen from its goal), whose answers are returned."""
-        vis = self._point_memo(p, doors).vis
-        todo = idx[vis[idx] < 0]
-        ends = self.roadmap.nodes[todo] if extra is None else np.vstack([self.roadmap.nodes[todo], extra])
-        if not len(ends):
-            return np.zeros(0, dtype=bool)
-        ok = self._static_free(np.broadcast_to(np.asarray(p, dtype=float), ends.shape), ends)
-        vis[todo] = ok[: len(todo)]
-        return ok[len(todo):]
+        """Visibility between roadmap nodes under ``doors`` (:meth:`Visibility.between_nodes`)."""
+        return self.vis.between_nodes(doors, self._door_mask(doors))
 
     def _free_points(self, pts: np.ndarray) -> np.ndarray:
         """Which points the robot may stand on: clear of bounds, walls, furniture, closed doors.
@@ -386,45 +308,11 @@ class BasePlanner:
         return all_nodes, all_edges, lengths
 
     def _candidates(self, p: Point, nodes: np.ndarray, k: int = 16) -> tuple[np.ndarray, np.ndarray]:
-        """``p``'s link candidates among ``nodes``: its ``k`` nearest and the nearest 24 within
-        3 m that are not OMPL samples (corners, doors, places, rings), sorted; and their
-        distances from ``p``.  Memoised for the roadmap's own nodes (:meth:`_roadmap_candidates`)."""
+        """``p``'s link candidates among ``nodes`` (:meth:`Visibility.select`), with their
+        distances; memoised for the roadmap's own nodes."""
         if nodes is self.roadmap.nodes and k == 16:
-            return self._roadmap_candidates((p,))[0]
-        return self._select(np.array([p], dtype=float), nodes[:, 0], nodes[:, 1], k)[0]
-
-    def _select(self, here: np.ndarray, x: np.ndarray, y: np.ndarray,
-                k: int = 16) -> list[tuple[np.ndarray, np.ndarray]]:
-        """The candidates of each point of ``here`` among the nodes at ``x``, ``y``, chosen by
-        squared distance (no square roots over every node; the same order), with distances."""
-        dx, dy = x[None, :] - here[:, :1], y[None, :] - here[:, 1:]
-        d2 = dx * dx + dy * dy
-        first = int(self.roadmap.corner_nodes[0]) if len(self.roadmap.corner_nodes) else len(self.roadmap.nodes)
-        near = np.argpartition(d2, min(k, d2.shape[1] - 1), axis=1)[:, :k]
-        within = d2[:, first:] <= 9.0  # within 3 m
-        pick = np.zeros(d2.shape, dtype=bool)
-        pick[np.arange(len(here))[:, None], near] = True
-        out = []
-        for row in range(len(here)):
-            special = first + np.flatnonzero(within[row])
-            if len(special) > 24:
-                special = special[np.argsort(d2[row, special], kind="stable")[:24]]
-            pick[row, special] = True
-            cand = np.flatnonzero(pick[row])
-            out.append((cand, np.hypot(x[cand] - here[row, 0], y[cand] - here[row, 1])))
-        return out
-
-    def _roadmap_candidates(self, points: tuple[Point, ...]) -> list[tuple[np.ndarray, np.ndarray]]:
-        """:meth:`_candidates` among the roadmap's nodes for several points, those not memoised
-        yet selected together."""
-        memos = [self._point_memo(p, self._doors()) for p in points]
-        todo = [m for m in memos if m.cand is None]
-        if todo:
-            if self._xy is None:
-                self._xy = (self.roadmap.nodes[:, 0].copy(), self.roadmap.nodes[:, 1].copy())
-            for m, got in zip(todo, self._select(np.array([m.point for m in todo]), *self._xy), strict=True):
-                m.cand = got
-        return [m.cand for m in memos if m.cand is not None]
+            return self.vis.candidates((p,), self._doors())[0]
+        return self.vis.select(np.array([p], dtype=float), nodes[:, 0], nodes[:, 1], k)[0]
 
     def _links(self, p: Point, nodes: np.ndarray, discs: tuple[Disc, ...], k: int = 16,
                also: Point | None = None, goal: bool = False) -> tuple[np.ndarray, np.ndarray, bool]:
@@ -443,8 +331,8 @@ class BasePlanner:
         ends = nodes[cand] if also is None else np.vstack([nodes[cand], [also]])
         here = np.broadcast_to(np.asarray(p, float), (len(ends), 2))
         off = ends[split:]  # ring milestones, and ``also``: not in the memo
-        fresh = self._settle(doors, p, cand[:split], off if len(off) else None)
-        ok = np.concatenate([self._point_memo(p, doors).vis[cand[:split]] == 1, fresh])
+        fresh = self.vis.settle(doors, p, cand[:split], off if len(off) else None)
+        ok = np.concatenate([self.vis.point(p, doors).vis[cand[:split]] == 1, fresh])
         if goal:
             ok = self._people_free(ends, here, ok, discs, goal=p)
         else:
@@ -454,19 +342,8 @@ class BasePlanner:
         return cand[ok], d[ok], direct
 
     def _point_free(self, p: Point) -> bool:
-        """May the robot stand on ``p`` (:meth:`_free_points`; memoised per point and doors)?"""
-        memo = self._point_memo(p, self._doors())
-        if memo.free is None:  # one point: plain floats beat numpy's call overhead
-            x, y = p
-            free = self.scene.static_free(x, y)
-            r2 = self.scene.radius * self.scene.radius
-            for x0, y0, x1, y1 in self.scene.closed_doors().tolist() if free else ():
-                dx = x0 - x if x < x0 else (x - x1 if x > x1 else 0.0)
-                dy = y0 - y if y < y0 else (y - y1 if y > y1 else 0.0)
-                if dx * dx + dy * dy < r2:
-                    free = False
-            memo.free = free
-        return memo.free
+        """May the robot stand on ``p`` (:meth:`_free_points`' rule; memoised)?"""
+        return self.vis.point_free(p, self._doors())
 
     def _tree(self, s: Point, layer: Layer) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Distances and predecessors from ``s`` over ``layer``'s graph (cached), and its nodes:
@@ -517,8 +394,8 @@ class BasePlanner:
         yet, a second the shortcut's pairs they do not know.
         """
         nodes = self.roadmap.nodes
-        (cs, ds), (cg, dg) = self._roadmap_candidates((s, g))
-        vs, vg = self._point_memo(s, doors).vis, self._point_memo(g, doors).vis
+        (cs, ds), (cg, dg) = self.vis.candidates((s, g), doors)
+        vs, vg = self.vis.point(s, doors).vis, self.vis.point(g, doors).vis
         # one exact test: the straight way and every link not in the memos yet
         us, ug = cs[vs[cs] < 0], cg[vg[cg] < 0]
         here = np.array([s, g], dtype=float)
@@ -574,7 +451,7 @@ class BasePlanner:
         doors = self._doors()
         P = np.asarray(pts, dtype=float)
         node_vis = self._node_memo(doors)
-        vs, vg = self._point_memo(pts[0], doors).vis, self._point_memo(pts[-1], doors).vis
+        vs, vg = self.vis.point(pts[0], doors).vis, self.vis.point(pts[-1], doors).vis
         inner = np.maximum(np.asarray(ids[1:-1]), 0)
         s_row, g_col = vs[inner].tolist(), vg[inner].tolist()
         sub = node_vis[np.ix_(inner, inner)].tolist()
