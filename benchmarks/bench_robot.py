@@ -21,9 +21,9 @@ apartment, over random reachable pose pairs:
 
 Timing follows ``timeit``: the garbage collector is off while the queries run (collected
 between rounds), so no collection lands in anyone's timing.  A full ``gc.collect()``
-before every single query, as this benchmark used to do, puts each query in a cache
-state no query meets in a run (a cache *hit* then costs ~0.1 ms instead of ~0.02 ms):
-that measurement is still printed, for ours and before, as the "cold" line.
+before every single query, as this benchmark used to do, makes each query first reload
+the interpreter's working set, a state no query meets in a run: that measurement is still
+printed, for ours and before, as the "cold" line.
 
 Targets: motion query <= 0.5 ms median, >= 5x a fresh RRTConnect, paths <= 5 % longer;
 navigation >= 50x real time.
