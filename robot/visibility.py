@@ -157,17 +157,14 @@ class Visibility:
         for the chosen; the same order)."""
         dx, dy = x[None, :] - here[:, :1], y[None, :] - here[:, 1:]
         d2 = dx * dx + dy * dy
-        first = self.first
-        near = np.argpartition(d2, min(k, d2.shape[1] - 1), axis=1)[:, :k]
-        within = d2[:, first:] <= 9.0  # within 3 m
+        rows = np.arange(len(here))[:, None]
         pick = np.zeros(d2.shape, dtype=bool)
-        pick[np.arange(len(here))[:, None], near] = True
-        out = []
-        for row in range(len(here)):
-            special = first + np.flatnonzero(within[row])
-            if len(special) > 24:
-                special = special[np.argsort(d2[row, special], kind="stable")[:24]]
-            pick[row, special] = True
-            cand = np.flatnonzero(pick[row])
-            out.append((cand, np.hypot(x[cand] - here[row, 0], y[cand] - here[row, 1])))
-        return out
+        pick[rows, np.argpartition(d2, min(k, d2.shape[1] - 1), axis=1)[:, :k]] = True
+        # the nearest 24 within 3 m (9 m²) of the others, ties to the lower index, every row at once
+        far = d2[:, self.first:]
+        order = np.argsort(np.where(far <= 9.0, far, np.inf), axis=1, kind="stable")[:, :24]
+        pick[:, self.first:][rows, order] |= far[rows, order] <= 9.0
+        r, cand = np.nonzero(pick)
+        dist = np.hypot(x[cand] - here[r, 0], y[cand] - here[r, 1])
+        cut = np.cumsum(pick.sum(axis=1))[:-1]
+        return list(zip(np.split(cand, cut), np.split(dist, cut), strict=True))
