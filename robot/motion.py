@@ -123,7 +123,7 @@ class BasePlanner:
        (start, closed doors); the goal is linked to it, the route shortened.  After
        ``table_after`` such searches under one set of closed doors, the roadmap's
        all-pairs table for them is built once and new starts read their route off it
-       (:meth:`_table_route`, same lengths); ``table_after=None`` always searches;
+       (:meth:`_table_query`, same lengths); ``table_after=None`` always searches;
     2. if that path is clear of people, it is the answer (people only add constraints,
        so it is still the shortest);
     3. otherwise the **people layer**: the roadmap less the edges people block, plus a
@@ -134,7 +134,9 @@ class BasePlanner:
     the rule the ``navigate`` skill checks the path ahead with, so every path returned
     is one the skill drives.  A start in collision (braked next to a door jamb, pushed
     against a wall) is snapped to the nearest free point first (:meth:`snap`); the
-    path then starts with that short move.
+    path then starts with that short move.  Straight-line tests against walls, furniture
+    and closed doors are made once and remembered in :attr:`vis`
+    (:class:`robot.visibility.Visibility`).
     """
 
     def __init__(self, spec: WorldSpec, scene: Scene, seed: int = 1, milestones: int | None = None,
