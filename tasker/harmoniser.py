@@ -36,15 +36,16 @@ its ``strict`` safe state and waits again (``docs/model.md``).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
-from typing import Any
+from typing import Any, overload
 
 from tasker.agent import DynamicAgent
 from tasker.errors import AgentEnded, ConfigError, InvariantViolation, TaskerError, WorldError
 from tasker.messages import Command, Flag, FsmState, ScheduleParams, SPRequest
 from tasker.schedulers.base import Candidate, Scheduler, ScheduleView
+from tasker.schedulers.index import CandidateIndex
 from tasker.securing import HazardSource, HazardWatch
 from tasker.trace import Trace
 
@@ -93,6 +94,32 @@ class OscillationGuard:
             raise ConfigError(f"OscillationGuard.count must be an integer >= 1, got {self.count!r}")
 
 
+class _IdleCandidates(Sequence[Candidate]):
+    """``ScheduleView.candidates`` for an indexed scheduler: the scan's list, built only if read."""
+
+    def __init__(self, idle: Mapping[str, None], cands: Mapping[str, Candidate]) -> None:
+        self._idle, self._cands = idle, cands
+        self._items: list[Candidate] | None = None
+
+    def _list(self) -> list[Candidate]:
+        if self._items is None:
+            self._items = [c for a in self._idle if (c := self._cands.get(a)) is not None]
+        return self._items
+
+    def __len__(self) -> int:
+        return len(self._list())
+
+    @overload
+    def __getitem__(self, i: int) -> Candidate: ...
+    @overload
+    def __getitem__(self, i: slice) -> Sequence[Candidate]: ...
+    def __getitem__(self, i: int | slice) -> Candidate | Sequence[Candidate]:
+        return self._list()[i]
+
+    def __iter__(self) -> Iterator[Candidate]:
+        return iter(self._list())
+
+
 AgentFactory = Callable[[str, Request, float, Callable[[DynamicAgent], None]], DynamicAgent]
 
 
@@ -114,6 +141,18 @@ class TaskHarmoniser:
     hazard's budget runs out (module docstring).  ``secure_margin_s`` is the slack
     added to the estimated time to secure.
     """
+
+    incremental: bool = True
+    """Keep the candidates of an :attr:`~tasker.schedulers.base.Scheduler.indexed`
+    scheduler in a heap updated on each report (:mod:`tasker.schedulers.index`), so a
+    decision does not scan every waiting agent.  False (on an instance or the class)
+    scans, as every unindexed scheduler does: the reference computation, kept
+    callable; decisions and traces are the same either way."""
+
+    scan_below: int = 32
+    """With no more waiting agents than this, a decision scans them even when
+    :attr:`incremental`: a short scan is cheaper than keeping the heap.  Reports
+    still mark their agents, so the heap is exact again as soon as it is used."""
 
     def __init__(
         self,
@@ -151,6 +190,7 @@ class TaskHarmoniser:
         self._new_data = False
         self._in_cmd: set[str] = set()
         self._cands: dict[str, Candidate] = {}
+        self._index: CandidateIndex | None = None  # built at the first indexed decision
         self._order: dict[str, int] = {}
         self._seq = 0
         self._susp_seq: dict[str, int] = {}
@@ -248,6 +288,8 @@ class TaskHarmoniser:
             self.agents.pop(agent_id, None)
             self._idle.pop(agent_id, None)
             self._cands.pop(agent_id, None)
+            if self._index is not None:
+                self._index.discard(agent_id)
             self._susp_seq.pop(agent_id, None)
             self._became.pop(agent_id, None)
             if self.exe_da == agent_id:
@@ -265,10 +307,18 @@ class TaskHarmoniser:
         name = self.scheduler.name
         for _ in range(len(self._idle) + 2):  # each retry follows an agent that ended while asked
             exe = self._cands.get(self.exe_da) if self.exe_da is not None else None
-            candidates = [c for a in self._idle if (c := self._cands.get(a)) is not None]
-            if not candidates:
-                return
-            view = ScheduleView(now=now, exe=exe, candidates=candidates, req_sp=self._req_sp, fresh=self._fresh)
+            index = self._candidate_index() if len(self._idle) > self.scan_below else None
+            if index is not None and index.ready(self._cands) and not index.needs_scan(self._idle):
+                lowest = index.lowest(self._idle)
+                if lowest is None:
+                    return
+                view = ScheduleView(now=now, exe=exe, candidates=_IdleCandidates(self._idle, self._cands),
+                                    req_sp=self._req_sp, fresh=self._fresh, lowest=self._cands[lowest])
+            else:
+                candidates = [c for a in self._idle if (c := self._cands.get(a)) is not None]
+                if not candidates:
+                    return
+                view = ScheduleView(now=now, exe=exe, candidates=candidates, req_sp=self._req_sp, fresh=self._fresh)
             try:
                 decision = self.scheduler.schedule(view)
             except AgentEnded:
@@ -303,6 +353,16 @@ class TaskHarmoniser:
             del self._idle[choice]
             self.irr_da = choice
             self._roles_dirty = True
+
+    def _candidate_index(self) -> CandidateIndex | None:
+        """The heap of candidates' keys for the current scheduler, or None to scan (built on first use)."""
+        if not (self.incremental and self.scheduler.indexed):
+            return None
+        if self._index is None or self._index.scheduler is not self.scheduler:  # first use, or a new scheduler
+            self._index = CandidateIndex(self.scheduler)
+            for agent in self._cands:
+                self._index.touch(agent)
+        return self._index
 
     def _held(self, dac: str, exe: str, now: float) -> dict[str, Any] | None:
         """The oscillation guard: why a preemption of ``exe`` by ``dac`` is held back, or None."""
@@ -462,8 +522,11 @@ class TaskHarmoniser:
         if report.fsm_state is FsmState.END:
             self._ended.append(agent.id)
         elif report.params is not None:
-            self._cands[agent.id] = Candidate(agent.id, agent.ctx.task_type, report.params,
-                                              agent.ctx.request_time, self._order.get(agent.id, 0))
+            cand = Candidate(agent.id, agent.ctx.task_type, report.params,
+                             agent.ctx.request_time, self._order.get(agent.id, 0))
+            self._cands[agent.id] = cand
+            if self._index is not None:
+                self._index.touch(agent.id)
 
     def _emit_roles(self, now: float) -> None:
         self._roles_dirty = False

@@ -56,6 +56,7 @@ class Alg2(Scheduler):
 
     name = "alg2"
     preemptive = True
+    indexed = True  # dac is the lowest queue_key: the harmoniser may find it without a scan
 
     def __init__(self, classes: Sequence[Sequence[str]] = DEFAULT_CLASSES, hysteresis: float = 1.0) -> None:
         if not isinstance(hysteresis, int | float) or not 0 < hysteresis <= 1:
@@ -81,13 +82,21 @@ class Alg2(Scheduler):
         """Lowest (class, reported cost, request order) first: the order Alg. 2 picks ``dac`` in."""
         return (self.rank(c.task_type), self.cost_params(c, self.name).cost, c.order)
 
+    def select_key(self, c: Candidate) -> tuple[int, float, int]:
+        """:meth:`queue_key`, inlined: the harmoniser's index computes it for every report."""
+        p = c.params
+        if not isinstance(p, CostParams):
+            p = self.cost_params(c, self.name)  # raises the error the scan would
+        return (self._rank.get(c.task_type, self._lowest), p.cost, c.order)
+
     def schedule(self, view: ScheduleView) -> Decision:
-        best: Candidate | None = None
-        best_key: tuple[int, float, int] | None = None
-        for c in view.candidates:  # one pass: lowest (class, cost, request order), lines 3-4
-            key = (self._rank.get(c.task_type, self._lowest), self.cost_params(c, self.name).cost, c.order)
-            if best_key is None or key < best_key:
-                best, best_key = c, key
+        best: Candidate | None = view.lowest  # found by the harmoniser's index, or
+        best_key: tuple[int, float, int] | None = None if best is None else self.queue_key(best)
+        if best is None:
+            for c in view.candidates:  # one pass: lowest (class, cost, request order), lines 3-4
+                key = (self._rank.get(c.task_type, self._lowest), self.cost_params(c, self.name).cost, c.order)
+                if best_key is None or key < best_key:
+                    best, best_key = c, key
         if best is None or best_key is None:
             return NO_CHANGE
         exe = view.exe

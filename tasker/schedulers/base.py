@@ -32,10 +32,16 @@ class ScheduleView:
     """Read-only input of ``pf_schedule``.
 
     ``exe`` is the executing agent (``exeDA``) or None; ``candidates`` are the idle
-    agents (``D_r``) whose report is initialised, in request order.  ``req_sp``
+    agents (``D_r``) whose report is initialised, in ``idleDA`` order.  ``req_sp``
     and ``fresh`` ask an agent now; either raises
     :class:`~tasker.errors.AgentEnded` if the agent's hook raised (the harmoniser
     then schedules again without it).
+
+    ``lowest`` is set by a harmoniser that keeps its candidates indexed for an
+    :attr:`Scheduler.indexed` scheduler (:mod:`tasker.schedulers.index`): the
+    candidate with the lowest :meth:`Scheduler.select_key`, found without a scan.
+    Such a scheduler asks for it through :meth:`best` and need not read
+    ``candidates`` at all (the harmoniser then passes a sequence built only if read).
     """
 
     now: float
@@ -43,6 +49,18 @@ class ScheduleView:
     candidates: Sequence[Candidate]
     req_sp: Callable[[str, SPRequest], Any]
     fresh: Callable[[str], ScheduleParams | None] | None = None
+    lowest: Candidate | None = None
+
+    def best(self, key: Callable[[Candidate], Any]) -> Candidate | None:
+        """The candidate with the lowest ``key`` (None if there is none).
+
+        ``key`` must be the scheduler's :meth:`Scheduler.select_key`: when the
+        harmoniser has found that candidate already (:attr:`lowest`), it is returned
+        in O(1); otherwise the candidates are scanned, the first lowest winning.
+        """
+        if self.lowest is not None:
+            return self.lowest
+        return min(self.candidates, key=key, default=None)
 
     def params_now(self, c: Candidate) -> ScheduleParams:
         """``c``'s parameters computed by its agent at :attr:`now` (``compute_params``).
@@ -78,6 +96,12 @@ class Scheduler:
 
     name: ClassVar[str] = ""
     preemptive: ClassVar[bool] = True
+    indexed: ClassVar[bool] = False
+    """True when :meth:`schedule` picks its candidate as the lowest :meth:`select_key`
+    (through :meth:`ScheduleView.best`) and reads nothing else of the other candidates:
+    the harmoniser then keeps the candidates in a heap updated on each report, and a
+    decision costs O(log n) instead of a scan of every waiting agent
+    (:mod:`tasker.schedulers.index`)."""
 
     def schedule(self, view: ScheduleView) -> Decision:
         raise NotImplementedError
@@ -90,6 +114,18 @@ class Scheduler:
         resumes.  Default: request order.
         """
         return (c.order,)
+
+    def select_key(self, c: Candidate) -> tuple[Any, ...]:
+        """The key an :attr:`indexed` scheduler minimises over the candidates.
+
+        A pure function of ``c`` (its type, reported parameters and request order)
+        and of the scheduler's fixed configuration, never of the time or of other
+        agents; unique per candidate (end it with ``c.order``) so that the lowest one
+        does not depend on the order candidates are scanned in.  Keys made only of
+        real numbers are indexed; any other key (or one that raises) makes the
+        harmoniser scan, so errors surface in :meth:`schedule` as they would unindexed.
+        """
+        return self.queue_key(c)
 
     @staticmethod
     def cost_params(c: Candidate, algorithm: str) -> CostParams:

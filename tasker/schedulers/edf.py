@@ -13,6 +13,7 @@ from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, Sc
 class EarliestDeadlineFirst(Scheduler):
     name = "edf"
     preemptive = True
+    indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
 
     def deadline(self, c: Candidate) -> float:
         d = self.cost_params(c, self.name).deadline
@@ -22,9 +23,9 @@ class EarliestDeadlineFirst(Scheduler):
         return (self.deadline(c), c.order)
 
     def schedule(self, view: ScheduleView) -> Decision:
-        if not view.candidates:
+        best = view.best(self.select_key)
+        if best is None:
             return NO_CHANGE
-        best = min(view.candidates, key=self.queue_key)
         if view.exe is None:
             return Decision(best.id)
         d_dac, d_exe = self.deadline(best), self.deadline(view.exe)

@@ -8,8 +8,10 @@ from tasker.schedulers.base import NO_CHANGE, Decision, Scheduler, ScheduleView
 class Fifo(Scheduler):
     name = "fifo"
     preemptive = False
+    indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
 
     def schedule(self, view: ScheduleView) -> Decision:
-        if view.exe is not None or not view.candidates:
+        if view.exe is not None:
             return NO_CHANGE
-        return Decision(min(view.candidates, key=lambda c: c.order).id)
+        best = view.best(self.select_key)  # queue_key: request order
+        return NO_CHANGE if best is None else Decision(best.id)

@@ -15,6 +15,7 @@ from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, Sc
 class FixedPriority(Scheduler):
     name = "priority"
     preemptive = True
+    indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
 
     def __init__(self, priorities: Mapping[str, int] | None = None, default: int = 0) -> None:
         self.priorities = dict(priorities or {})
@@ -28,9 +29,9 @@ class FixedPriority(Scheduler):
         return (-self.priority(c), c.order)
 
     def schedule(self, view: ScheduleView) -> Decision:
-        if not view.candidates:
+        best = view.best(self.select_key)
+        if best is None:
             return NO_CHANGE
-        best = min(view.candidates, key=self.queue_key)
         if view.exe is None:
             return Decision(best.id)
         p_dac, p_exe = self.priority(best), self.priority(view.exe)

@@ -26,6 +26,7 @@ def priority(s: Scheduler, c: Candidate) -> int:
 class LongestFirst(Scheduler):
     name = "simple"
     preemptive = True
+    indexed = True  # the lowest key runs: the harmoniser may find it without a scan
 
     def __init__(self, hesitance: float = 0.5) -> None:
         if not isinstance(hesitance, int | float) or not 0 <= hesitance:
@@ -35,14 +36,17 @@ class LongestFirst(Scheduler):
     def key(self, c: Candidate) -> tuple[float, float, int]:
         return (-priority(self, c), -self.cost_params(c, self.name).c_time, c.order)
 
+    def select_key(self, c: Candidate) -> tuple[float, float, int]:
+        return self.key(c)
+
     def better(self, dac: float, exe: float) -> bool:
         """Does a candidate of ``cTime`` ``dac`` beat the executing one (``exe``) at equal priority?"""
         return dac > (1 + self.hesitance) * exe
 
     def schedule(self, view: ScheduleView) -> Decision:
-        if not view.candidates:
+        best = view.best(self.select_key)
+        if best is None:
             return NO_CHANGE
-        best = min(view.candidates, key=self.key)
         exe = view.exe
         if exe is None:
             return Decision(best.id)

@@ -8,12 +8,13 @@ from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, Sc
 class ShortestJobFirst(Scheduler):
     name = "sjf"
     preemptive = False
+    indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
 
     def queue_key(self, c: Candidate) -> tuple[float, int]:
         return (self.cost_params(c, self.name).c_time, c.order)
 
     def schedule(self, view: ScheduleView) -> Decision:
-        if view.exe is not None or not view.candidates:
+        if view.exe is not None:
             return NO_CHANGE
-        best = min(view.candidates, key=self.queue_key)
-        return Decision(best.id)
+        best = view.best(self.select_key)
+        return NO_CHANGE if best is None else Decision(best.id)

@@ -9,14 +9,15 @@ from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, Sc
 class ShortestRemainingTimeFirst(Scheduler):
     name = "srtf"
     preemptive = True
+    indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
 
     def queue_key(self, c: Candidate) -> tuple[float, int]:
         return (self.cost_params(c, self.name).c_time, c.order)
 
     def schedule(self, view: ScheduleView) -> Decision:
-        if not view.candidates:
+        best = view.best(self.select_key)
+        if best is None:
             return NO_CHANGE
-        best = min(view.candidates, key=self.queue_key)
         if view.exe is None:
             return Decision(best.id)
         t_dac = self.cost_params(best, self.name).c_time
