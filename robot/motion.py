@@ -614,6 +614,7 @@ class BasePlanner:
 
 APPROACH = 0.9  # metres from a person's centre when the robot goes "to" them
 APPROACH_DIRECTIONS = 16
+APPROACH_RINGS = (APPROACH, 1.1, 1.3)  # tried in turn: a farther ring only when no pose of the nearer is reachable
 
 
 class MotionEstimator:
@@ -659,14 +660,23 @@ class MotionEstimator:
 
         Candidates lie in ``APPROACH_DIRECTIONS`` directions around the person; ties go to
         the first direction (east, then counter-clockwise), so the choice is deterministic.
-        ``(None, UNREACHABLE)`` when no candidate is reachable.
+        When no pose of that ring is reachable (a person lying between furniture and a
+        wall, someone else standing beside them), the next ring of ``APPROACH_RINGS`` is
+        tried, nearest first.  ``(None, UNREACHABLE)`` when no candidate is reachable.
         """
+        for radius in APPROACH_RINGS:
+            best = self._approach_ring(start, person, radius)
+            if best[0] is not None:
+                return best
+        return None, UNREACHABLE
+
+    def _approach_ring(self, start: Pose, person: str, radius: float) -> tuple[Pose | None, MotionEstimate]:
         scene = self.planner.scene
         d = scene.people[person]
         cands = []
         for k in range(APPROACH_DIRECTIONS):
             a = 2 * math.pi * k / APPROACH_DIRECTIONS
-            gx, gy = d.x + APPROACH * math.cos(a), d.y + APPROACH * math.sin(a)
+            gx, gy = d.x + radius * math.cos(a), d.y + radius * math.sin(a)
             if scene.free(gx, gy, ignore=(person,)):
                 # the straight-line drive time bounds the travel time from below (the profile
                 # is concave, turns cost >= 0), so candidates are tried nearest first and

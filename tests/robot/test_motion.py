@@ -118,6 +118,30 @@ def test_estimate_to_a_person_is_to_the_pose_navigation_drives_to(paper) -> None
     assert math.dist(goal[:2], (9.3, 0.5)) == pytest.approx(APPROACH)
 
 
+def test_approach_tries_a_farther_ring_when_the_near_one_is_shut(paper, monkeypatch) -> None:
+    """A person lying between the bed and the wall with people at both ends: no pose 0.9 m
+    away is free and reachable (the one ring the day benchmark's falls died of), a pose on a
+    farther ring is, and estimate and navigation agree on it."""
+    import dataclasses
+
+    from robot import motion as m
+
+    # the paper apartment's bedroom: the bed spans y 5.2-7.4 from x 9.8; p lies south of it
+    motion = m.motion_model(dataclasses.replace(paper, people={}))
+    scene = motion.planner.scene
+    scene.set_person("p", 10.5, 4.6, "fallen")
+    scene.set_person("q", 9.6, 4.6, "standing")
+    scene.set_person("r", 11.4, 4.6, "standing")
+    start = paper.places["hall"]
+    monkeypatch.setattr(m, "APPROACH_RINGS", (m.APPROACH,))
+    assert motion.approach(start, "p") == (None, UNREACHABLE)
+    monkeypatch.undo()
+    goal, est = motion.approach(start, "p")
+    assert goal is not None and est.reachable and est.end_pose == goal
+    assert any(math.dist(goal[:2], (10.5, 4.6)) == pytest.approx(r) for r in m.APPROACH_RINGS[1:])
+    assert motion.estimate(start, (10.5, 4.6, 0.0)) == est
+
+
 def test_travel_matrix_in_one_call(paper) -> None:
     from robot.motion import travel_matrix
     from tasker.errors import UnknownName
