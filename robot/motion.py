@@ -22,7 +22,8 @@
 **Caching.**  Results and search trees are cached by exactly what they depend on
 (start, goal, closed doors, people), so a cached answer can never describe a scene
 that no longer exists; the roadmap itself covers only walls and furniture and never
-needs rebuilding.
+needs rebuilding.  Straight-line tests against walls, furniture and closed doors — what
+a query spends its time on — are made once and remembered (:mod:`robot.visibility`).
 """
 
 from __future__ import annotations
@@ -36,8 +37,9 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from robot.roadmap import Roadmap, heading, path_length
-from robot.scene import Disc, Scene, point_box_distance, segments_clear
+from robot.scene import Disc, Scene, point_box_distance
 from robot.spec import RobotSpec, WorldSpec
+from robot.visibility import Visibility
 from tasker.world import UNREACHABLE, MotionEstimate, Pose
 
 Point = tuple[float, float]
@@ -121,7 +123,7 @@ class BasePlanner:
        (start, closed doors); the goal is linked to it, the route shortened.  After
        ``table_after`` such searches under one set of closed doors, the roadmap's
        all-pairs table for them is built once and new starts read their route off it
-       (:meth:`_table_route`, same lengths); ``table_after=None`` always searches;
+       (:meth:`_table_query`, same lengths); ``table_after=None`` always searches;
     2. if that path is clear of people, it is the answer (people only add constraints,
        so it is still the shortest);
     3. otherwise the **people layer**: the roadmap less the edges people block, plus a
@@ -132,7 +134,9 @@ class BasePlanner:
     the rule the ``navigate`` skill checks the path ahead with, so every path returned
     is one the skill drives.  A start in collision (braked next to a door jamb, pushed
     against a wall) is snapped to the nearest free point first (:meth:`snap`); the
-    path then starts with that short move.
+    path then starts with that short move.  Straight-line tests against walls, furniture
+    and closed doors are made once and remembered in :attr:`vis`
+    (:class:`robot.visibility.Visibility`).
     """
 
     def __init__(self, spec: WorldSpec, scene: Scene, seed: int = 1, milestones: int | None = None,
@@ -146,32 +150,35 @@ class BasePlanner:
         self._rings: OrderedDict[tuple[Disc, tuple[str, ...]], tuple[np.ndarray, np.ndarray]] = OrderedDict()
         self._trees: OrderedDict[tuple[object, ...], tuple[np.ndarray, np.ndarray, np.ndarray]] = OrderedDict()
         self._graphs: OrderedDict[Layer, tuple[np.ndarray, np.ndarray, np.ndarray, csr_matrix]] = OrderedDict()
-        self._starts: OrderedDict[tuple[Point, tuple[str, ...]], tuple[np.ndarray, np.ndarray]] = OrderedDict()
         self._door_searches: dict[tuple[str, ...], int] = {}  # door-layer searches per set of closed doors
         self.table_after = table_after
         self.searches = 0  # Dijkstra runs so far (benchmarks and tests read it)
-        self._boxes_key: tuple[str, ...] | None = None
-        self._all_boxes = np.zeros((0, 4))
+        self._doors_at = -1  # the scene version _closed was read at
+        self._closed: tuple[str, ...] = ()
+        self.vis = Visibility(self.roadmap, scene)  # straight-line tests, memoised (never people)
+        self._tables: dict[tuple[str, ...], tuple[np.ndarray, np.ndarray]] = {}
 
     def forget_starts(self) -> None:
-        """Drop every per-start result (search trees, start links, answers), keeping what
-        depends on the scene alone (layer graphs, door tables): the next query from any start
-        is planned as from a new one (benchmarks measure new-source queries this way)."""
+        """Drop every per-start result (search trees, start and goal links, answers), keeping
+        what depends on the scene alone (layer graphs, door tables, visibility between roadmap
+        nodes): the next query from any start is planned as from a new one (benchmarks measure
+        new-source queries this way)."""
         self._trees.clear()
-        self._starts.clear()
         self._cache.clear()
+        self.vis.forget_points()
 
     # ---- the scene, by layer -----------------------------------------------------------
     def _doors(self) -> tuple[str, ...]:
-        return tuple(n for n, o in sorted(self.scene.door_open.items()) if not o)
+        """The closed doors, sorted (looked up again only when the scene's version moves)."""
+        if self._doors_at != self.scene.version:
+            self._closed = tuple(n for n, o in sorted(self.scene.door_open.items()) if not o)
+            self._doors_at = self.scene.version
+        return self._closed
 
-    def _boxes(self) -> np.ndarray:
-        """Walls, furniture and closed doors as one array (cached per set of closed doors)."""
-        doors = self._doors()
-        if self._boxes_key != doors:
-            self._boxes_key = doors
-            self._all_boxes = np.vstack([self.scene.static, self.scene.closed_doors()])
-        return self._all_boxes
+    def _static_free(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Which segments ``a[i]→b[i]`` are clear of the bounds, walls, furniture and closed
+        doors (exact; people are not looked at)."""
+        return self.vis.free(a, b, self._doors())
 
     def _free_segments(self, a: np.ndarray, b: np.ndarray, discs: tuple[Disc, ...], leaving: bool = True,
                        goal: Point | None = None) -> np.ndarray:
@@ -182,16 +189,21 @@ class BasePlanner:
         from ``a`` to ``b`` (``leaving``), stopping at ``goal``; roadmap edges, which are
         searched both ways, with ``leaving=False``.
         """
-        scene, r = self.scene, self.scene.radius
         a, b = np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2)
-        lo, hi = np.minimum(a, b), np.maximum(a, b)
-        ok = (lo[:, 0] >= scene.xmin + r) & (hi[:, 0] <= scene.xmax - r) & (lo[:, 1] >= scene.ymin + r)
-        ok &= hi[:, 1] <= scene.ymax - r
-        ok &= segments_clear(a, b, self._boxes(), r)
+        ok = self._static_free(a, b)
+        return self._people_free(a, b, ok, discs, leaving, goal)
+
+    def _people_free(self, a: np.ndarray, b: np.ndarray, ok: np.ndarray, discs: tuple[Disc, ...],
+                     leaving: bool = True, goal: Point | None = None) -> np.ndarray:
+        """``ok`` (segments clear of everything else) less those ``discs`` block."""
         if discs and ok.any():
             idx = np.flatnonzero(ok)
-            ok[idx] = scene.people_clear(a[idx], b[idx], discs, leaving=leaving, goal=goal)
+            ok[idx] = self.scene.people_clear(a[idx], b[idx], discs, leaving=leaving, goal=goal)
         return ok
+
+    def _node_memo(self, doors: tuple[str, ...]) -> np.ndarray:
+        """Visibility between roadmap nodes under ``doors`` (:meth:`Visibility.between_nodes`)."""
+        return self.vis.between_nodes(doors, self._door_mask(doors))
 
     def _free_points(self, pts: np.ndarray) -> np.ndarray:
         """Which points the robot may stand on: clear of bounds, walls, furniture, closed doors.
@@ -297,27 +309,43 @@ class BasePlanner:
         lengths = np.hypot(*(all_nodes[all_edges[:, 0]] - all_nodes[all_edges[:, 1]]).T)
         return all_nodes, all_edges, lengths
 
+    def _candidates(self, p: Point, nodes: np.ndarray, k: int = 16) -> tuple[np.ndarray, np.ndarray]:
+        """``p``'s link candidates among ``nodes`` (:meth:`Visibility.select`), with their
+        distances; memoised for the roadmap's own nodes."""
+        if nodes is self.roadmap.nodes and k == 16:
+            return self.vis.candidates((p,), self._doors())[0]
+        return self.vis.select(np.array([p], dtype=float), nodes[:, 0], nodes[:, 1], k)[0]
+
     def _links(self, p: Point, nodes: np.ndarray, discs: tuple[Disc, ...], k: int = 16,
                also: Point | None = None, goal: bool = False) -> tuple[np.ndarray, np.ndarray, bool]:
-        """Nodes visible from ``p`` among its ``k`` nearest and the nearest 24 milestones within
-        3 m that are not OMPL samples (corners, doors, places, rings), with distances; and
-        whether ``p`` sees ``also`` directly (one vectorised test for all).
+        """Nodes visible from ``p`` among its link candidates (:meth:`_candidates`), with
+        distances; and whether ``p`` sees ``also`` directly.
 
         ``p`` is the path's start (segments ``p → node``), or with ``goal`` its goal
-        (segments ``node → p`` and ``also → p``): people are judged in driving order."""
-        d = np.hypot(nodes[:, 0] - p[0], nodes[:, 1] - p[1])
-        first = int(self.roadmap.corner_nodes[0]) if len(self.roadmap.corner_nodes) else len(self.roadmap.nodes)
-        near = np.argpartition(d, min(k, len(d) - 1))[:k]
-        special = first + np.flatnonzero(d[first:] <= 3.0)
-        if len(special) > 24:
-            special = special[np.argsort(d[special], kind="stable")[:24]]
-        cand = np.unique(np.concatenate([near, special]))
+        (segments ``node → p`` and ``also → p``): people are judged in driving order.  Walls,
+        furniture and closed doors come from the visibility memo, tested (all at once) only
+        where it does not know yet; people are judged afresh.
+        """
+        cand, d = self._candidates(p, nodes, k)
+        doors = self._doors()
+        n_rm = len(self.roadmap.nodes)
+        split = int(np.searchsorted(cand, n_rm))
         ends = nodes[cand] if also is None else np.vstack([nodes[cand], [also]])
-        here = np.repeat([p], len(ends), axis=0)
-        ok = self._free_segments(ends, here, discs, goal=p) if goal else self._free_segments(here, ends, discs)
+        here = np.broadcast_to(np.asarray(p, float), (len(ends), 2))
+        off = ends[split:]  # ring milestones, and ``also``: not in the memo
+        fresh = self.vis.settle(doors, p, cand[:split], off if len(off) else None)
+        ok = np.concatenate([self.vis.point(p, doors).vis[cand[:split]] == 1, fresh])
+        if goal:
+            ok = self._people_free(ends, here, ok, discs, goal=p)
+        else:
+            ok = self._people_free(here, ends, ok, discs)
         direct = bool(ok[-1]) if also is not None else False
         ok = ok[: len(cand)]
-        return cand[ok], d[cand[ok]], direct
+        return cand[ok], d[ok], direct
+
+    def _point_free(self, p: Point) -> bool:
+        """May the robot stand on ``p`` (:meth:`_free_points`' rule; memoised)?"""
+        return self.vis.point_free(p, self._doors())
 
     def _tree(self, s: Point, layer: Layer) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Distances and predecessors from ``s`` over ``layer``'s graph (cached), and its nodes:
@@ -350,58 +378,141 @@ class BasePlanner:
         return (not layer[1] and self.table_after is not None
                 and self._door_searches.get(layer[0], 0) >= self.table_after)
 
-    def _start_links(self, s: Point, doors: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
-        """The roadmap nodes start ``s`` links to on the door layer, and their distances (cached)."""
-        key = (s, doors)
-        if key not in self._starts:
-            si, sd, _ = self._links(s, self.roadmap.nodes, ())
-            self._starts[key] = (si, sd)
-            if len(self._starts) > 512:
-                self._starts.popitem(last=False)
-        self._starts.move_to_end(key)
-        return self._starts[key]
+    def _door_table(self, doors: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """The roadmap's all-pairs distances and predecessors under ``doors`` (looked up once)."""
+        if doors not in self._tables:
+            self._tables[doors] = self.roadmap.all_pairs(self._door_mask(doors))
+            if len(self._tables) > 4:
+                self._tables.pop(next(iter(self._tables)))
+        return self._tables[doors]
 
-    def _table_route(self, s: Point, doors: tuple[str, ...], gi: np.ndarray, gd: np.ndarray) -> list[int] | None:
-        """The door layer's shortest route of roadmap nodes from start ``s`` to one of the goal's
-        links ``gi`` (at ``gd``), read off the all-pairs table of ``doors`` instead of searched:
-        the least ``link(s, a) + table[a, b] + link(b, goal)`` over the start's links ``a`` and
-        the goal's ``b``, then ``table``'s predecessors from ``b`` back to ``a``.  The same
-        length as :meth:`_tree`'s search (which adds the same 1e-9 to each start link)."""
-        si, sd = self._start_links(s, doors)
-        if not len(si):
+    def _table_query(self, s: Point, g: Point, doors: tuple[str, ...]) -> list[Point] | None:
+        """The door layer's shortest path, its route read off the all-pairs table of ``doors``.
+
+        The route is the least ``link(s, a) + table[a, b] + link(b, goal)`` over the start's
+        visible links ``a`` and the goal's ``b`` (the length :meth:`_tree`'s search gives, which
+        adds the same 1e-9 to each start link), then ``table``'s predecessors from ``b`` back to
+        ``a``.  One exact test covers the straight way and the links the memos do not know
+        yet, a second the shortcut's pairs they do not know.
+        """
+        nodes = self.roadmap.nodes
+        (cs, ds), (cg, dg) = self.vis.candidates((s, g), doors)
+        vs, vg = self.vis.point(s, doors).vis, self.vis.point(g, doors).vis
+        # one exact test: the straight way and every link not in the memos yet
+        us, ug = cs[vs[cs] < 0], cg[vg[cg] < 0]
+        here = np.array([s, g], dtype=float)
+        k = 1 + len(us)  # the straight way first, then the start's links, then the goal's
+        ok = self._static_free(np.repeat(here, [k, len(ug)], axis=0),
+                               np.concatenate([here[1:], nodes[us], nodes[ug]]))
+        vs[us] = ok[1:k]
+        vg[ug] = ok[k:]
+        if ok[0]:
+            return [s, g]
+        ks, kg = vs[cs] == 1, vg[cg] == 1
+        si, gi = cs[ks], cg[kg]
+        if not (len(si) and len(gi)):
             return None
-        table, pred = self.roadmap.all_pairs(self._door_mask(doors))
-        total = (sd + 1e-9)[:, None] + table[np.ix_(si, gi)] + gd[None, :]
-        i, j = np.unravel_index(int(np.argmin(total)), total.shape)
+        table, pred = self._door_table(doors)
+        total = (ds[ks] + 1e-9)[:, None] + table[si[:, None], gi] + dg[kg][None, :]
+        flat = int(np.argmin(total))
+        i, j = divmod(flat, len(gi))
         if not math.isfinite(total[i, j]):
             return None
-        a, row = int(si[i]), pred[si[i]]
-        route = [int(gi[j])]
+        pts, ids = self._route_points(s, g, nodes, self._walk(pred, int(si[i]), int(gi[j])))
+        return self._shortcut(pts, (), ids, direct=False)
+
+    @staticmethod
+    def _walk(pred: np.ndarray, a: int, b: int) -> list[int]:
+        """Roadmap nodes from ``a`` to ``b`` along the all-pairs predecessors."""
+        row = pred[a]
+        route = [b]
         while route[-1] != a:
             route.append(int(row[route[-1]]))
         return route[::-1]
 
-    def _shortcut(self, pts: list[Point], discs: tuple[Disc, ...]) -> list[Point]:
-        """The shortest chain through ``pts`` whose links are all collision-free."""
+    def _route_points(self, s: Point, g: Point, nodes: np.ndarray, route: list[int]) -> tuple[list[Point], list[int]]:
+        """The points of ``s``, the ``route`` nodes and ``g``, and which roadmap node each is
+        (``-1`` for the ends and for ring milestones)."""
+        n_rm = len(self.roadmap.nodes)
+        pts = [s] + [(float(x), float(y)) for x, y in nodes[route].tolist()] + [g]
+        return pts, [-1] + [k if k < n_rm else -1 for k in route] + [-1]
+
+    def _shortcut(self, pts: list[Point], discs: tuple[Disc, ...], ids: list[int],
+                  direct: bool | None = None) -> list[Point]:
+        """The shortest chain through ``pts`` whose links are all collision-free.
+
+        ``ids`` names the roadmap node each point is (``-1``: the start, the goal, a ring
+        milestone).  Walls, furniture and closed doors between two nodes, or between the
+        start or the goal and a node, come from the visibility memos; what they do not know
+        is tested in one call (and remembered); ``direct`` is the start–goal pair's answer if
+        known.  People are judged afresh.
+        """
         n = len(pts)
         if n <= 2:
             return pts
-        P = np.asarray(pts)
-        ii, jj = np.triu_indices(n, 1)
-        free = np.zeros((n, n), dtype=bool)
-        free[ii, jj] = self._free_segments(P[ii], P[jj], discs, goal=pts[-1])
-        free[np.arange(n - 1), np.arange(1, n)] = True  # route links are valid by construction
-        seg = np.hypot(*(P[None, :, :] - P[:, None, :]).transpose(2, 0, 1))
-        best = np.full(n, math.inf)
-        back = np.zeros(n, dtype=int)
+        doors = self._doors()
+        P = np.asarray(pts, dtype=float)
+        node_vis = self._node_memo(doors)
+        vs, vg = self.vis.point(pts[0], doors).vis, self.vis.point(pts[-1], doors).vis
+        inner = np.maximum(np.asarray(ids[1:-1]), 0)
+        s_row, g_col = vs[inner].tolist(), vg[inner].tolist()
+        sub = node_vis[np.ix_(inner, inner)].tolist()
+        # what the memos know of every pair that is not a route link (those are valid by
+        # construction); plain Python: a route has a few dozen points at most
+        on = [k >= 0 for k in ids]
+        fr = [[j == i + 1 for j in range(n)] for i in range(n)]
+        clear: list[tuple[int, int]] = []
+        unknown: list[tuple[int, int]] = []
+        for i in range(n - 2):
+            for j in range(i + 2, n):
+                if i == 0:
+                    v = (-1 if direct is None else int(direct)) if j == n - 1 else (s_row[j - 1] if on[j] else -1)
+                elif j == n - 1:
+                    v = g_col[i - 1] if on[i] else -1
+                else:
+                    v = sub[i - 1][j - 1] if on[i] and on[j] else -1
+                if v < 0:
+                    unknown.append((i, j))
+                elif v:
+                    clear.append((i, j))
+        if unknown:
+            u = np.array(unknown)
+            got = self._static_free(P[u[:, 0]], P[u[:, 1]]).tolist()
+            for (i, j), v in zip(unknown, got, strict=True):
+                if v:
+                    clear.append((i, j))
+                if i == 0 and j == n - 1:
+                    continue  # the start–goal pair: not memoised
+                if i == 0:
+                    if on[j]:
+                        vs[ids[j]] = v
+                elif j == n - 1:
+                    if on[i]:
+                        vg[ids[i]] = v
+                elif on[i] and on[j]:
+                    node_vis[ids[i], ids[j]] = node_vis[ids[j], ids[i]] = v
+        if discs and clear:
+            c = np.array(clear)
+            fine = self.scene.people_clear(P[c[:, 0]], P[c[:, 1]], discs, goal=pts[-1]).tolist()
+            clear = [pair for pair, v in zip(clear, fine, strict=True) if v]
+        for i, j in clear:
+            fr[i][j] = True
+        seg = np.hypot(*(P[None, :, :] - P[:, None, :]).transpose(2, 0, 1)).tolist()
+        # the least-cost chain, first predecessor on ties; plain floats: n is small
+        best = [math.inf] * n
+        back = [0] * n
         best[0] = 0.0
         for j in range(1, n):
-            cand = np.where(free[:j, j], best[:j] + seg[:j, j], math.inf)
-            back[j] = int(np.argmin(cand))
-            best[j] = cand[back[j]]
+            bj, bi = math.inf, 0
+            for i in range(j):
+                if fr[i][j]:
+                    c = best[i] + seg[i][j]
+                    if c < bj:
+                        bj, bi = c, i
+            best[j], back[j] = bj, bi
         out = [n - 1]
         while out[-1] != 0:
-            out.append(int(back[out[-1]]))
+            out.append(back[out[-1]])
         return [pts[k] for k in reversed(out)]
 
     def snap(self, p: Point, discs: tuple[Disc, ...] = ()) -> Point | None:
@@ -409,7 +520,7 @@ class BasePlanner:
         ``SNAP_REACH``, reached from ``p`` without coming closer to any of ``discs`` than it is
         (:meth:`Scene.people_clear <robot.scene.Scene.people_clear>`): a start braked against a
         door jamb is moved off it, a start beside a person stays where it is."""
-        if self._free_points(np.array([p]))[0]:
+        if self._point_free(p):
             return p
         radii = np.arange(1, int(SNAP_REACH / SNAP_STEP) + 1) * SNAP_STEP
         ang = 2 * math.pi * np.arange(32) / 32
@@ -424,8 +535,8 @@ class BasePlanner:
         return (float(pts[ok[0], 0]), float(pts[ok[0], 1]))
 
     def _query(self, s: Point, g: Point, layer: Layer) -> tuple[Point, ...] | None:
-        discs = layer[1]
-        if not self._free_points(np.array([g]))[0]:
+        doors, discs = layer
+        if not self._point_free(g):
             return None
         s0 = s
         snapped = self.snap(s, discs)
@@ -436,31 +547,25 @@ class BasePlanner:
         if math.hypot(g[0] - s[0], g[1] - s[1]) < 1e-6:
             return (*head, s, g)
         if self._use_table(layer):
-            nodes = self.roadmap.nodes
-            gi, gd, direct = self._links(g, nodes, discs, also=s, goal=True)
-            if direct:
-                return (*head, s, g)
-            route = self._table_route(s, layer[0], gi, gd) if len(gi) else None
-            if route is None:
-                return None
-        else:
-            dist, pred, nodes = self._tree(s, layer)
-            gi, gd, direct = self._links(g, nodes, discs, also=s, goal=True)
-            if direct:
-                return (*head, s, g)
-            if not len(gi):
-                return None
-            total = dist[gi] + gd
-            b = int(np.argmin(total))
-            if not math.isfinite(total[b]):
-                return None
-            route = [int(gi[b])]
-            n = len(nodes)
-            while route[-1] != n:
-                route.append(int(pred[route[-1]]))
-            route = route[-2::-1]
-        pts = [s] + [(float(x), float(y)) for x, y in nodes[route]] + [g]
-        return (*head, *self._shortcut(pts, discs))
+            path = self._table_query(s, g, doors)
+            return None if path is None else (*head, *path)
+        nodes = self._layer_graph(layer)[0]
+        gi, gd, direct = self._links(g, nodes, discs, also=s, goal=True)
+        if direct:
+            return (*head, s, g)
+        if not len(gi):
+            return None
+        dist, pred, nodes = self._tree(s, layer)
+        total = dist[gi] + gd
+        b = int(np.argmin(total))
+        if not math.isfinite(total[b]):
+            return None
+        route = [int(gi[b])]
+        n = len(nodes)
+        while route[-1] != n:
+            route.append(int(pred[route[-1]]))
+        pts, ids = self._route_points(s, g, nodes, route[-2::-1])
+        return (*head, *self._shortcut(pts, discs, ids))
 
     def plan(self, start: Point, goal: Point) -> tuple[Point, ...] | None:
         """A collision-free polyline from ``start`` to ``goal``, or None when there is none."""
