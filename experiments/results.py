@@ -458,7 +458,8 @@ def render(rows: Sequence[RunRow], command: str, notes: str = "") -> str:
     pairs, every, constant = tested_pairs(rows)
     versions = sorted({str(r.record.get("tasker_version", "?")) for r in ok})
     out = ["# Static versus planned suspension: results", "",
-           "Regenerate (the sweep resumes: only runs missing from the database are run, on one worker; the runs "
+           "Regenerate (the sweep resumes: only runs missing from the database are run, on one worker unless "
+           "`--workers N` says more; the runs "
            f"below took {_fmt(math.fsum(r.wall or 0.0 for r in rows) / 60)} minutes of worker wall time on a "
            "shared machine):", "", "```bash", command, "```", "",
            DECLARATION.rstrip(), "",
