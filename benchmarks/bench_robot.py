@@ -3,7 +3,7 @@
 Run ``python benchmarks/bench_robot.py``.  In one run it measures, in the paper's
 apartment, over random reachable pose pairs:
 
-* our :class:`robot.motion.MotionEstimator` with the world's **people in the scene**
+* our :class:`robot.estimator.MotionEstimator` with the world's **people in the scene**
   (roadmap grown once, result cache off so every query is really planned) against a
   fresh OMPL ``RRTConnect`` + ``simplify`` query on the same scene (people included in
   its checker), printing the speed and path-length ratios.  Two kinds of query: a
@@ -43,7 +43,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from robot.motion import BasePlanner, DriveLimits, MotionEstimator  # noqa: E402
+from robot.estimator import MotionEstimator  # noqa: E402
+from robot.motion import BasePlanner, DriveLimits  # noqa: E402
 from robot.roadmap import ompl_setup, path_length  # noqa: E402
 from robot.scene import Scene  # noqa: E402
 from robot.sim import Simulation  # noqa: E402

@@ -112,7 +112,7 @@ def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float)
 
     Without a motion model (or a pose) the declared ``travel_s`` is used, never zero.
     Pairs joined by a ``door_between`` fact are timed with the motion model's optional
-    ``estimate_ignoring_doors`` (``robot.motion.MotionEstimator`` has it).  A motion model
+    ``estimate_ignoring_doors`` (``robot.estimator.MotionEstimator`` has it).  A motion model
     with a ``table(poses)`` method (the same class) gives the whole matrix in one pass.
     """
     places = sorted(n for n, t in world.objects.items() if t == PLACE_TYPE)
@@ -121,7 +121,7 @@ def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float)
     through_door = {(f[2], f[3]) for f in world.matching("door_between") if len(f) == 4}
     ignoring_doors = getattr(motion, "estimate_ignoring_doors", None)
     out: dict[tuple[str, str], float] = {}
-    table = getattr(motion, "table", None)  # a whole matrix in one pass (robot.motion.MotionEstimator)
+    table = getattr(motion, "table", None)  # a whole matrix in one pass (robot.estimator.MotionEstimator)
     posed = [n for n in places if n in world.poses]
     if table is not None and len(posed) > 1:
         matrix = table([world.poses[n] for n in posed])
@@ -149,7 +149,7 @@ def _past_people(world: WorldState, motion: MotionModel | None, out: dict[tuple[
     the ``navigate`` skill waits for them to clear (it fails only after making no progress
     for a while).  Making the leg unreachable would make ``upTsk`` unsolvable — the task
     failed — on a moment's crowding.  With a motion model's optional
-    ``estimate_ignoring_people`` (doors as they are; ``robot.motion.MotionEstimator`` has
+    ``estimate_ignoring_people`` (doors as they are; ``robot.estimator.MotionEstimator`` has
     it), such a leg gets the free building's time; a leg behind a closed door, or walled
     off, stays ``inf``.
     """

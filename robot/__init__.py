@@ -18,7 +18,7 @@ def __getattr__(name: str) -> object:
 
         return Simulation
     if name == "motion_model":
-        from robot.motion import motion_model
+        from robot.estimator import motion_model
 
         return motion_model
     raise AttributeError(f"module 'robot' has no attribute {name!r}")

@@ -95,7 +95,7 @@ def _world(args: argparse.Namespace) -> int:
 
 
 def _cost(args: argparse.Namespace) -> int:
-    from robot.motion import motion_model
+    from robot.estimator import motion_model
 
     if len(args.points) < 2:
         raise UsageError("PLACE", f"expected at least two places or points, got {len(args.points)}")

@@ -30,8 +30,9 @@ from pathlib import Path
 import numpy as np
 
 from robot.control import STOP
+from robot.estimator import MotionEstimator
 from robot.mjworld import TIMESTEP, MjApartment
-from robot.motion import BasePlanner, DriveLimits, MotionEstimator, open_planner
+from robot.motion import BasePlanner, DriveLimits, open_planner
 from robot.people import People, Person
 from robot.recording import PersonState, Recorder
 from robot.scene import PERSON_RADIUS, Scene, point_box_distance, segments_clear

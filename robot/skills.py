@@ -28,7 +28,8 @@ from typing import Protocol
 import numpy as np
 
 from robot.control import STOP, Command, PathFollower
-from robot.motion import BasePlanner, DriveLimits, MotionEstimator
+from robot.estimator import MotionEstimator
+from robot.motion import BasePlanner, DriveLimits
 from robot.people import People
 from robot.scene import Scene, point_box_distance
 from robot.spec import WorldSpec

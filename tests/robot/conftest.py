@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from robot.motion import MotionEstimator, motion_model
+from robot.estimator import MotionEstimator, motion_model
 from robot.spec import WorldSpec, load_world
 
 

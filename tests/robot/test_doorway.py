@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from robot.motion import APPROACH, motion_model
+from robot.estimator import APPROACH, motion_model
 from robot.scene import Scene
 from robot.sim import Simulation
 from robot.spec import PersonSpec, WorldSpec

@@ -105,7 +105,7 @@ def test_drive_limits_reject_nonsense() -> None:
 
 
 def test_estimate_to_a_person_is_to_the_pose_navigation_drives_to(paper) -> None:
-    from robot.motion import APPROACH, motion_model
+    from robot.estimator import APPROACH, motion_model
 
     motion = motion_model(paper)
     scene = motion.planner.scene
@@ -124,7 +124,7 @@ def test_approach_tries_a_farther_ring_when_the_near_one_is_shut(paper, monkeypa
     farther ring is, and estimate and navigation agree on it."""
     import dataclasses
 
-    from robot import motion as m
+    from robot import estimator as m
 
     # the paper apartment's bedroom: the bed spans y 5.2-7.4 from x 9.8; p lies south of it
     motion = m.motion_model(dataclasses.replace(paper, people={}))
@@ -143,7 +143,7 @@ def test_approach_tries_a_farther_ring_when_the_near_one_is_shut(paper, monkeypa
 
 
 def test_travel_matrix_in_one_call(paper) -> None:
-    from robot.motion import travel_matrix
+    from robot.estimator import travel_matrix
     from tasker.errors import UnknownName
 
     m = travel_matrix(paper, ["hall", "kitchen", "john", (6.0, 2.0)], seed=1)
@@ -155,7 +155,7 @@ def test_travel_matrix_in_one_call(paper) -> None:
 
 
 def test_table_is_one_search_per_source(paper) -> None:
-    from robot.motion import motion_model
+    from robot.estimator import motion_model
 
     motion = motion_model(paper)
     poses = [paper.places[n] for n in sorted(paper.places)]
@@ -166,7 +166,7 @@ def test_table_is_one_search_per_source(paper) -> None:
 
 
 def test_travel_matrix_and_seed_checks_fire() -> None:
-    from robot.motion import TravelMatrix
+    from robot.estimator import TravelMatrix
     from robot.roadmap import ompl_seed
 
     with pytest.raises(ValueError, match="2 labels need 2 poses"):

@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robot.motion import BasePlanner, motion_model
+from robot.estimator import motion_model
+from robot.motion import BasePlanner
 from robot.scene import Scene
 from robot.spec import load_world, shipped_worlds
 from robot.tiago import robot_dimensions
