@@ -15,8 +15,8 @@ from pathlib import Path
 from typing import IO, Any
 
 EVENTS = (
-    "run", "request", "rejected", "transition", "command", "roles", "decision", "plan",
-    "stage", "params", "mode", "change", "world", "hazard", "role", "secure", "end",
+    "run", "request", "transition", "command", "roles", "decision", "plan",
+    "stage", "mode", "change", "world", "hazard", "role", "secure", "end",
 )
 
 
