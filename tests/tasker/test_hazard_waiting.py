@@ -79,19 +79,28 @@ def chore() -> SyntheticTask:
     return SyntheticTask("chore", [st("sweep", 40.0), st("mop", 40.0)], weight=1.0)
 
 
-def run(scheduler: str, *, hazard_waiting: bool, policy: str = "conditional", swap_to: str | None = None,
-        seed: int = 0, jitter: float = 0.0, **options: Any) -> tuple[list[dict[str, Any]], SimulationLoop]:
-    """stew at 0, chore (more urgent under ``scheduler``) at 5; ``swap_to`` replaces the scheduler at 6."""
-    world = Facts()
+def watched(world: Facts, scheduler: Any, *, policy: str = "conditional", hazard_waiting: bool = True,
+            **loop_options: Any) -> SimulationLoop:
+    """A loop of stew and chore over ``world`` whose Monitor writes hazard events and tells the
+    harmoniser which hazards hold (as the runner wires it)."""
     store = TaskStore([stew(world), chore()])
-    loop = SimulationLoop(store, schedulers.create(scheduler, **options), seed=seed,
-                          core=EffectExecutor(world, seed, jitter),
-                          rates=Rates(rep_rate=1.0, task_exe_rate=10.0, sp_up_rate=1.0),
-                          strategy=Strategy("static", "static", policy), hazard_waiting=hazard_waiting)
+    loop_options.setdefault("core", EffectExecutor(world))
+    loop = SimulationLoop(store, scheduler, strategy=Strategy("static", "static", policy),
+                          hazard_waiting=hazard_waiting, **loop_options)
     monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning, world.snapshot,
                       task_types=store.names())
     loop.observers.append(monitor.observe)
     loop.harmoniser.hazards = monitor.active
+    return loop
+
+
+def run(scheduler: str, *, hazard_waiting: bool, policy: str = "conditional", swap_to: str | None = None,
+        seed: int = 0, jitter: float = 0.0, **options: Any) -> tuple[list[dict[str, Any]], SimulationLoop]:
+    """stew at 0, chore (more urgent under ``scheduler``) at 5; ``swap_to`` replaces the scheduler at 6."""
+    world = Facts()
+    loop = watched(world, schedulers.create(scheduler, **options), policy=policy, hazard_waiting=hazard_waiting,
+                   seed=seed, core=EffectExecutor(world, seed, jitter),
+                   rates=Rates(rep_rate=1.0, task_exe_rate=10.0, sp_up_rate=1.0))
     loop.request(0.0, "stew", {"priority": 1, "deadline": 1000.0})
     loop.request(5.0, "chore", {"priority": 5, "deadline": 100.0})
     if swap_to is not None:
@@ -201,13 +210,7 @@ def test_the_margin_must_be_a_finite_number() -> None:
 
 def test_a_task_terminated_while_securing_ends_after_reaching_its_safe_state() -> None:
     world = Facts()
-    store = TaskStore([stew(world), chore()])
-    loop = SimulationLoop(store, schedulers.create("priority"), core=EffectExecutor(world),
-                          strategy=Strategy("static", "static", "conditional"), hazard_waiting=True)
-    monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning, world.snapshot,
-                      task_types=store.names())
-    loop.observers.append(monitor.observe)
-    loop.harmoniser.hazards = monitor.active
+    loop = watched(world, schedulers.create("priority"))
     loop.request(0.0, "stew", {"priority": 1})
     loop.request(5.0, "chore", {"priority": 5})
     trace = loop.trace
@@ -230,13 +233,7 @@ def test_a_task_terminated_while_securing_ends_after_reaching_its_safe_state() -
 
 def test_a_hazard_whose_task_ended_is_not_secured() -> None:
     world = Facts()
-    store = TaskStore([stew(world), chore()])
-    loop = SimulationLoop(store, schedulers.create("priority"), core=EffectExecutor(world),
-                          strategy=Strategy("static", "static", "conditional"), hazard_waiting=True)
-    monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning, world.snapshot,
-                      task_types=store.names())
-    loop.observers.append(monitor.observe)
-    loop.harmoniser.hazards = monitor.active
+    loop = watched(world, schedulers.create("priority"))
     loop.request(0.0, "stew", {"priority": 1})
     loop.request(5.0, "chore", {"priority": 5})
     loop.terminate(7.0, "d1", "ends in wait: the flame stays on, nobody's task")
