@@ -17,7 +17,7 @@ from typing import Any
 import unified_planning as up
 
 from planners.checks import CheckedDomain, PddlError
-from tasker.world import Fact, MotionModel, WorldState
+from tasker.world import Fact, MotionModel, Pose, WorldState
 
 PLACE_TYPE = "place"
 TRAVEL_FUNCTION = "travel-time"
@@ -156,13 +156,11 @@ def _past_people(world: WorldState, motion: MotionModel | None, out: dict[tuple[
     ignoring_people = getattr(motion, "estimate_ignoring_people", None)
     if ignoring_people is None:
         return
-    robots = sorted(n for n, t in world.objects.items() if t == "robot")
-    here = world.poses.get(robots[0]) if robots else None
-    at = {f[2] for f in world.facts if len(f) == 3 and f[0] == "at" and robots and f[1] == robots[0]}
+    robot = _robot_where(world)
     for (a, b), secs in sorted(out.items()):
         if math.isfinite(secs) or b not in world.poses:
             continue
-        start = here if a in at and len(at) == 1 and here is not None else world.poses.get(a)
+        start = robot[1] if robot is not None and robot[0] == a else world.poses.get(a)
         if start is not None:
             out[a, b] = float(ignoring_people(start, world.poses[b]).time_s)
 
@@ -176,17 +174,24 @@ def _from_robot(world: WorldState, motion: MotionModel | None, out: dict[tuple[s
     direct leg through people standing *there* and make the planner detour through another
     place, while the robot itself is already past them.
     """
-    robots = sorted(n for n, t in world.objects.items() if t == "robot")
-    here = world.poses.get(robots[0]) if robots and motion is not None else None
-    at = [f[2] for f in world.facts if len(f) == 3 and f[0] == "at" and robots and f[1] == robots[0]]
-    if here is None or len(at) != 1 or motion is None:
+    robot = _robot_where(world)
+    if robot is None or motion is None:
         return
-    a = at[0]
+    a, here = robot
     for b in sorted(n for n, t in world.objects.items() if t == PLACE_TYPE):
         if b == a or b not in world.poses:
             continue
         estimate = ignoring_doors if ((a, b) in through_door and ignoring_doors is not None) else motion.estimate
         out[a, b] = float(estimate(here, world.poses[b]).time_s)
+
+
+def _robot_where(world: WorldState) -> tuple[str, Pose] | None:
+    """The robot's place (its one ``at`` fact) and its pose, or None when either is unknown."""
+    robots = sorted(n for n, t in world.objects.items() if t == "robot")
+    if not robots or robots[0] not in world.poses:
+        return None
+    at = [f[2] for f in world.facts if len(f) == 3 and f[0] == "at" and f[1] == robots[0]]
+    return (at[0], world.poses[robots[0]]) if len(at) == 1 else None
 
 
 def _atom(fact: Iterable[str]) -> str:
