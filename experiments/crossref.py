@@ -67,17 +67,14 @@ def arg_types(task: TaskType) -> dict[str, set[str]]:
         literals.extend(branch.when)
         literals.extend(branch.goal)
     out: dict[str, set[str]] = {}
-    try:
-        model: Any = domain.checked.model  # type: ignore[union-attr]
-    except AttributeError:  # a task type without a checked PDDL domain
-        model = None
+    actions: Mapping[str, Any] = getattr(domain, "actions", {}) or {}
     templates = [*getattr(spec, "static_update", ())]
     for branch in getattr(spec, "static_suspension", ()):
         templates.extend(branch.stages)
     for template in templates:  # static stages: the PDDL action's parameter types, by position
         try:
-            params = [p.type.name if p.type.is_user_type() else "" for p in model.action(template.action).parameters]
-        except Exception:  # no such action, or not a unified-planning model: the planner's checks say so
+            params = list(actions[template.action].param_types)
+        except (KeyError, AttributeError):  # no such action, or not a PDDL task type: the planner's checks say so
             continue
         for i, a in enumerate(template.args):
             if a.startswith("$at:") and a != "$at:robot":

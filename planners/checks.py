@@ -7,6 +7,10 @@ one (unknown predicate, wrong arity, undefined type or object, missing goal) a
 first, so an error is blamed on the right file.  Requirements that Fast Downward
 cannot handle are refused from the domain's ``:requirements`` and from the problem
 kind UP computes.
+
+unified-planning and pyparsing are imported by the checks that use them, not by this
+module: its exceptions are raised by code (task loading from remembered checks,
+:mod:`planners.problem`) that must not pay for them.
 """
 
 from __future__ import annotations
@@ -18,16 +22,13 @@ import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import pyparsing
-import unified_planning as up
-from unified_planning.environment import get_environment
-from unified_planning.io import PDDLReader
-from unified_planning.io.pddl_reader import PDDLGrammar
-from unified_planning.io.utils import parse_string
-
-from planners.kind import supported_kind
 from tasker.errors import TaskerError
+
+if TYPE_CHECKING:
+    import unified_planning as up
+    from unified_planning.io.pddl_reader import PDDLGrammar
 
 SUPPORTED_REQUIREMENTS = frozenset({
     ":strips", ":typing", ":negative-preconditions", ":disjunctive-preconditions", ":equality",
@@ -51,6 +52,8 @@ _names_lock = threading.Lock()
 def _lenient_names() -> Iterator[None]:
     """PDDL keeps types and objects in separate namespaces (an object ``robot`` of type
     ``robot`` is fine); UP refuses that unless ``error_used_name`` is off while reading."""
+    from unified_planning.environment import get_environment
+
     env = get_environment()
     with _names_lock, warnings.catch_warnings():
         warnings.filterwarnings("ignore", message=".*already defined.*")
@@ -94,6 +97,8 @@ def _read(path: str | Path) -> str:
 
 def _located(file: str | Path, exc: BaseException) -> PddlError:
     """Turn a reader exception into a :class:`PddlError` with the line when there is one."""
+    import pyparsing
+
     if isinstance(exc, pyparsing.ParseBaseException):
         return PddlError(file, f"syntax error: {exc.msg}", exc.lineno, exc.col)
     text = str(exc).strip()
@@ -109,6 +114,10 @@ def _located(file: str | Path, exc: BaseException) -> PddlError:
 
 def declared_requirements(domain_text: str, file: str | Path = "<domain>") -> tuple[str, ...]:
     """The ``:requirements`` a domain declares, read with UP's own PDDL grammar."""
+    import pyparsing
+    from unified_planning.io.pddl_reader import PDDLGrammar
+    from unified_planning.io.utils import parse_string
+
     global _grammar
     if _grammar is None:
         _grammar = PDDLGrammar()
@@ -130,6 +139,8 @@ def check_requirements(domain_text: str, file: str | Path) -> None:
 
 def check_kind(problem: up.model.Problem, file: str | Path) -> None:
     """Refuse a problem whose UP problem kind needs features the planner lacks."""
+    from planners.kind import supported_kind
+
     supported = set(supported_kind().features)
     extra = sorted(set(problem.kind.features) - supported - _TOLERATED_FEATURES)
     if extra:
@@ -138,33 +149,50 @@ def check_kind(problem: up.model.Problem, file: str | Path) -> None:
 
 @dataclass(frozen=True, slots=True)
 class CheckedDomain:
-    """A domain that parsed and passed the checks: its text and UP's domain-only model."""
+    """A domain that passed the checks (now, or in a process that remembered it: :mod:`planners.cache`).
+
+    Only its file and text: what task types need of it is :class:`planners.problem.DomainModel`.
+    """
 
     path: Path
     text: str
-    model: up.model.Problem
-
-    @property
-    def name(self) -> str:
-        return self.model.name
 
 
 def load_domain(path: str | Path) -> CheckedDomain:
     """Read and check a ``domain.pddl``; raise :class:`PddlError` naming the file and line."""
     text = _read(path)
     check_requirements(text, path)
+    parse_domain(text, path)
+    return CheckedDomain(Path(path), text)
+
+
+def remembered_domain(path: str | Path) -> CheckedDomain:
+    """A ``domain.pddl`` whose checks passed before with this exact content (the caller
+    knows it from :mod:`planners.cache`): read, not checked again."""
+    return CheckedDomain(Path(path), _read(path))
+
+
+def parse_domain(text: str, file: str | Path = "<domain>") -> up.model.Problem:
+    """UP's domain-only model of ``text``; raise :class:`PddlError` naming ``file`` and the line."""
+    import pyparsing
+    import unified_planning as up
+    from unified_planning.io import PDDLReader
+
     try:
         with _lenient_names():
-            model = PDDLReader().parse_problem_string(text)
+            return PDDLReader().parse_problem_string(text)
     except (pyparsing.ParseBaseException, SyntaxError, up.exceptions.UPException, KeyError, ValueError) as exc:
-        raise _located(path, exc) from None
-    return CheckedDomain(Path(path), text, model)
+        raise _located(file, exc) from None
 
 
 def load_problem_text(
     domain: CheckedDomain, problem_text: str, problem_file: str | Path = "<problem>"
 ) -> up.model.Problem:
     """Parse a problem against a checked domain; check its goal and problem kind."""
+    import pyparsing
+    import unified_planning as up
+    from unified_planning.io import PDDLReader
+
     try:
         with _lenient_names():
             problem = PDDLReader().parse_problem_string(domain.text, problem_text)

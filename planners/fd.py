@@ -7,7 +7,7 @@ C++ search binary shipped with ``up_fast_downward`` is started, which brings a s
 problem down to a few tens of milliseconds.
 
 The translator keeps its options in a module global (``options.options``) and prints
-to ``sys.stdout``, so every call holds :data:`_TRANSLATE_LOCK` while it runs.
+to ``sys.stdout``, so every call holds :data:`TRANSLATE_LOCK` while it runs.
 
 This module works on PDDL *text*: :func:`run_fast_downward` takes a domain and a
 problem and returns an :class:`FDOutcome` with the plan as tuples of strings, exactly
@@ -49,7 +49,7 @@ AXIOM_SEARCH = "astar(blind())"
 
 UNSUPPORTED_FEATURE = 34
 
-_TRANSLATE_LOCK = threading.Lock()
+TRANSLATE_LOCK = threading.Lock()
 
 
 class FDExit(StrEnum):
@@ -120,7 +120,7 @@ def _translate(domain_file: str, problem_file: str, sas_file: str) -> tuple[int,
     from fast_downward.translate import options as translate_options
 
     out = io.StringIO()
-    with _TRANSLATE_LOCK, contextlib.redirect_stdout(out):
+    with TRANSLATE_LOCK, contextlib.redirect_stdout(out):
         translate_options.set_options([domain_file, problem_file, "--sas-file", sas_file])
         try:
             translate_main.main()

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from planners import cache
-from planners.checks import DefinitionError, load_domain, load_problem_text
+from planners.checks import DefinitionError, load_domain, load_problem_text, remembered_domain
 from planners.pddl_task import PddlTaskType
 from planners.problem import DomainModel
 from planners.results import PlanStatus
@@ -184,16 +184,19 @@ def load_task(folder: str | Path, *, use_cache: bool = True) -> PddlTaskType:
     (``tasker check`` does, so that it reports what the planner says today)."""
     folder = Path(folder)
     spec = read_task_toml(folder / "task.toml")
-    dm = DomainModel(load_domain(spec.domain_file))
+    # what the checks read: task.toml, the domain and task.py (not, e.g., a problem.pddl lying beside them)
+    key = cache.content_key("task-folder", cache.file_parts([folder / "task.toml", spec.domain_file,
+                                                              folder / "task.py"]))
+    remembered = use_cache and cache.passed("task-folder", key)
+    # a remembered folder skips unified-planning's reading of the domain (and its import, ~1 s);
+    # the DomainModel is read the same way either way (planners.schema), so answers do not depend on it
+    dm = DomainModel(remembered_domain(spec.domain_file) if remembered else load_domain(spec.domain_file))
     _cross_check(spec, dm)
     _check_suspension(spec, dm)
     bindings = _check_meaning(spec, dm)
     task = PddlTaskType(spec, dm, hooks=_load_hooks(spec))
     task.meaning = meaning_of(spec, bindings)
-    # what the checks read: task.toml, the domain and task.py (not, e.g., a problem.pddl lying beside them)
-    key = cache.content_key("task-folder", cache.file_parts([folder / "task.toml", spec.domain_file,
-                                                              folder / "task.py"]))
-    if not (use_cache and cache.passed("task-folder", key)):
+    if not remembered:
         _check_example(task)
         cache.record("task-folder", key, {"folder": str(folder.resolve()), "name": spec.name})
     return task

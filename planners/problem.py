@@ -1,7 +1,8 @@
 """From a world state to a PDDL problem, and from a plan step back to its grounded effects.
 
-:class:`DomainModel` reads what task types need from UP's model of a checked domain
-(predicates and their types, each action's parameters, effects and constant cost).
+:class:`DomainModel` holds what task types need of a checked domain (predicates and
+their types, each action's parameters, effects and constant cost), read by
+:mod:`planners.schema`.
 :func:`render_problem` writes a standard PDDL problem: the world's objects whose type
 the domain knows, the facts over them, travel times between places, and the goal.
 """
@@ -14,9 +15,8 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-import unified_planning as up
-
 from planners.checks import CheckedDomain, PddlError
+from planners.schema import SchemaError, read_schema
 from tasker.world import Fact, MotionModel, Pose, WorldState
 
 PLACE_TYPE = "place"
@@ -26,63 +26,24 @@ UNREACHABLE_COST = 1_000_000
 """``travel-time`` written for a pair that is not connected (it can never be used)."""
 
 
-@dataclass(frozen=True, slots=True)
-class EffectTemplate:
-    """One unconditional Boolean effect of an action: ``(fluent, args, positive)``.
+class DomainModel:
+    """Read-only view of a checked domain, built once when a task folder is loaded.
 
-    ``args`` holds parameter names prefixed with ``?`` or object names.
+    Its contents come from :func:`planners.schema.read_schema` (Fast Downward's parser),
+    so building one imports neither unified-planning nor pyparsing.
     """
 
-    fluent: str
-    args: tuple[str, ...]
-    positive: bool
-
-
-@dataclass(frozen=True, slots=True)
-class ActionModel:
-    """What a task type needs of one PDDL action."""
-
-    name: str
-    params: tuple[str, ...]
-    effects: tuple[EffectTemplate, ...]
-    constant_cost: float | None
-
-
-class DomainModel:
-    """Read-only view of a checked domain, built once when a task folder is loaded."""
-
     def __init__(self, domain: CheckedDomain) -> None:
-        m = domain.model
+        try:
+            schema = read_schema(domain.text)
+        except SchemaError as exc:
+            raise PddlError(domain.path, f"Fast Downward's parser refuses the domain: {exc}") from None
         self.checked = domain
-        self.name = m.name
-        self.types: dict[str, set[str]] = {}
-        for t in m.user_types:
-            chain, cur = set(), t
-            while cur is not None:
-                chain.add(cur.name)
-                cur = cur.father
-            self.types[t.name] = chain
-        self.predicates: dict[str, tuple[str, ...]] = {
-            f.name: tuple(p.type.name if p.type.is_user_type() else "" for p in f.signature)
-            for f in m.fluents if f.type.is_bool_type()
-        }
-        self.functions = {f.name for f in m.fluents if not f.type.is_bool_type()}
-        self.actions = {a.name: self._action(a) for a in m.actions}
-
-    @staticmethod
-    def _action(a: up.model.InstantaneousAction) -> ActionModel:
-        def ref(e: up.model.FNode) -> str:
-            return f"?{e.parameter().name}" if e.is_parameter_exp() else e.object().name
-
-        effects, cost = [], None
-        for e in a.effects:
-            if e.is_increase() and e.fluent.fluent().name == "total-cost":
-                cost = float(e.value.constant_value()) if e.value.is_constant() else None
-            elif not (e.is_conditional() or e.is_forall() or e.is_increase() or e.is_decrease()) \
-                    and e.value.is_bool_constant():
-                args = tuple(ref(x) for x in e.fluent.args)
-                effects.append(EffectTemplate(e.fluent.fluent().name, args, e.value.bool_constant_value()))
-        return ActionModel(a.name, tuple(p.name for p in a.parameters), tuple(effects), cost)
+        self.name = schema.name
+        self.types: dict[str, set[str]] = {name: set(chain) for name, chain in schema.types}
+        self.predicates: dict[str, tuple[str, ...]] = dict(schema.predicates)
+        self.functions = set(schema.functions)
+        self.actions = {a.name: a for a in schema.actions}
 
     def has_type(self, obj_type: str, wanted: str) -> bool:
         return wanted == "" or wanted in self.types.get(obj_type, ())
