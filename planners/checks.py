@@ -16,6 +16,7 @@ module: its exceptions are raised by code (task loading from remembered checks,
 from __future__ import annotations
 
 import contextlib
+import io
 import re
 import threading
 import warnings
@@ -128,8 +129,27 @@ def declared_requirements(domain_text: str, file: str | Path = "<domain>") -> tu
     return tuple(str(f) for f in res.get("features", []) if str(f) != ":requirements")
 
 
+def _supported_at_a_glance(domain_text: str) -> bool:
+    """Whether Fast Downward's s-expression reader (a few ms, no grammar) finds the domain's
+    ``:requirements`` all supported.  When it does, unified-planning's grammar would read them
+    the same way, and any syntax error elsewhere is reported by :func:`parse_domain`, which
+    reads the whole text with that grammar next; otherwise the grammar decides (and words it)."""
+    from fast_downward.translate.pddl_parser import lisp_parser
+    from fast_downward.translate.pddl_parser.parse_error import ParseError
+
+    try:
+        nested = lisp_parser.parse_nested_list(io.StringIO(domain_text))
+    except (ParseError, StopIteration):  # StopIteration: no token at all
+        return False
+    blocks = [b for b in nested if isinstance(b, list) and b and b[0] == ":requirements"]
+    return len(blocks) <= 1 and all(len(b) > 1 for b in blocks) and all(
+        isinstance(r, str) and r in SUPPORTED_REQUIREMENTS for b in blocks for r in b[1:])
+
+
 def check_requirements(domain_text: str, file: str | Path) -> None:
     """Refuse a domain that declares a requirement Fast Downward cannot handle."""
+    if _supported_at_a_glance(domain_text):
+        return
     bad = [r for r in declared_requirements(domain_text, file) if r not in SUPPORTED_REQUIREMENTS]
     if bad:
         line = next((i for i, s in enumerate(domain_text.splitlines(), 1) if bad[0] in s.lower()), None)

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from experiments.cli import main
-from planners.checks import DefinitionError, PddlError, load_problem
+from planners.checks import SUPPORTED_REQUIREMENTS, DefinitionError, PddlError, load_problem
 from tests.planners.conftest import DOMAIN, problem_text
 
 Mutation = Callable[[str, str], tuple[str, str]]
@@ -82,3 +82,20 @@ def test_missing_file(tmp_path: Path, pddl_files: tuple[Path, Path]) -> None:
 def test_error_format() -> None:
     err = PddlError("x.pddl", "bad", 3, 7)
     assert str(err) == "x.pddl:3:7: bad" and err.line == 3 and err.col == 7
+
+
+@pytest.mark.parametrize("requirements", [
+    ":strips :typing :action-costs", ":adl", ":strips :durative-actions", ":fluents", "", ":strips :bogus",
+    ":strips) (:requirements :typing",
+])
+def test_requirements_at_a_glance_agree_with_the_grammar(requirements: str) -> None:
+    """The quick s-expression look at ``:requirements`` never passes what the grammar refuses."""
+    from planners.checks import _supported_at_a_glance, declared_requirements
+
+    text = DOMAIN.replace(":strips :typing :action-costs", requirements)
+    try:
+        grammar_ok = all(r in SUPPORTED_REQUIREMENTS for r in declared_requirements(text))
+    except PddlError:
+        grammar_ok = False
+    if _supported_at_a_glance(text):
+        assert grammar_ok
