@@ -120,3 +120,16 @@ def test_remembered_task_folders_load_without_unified_planning(tmp_path: Path) -
                            check=True).stdout.strip().splitlines()[-1] for _ in range(2)]
     assert runs[0] == "['ConfigSpace', 'pyparsing', 'unified_planning']"
     assert runs[1] == "[]"
+
+
+def test_a_domain_fast_downward_refuses_is_a_definition_error(tmp_path: Path) -> None:
+    """unified-planning reads fractional action costs; Fast Downward, which would plan with the
+    domain, does not: loading says so, naming the file, instead of failing at the first plan."""
+    from planners.checks import PddlError, load_domain
+    from planners.problem import DomainModel
+
+    path = tmp_path / "domain.pddl"
+    path.write_text(DOMAIN.replace("(increase (total-cost) 1)))\n  (:action drop", "(increase (total-cost) 1.5)))\n"
+                                   "  (:action drop"))
+    with pytest.raises(PddlError, match=r"domain\.pddl: Fast Downward's parser refuses the domain: .*[Ff]ractional"):
+        DomainModel(load_domain(path))
