@@ -240,6 +240,8 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
         ("switches (ours)", "switches", lambda r: r["switches"]),
         ("abandonments (robot leaves a fallen person's 2 m circle)", "abandonments", lambda r: r.get("abandonments")),
         ("falls abandoned at least once", "abandoned", lambda r: r.get("abandoned_falls")),
+        ("abandonments for another task (ours: not while driving to the person)", "abandon_other",
+         lambda r: r.get("abandonments_other_task")),
         ("travel distance (m)", "travel", lambda r: r.get("travel_m")),
         ("longest queue ordered (lookahead)", "longest", lambda r: r["longest_order"] or None),
         ("decisions not proven optimal (lookahead)", "anytime", lambda r: r["anytime_decisions"] if r["longest_order"]

@@ -12,6 +12,13 @@ is still fallen, each time the robot, having been within ``RADIUS_M`` of the per
 is next seen farther away counts as one abandonment.  Passing by on another task and
 going on counts too: the robot was there and left the person lying.
 
+**Abandonment for another task** (ours, beside TaBSA's): the same count, less the times
+the robot left the circle while the fall's own agent was the executing one (``exeDA`` of
+the trace's ``roles`` events).  TaBSA's circle ignores walls: a robot 1.9 m from a person
+lying behind a wall must leave the circle to drive round to them, which TaBSA's count
+calls abandonment; this one does not.  The robot leaving because another task took it
+still counts.
+
 **Travel distance**: the length of the robot's sampled path (x, y), in metres.
 """
 
@@ -45,16 +52,21 @@ def travel_m(samples: Sequence[_Sample]) -> float:
 
 
 def abandonments(events: Iterable[Mapping[str, Any]], samples: Sequence[_Sample], *,
-                 radius: float = RADIUS_M) -> dict[str, int]:
-    """Per agent whose request is about a fallen person: how many times the robot left them (see above)."""
+                 radius: float = RADIUS_M, for_another_task: bool = False) -> dict[str, int]:
+    """Per agent whose request is about a fallen person: how many times the robot left them
+    (see above); with ``for_another_task``, only while another agent was ``exeDA``."""
     requests: list[tuple[str, float, list[str]]] = []
     ended: dict[str, float] = {}
+    roles: list[tuple[float, str | None]] = []  # (t, exeDA) as the trace's roles events set it
     for e in events:
         if e["event"] == "request":
             names = [v for v in e["args"].values() if isinstance(v, str)]
             requests.append((e["agent"], float(e["t"]), names))
         elif e["event"] == "end":
             ended.setdefault(e["agent"], float(e["t"]))
+        elif e["event"] == "roles":
+            roles.append((float(e["t"]), e.get("exeDA")))
+    role_times = [t for t, _ in roles]
     out: dict[str, int] = {}
     times = [s.t for s in samples]
     for agent, t0, names in requests:
@@ -75,11 +87,19 @@ def abandonments(events: Iterable[Mapping[str, Any]], samples: Sequence[_Sample]
             if p.posture != FALLEN:
                 break
             near = math.hypot(s.robot[0] - p.x, s.robot[1] - p.y) <= radius
-            if inside and not near:
+            if inside and not near and not (for_another_task and _executing(roles, role_times, s.t) == agent):
                 left += 1
             inside = near
         out[agent] = left
     return out
+
+
+def _executing(roles: Sequence[tuple[float, str | None]], times: Sequence[float], t: float) -> str | None:
+    """``exeDA`` at time ``t``: the last ``roles`` event at or before it."""
+    import bisect
+
+    k = bisect.bisect_right(times, t) - 1
+    return roles[k][1] if k >= 0 else None
 
 
 def _first_at(times: Sequence[float], t: float) -> int | None:
@@ -90,7 +110,10 @@ def _first_at(times: Sequence[float], t: float) -> int | None:
 
 
 def path_metrics(events: Iterable[Mapping[str, Any]], samples: Sequence[_Sample]) -> dict[str, Any]:
-    """``abandonments`` (total), ``abandoned_falls`` (falls left at least once), ``travel_m``."""
+    """``abandonments`` (total, TaBSA's), ``abandoned_falls`` (falls left at least once),
+    ``abandonments_other_task`` (left while another task ran), ``travel_m``."""
+    events = list(events)
     per = abandonments(events, samples)
+    other = abandonments(events, samples, for_another_task=True)
     return {"abandonments": sum(per.values()), "abandoned_falls": sum(1 for v in per.values() if v),
-            "travel_m": round(travel_m(samples), 3)}
+            "abandonments_other_task": sum(other.values()), "travel_m": round(travel_m(samples), 3)}

@@ -202,6 +202,9 @@ def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str
     world_file = path.parent / world
     if not world_file.is_file():
         raise t.error("world", f"no world file {world_file} (a .toml file relative to the protocol)")
+    from robot.spec import load_world  # the world's TOML only (no MuJoCo): its places and rooms
+
+    spec = load_world(world_file)
     lead = t.number("lead_s", 120.0, positive=True)
     exe_rate = t.number("task_exe_rate", 10.0, positive=True)
     sites_t = t.table("sites")
@@ -211,10 +214,16 @@ def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str
         check_name(sites_t, name, name, sorted(sites), "site of [apartment.sites]")
         st = sites_t.table(name)
         places[name] = st.string("place")
+        check_name(st, "place", places[name], spec.places, "place",
+                   f"a site's place is a place of the world file {world}")
         raw = st.raw("spots")
         if not isinstance(raw, list) or not raw:
             raise st.error("spots", f"expected a list of [x, y] where the site's people stand, got {raw!r}")
         spots[name] = tuple(_pose(st, "spots", v) for v in raw)
+        for i, xy in enumerate(spots[name]):
+            why = _not_standable(spec, xy)
+            if why:
+                raise st.error("spots", f"spot {i + 1} {list(xy)} is {why}: a person cannot stand there")
         st.done()
     missing = sorted(set(sites) - set(places))
     if missing:
@@ -247,6 +256,19 @@ def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str
     t.done()
     return RobotBackend(world=str(world_file.resolve()), places=places, spots=spots, tasks=out, lead_s=lead,
                         task_exe_rate=exe_rate)
+
+
+def _not_standable(spec: Any, xy: Pose) -> str:
+    """Why no person can stand at ``xy`` in world ``spec`` (empty if one can): outside every
+    room, or inside a wall, a piece of furniture or a door leaf."""
+    x, y = xy[0], xy[1]
+    if not any(r[0] <= x <= r[2] and r[1] <= y <= r[3] for r in spec.rooms.values()):
+        return f"in no room of world {spec.name!r} (rooms: {', '.join(sorted(spec.rooms))})"
+    for o in spec.obstacles:
+        b = o.box
+        if b[0] <= x <= b[2] and b[1] <= y <= b[3]:
+            return f"inside {o.kind} {o.name!r}"
+    return ""
 
 
 def _suggest(value: str) -> str:

@@ -226,6 +226,7 @@ class Scene:
         self.door_boxes: dict[str, Box] = {n: d.box for n, d in spec.doors.items()}
         self.door_open: dict[str, bool] = {n: d.open for n, d in spec.doors.items()}
         self.people: dict[str, Disc] = {}
+        self.making_way: set[str] = set()  # people who follow the robot: never in its way
         self.version = 0
         self._closed = np.zeros((0, 4))
         self._refresh_doors()
@@ -251,6 +252,14 @@ class Scene:
         if self.people.pop(name, None) is not None:
             self.version += 1
 
+    def set_making_way(self, name: str, yes: bool) -> None:
+        """Person ``name`` follows the robot (``yes``) or no longer does.  Someone who follows
+        walks the robot's trail and steps aside for it, as a guided person does, so they are
+        no obstacle to anything the robot plans or drives: :meth:`discs` leaves them out."""
+        if (name in self.making_way) != yes:
+            (self.making_way.add if yes else self.making_way.discard)(name)
+            self.version += 1
+
     def closed_doors(self) -> np.ndarray:
         return self._closed
 
@@ -262,7 +271,8 @@ class Scene:
         return None
 
     def discs(self, ignore: tuple[str, ...] = ()) -> list[Disc]:
-        return [d for n, d in sorted(self.people.items()) if n not in ignore]
+        """The people in the robot's way (less ``ignore``): all but those making way for it."""
+        return [d for n, d in sorted(self.people.items()) if n not in ignore and n not in self.making_way]
 
     # ---- queries ---------------------------------------------------------------------
     def in_bounds(self, x: float, y: float) -> bool:

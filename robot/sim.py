@@ -259,6 +259,7 @@ class Simulation:
             (self.held.add if value else self.held.discard)(obj)
         elif b.kind == "follower":
             self.people[obj].following = value
+            self.scene.set_making_way(obj, value)
         else:
             person = self.people[obj]
             person.waiting = value

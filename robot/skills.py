@@ -208,15 +208,13 @@ class Navigate(Skill):
         if len(ahead) < 2:
             return False
         # people by the planner's own rule (Scene.people_clear): what it plans, this accepts.
-        # Whoever follows the robot was planned around but is not checked against: they walk
-        # its trail, up to it, and would otherwise make it re-plan at each of their steps.
-        followers = tuple(p.name for p in self.sim.people if p.following)
+        # Whoever follows the robot is in neither (Scene.making_way): they walk its trail.
         scene = self.sim.scene
         pts = np.asarray(ahead)
         if len(scene.closed_doors()) and not scene.segments_free(pts[:-1], pts[1:], static=False,
                                                                  ignore=tuple(scene.people)).all():
             return True  # a door closed across the way
-        return not scene.path_clear(ahead, slack=TRACKING_SLACK, ignore=followers)
+        return not scene.path_clear(ahead, slack=TRACKING_SLACK)
 
     def control(self, now: float, dt: float) -> Command:
         f = self.follower

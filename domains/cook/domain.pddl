@@ -1,11 +1,16 @@
 ; cook: put a pan on the cooker, cook, turn the cooker off and put the hot pan down.
+; A door found closed on the way is opened with an empty hand (as in carry_object).
 (define (domain cook)
   (:requirements :strips :typing :negative-preconditions :action-costs)
-  (:types locatable place - object
+  (:types locatable place door - object
           robot pan cooker - locatable)
   (:predicates
     (at ?x - locatable ?p - place)
     (connected ?from ?to - place)
+    (free_passage ?from ?to - place)
+    (door_between ?d - door ?from ?to - place)
+    (door_at ?d - door ?p - place)
+    (open ?d - door)
     (holding ?r - robot ?k - pan)
     (hand_empty ?r - robot)
     (on_counter ?k - pan)
@@ -18,7 +23,7 @@
 
   (:action navigate
     :parameters (?r - robot ?from ?to - place)
-    :precondition (and (at ?r ?from) (connected ?from ?to))
+    :precondition (and (at ?r ?from) (connected ?from ?to) (free_passage ?from ?to))
     :effect (and (not (at ?r ?from)) (at ?r ?to)
                  (increase (total-cost) (travel-time ?from ?to))))
 
@@ -60,4 +65,20 @@
     :parameters (?r - robot ?k - pan ?c - cooker ?p - place)
     :precondition (and (at ?r ?p) (at ?c ?p) (on_cooker ?k ?c) (cooker_on ?c) (not (cooked ?k)))
     :effect (and (cooked ?k) (increase (total-cost) 120)))
+
+  (:action navigate_through
+    :parameters (?r - robot ?d - door ?from ?to - place)
+    :precondition (and (at ?r ?from) (connected ?from ?to) (door_between ?d ?from ?to) (open ?d))
+    :effect (and (not (at ?r ?from)) (at ?r ?to)
+                 (increase (total-cost) (travel-time ?from ?to))))
+
+  (:action open_door
+    :parameters (?r - robot ?d - door ?p - place)
+    :precondition (and (at ?r ?p) (door_at ?d ?p) (hand_empty ?r) (not (open ?d)))
+    :effect (and (open ?d) (increase (total-cost) 6)))
+
+  (:action close_door
+    :parameters (?r - robot ?d - door ?p - place)
+    :precondition (and (at ?r ?p) (door_at ?d ?p) (hand_empty ?r) (open ?d))
+    :effect (and (not (open ?d)) (increase (total-cost) 6)))
 )

@@ -36,7 +36,9 @@ class LongestFirst(Scheduler):
     def key(self, c: Candidate) -> tuple[float, float, int]:
         return (-priority(self, c), -self.cost_params(c, self.name).c_time, c.order)
 
-    def select_key(self, c: Candidate) -> tuple[float, float, int]:
+    def queue_key(self, c: Candidate) -> tuple[float, float, int]:
+        """This scheduler's own ranking (not request order): the tasks it runs first are the
+        ones a suspended task waits for (the ``expected_s`` of ``susp``)."""
         return self.key(c)
 
     def better(self, dac: float, exe: float) -> bool:

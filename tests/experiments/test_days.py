@@ -6,11 +6,13 @@ fast; the shipped protocols' days are run by ``python -m experiments.dayreport``
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import pytest
 
 from experiments import dayreport, days, protocol
+from robot.estimator import motion_model
 from tasker import schedulers
 from tasker.errors import ConfigError
 
@@ -111,3 +113,43 @@ def test_every_spot_and_place_of_the_robot_world_is_clear(name: str) -> None:
     assert all(clearance(*s) >= 0.3 for spots in proto.robot.spots.values() for s in spots)
     assert all(clearance(p[0], p[1]) >= 0.4 for p in world.places.values())
     assert set(proto.robot.places.values()) <= set(world.places)
+
+
+def _unreachable(motion, places, spec) -> list[tuple[str, str]]:  # type: ignore[no-untyped-def]
+    return [(a, b) for a, b in itertools.permutations(places, 2)
+            if not motion.estimate(spec.places[a], spec.places[b]).reachable]
+
+
+@pytest.mark.parametrize("name", ["tabsa", "tabsa-short"])
+def test_no_spot_walls_the_robot_in(name: str) -> None:
+    """Where the day's people stand must not wall the robot in: they hold their site's spots
+    for minutes and may fall there, so with one person at any spot (standing, or fallen, the
+    widest posture), and with every spot held by a standing person at once, every place the
+    robot can reach in the empty apartment stays reachable from every other.  (Seed 5 of
+    the full day stranded the robot: the hall's spots lay on the 2 m hall's centre line.)"""
+    from robot.spec import load_world
+
+    backend = days.load(name).robot
+    assert backend is not None
+    spec = load_world(backend.world)
+    motion = motion_model(spec, people=False)
+    scene = motion.planner.scene
+    # places the robot can reach at all (a protocol may ground where idle people wait in
+    # a room it cannot enter)
+    places = [p for p in spec.places
+              if any(motion.estimate(spec.places[p], spec.places[q]).reachable for q in spec.places if q != p)]
+    assert len(places) >= 2 and not _unreachable(motion, places, spec)
+    spots = [(site, k, xy) for site, xys in backend.spots.items() for k, xy in enumerate(xys)]
+    walls = []
+    for (site, k, xy), posture in itertools.product(spots, ("standing", "fallen")):
+        scene.set_person("someone", xy[0], xy[1], posture)
+        cut = _unreachable(motion, places, spec)
+        scene.remove_person("someone")
+        if cut:
+            walls.append(f"{site} spot {k} {xy} ({posture}) cuts {cut[:3]}")
+    for i, (_, _, xy) in enumerate(spots):
+        scene.set_person(f"p{i}", xy[0], xy[1], "standing")
+    cut = _unreachable(motion, places, spec)
+    if cut:
+        walls.append(f"every spot held by a standing person cuts {cut[:3]}")
+    assert not walls, "\n".join(walls)

@@ -33,7 +33,8 @@ def test_travel_is_the_length_of_the_sampled_path() -> None:
 def test_leaving_the_circle_before_helping_is_an_abandonment() -> None:
     # from the request (t=1): 3 out, 1.5 in, 1 in, 2.5 OUT (1), 1 in, 1, 1; t=8 (3 m) is after the end at 7.5
     assert abandonments(EVENTS, samples()) == {"d1": 1}
-    assert path_metrics(EVENTS, samples()) == {"abandonments": 1, "abandoned_falls": 1, "travel_m": 9.0}
+    assert path_metrics(EVENTS, samples()) == {"abandonments": 1, "abandoned_falls": 1,
+                                               "abandonments_other_task": 1, "travel_m": 9.0}
 
 
 def test_leaving_after_helping_is_not() -> None:
@@ -50,3 +51,19 @@ def test_a_smaller_circle_changes_the_count() -> None:
     assert abandonments(EVENTS, samples(), radius=1.2) == {"d1": 1}
     # radius 0.9: the robot is never inside, so it never leaves
     assert abandonments(EVENTS, samples(), radius=0.9) == {"d1": 0}
+
+
+def _roles(*changes: tuple[float, str | None]) -> list[dict[str, object]]:
+    return [{"t": t, "event": "roles", "exeDA": a, "irrDA": None, "idleDA": []} for t, a in changes]
+
+
+def test_leaving_while_driving_to_the_person_is_not_for_another_task() -> None:
+    # the robot leaves the circle at t=4; who executes then decides
+    theirs = sorted(EVENTS + _roles((1.0, "d1")), key=lambda e: e["t"])
+    assert abandonments(theirs, samples()) == {"d1": 1}  # TaBSA's count: walls and all
+    assert abandonments(theirs, samples(), for_another_task=True) == {"d1": 0}
+    assert path_metrics(theirs, samples())["abandonments_other_task"] == 0
+    other = sorted(EVENTS + _roles((1.0, "d1"), (3.5, "d2"), (5.0, "d1")), key=lambda e: e["t"])
+    assert abandonments(other, samples(), for_another_task=True) == {"d1": 1}  # escort took the robot at 3.5
+    back = sorted(EVENTS + _roles((1.0, "d2"), (4.0, "d1")), key=lambda e: e["t"])
+    assert abandonments(back, samples(), for_another_task=True) == {"d1": 0}  # d1 executing from t=4 on

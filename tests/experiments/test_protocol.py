@@ -72,6 +72,29 @@ def test_bad_protocols_name_file_line_and_field(tmp_path: Path) -> None:
         protocol.load(write(tmp_path, text.replace("planning_time_s =", "planing_time_s =")))
 
 
+
+def test_a_robot_backend_names_its_world_and_its_spots_stand_in_it(tmp_path: Path) -> None:
+    """Sites' places are the world's, and each spot lies in a room, clear of walls and furniture."""
+    text = TABSA.read_text(encoding="utf-8")
+    world = 'world = "tabsa_apartment.toml"'
+    assert world in text
+    text = text.replace(world, f'world = "{(TABSA.parent / "tabsa_apartment.toml").as_posix()}"')
+    protocol.load(write(tmp_path, text))
+    hall = next(line for line in text.splitlines() if line.startswith("hall = { place"))
+    cases = [
+        (hall.replace('place = "hall"', 'place = "hal"'),
+         r"robot_backend\.sites\.hall\.place: no place 'hal'; did you mean 'hall'"),
+        (hall.replace("spots = [[", "spots = [[60.0, 4.0], ["),
+         r"robot_backend\.sites\.hall\.spots: spot 1 \[60\.0, 4\.0\] is in no room"),
+        (hall.replace("spots = [[", "spots = [[5.0, 4.0], ["),
+         r"robot_backend\.sites\.hall\.spots: spot 1 \[5\.0, 4\.0\] is inside wall"),
+    ]
+    for bad, message in cases:
+        with pytest.raises(InputError, match=r"p\.toml:\d+: " + message):
+            protocol.load(write(tmp_path, text.replace(hall, bad)))
+    with pytest.raises(InputError, match=r"robot_backend\.world: no world file"):
+        protocol.load(write(tmp_path, text.replace((TABSA.parent / "tabsa_apartment.toml").as_posix(), "nope.toml")))
+
 # -- metrics on a hand-made day -----------------------------------------------------------------------
 
 def ev(t: float, event: str, **f: object) -> dict[str, object]:

@@ -197,3 +197,21 @@ def test_an_unknown_target_fails_at_once(paper) -> None:
     sim.begin("d1", stage, 0.0)
     status = sim.poll("d1", stage, 0.1)
     assert status.state is SkillState.FAILED and "unknown navigation target 'nowhere'" in status.reason
+
+
+def test_a_person_who_follows_the_robot_never_blocks_its_way(paper) -> None:
+    """The person being guided stands in the bathroom doorway, between the robot and the way
+    out (paper variant 14, household seed 5): while they are just standing there the robot
+    cannot leave the bathroom; once they follow it (the guide's `follower` binding), they
+    make way, so the planner and the skill's check of the path ahead both let it through."""
+    motion = motion_model(paper, people=False)
+    scene = motion.planner.scene
+    scene.set_person("alice", 7.0, 2.0, "standing")  # the hall/bathroom doorway's middle
+    start, goal = paper.places["bathroom"], paper.places["hall"]
+    assert not motion.estimate(start, goal).reachable
+    scene.set_making_way("alice", True)
+    est = motion.estimate(start, goal)
+    assert est.reachable
+    assert scene.path_clear(list(est.path))
+    scene.set_making_way("alice", False)  # told to stop following: in the way again
+    assert not motion.estimate(start, goal).reachable

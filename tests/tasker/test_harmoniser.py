@@ -263,6 +263,23 @@ def test_expected_interruption_counts_the_queue_ahead_of_the_suspended_task() ->
     assert first(tr.events, event="command", agent="d3", flag="start")["predicted_s"] == pytest.approx(2.0)
 
 
+@pytest.mark.parametrize(("scheduler", "other", "ahead"), [("simple", 30.0, 30.0), ("simple2", 5.0, 5.0),
+                                                          ("simple", 5.0, 0.0), ("simple2", 30.0, 0.0)])
+def test_the_expected_interruption_follows_the_schedulers_own_ranking(scheduler: str, other: float,
+                                                                      ahead: float) -> None:
+    """simple ranks longest first, simple2 shortest first: a task requested after the executing
+    one but ranked ahead of it by the scheduler runs before it resumes (request order is not
+    their queue)."""
+    tasks = [guide("guide"), SyntheticTask("other", [st("s", other)]), SyntheticTask("fell", [st("check", 2)])]
+    loop = make_loop(tasks, scheduler=scheduler, hesitance=10.0)  # hesitance: d2 never preempts d1
+    loop.request(0.0, "guide")  # d1: 19 s of stages
+    loop.request(1.0, "other")  # d2: waits, ranked ahead of d1 or behind it
+    loop.request(3.0, "fell", {"priority": 3})  # d3: a higher priority preempts d1
+    tr = loop.run()
+    susp = first(tr.events, event="command", agent="d1", flag="susp")
+    assert susp["by"] == "d3" and susp["expected_s"] == pytest.approx(2.0 + ahead)
+
+
 def test_a_choice_with_no_executing_agent_leaves_a_decision() -> None:
     loop = make_loop([guide("a"), guide("b")], scheduler="fifo")
     loop.request(0.0, "a")
