@@ -7,9 +7,11 @@ the right arity, static templates name real actions with the right arity), and, 
 the folder ships an ``[example]`` world, that the problem built from it is valid PDDL
 and that Fast Downward solves it.
 
-The example check (a UP parse of the problem and a planner call) is the costly part;
-once it passed for a folder's exact content it is recorded in the check cache
-(:mod:`planners.cache`) and not repeated in later processes.
+The checks with unified-planning (reading the domain, parsing the example problem) and the
+planner call are the costly part; once they passed for a folder's exact content it is
+recorded in the check cache (:mod:`planners.cache`) and later processes skip them — without
+importing unified-planning at all: the :class:`~planners.problem.DomainModel` is always read
+by Fast Downward's parser (:mod:`planners.schema`), checked or remembered.
 """
 
 from __future__ import annotations
