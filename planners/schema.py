@@ -91,6 +91,8 @@ def _read(text: str) -> DomainSchema:
              _axioms) = parsing_functions.parse_domain_pddl(parsing_functions.Context(), nested)
         except (ParseError, SystemExit) as exc:  # the translator reports bad input both ways
             raise SchemaError(" ".join(str(exc).split())) from None
+        except Exception as exc:  # noqa: BLE001 - e.g. an assertion on an effect it cannot represent
+            raise SchemaError(f"{type(exc).__name__}: {' '.join(str(exc).split())}") from None
 
     # as unified-planning reads PDDL: ``object`` is a user type (the root of all others) only
     # when something is untyped or typed ``object``; otherwise it is no type of the domain
