@@ -118,7 +118,7 @@ def test_remembered_task_folders_load_without_unified_planning(tmp_path: Path) -
     env = {"TASKER_CACHE": str(tmp_path), "PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"}
     runs = [subprocess.run([sys.executable, "-c", _LOAD], capture_output=True, text=True, env=env, cwd=ROOT,
                            check=True).stdout.strip().splitlines()[-1] for _ in range(2)]
-    assert runs[0] == "['ConfigSpace', 'pyparsing', 'unified_planning']"
+    assert "'unified_planning'" in runs[0]  # the first load checks with unified-planning
     assert runs[1] == "[]"
 
 
