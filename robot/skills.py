@@ -59,7 +59,12 @@ class SkillHost(Protocol):
 
     def doors_closed_by(self, stage: Stage) -> tuple[str, ...]: ...
 
-BLOCK_TIMEOUT = 5.0  # seconds a blocked path is retried before the skill fails
+# Seconds a blocked path is retried before the skill fails.  People block a way while they
+# pass: a person walking through a doorway towards the robot holds it for the length of
+# both clearances and the leaf (2 x (0.25 + 0.35) + 0.1 = 1.3 m), 6.5 s at the protocols'
+# slowest escort pace (0.2 m/s) and about 12 s at the 0.11 m/s a day's person was seen
+# walking to their site.  30 s outlasts that, and fails a way held for good soon enough.
+BLOCK_TIMEOUT = 30.0
 STALL_TIMEOUT = 2 * BLOCK_TIMEOUT  # seconds without moving STALL_MOVE metres before the skill gives up
 STALL_MOVE = 0.1
 CHECK_PERIOD = 0.2  # seconds between checks of the path ahead
