@@ -259,16 +259,13 @@ def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str
 
 
 def _not_standable(spec: Any, xy: Pose) -> str:
-    """Why no person can stand at ``xy`` in world ``spec`` (empty if one can): outside every
-    room, or inside a wall, a piece of furniture or a door leaf."""
-    x, y = xy[0], xy[1]
-    if not any(r[0] <= x <= r[2] and r[1] <= y <= r[3] for r in spec.rooms.values()):
+    """Why no person can stand at ``xy`` in world ``spec`` (empty if one can): in no room, or
+    outside the world's free space (:func:`robot.spec.point_problem`)."""
+    from robot.spec import point_problem, room_of
+
+    if room_of(spec, xy[0], xy[1]) is None:
         return f"in no room of world {spec.name!r} (rooms: {', '.join(sorted(spec.rooms))})"
-    for o in spec.obstacles:
-        b = o.box
-        if b[0] <= x <= b[2] and b[1] <= y <= b[3]:
-            return f"inside {o.kind} {o.name!r}"
-    return ""
+    return point_problem(spec, xy[0], xy[1]) or ""
 
 
 def _suggest(value: str) -> str:
