@@ -24,6 +24,7 @@ still counts.
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any, Protocol
@@ -96,15 +97,11 @@ def abandonments(events: Iterable[Mapping[str, Any]], samples: Sequence[_Sample]
 
 def _executing(roles: Sequence[tuple[float, str | None]], times: Sequence[float], t: float) -> str | None:
     """``exeDA`` at time ``t``: the last ``roles`` event at or before it."""
-    import bisect
-
     k = bisect.bisect_right(times, t) - 1
     return roles[k][1] if k >= 0 else None
 
 
 def _first_at(times: Sequence[float], t: float) -> int | None:
-    import bisect
-
     k = bisect.bisect_left(times, t - 1e-9)
     return k if k < len(times) else None
 
