@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
+from tasker.task import TaskContext
 from tasker.world import Fact, WorldState
 
 DOOR_BETWEEN = "door_between"
@@ -27,3 +28,9 @@ def free_passages(world: WorldState) -> Iterator[Fact]:
         for b in places:
             if a != b and (a, b) not in doors:
                 yield (FREE_PASSAGE, a, b)
+
+
+def extra_facts(ctx: TaskContext, world: WorldState) -> Iterator[Fact]:
+    """The ``extra_facts`` hook of a task folder that needs nothing else: its free passages
+    (a ``task.py`` re-exports it: ``from domains.doors import extra_facts``)."""
+    return free_passages(world)

@@ -5,13 +5,6 @@ static and the planned strategy pursue the same goal."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from domains.doors import extra_facts
 
-from domains.doors import free_passages
-from tasker.task import TaskContext
-from tasker.world import Fact, WorldState
-
-
-def extra_facts(ctx: TaskContext, world: WorldState) -> Iterable[Fact]:
-    """Every ordered pair of places with no door between them is a free passage."""
-    return free_passages(world)
+__all__ = ["extra_facts"]
