@@ -65,7 +65,8 @@ class MotionEstimator:
         return self.planner.closed_doors()
 
     def approach(self, start: Pose, person: str) -> tuple[Pose | None, MotionEstimate]:
-        """The cheapest reachable pose ``APPROACH`` metres from ``person``, facing them.
+        """The cheapest reachable pose ``APPROACH`` metres from ``person``, facing them, with no
+        wall or closed door between them (:meth:`Scene.sees <robot.scene.Scene.sees>`).
 
         Candidates lie in ``APPROACH_DIRECTIONS`` directions around the person; ties go to
         the first direction (east, then counter-clockwise), so the choice is deterministic.
@@ -86,7 +87,9 @@ class MotionEstimator:
         for k in range(APPROACH_DIRECTIONS):
             a = 2 * math.pi * k / APPROACH_DIRECTIONS
             gx, gy = d.x + radius * math.cos(a), d.y + radius * math.sin(a)
-            if scene.free(gx, gy, ignore=(person,)):
+            # a pose the person can be helped from: free, and with no wall between them (a
+            # pose 0.9 m away through a wall is the wrong side of it)
+            if scene.free(gx, gy, ignore=(person,)) and scene.sees((gx, gy), (d.x, d.y)):
                 # the straight-line drive time bounds the travel time from below (the profile
                 # is concave, turns cost >= 0), so candidates are tried nearest first and
                 # the search stops once no farther one can beat the best

@@ -222,6 +222,7 @@ class Scene:
         self.radius = float(radius)
         (self.xmin, self.ymin), (self.xmax, self.ymax) = spec.bounds
         self.static = np.array([o.box for o in spec.obstacles], dtype=float).reshape(-1, 4)
+        self.walls = np.array([o.box for o in spec.obstacles if o.kind == "wall"], dtype=float).reshape(-1, 4)
         self._static_list: list[Box] = [o.box for o in spec.obstacles]
         self.door_boxes: dict[str, Box] = {n: d.box for n, d in spec.doors.items()}
         self.door_open: dict[str, bool] = {n: d.open for n, d in spec.doors.items()}
@@ -290,6 +291,14 @@ class Scene:
             if dx * dx + dy * dy < r2:
                 return False
         return True
+
+    def sees(self, a: tuple[float, float], b: tuple[float, float]) -> bool:
+        """Is there a line from ``a`` to ``b`` that crosses no wall and no closed door?  (Furniture
+        is low: the robot beside a sofa still sees, and helps, the person lying behind it.)"""
+        boxes = np.vstack([self.walls, self._closed])
+        if not len(boxes):
+            return True
+        return bool(segments_clear(np.array([a], dtype=float), np.array([b], dtype=float), boxes, 1e-9)[0])
 
     def clearance(self, d: Disc) -> float:
         """How close the robot's centre may come to person ``d``'s centre: their radius plus its."""

@@ -215,3 +215,23 @@ def test_a_person_who_follows_the_robot_never_blocks_its_way(paper) -> None:
     assert scene.path_clear(list(est.path))
     scene.set_making_way("alice", False)  # told to stop following: in the way again
     assert not motion.estimate(start, goal).reachable
+
+
+def test_a_person_is_approached_from_their_side_of_a_wall() -> None:
+    """Full TaBSA day, seed 2: p13 fell 0.4 m north of the living/kitchen wall; from the
+    living room the robot went to a pose 0.9 m from them through the wall (living-room
+    side), was walled into that corner by people and failed 4 tasks.  An approach pose must
+    see the person: no wall or closed door between them."""
+    from pathlib import Path
+
+    from robot.spec import load_world
+
+    world = load_world(Path(__file__).resolve().parents[2] / "experiments" / "protocols" / "tabsa_apartment.toml")
+    motion = motion_model(world, people=False)
+    scene = motion.planner.scene
+    scene.set_person("p13", 4.21, 4.9, "fallen")
+    for start in ((3.0, 3.0, 0.0), (6.0, 3.0, 1.57), (3.0, 6.6, 0.0)):  # living room, hall, kitchen
+        pose, est = motion.approach(start, "p13")
+        assert pose is not None and est.reachable
+        assert pose[1] > 4.55, (start, pose)  # in the kitchen, north of the wall (y 4.45-4.55)
+        assert scene.sees(pose[:2], (4.21, 4.9))
