@@ -4,12 +4,15 @@ Each person is moved kinematically on the simulation clock (deterministic, no
 randomness).  What a person does in a step, in order of precedence:
 
 1. **fallen** people lie still;
-2. :attr:`Person.waiting` (the person was told to wait): stand still — after stepping to
+2. :attr:`Person.giving_room` (someone lies fallen close by): step to the spot the world
+   gave, clear of the ring the robot helps from, and stand there until they are up again
+   (no such spot: carry on);
+3. :attr:`Person.waiting` (the person was told to wait): stand still — after stepping to
    :attr:`Person.aside` if the world gave one (out of a doorway: nobody waits in one);
-3. :attr:`Person.following` (the person follows the robot): walk along the robot's
+4. :attr:`Person.following` (the person follows the robot): walk along the robot's
    trail and stop ``FOLLOW_GAP`` metres (along the trail) behind the robot — the trail
    keeps them off walls;
-4. otherwise the **script**: ``walk`` waypoints ``(t, x, y)`` say where the person is
+5. otherwise the **script**: ``walk`` waypoints ``(t, x, y)`` say where the person is
    at time ``t``; the person heads for the scripted position of *now* at their walking
    speed, so after a reaction ends they walk back onto the script instead of jumping.
 
@@ -47,6 +50,8 @@ class Person:
         self.following = False
         self.waiting = False
         self.aside: tuple[float, float] | None = None  # where a waiting person steps to first
+        # (fallen person, where to stand or None to stand still): room given to someone fallen
+        self.giving_room: tuple[str, tuple[float, float] | None] | None = None
 
     @property
     def pose(self) -> Pose:
@@ -111,6 +116,9 @@ class Person:
             self._trail = []
         if self.posture == "fallen":
             return
+        if self.giving_room is not None and self.giving_room[1] is not None:
+            self._walk_to(self.giving_room[1][0], self.giving_room[1][1], dt)
+            return
         if self.waiting:
             if self.aside is not None:
                 self._walk_to(self.aside[0], self.aside[1], dt)
@@ -124,9 +132,12 @@ class Person:
             self._walk_to(target[0], target[1], dt)
 
     def stepping_aside(self) -> bool:
-        """Waiting, and not yet where :attr:`aside` says to wait."""
-        return (self.waiting and self.aside is not None and self.posture != "fallen"
-                and math.hypot(self.aside[0] - self.x, self.aside[1] - self.y) > 1e-9)
+        """Not yet where :attr:`giving_room` or, waiting, :attr:`aside` says to stand."""
+        if self.posture == "fallen":
+            return False
+        spot = self.giving_room[1] if self.giving_room is not None else None
+        spot = spot if spot is not None else (self.aside if self.waiting else None)
+        return spot is not None and math.hypot(spot[0] - self.x, spot[1] - self.y) > 1e-9
 
     def _stand_up(self) -> None:
         if self.posture == "sitting":

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from robot.control import STOP
-from robot.estimator import MotionEstimator
+from robot.estimator import APPROACH, MotionEstimator
 from robot.mjworld import TIMESTEP, MjApartment
 from robot.motion import BasePlanner, DriveLimits, open_planner
 from robot.people import People, Person
@@ -47,8 +47,8 @@ from tasker.world import Fact, Pose, WorldState
 CONTROL_DT = 0.02  # seconds: the base controller and the people run at 50 Hz
 AT_TOLERANCE = 0.3  # metres: the robot starts "at" a place this close
 TOGETHER = 1.5  # metres: a person this close to the robot is symbolically at the robot's place
-WAIT_MARGIN = 0.05  # metres beyond a standing person's radius and the robot's width (Simulation._out_of_doorways)
-ASIDE_STEP, ASIDE_MAX, ASIDE_DIRECTIONS = 0.1, 2.0, 16  # where a person told to wait looks for a spot
+WAIT_MARGIN = 0.05  # metres beyond a standing person's radius and the robot's width (Simulation._aside_spot)
+ASIDE_STEP, ASIDE_MAX, ASIDE_DIRECTIONS = 0.1, 3.0, 16  # where a person stepping aside looks for a spot
 
 
 class Simulation:
@@ -124,6 +124,8 @@ class Simulation:
         nxt = events[p._event][0] if p._event < len(events) else math.inf
         if ("following", p.name) in self.facts or p.stepping_aside():
             return self.time
+        if p.giving_room is not None and p.giving_room[1] is not None:
+            return nxt  # standing clear of someone fallen until a posture changes
         if p.posture == "fallen" or ("told_to_wait", p.name) in self.facts or not p.spec.walk:
             return nxt
         walk = p.spec.walk
@@ -168,6 +170,7 @@ class Simulation:
         t = round(self._ticks * CONTROL_DT, 9)
         x, y, _ = self.mj.pose()
         self.people.step(t, CONTROL_DT, self.facts, (x, y))
+        self._give_room()
         self._sync_people()
         cmd = self.skill.control(t, CONTROL_DT) if self.skill is not None else STOP
         self._last_cmd = cmd
@@ -192,7 +195,8 @@ class Simulation:
 
     def advance(self, now: float) -> None:
         """Step control and physics in fixed ticks up to simulated time ``now``."""
-        self._sync_people()  # a posture set from outside since the last tick
+        self._give_room()  # a posture set from outside since the last tick
+        self._sync_people()
         while self.time + CONTROL_DT <= now + 1e-9:
             if not self._fast_forward(now):
                 self._tick()
@@ -263,33 +267,66 @@ class Simulation:
         else:
             person = self.people[obj]
             person.waiting = value
-            person.aside = self._out_of_doorways(person) if value else None
+            person.aside = self._aside_spot(person) if value else None
         return True
 
-    def _out_of_doorways(self, p: Person) -> tuple[float, float] | None:
-        """Where a standing person told to wait steps so that the robot can pass the doorway
-        they stand in or by: the nearest spot of their own room (rings of ``ASIDE_STEP``
-        metres, ``ASIDE_DIRECTIONS`` directions, east first) at least ``clear`` metres — their
-        radius, the robot's width and ``WAIT_MARGIN`` — from every door's leaf, and free of
-        walls and furniture.  None when they stand clear already, are not standing (nobody
-        sitting or lying moves aside), or no such spot lies within ``ASIDE_MAX`` metres."""
-        if p.posture != "standing" or not self.spec.doors:
+    def _room_clear(self) -> float:
+        """How far a standing bystander keeps from a fallen person's centre: the near approach
+        ring (``robot.estimator.APPROACH``), the robot on it (its radius), a lane as wide as
+        the robot beside that, their own radius and ``WAIT_MARGIN``: every pose of the ring the
+        robot helps from stays free of them, and so does a way in to it."""
+        return APPROACH + 3 * self.scene.radius + PERSON_RADIUS["standing"] + WAIT_MARGIN
+
+    def _give_room(self) -> None:
+        """Bystanders make room for help: a standing person who is neither following the robot
+        nor already giving room, and who comes within :meth:`_room_clear` of someone fallen,
+        steps to the nearest spot of their own room clear of every fallen person and of the
+        doorways (:meth:`_aside_spot`; none within ``ASIDE_MAX``: they carry on) and stays
+        there while that person is down; then they return to what they were doing."""
+        fallen = [p for p in self.people if p.posture == "fallen"]
+        for p in self.people:
+            if p.giving_room is not None:
+                if self.people[p.giving_room[0]].posture != "fallen" or p.following or p.posture != "standing":
+                    p.giving_room = None
+                continue
+            if not fallen or p.posture != "standing" or p.following:
+                continue
+            near = self._room_clear()
+            for f in fallen:
+                if math.hypot(p.x - f.x, p.y - f.y) < near:
+                    p.giving_room = (f.name, self._aside_spot(p))
+                    break
+
+    def _aside_spot(self, p: Person) -> tuple[float, float] | None:
+        """Where standing person ``p`` steps to be out of the robot's way: the nearest spot of
+        their own room (rings of ``ASIDE_STEP`` metres, ``ASIDE_DIRECTIONS`` directions, east
+        first) at least ``clear`` metres — their radius, the robot's width and ``WAIT_MARGIN``
+        — from every door's leaf, at least :meth:`_room_clear` from every fallen person, free
+        of walls and furniture, and reached in a straight line that crosses neither.  None when they stand clear already, are not standing
+        (nobody sitting or lying moves aside), or no such spot lies within ``ASIDE_MAX`` metres."""
+        if p.posture != "standing":
             return None
         clear = PERSON_RADIUS["standing"] + 2 * self.scene.radius + WAIT_MARGIN
-        leaves = np.array([d.box for _, d in sorted(self.spec.doors.items())], dtype=float)
+        leaves = np.array([d.box for _, d in sorted(self.spec.doors.items())], dtype=float).reshape(-1, 4)
+        fallen = np.array([(f.x, f.y) for f in self.people if f.posture == "fallen"], dtype=float).reshape(-1, 2)
+        near = self._room_clear()
 
-        def off_doors(x: float, y: float) -> bool:
-            return bool(point_box_distance(np.array([x]), np.array([y]), leaves).min() >= clear)
+        def clear_here(x: float, y: float) -> bool:
+            if len(leaves) and point_box_distance(np.array([x]), np.array([y]), leaves).min() < clear:
+                return False
+            return not len(fallen) or bool(np.hypot(fallen[:, 0] - x, fallen[:, 1] - y).min() >= near)
 
-        if off_doors(p.x, p.y):
+        if clear_here(p.x, p.y):
             return None
         room = room_of(self.spec, p.x, p.y)
+        here = np.array([[p.x, p.y]])
         for ring in range(1, round(ASIDE_MAX / ASIDE_STEP) + 1):
             r = ring * ASIDE_STEP
             for k in range(ASIDE_DIRECTIONS):
                 a = 2 * math.pi * k / ASIDE_DIRECTIONS
                 x, y = round(p.x + r * math.cos(a), 3), round(p.y + r * math.sin(a), 3)
-                if room_of(self.spec, x, y) == room and off_doors(x, y) and self.scene.static_free(x, y):
+                if (room_of(self.spec, x, y) == room and clear_here(x, y) and self.scene.static_free(x, y)
+                        and segments_clear(here, np.array([[x, y]]), self.scene.static, 1e-9)[0]):
                     return (x, y)
         return None
 

@@ -235,3 +235,41 @@ def test_a_person_is_approached_from_their_side_of_a_wall() -> None:
         assert pose is not None and est.reachable
         assert pose[1] > 4.55, (start, pose)  # in the kitchen, north of the wall (y 4.45-4.55)
         assert scene.sees(pose[:2], (4.21, 4.9))
+
+
+def test_bystanders_make_room_for_help(paper) -> None:
+    """The bedroom case of ``test_approach_tries_a_farther_ring_when_the_near_one_is_shut``:
+    p lies between the bed and the wall, q and r stand at both ends, so no pose the robot
+    could help from is free.  When p falls, q steps clear of the ring the robot helps from,
+    within their own room and off the doorways, and p becomes reachable; r, in the dead end
+    between the bed and the walls, has no such spot and stays.  Once p is up, q walks back
+    onto their script."""
+    from robot.spec import room_of
+
+    def person(name: str, x: float, y: float, events=()) -> PersonSpec:
+        return PersonSpec(name, (x, y, 0.0), "standing", 0.5, ((0.0, x, y), (100.0, x, y)), tuple(events))
+
+    world = dataclasses.replace(paper, people={
+        "p": person("p", 10.5, 4.6, [(1.0, "fallen")]),
+        "q": person("q", 9.6, 4.6),
+        "r": person("r", 11.4, 4.6),
+    })
+    sim = Simulation(world)
+    start = paper.places["hall"]
+    sim.advance(0.5)
+    assert sim.people["q"].giving_room is None and sim.people["r"].giving_room is None  # p standing
+    sim.advance(1.1)
+    assert sim.motion.approach(start, "p")[0] is None  # p just fell: q and r still at both ends
+    assert sim.people["p"].posture == "fallen"
+    assert sim.people["q"].giving_room is not None and sim.people["r"].giving_room is not None
+    sim.advance(8.0)
+    q, r = sim.people["q"], sim.people["r"]
+    assert math.dist((q.x, q.y), (10.5, 4.6)) >= sim._room_clear() - 1e-9
+    assert room_of(world, q.x, q.y) == room_of(world, 10.5, 4.6) == "bedroom"
+    assert r.giving_room == ("p", None) and (r.x, r.y) == (11.4, 4.6)
+    goal, est = sim.motion.approach(start, "p")
+    assert goal is not None and est.reachable and math.dist(goal[:2], (10.5, 4.6)) == pytest.approx(0.9)
+    sim.people["p"].set_posture("standing")  # helped up: the bystanders go back to their scripts
+    sim.advance(20.0)
+    assert sim.people["q"].giving_room is None
+    assert math.dist((sim.people["q"].x, sim.people["q"].y), (9.6, 4.6)) < 1e-6
