@@ -93,6 +93,7 @@ class Simulation:
         self._ticks = 0
         self._last_cmd = STOP
         self._synced: dict[str, tuple[float, float, float, str]] = {}
+        self._fallen: tuple[str, ...] = ()  # who lay fallen at the last look (Simulation._give_room)
         self.physics_ticks = 0  # control ticks that stepped MuJoCo (the rest: robot at rest, nothing to do)
         self._sync_people()
         self._record()
@@ -278,37 +279,46 @@ class Simulation:
         return APPROACH + 3 * self.scene.radius + PERSON_RADIUS["standing"] + WAIT_MARGIN
 
     def _give_room(self) -> None:
-        """Bystanders make room for help: a standing person who is neither following the robot
-        nor already giving room, and who comes within :meth:`_room_clear` of someone fallen,
-        steps to the nearest spot of their own room clear of every fallen person and of the
-        doorways (:meth:`_aside_spot`; none within ``ASIDE_MAX``: they carry on) and stays
-        there while that person is down; then they return to what they were doing."""
-        fallen = [p for p in self.people if p.posture == "fallen"]
+        """Bystanders make room for help: a standing person who is not following the robot and
+        who comes within :meth:`_room_clear` of someone fallen they can see (no wall or closed
+        door between) steps to the nearest spot of their own room clear of every fallen person
+        they see and of the doorways (:meth:`_aside_spot`; none within ``ASIDE_MAX``: they carry
+        on) and stays there while that person is down; then they return to what they were
+        doing.  Whenever someone falls or gets up, everyone looks again."""
+        fallen = tuple(p.name for p in self.people if p.posture == "fallen")
+        if fallen != self._fallen:
+            self._fallen = fallen
+            for p in self.people:
+                p.giving_room = None
+        if not fallen:
+            return
+        near = self._room_clear()
         for p in self.people:
             if p.giving_room is not None:
-                if self.people[p.giving_room[0]].posture != "fallen" or p.following or p.posture != "standing":
+                if p.following or p.posture != "standing":
                     p.giving_room = None
                 continue
-            if not fallen or p.posture != "standing" or p.following:
+            if p.posture != "standing" or p.following:
                 continue
-            near = self._room_clear()
-            for f in fallen:
-                if math.hypot(p.x - f.x, p.y - f.y) < near:
-                    p.giving_room = (f.name, self._aside_spot(p))
+            for name in fallen:
+                f = self.people[name]
+                if math.hypot(p.x - f.x, p.y - f.y) < near and self.scene.sees((p.x, p.y), (f.x, f.y)):
+                    p.giving_room = (name, self._aside_spot(p))
                     break
 
     def _aside_spot(self, p: Person) -> tuple[float, float] | None:
         """Where standing person ``p`` steps to be out of the robot's way: the nearest spot of
         their own room (rings of ``ASIDE_STEP`` metres, ``ASIDE_DIRECTIONS`` directions, east
         first) at least ``clear`` metres — their radius, the robot's width and ``WAIT_MARGIN``
-        — from every door's leaf, at least :meth:`_room_clear` from every fallen person, free
+        — from every door's leaf, at least :meth:`_room_clear` from every fallen person they see, free
         of walls and furniture, and reached in a straight line that crosses neither.  None when they stand clear already, are not standing
         (nobody sitting or lying moves aside), or no such spot lies within ``ASIDE_MAX`` metres."""
         if p.posture != "standing":
             return None
         clear = PERSON_RADIUS["standing"] + 2 * self.scene.radius + WAIT_MARGIN
         leaves = np.array([d.box for _, d in sorted(self.spec.doors.items())], dtype=float).reshape(-1, 4)
-        fallen = np.array([(f.x, f.y) for f in self.people if f.posture == "fallen"], dtype=float).reshape(-1, 2)
+        fallen = np.array([(f.x, f.y) for f in self.people
+                           if f.posture == "fallen" and self.scene.sees((p.x, p.y), (f.x, f.y))], dtype=float).reshape(-1, 2)
         near = self._room_clear()
 
         def clear_here(x: float, y: float) -> bool:
