@@ -459,8 +459,18 @@ class TaskHarmoniser:
         return self._seq
 
     def _start_data(self, agent_id: str) -> dict[str, Any]:
-        """``data`` of a ``start``: the cTime the agent last reported, as ``predicted_s``."""
-        c_time = self._c_time(agent_id)
+        """``data`` of a ``start``: the agent's cTime from the world as it is at the start, as
+        ``predicted_s`` (its parameters computed now: the task it replaces has suspended since
+        its last report, e.g. put down what it held); the last reported one if that fails."""
+        c_time = None
+        try:
+            fresh = self._fresh(agent_id)
+            value = getattr(fresh, "c_time", None)
+            c_time = float(value) if isinstance(value, int | float) else None
+        except Exception:  # the hook failed (the agent ends with its reason): the last report
+            c_time = None
+        if c_time is None:
+            c_time = self._c_time(agent_id)
         return {} if c_time is None else {"predicted_s": c_time}
 
     def _c_time(self, agent_id: str) -> float | None:

@@ -290,3 +290,20 @@ def test_a_choice_with_no_executing_agent_leaves_a_decision() -> None:
     assert [(d["dac"], d["exeDA"], d["rule"]) for d in decisions] == [("d1", None, "no exeDA"),
                                                                       ("d2", None, "no exeDA")]
     assert [d["t"] for d in decisions] == [s["t"] for s in starts]
+
+
+def test_a_start_predicts_from_the_moment_of_the_start() -> None:
+    """predicted_s is the cTime computed at the start, not at the last report: the task it
+    replaces has suspended in between (in compound, put down the vase cook's plan needs gone)."""
+    from dataclasses import replace
+
+    class Clock(SyntheticTask):  # a cTime that says when it was computed
+        def compute_params(self, ctx: TaskContext):  # type: ignore[no-untyped-def]
+            return replace(super().compute_params(ctx), c_time=ctx.now)
+
+    loop = make_loop([guide("guide"), Clock("fell", [st("approach", 3), st("check", 2)])], **FELL)
+    loop.request(0.0, "guide")
+    loop.request(2.0, "fell")
+    tr = loop.run()
+    start = first(tr.events, event="command", agent="d2", flag="start")
+    assert start["predicted_s"] == pytest.approx(start["t"])
