@@ -310,15 +310,16 @@ class Simulation:
         """Where standing person ``p`` steps to be out of the robot's way: the nearest spot of
         their own room (rings of ``ASIDE_STEP`` metres, ``ASIDE_DIRECTIONS`` directions, east
         first) at least ``clear`` metres — their radius, the robot's width and ``WAIT_MARGIN``
-        — from every door's leaf, at least :meth:`_room_clear` from every fallen person they see, free
-        of walls and furniture, and reached in a straight line that crosses neither.  None when they stand clear already, are not standing
-        (nobody sitting or lying moves aside), or no such spot lies within ``ASIDE_MAX`` metres."""
+        — from every door's leaf, at least :meth:`_room_clear` from every fallen person they
+        see, free of walls and furniture, and reached in a straight line that crosses neither.
+        None when they stand clear already, are not standing (nobody sitting or lying moves
+        aside), or no such spot lies within ``ASIDE_MAX`` metres."""
         if p.posture != "standing":
             return None
         clear = PERSON_RADIUS["standing"] + 2 * self.scene.radius + WAIT_MARGIN
         leaves = np.array([d.box for _, d in sorted(self.spec.doors.items())], dtype=float).reshape(-1, 4)
-        fallen = np.array([(f.x, f.y) for f in self.people
-                           if f.posture == "fallen" and self.scene.sees((p.x, p.y), (f.x, f.y))], dtype=float).reshape(-1, 2)
+        seen = [(f.x, f.y) for f in self.people if f.posture == "fallen" and self.scene.sees((p.x, p.y), (f.x, f.y))]
+        fallen = np.array(seen, dtype=float).reshape(-1, 2)
         near = self._room_clear()
 
         def clear_here(x: float, y: float) -> bool:
