@@ -16,8 +16,10 @@ told to wait, the robot must come back, greet them again and apologise (Alg. 3).
   fact re-grounded to the nearest place), the request's facts, Alg. 3's
   ``suspended_facts`` when the task was or will be suspended, ``task.py``'s facts; for
   an agent that would be suspended to go there, its suspension (genSusp) applied
-  first — solved with the task's planner, or the template ``exeTsk`` under the static
-  strategy, then timed by :func:`walk`.
+  first; and what the task before it leaves changed (``TaskContext.handover``: the
+  executing task's suspension for a start now, the completion of the agent a ``cc``
+  request names in ``after``) — solved with the task's planner, or the template
+  ``exeTsk`` under the static strategy, then timed by :func:`walk`.
 
 **Caching.**  Plans are cached by the symbolic problem: objects, init facts and goal,
 with travel times taken from the *reference table* — place-to-place times with nobody
@@ -211,8 +213,11 @@ class Estimator:
 
     # -- public -------------------------------------------------------------------------
 
-    def estimate(self, ctx: TaskContext, start: Pose | None = None) -> Estimate:
-        """``cTime`` and ``endPose`` of the task in ``ctx``, started from ``start`` (the robot's pose if None)."""
+    def estimate(self, ctx: TaskContext, start: Pose | None = None, after: str | None = None) -> Estimate:
+        """``cTime`` and ``endPose`` of the task in ``ctx``, started from ``start`` (the robot's pose if None).
+
+        ``after``: the agent whose completion this start follows (Alg. 2's ``cc``); None: the
+        task would start now, replacing the executing one (see :meth:`_hypothetical`)."""
         task = self.task
         world = ctx.world if isinstance(ctx.world, WorldState) else None
         if world is None:
@@ -223,24 +228,34 @@ class Estimator:
             elapsed = max(0.0, ctx.now - ctx.stage_started) if ctx.stage_started is not None else 0.0
             return self._timed(ctx.remaining, here, world, ctx.motion, Source.REMAINING, elapsed=elapsed)
         try:
-            hypo = self._hypothetical(ctx, start if elsewhere else None)
+            hypo = self._hypothetical(ctx, start if elsewhere else None, after)
             return self._from_state(hypo)
         except PlanningFailed as exc:
             return Estimate(math.inf, None, Source.UNSOLVABLE, note=str(exc))
 
     # -- the hypothetical state ------------------------------------------------------------
 
-    def _hypothetical(self, ctx: TaskContext, start: Pose | None) -> TaskContext:
-        """The context upTsk would see: the world now, or after a suspension with the robot at ``start``."""
+    def _hypothetical(self, ctx: TaskContext, start: Pose | None, after: str | None = None) -> TaskContext:
+        """The context upTsk would see: the world now, or after a suspension with the robot at
+        ``start``; and in either case with what the task before it leaves changed
+        (:attr:`TaskContext.handover <tasker.task.TaskContext.handover>`: the executing task's
+        suspension, or the completion of ``after``), e.g. the vase it held put down."""
         world = ctx.world
         assert isinstance(world, WorldState)
         suspended = ctx.suspended
+        if start is not None and (executing(ctx) or ctx.suspended):
+            # the robot leaves this task to go to ``start``: the task suspends first (genSusp)
+            world = self._apply(self.suspension_stages(replace(ctx, suspended=True)), world)
+            suspended = True
+        effects = ctx.handover(after) if ctx.handover is not None else None
+        if effects:
+            world = world.updated(add=effects.add, delete=effects.delete)
         if start is not None:
-            if executing(ctx) or ctx.suspended:
-                # the robot leaves this task to go to ``start``: the task suspends first (genSusp)
-                world = self._apply(self._suspension_stages(replace(ctx, suspended=True)), world)
-                suspended = True
             world = moved_robot(world, start)
+        elif effects:  # the robot's place is read off its pose again, whatever the effects said
+            here = world.poses.get(robot_name(world))
+            if here is not None:
+                world = moved_robot(world, here)
         return replace(ctx, world=world, suspended=suspended)
 
     @staticmethod
@@ -250,7 +265,7 @@ class Estimator:
                                   delete=[tuple(f) for f in s.data.get("delete", ())])
         return world
 
-    def _suspension_stages(self, ctx: TaskContext) -> tuple[Stage, ...]:
+    def suspension_stages(self, ctx: TaskContext) -> tuple[Stage, ...]:
         """What genSusp would do now; only its effects matter here, so no travel table is built."""
         task = self.task
         if ctx.strategy.suspension != "static":

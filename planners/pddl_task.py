@@ -27,10 +27,10 @@ import contextlib
 import math
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
-from planners.estimates import estimator_for
+from planners.estimates import estimator_for, executing
 from planners.planner import PddlText, Planner
 from planners.problem import DomainModel, PortablePddl, holds, portable, render_problem, travel_table
 from planners.results import PlanResult, PlanStatus
@@ -39,10 +39,12 @@ from planners.taskspec import Branch, Literal, TaskSpec
 from tasker.errors import PlanningFailed, UnknownName
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
 from tasker.stage import Purpose, Stage, StagePlan
-from tasker.task import TaskContext, TaskType
+from tasker.task import Effects, Leaving, TaskContext, TaskType
 from tasker.world import Pose, WorldState
 
 INTERRUPTION_KEY = "interruption_s"
+PREPLAN_KEY = "_suspension_planned_ahead"
+"""``ctx.memory`` key: (symbolic suspension problem, its PlanResult or None if the goal held)."""
 """``ctx.memory`` key: expected length of an interruption (s); unknown means long."""
 
 _shared_planner: Planner | None = None
@@ -140,8 +142,11 @@ class PddlTaskType(TaskType):
         if ctx.strategy.suspension == "static":
             return self.static_suspension(ctx)
         world, goal, branch = self.suspension_inputs(ctx)
-        outcome = self._plan(ctx, world, goal, self.suspension_facts(ctx, world), Purpose.GEN_SUSP,
-                             label=branch.label)
+        extra = self.suspension_facts(ctx, world)
+        ready = self._preplanned(ctx, world, goal, extra, branch.label)
+        if ready is not None:
+            return ready
+        outcome = self._plan(ctx, world, goal, extra, Purpose.GEN_SUSP, label=branch.label)
         if isinstance(outcome, StagePlan):
             return outcome
         why = {PlanStatus.UNSOLVABLE: "suspension goal unsolvable", PlanStatus.TIMEOUT: "planner timed out"}
@@ -149,7 +154,12 @@ class PddlTaskType(TaskType):
                               f"{why.get(outcome.status, 'planner error')} for {goal}")
 
     def compute_params(self, ctx: TaskContext) -> CostParams:
-        """``cost = cps * (age + cTime)``; cTime and endPose from :meth:`estimate` of the state now."""
+        """``cost = cps * (age + cTime)``; cTime and endPose from :meth:`estimate` of the state now.
+
+        While a stage of ``exeTsk`` runs under the planned suspension strategy, the
+        suspension of the state now is planned here too (:meth:`_preplan_suspension`)."""
+        if executing(ctx) and ctx.strategy.suspension != "static" and isinstance(ctx.world, WorldState):
+            self._preplan_suspension(ctx)
         c_time, end = self.estimate(ctx, None)
         cost = self.spec.cps * (ctx.age + c_time) if math.isfinite(c_time) else math.inf
         return CostParams(self.name, cost=cost, cps=self.spec.cps, c_time=c_time, end_pose=end)
@@ -160,7 +170,8 @@ class PddlTaskType(TaskType):
             raise UnknownName("schedule parameter", request.sp_id, [SP_COMPLETION])
         pose = next((request.args[k] for k in ("pose", "start_pose", "end_pose") if request.args.get(k)), None)
         start = (float(pose[0]), float(pose[1]), float(pose[2]) if len(pose) > 2 else 0.0) if pose else None
-        c_time, _ = self.estimate(ctx, start)
+        after = request.args.get("after")
+        c_time, _ = self.estimate(ctx, start, after=str(after) if after is not None else None)
         cc = self.spec.cps * (ctx.age + c_time) if math.isfinite(c_time) else math.inf
         return CompletionCost(cc=cc, ccps=self.spec.cps)
 
@@ -275,6 +286,50 @@ class PddlTaskType(TaskType):
                          info={"planner": result.planner, "cost": result.cost, "cached": result.cached,
                                "planner_time_s": result.wall_time_s})
 
+    # -- a suspension planned ahead --------------------------------------------------------
+
+    @staticmethod
+    def _suspension_key(world: WorldState, goal: list[Literal], extra: list[Literal], label: str) -> tuple[Any, ...]:
+        """The symbolic suspension problem: a plan for it is valid whatever the travel times."""
+        return (world.facts, frozenset(extra), tuple(goal), label)
+
+    def _preplan_suspension(self, ctx: TaskContext) -> None:
+        """Plan the suspension of the state now, while ``exeTsk`` runs, once per symbolic state
+        (``ctx.memory[PREPLAN_KEY]``): a ``susp`` that arrives in the same state then finds its
+        plan made and takes the static strategy's ``static_time_s``, not ``planning_time_s``.
+        Not journalled: only the suspension genSusp uses is (:meth:`_preplanned`)."""
+        world, goal, branch = self.suspension_inputs(ctx)
+        extra = self.suspension_facts(ctx, world)
+        key = self._suspension_key(world, goal, extra, branch.label)
+        held = ctx.memory.get(PREPLAN_KEY)
+        if held is not None and held[0] == key:
+            return
+        text, init, _ = self.problem_text(ctx, world, goal, extra)
+        if holds(init, goal):
+            ctx.memory[PREPLAN_KEY] = (key, None)
+            return
+        result = self.planner.solve(text, timeout=self.timeout)
+        ctx.memory[PREPLAN_KEY] = (key, result) if result.solved and result.plan is not None else None
+
+    def _preplanned(self, ctx: TaskContext, world: WorldState, goal: list[Literal], extra: list[Literal],
+                    label: str) -> StagePlan | None:
+        """genSusp's plan if :meth:`_preplan_suspension` made it for this very symbolic state."""
+        held = ctx.memory.get(PREPLAN_KEY)
+        if held is None or held[0] != self._suspension_key(world, goal, extra, label):
+            return None
+        text, init, travel = self.problem_text(ctx, world, goal, extra)
+        result: PlanResult | None = held[1]
+        self._record(ctx, Purpose.GEN_SUSP, label, text, result)
+        if result is None:
+            return StagePlan((), Purpose.GEN_SUSP, strategy="planned", sim_time=self.spec.static_time_s,
+                             note="goal already holds" + (f" ({label})" if label else ""))
+        assert result.plan is not None
+        stages = self.builder.from_steps(result.plan, travel, ctx.args)
+        return StagePlan(stages, Purpose.GEN_SUSP, strategy="planned", sim_time=self.spec.static_time_s,
+                         note=(label + "; " if label else "") + "planned ahead, during exeTsk",
+                         info={"planner": result.planner, "cost": result.cost, "cached": True,
+                               "planner_time_s": result.wall_time_s, "planned_ahead": True})
+
     def _record(self, ctx: TaskContext, purpose: Purpose, label: str, text: PddlText,
                 result: PlanResult | None) -> None:
         journal = _journal.get()
@@ -300,11 +355,22 @@ class PddlTaskType(TaskType):
                 total += a.duration if a.duration is not None else (model.constant_cost or 0.0)
         return total
 
-    def estimate(self, ctx: TaskContext, start: Pose | None) -> tuple[float, Pose | None]:
+    def estimate(self, ctx: TaskContext, start: Pose | None, after: str | None = None) -> tuple[float, Pose | None]:
         """Seconds to complete the task from ``start`` (the robot's pose if None) and the end pose.
 
         From a plan of the state asked about (:mod:`planners.estimates`), never from the
         stale remainder of a plan made before a suspension; ``inf`` when it cannot be done.
+        ``after``: the agent whose completion the start follows (None: it would start now).
         """
-        est = estimator_for(self).estimate(ctx, start)
+        est = estimator_for(self).estimate(ctx, start, after)
         return est.c_time, est.end_pose
+
+    def leaves(self, ctx: TaskContext, how: Leaving) -> Effects | None:
+        """What the task would leave changed: for ``suspend``, the effects of the suspension
+        genSusp would make now (planned or the decision list, as the strategy says); for
+        ``complete``, those of the stages of ``exeTsk`` still to run."""
+        if how == "suspend":
+            if not isinstance(ctx.world, WorldState):
+                return None
+            return Effects.of(estimator_for(self).suspension_stages(replace(ctx, suspended=True))) or None
+        return super().leaves(ctx, how)

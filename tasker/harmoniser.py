@@ -47,6 +47,7 @@ from tasker.messages import Command, Flag, FsmState, ScheduleParams, SPRequest
 from tasker.schedulers.base import Candidate, Scheduler, ScheduleView
 from tasker.schedulers.index import CandidateIndex
 from tasker.securing import HazardSource, HazardWatch
+from tasker.task import Effects
 from tasker.trace import Trace
 
 _TRACED = frozenset({"by", "expected_s", "predicted_s", "secure"})
@@ -181,6 +182,7 @@ class TaskHarmoniser:
         self._factory = agent_factory
         self._trace = trace
         self.agents: dict[str, DynamicAgent] = {}  # A_da
+        self._handovers: dict[tuple[str, str, float], Effects | None] = {}  # handover's answers
         self.exe_da: str | None = None
         self.irr_da: str | None = None
         self._idle: dict[str, None] = {}  # D_r, in request order
@@ -512,6 +514,32 @@ class TaskHarmoniser:
 
     def _req_sp(self, agent_id: str, request: SPRequest) -> Any:
         return self.agents[agent_id].request_sp(request, self.now)
+
+    def handover(self, asker: str, after: str | None = None) -> Effects | None:
+        """What another task would leave changed before ``asker`` could start (an estimate's
+        :attr:`TaskContext.handover <tasker.task.TaskContext.handover>`).
+
+        ``after=None``: the executing agent's suspension, if ``asker`` replaced it now
+        (None unless another agent runs a stage of ``exeTsk``); ``after`` an agent's id: what
+        that agent leaves changed when it completes.  From the agent's ``leaves`` hook on its
+        own context; one answer per agent, way and moment.  A hook that raises assumes nothing:
+        the agent's own hooks report its failure."""
+        other, how = (self.exe_da, "suspend") if after is None else (after, "complete")
+        if other is None or other == asker or other not in self.agents:
+            return None
+        agent = self.agents[other]
+        if how == "suspend" and agent.state is not FsmState.EXE_TSK:
+            return None  # already suspending, planning or securing: the world says what it is
+        key = (other, how, self.now)
+        if key not in self._handovers:
+            if len(self._handovers) > 64:
+                self._handovers.clear()
+            try:
+                effects = agent.task.leaves(agent.ctx, how)  # type: ignore[arg-type]
+            except Exception:
+                effects = None
+            self._handovers[key] = effects if isinstance(effects, Effects) and effects else None
+        return self._handovers[key]
 
     def _fresh(self, agent_id: str) -> ScheduleParams | None:
         return self.agents[agent_id].fresh_params(self.now)

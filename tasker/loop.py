@@ -16,6 +16,7 @@ byte.  A real-time runner can drive the same objects from a wall clock instead.
 
 from __future__ import annotations
 
+import functools
 import heapq
 import itertools
 import math
@@ -142,6 +143,7 @@ class SimulationLoop:
             now=now,
             core=self.core,
             motion=self.motion,
+            handover=functools.partial(self.harmoniser.handover, agent_id),
         )
         world = self._snapshot if self.world is not None else None
         agent = DynamicAgent(agent_id, task, ctx, trace=self.trace, rates=self.rates, core=self.core,

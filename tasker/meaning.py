@@ -209,8 +209,9 @@ class Monitor:
     ``meaning_of`` the :class:`Meaning` of a task type; ``facts`` the world's facts now
     (None without a world: then nothing is evaluated); ``robot`` the robot's name.
     Hazards of ``task_types`` (every type the run can request) are watched from the
-    start, so a pattern without ``$args`` that already holds (a door open in the world
-    file) belongs to nobody (``agent: null``) rather than to the next agent requested.
+    start.  A pattern without ``$args`` has one owner whichever types declare it: the
+    agent whose stage made it true, else nobody (``agent: null``: a door open in the world
+    file, or opened by a person).
     Call :meth:`observe` after each tick; it re-evaluates only when the facts or the
     set of live agents changed, and asks for the facts only when ``version`` (e.g. the
     world's clock and change counter) moved.  Edges are written in a fixed order (agent, hazard or
@@ -264,6 +265,9 @@ class Monitor:
         by_type: dict[str, list[Any]] = {t: [] for t in self.task_types}
         for a in agents:
             by_type.setdefault(a.ctx.task_type, []).append(a)
+        # patterns without $args, across every type that declares one: (name, fact) -> the
+        # declaring types' hazards, so that one fact has one owner whoever declares it
+        shared: dict[tuple[str, Fact], dict[str, Hazard]] = {}
         for task_type, members in by_type.items():
             for hz in self._meaning_of(task_type).hazards:
                 if any(tok.startswith("$") and tok != "$robot" for tok in hz.fact):
@@ -276,7 +280,11 @@ class Monitor:
                 atom = bind(hz.fact, {}, robot)
                 assert atom is not None
                 for f in matches(atom, facts):
-                    found[(self._owner(hz, task_type, f, members, made_by), hz.name, f)] = hz
+                    shared.setdefault((hz.name, f), {}).setdefault(task_type, hz)
+        type_of = {a.id: a.ctx.task_type for a in agents}
+        for (name, f), declared in shared.items():
+            owner = self._owner(name, f, declared, type_of, made_by)
+            found[(owner, name, f)] = declared[type_of[owner]] if owner is not None else next(iter(declared.values()))
         for key in sorted(set(self.hazards) - set(found), key=_order):
             self._since.pop(key, None)
             self._emit_hazard(now, key, self.hazards.pop(key), "off")
@@ -293,18 +301,18 @@ class Monitor:
         return tuple(ActiveHazard(key[0], key[1], key[2], self.hazards[key].budget_s, self._since[key])
                      for key in sorted(self.hazards, key=_order))
 
-    def _owner(self, hz: Hazard, task_type: str, fact: Fact, members: list[Any], made_by: list[str]) -> str | None:
-        """For a pattern without ``$args``: who already owns it, the agent whose stage made it
-        true in this tick, else the earliest live agent of the declaring type, else nobody."""
-        for (agent, name, f) in self.hazards:
-            if name == hz.name and f == fact and (agent is None or agent in {m.id for m in members}):
+    def _owner(self, name: str, fact: Fact, declared: Mapping[str, Hazard], type_of: Mapping[str, str],
+               made_by: list[str]) -> str | None:
+        """For a pattern without ``$args``: who already owns it, else the agent of a declaring
+        type whose stage made it true in this tick, else nobody — a door open in the world
+        file, opened by a person or by a task that does not declare it, is nobody's."""
+        for (agent, hname, f) in self.hazards:
+            if hname == name and f == fact:
                 return agent
-        ids = [m.id for m in members]
         for agent in made_by:
-            if agent in ids:
+            if type_of.get(agent) in declared:
                 return agent
-        live = [m.id for m in members if not m.ended]
-        return live[0] if live else None
+        return None
 
     def _emit_hazard(self, now: float, key: tuple[str | None, str, Fact], hz: Hazard, status: str) -> None:
         agent, name, fact = key

@@ -122,7 +122,11 @@ class SPRequest:
 _NUMBERS = (int, float)
 
 SP_COMPLETION = "cc"
-"""``spID`` of Alg. 2's request: cost of completing the task from a given start pose."""
+"""``spID`` of Alg. 2's request: cost of completing the task from a given start pose.
+
+Arguments: ``pose``, the start pose; ``after`` (optional), the id of the agent whose
+completion the start follows, so that the estimate assumes what that task leaves changed
+(:meth:`tasker.task.TaskType.leaves`)."""
 
 
 @dataclass(frozen=True, slots=True)

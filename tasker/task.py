@@ -15,6 +15,8 @@ hook                   called in (paper)                 returns
 ``generate_suspension`` ``genSusp``                      the ``exeSusp`` :class:`~tasker.stage.StagePlan`
 ``check_terminate``    ``compSP``, ``exeTsk``, ``wait``   a reason to end itself (``ic_term``) or None
 ``on_stage_done``      after each completed stage        nothing
+``leaves``             another agent's estimate          the facts it would leave changed
+                       (:attr:`TaskContext.handover`)     (:class:`Effects`) or None
 =====================  ===============================  ===================================
 
 ``update_task`` and ``generate_suspension`` may raise
@@ -29,14 +31,41 @@ the declared :class:`ArgSpec` tuple; task types add checks in ``check_args``.
 from __future__ import annotations
 
 import random
-from collections.abc import Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 from tasker.errors import BadRequest, ConfigError
 from tasker.meaning import NO_MEANING, Meaning
 from tasker.messages import CompletionCost, CostParams, ScheduleParams, SPRequest
 from tasker.stage import Purpose, Stage, StagePlan
+from tasker.world import Fact
+
+Leaving = Literal["suspend", "complete"]
+"""How a task is left, for :meth:`TaskType.leaves`: suspended now, or completed."""
+
+
+@dataclass(frozen=True, slots=True)
+class Effects:
+    """What a task leaves changed in the world: facts it adds and facts it deletes (net)."""
+
+    add: tuple[Fact, ...] = ()
+    delete: tuple[Fact, ...] = ()
+
+    @classmethod
+    def of(cls, stages: Iterable[Stage]) -> Effects:
+        """The net effect of ``stages`` run in order (their ``add``/``delete`` data)."""
+        net: dict[Fact, bool] = {}
+        for s in stages:
+            for f in s.data.get("delete", ()):
+                net[tuple(str(x) for x in f)] = False
+            for f in s.data.get("add", ()):
+                net[tuple(str(x) for x in f)] = True
+        return cls(tuple(f for f, v in net.items() if v), tuple(f for f, v in net.items() if not v))
+
+    def __bool__(self) -> bool:
+        return bool(self.add or self.delete)
+
 
 POLICIES = ("strict", "conditional")
 """Suspension policies (:attr:`Strategy.policy`)."""
@@ -123,6 +152,11 @@ class TaskContext:
     ``interrupted`` is the stage during which the last suspension happened;
     ``suspended`` is true once the task has been suspended (Alg. 3's *suspended*);
     ``stage_started`` is when the running stage of ``exeTsk`` began (None between stages).
+    ``handover(after)`` (set by the loop; None without a harmoniser) tells an estimate
+    what another task would leave changed before this one could start: with ``after=None``,
+    what the executing task's suspension would change if this task replaced it now; with
+    an agent's id, what that agent leaves changed when it completes (the start Alg. 2's
+    ``cc`` asks about).  None when there is nothing to assume.
     """
 
     agent: str
@@ -143,6 +177,7 @@ class TaskContext:
     stage_started: float | None = None
     suspended: bool = False
     terminating: bool = False
+    handover: Callable[[str | None], Effects | None] | None = None
 
     @property
     def current(self) -> Stage | None:
@@ -240,3 +275,12 @@ class TaskType:
 
     def on_stage_done(self, ctx: TaskContext, stage: Stage) -> None:
         """Called after a stage of ``exeTsk`` or ``exeSusp`` completes."""
+
+    def leaves(self, ctx: TaskContext, how: Leaving) -> Effects | None:
+        """What this task would leave changed if left now (``suspend``: its genSusp would run;
+        ``complete``: it runs to its end), for the estimates of the task that comes next.
+        Default: nothing for a suspension (the ``save`` behaviour); for a completion, the
+        ``add``/``delete`` data of the stages of ``exeTsk`` still to run."""
+        if how == "complete":
+            return Effects.of(ctx.remaining) or None
+        return None

@@ -120,8 +120,8 @@ class Alg2(Scheduler):
         """Lines 20-33 with parameters of one moment: both agents compute them at ``view.now``."""
         p_dac = self._cost(view.params_now(dac), dac)
         p_exe = self._cost(view.params_now(exe), exe)
-        a_dac = self._completion(view, dac, p_exe.end_pose)
-        a_exe = self._completion(view, exe, p_dac.end_pose)
+        a_dac = self._completion(view, dac, p_exe.end_pose, exe.id)  # dac once exeDA is complete
+        a_exe = self._completion(view, exe, p_dac.end_pose, dac.id)  # exeDA resumed once dac is complete
         c_switch = p_dac.cost + a_exe.cc + _mul(p_exe.cps, p_dac.c_time)
         c_wait = p_exe.cost + a_dac.cc + _mul(p_dac.cps, p_exe.c_time)
         record: dict[str, Any] = {
@@ -148,8 +148,8 @@ class Alg2(Scheduler):
         return params
 
     @staticmethod
-    def _completion(view: ScheduleView, c: Candidate, pose: Any) -> CompletionCost:
-        answer = view.req_sp(c.id, SPRequest(SP_COMPLETION, {"pose": pose}))
+    def _completion(view: ScheduleView, c: Candidate, pose: Any, after: str) -> CompletionCost:
+        answer = view.req_sp(c.id, SPRequest(SP_COMPLETION, {"pose": pose, "after": after}))
         if not isinstance(answer, CompletionCost):
             raise ConfigError(
                 f"alg2: task type {c.task_type!r} answered reqSP {SP_COMPLETION!r} with "

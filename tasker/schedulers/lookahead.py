@@ -200,11 +200,12 @@ class LookAhead(Scheduler):
         self.budgets = {str(k): float(v) for k, v in (budgets or {}).items()}
         self.hysteresis = float(hysteresis)
 
-    def _duration(self, view: ScheduleView, c: Candidate, p: CostParams, pose: Any) -> float:
-        """Seconds ``c`` takes if started at ``pose``: its reqSP answer back in seconds."""
+    def _duration(self, view: ScheduleView, c: Candidate, p: CostParams, pose: Any, after: str) -> float:
+        """Seconds ``c`` takes if started at ``pose`` once ``after`` is complete: its reqSP
+        answer back in seconds."""
         if pose is None or p.cps == 0:
             return p.c_time
-        answer = view.req_sp(c.id, SPRequest(SP_COMPLETION, {"pose": pose}))
+        answer = view.req_sp(c.id, SPRequest(SP_COMPLETION, {"pose": pose, "after": after}))
         if not isinstance(answer, CompletionCost):
             raise ConfigError(f"lookahead: task type {c.task_type!r} answered reqSP {SP_COMPLETION!r} with "
                               f"{type(answer).__name__}, expected CompletionCost")
@@ -216,7 +217,7 @@ class LookAhead(Scheduler):
         params = [self.cost_params(c, self.name) for c in jobs]
         has_exe = view.exe is not None
         first = [p.c_time + (self.switch_penalty_s if has_exe and k > 0 else 0.0) for k, p in enumerate(params)]
-        after = [[0.0 if i == j else self._duration(view, jobs[j], params[j], params[i].end_pose)
+        after = [[0.0 if i == j else self._duration(view, jobs[j], params[j], params[i].end_pose, jobs[i].id)
                   for j in range(len(jobs))] for i in range(len(jobs))]
         deadline = [math.inf if p.deadline is None else p.deadline for p in params]
         budget = [self.budgets.get(c.task_type, math.inf) for c in jobs]

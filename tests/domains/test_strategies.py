@@ -148,3 +148,24 @@ def test_cook_suspension_policy_is_the_same_factor_for_both_strategies(tasks: di
     off = ["turn_off"] if ("cooker_on", "cooker") in held.facts else []
     assert susp("strict", 10.0, held) == ["put_down", *off]
     assert susp("conditional", 10.0, held) == ["put_down"]
+
+
+def test_a_suspension_planned_ahead_takes_the_static_time(task: PddlTaskType) -> None:
+    """While exeTsk runs under the planned strategy, compSP plans the suspension of the state
+    now; a susp in that same symbolic state finds it made (static_time_s, the same stages as
+    planning then), a susp after the state changed plans again (planning_time_s)."""
+    ctx = make_ctx(task)
+    exe = task.update_task(ctx)
+    ctx.plan, ctx.stage_index, ctx.stage_started = exe, len(exe.stages) - 1, 0.0  # running its last stage
+    ctx.world = apply(ctx.world, exe.stages[: len(exe.stages) - 1])
+    task.compute_params(ctx)
+    ahead = task.generate_suspension(ctx)
+    fresh = task.generate_suspension(make_ctx(task, world=ctx.world))
+    assert fresh.sim_time == task.spec.planning_time_s and "planned ahead" not in (fresh.note or "")
+    assert ahead.sim_time == task.spec.static_time_s and ahead.strategy == "planned"
+    assert [s.action for s in ahead.stages] == [s.action for s in fresh.stages]
+    if ahead.stages:
+        assert "planned ahead" in (ahead.note or "")
+    ctx.world = apply(ctx.world, exe.stages[-1:])  # the state changed since compSP: plan again
+    again = task.generate_suspension(ctx)
+    assert "planned ahead" not in (again.note or "")

@@ -413,3 +413,27 @@ def test_people_in_the_way_slow_a_leg_but_never_cut_it(tasks: dict[str, PddlTask
     assert into and all(table[k] == pytest.approx(free[k]) for k in into)
     walled = travel_table(world, StraightLineMotion(blocked=frozenset({bedroom})), 10.0)
     assert all(math.isinf(walled[k]) for k in into)  # no estimate_ignoring_people: nothing to fall back on
+
+
+def test_a_waiting_task_is_estimated_from_the_state_the_executing_task_leaves() -> None:
+    """Compound: while carry holds the vase, cook (which needs an empty hand and knows no
+    vase) was estimated from the world now and came out unsolvable, so every decision
+    between them compared inf with inf.  Estimated from what carry's suspension (for a
+    start now) or completion (for Alg. 2's cc after it) leaves, cook is finite."""
+    from pathlib import Path
+
+    from experiments import scenario as scenarios
+    from experiments.runner import build_robot
+
+    path = Path(__file__).resolve().parents[2] / "experiments" / "sweeps" / "scenarios" / "compound.toml"
+    loop, _ = build_robot(scenarios.load(scenarios.resolve(str(path))), seed=1)
+    trace = loop.run(until=40.0)
+    held = [e for e in trace.events if e["event"] == "decision" and e.get("dac") == "d2" and e.get("exeDA") == "d1"]
+    assert held, "cook must be compared with carry while carry runs"
+    for e in held:
+        assert all(math.isfinite(float(e[k])) for k in ("cTime_dac", "cc_dac", "c_switch", "c_wait")), e
+    # the handover itself: carry's suspension puts the vase down, its completion too
+    h = loop.harmoniser
+    effects = h.handover("d2")
+    assert effects is not None and any(f[0] == "hand_empty" for f in effects.add)
+    assert h.handover("d1") is None  # the executing task assumes nothing about itself

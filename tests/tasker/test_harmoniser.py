@@ -307,3 +307,38 @@ def test_a_start_predicts_from_the_moment_of_the_start() -> None:
     tr = loop.run()
     start = first(tr.events, event="command", agent="d2", flag="start")
     assert start["predicted_s"] == pytest.approx(start["t"])
+
+
+def test_handover_tells_a_waiting_task_what_the_one_before_it_leaves() -> None:
+    """TaskContext.handover: with no argument, the executing task's suspension effects (a
+    start now replaces it); with an agent's id, that agent's completion effects; nothing
+    about the executing task itself, nor from a task that is not running exeTsk."""
+    from tasker.task import Effects
+
+    class Holder(SyntheticTask):
+        def leaves(self, ctx: TaskContext, how):  # type: ignore[no-untyped-def]
+            return Effects(add=(("put_down", how),), delete=(("holding", "vase"),))
+
+    seen: list = []
+
+    class Asker(SyntheticTask):
+        def compute_params(self, ctx: TaskContext):  # type: ignore[no-untyped-def]
+            seen.append((ctx.now, ctx.handover(None), ctx.handover("d1")))
+            return super().compute_params(ctx)
+
+    loop = make_loop([Holder("hold", [st("carry", 10)]), Asker("ask", [st("x", 1)])], hysteresis=0.5)
+    loop.request(0.0, "hold")
+    loop.request(2.0, "ask")
+    loop.run()
+    while_held = [s for s in seen if 2.0 <= s[0] < 10.0]
+    assert while_held
+    for _, now, done in while_held:
+        assert now == Effects(add=(("put_down", "suspend"),), delete=(("holding", "vase"),))
+        assert done == Effects(add=(("put_down", "complete"),), delete=(("holding", "vase"),))
+    assert loop.harmoniser.handover("d2") is None  # d1 has ended: nothing to assume
+    from tasker.stage import Stage
+
+    net = Effects.of([Stage("pick", data={"add": [["holding", "vase"]], "delete": [["hand_empty"]]}),
+                      Stage("put", data={"add": [["hand_empty"]], "delete": [["holding", "vase"]]})])
+    assert net == Effects(add=(("hand_empty",),), delete=(("holding", "vase"),))
+    assert not Effects.of([])

@@ -286,3 +286,28 @@ def test_the_runner_gives_the_harmoniser_the_monitors_hazards() -> None:
     assert harm.hazard_waiting and harm.hazards is not None
     assert isinstance(harm.hazards.__self__, Monitor)  # type: ignore[attr-defined]
     assert harm.hazards() == ()  # nothing observed yet
+
+
+def test_a_shared_pattern_hazard_is_owned_by_whoever_made_it_true() -> None:
+    """Two task types declare the same door hazard (a pattern without $args), a third does
+    not.  A door open from the start is nobody's; a door a declaring task opens is that
+    task's (not the earliest live agent of some declaring type); a door opened by a task
+    that does not declare the hazard is nobody's.  One fact, one owner, one edge."""
+    door = Hazard("door_open", ("open", "?d"), budget_s=60.0)
+    world = Facts()
+    world.facts.add(("open", "front"))
+    opener_a = SyntheticTask("a", [st("wait", 5.0), st("open_kitchen", 1.0, add=("open", "kitchen"))])
+    opener_b = SyntheticTask("b", [st("open_bath", 1.0, add=("open", "bath"))])
+    other = SyntheticTask("c", [st("open_hall", 1.0, add=("open", "hall"))])
+    opener_a.meaning = opener_b.meaning = Meaning(hazards=(door,))
+    store = TaskStore([opener_a, opener_b, other])
+    loop = SimulationLoop(store, schedulers.create("fifo"), core=EffectExecutor(world))
+    monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning, world.snapshot,
+                      task_types=store.names())
+    loop.observers.append(monitor.observe)
+    loop.request(0.0, "a")  # d1: opens the kitchen at ~6 s
+    loop.request(0.0, "b")  # d2: opens the bathroom after d1
+    loop.request(0.0, "c")  # d3: opens the hall, declares nothing
+    loop.run()
+    on = {tuple(e["fact"]): e["agent"] for e in loop.trace.events if e["event"] == "hazard" and e["status"] == "on"}
+    assert on == {("open", "front"): None, ("open", "kitchen"): "d1", ("open", "bath"): "d2", ("open", "hall"): None}
