@@ -270,7 +270,7 @@ class Estimator:
         task = self.task
         if ctx.strategy.suspension != "static":
             world, goal, _ = task.suspension_inputs(ctx)
-            steps, status, _ = self._plan(ctx, world, goal, task.suspension_facts(ctx, world))
+            steps, status, _ = self.plan(ctx, world, goal, task.suspension_facts(ctx, world))
             if status is PlanStatus.SOLVED:
                 return task.builder.from_steps(steps, {}, ctx.args)
         # static, or as genSusp: an unsolvable suspension falls back to the decision list
@@ -289,7 +289,7 @@ class Estimator:
         if ctx.strategy.update == "static":
             return self._template(ctx, start, "")
         hworld, goal, extra = task.update_inputs(ctx)
-        steps, status, note = self._plan(ctx, hworld, goal, extra)
+        steps, status, note = self.plan(ctx, hworld, goal, extra)
         if status is PlanStatus.TIMEOUT:
             self.stats.timeouts += 1
             return self._template(ctx, start, "planner timed out: template walk")
@@ -331,9 +331,10 @@ class Estimator:
 
         return check
 
-    def _plan(self, ctx: TaskContext, world: WorldState, goal: list[Literal], extra: list[Literal],
-              travel: Travel | None = None) -> tuple[tuple[PlanStep, ...], PlanStatus, str]:
-        """Steps reaching ``goal`` from ``world``, through the cache of symbolic problems."""
+    def plan(self, ctx: TaskContext, world: WorldState, goal: list[Literal], extra: list[Literal],
+             travel: Travel | None = None) -> tuple[tuple[PlanStep, ...], PlanStatus, str]:
+        """Steps reaching ``goal`` from ``world``, through the cache of symbolic problems
+        (travel times from :meth:`reference_table` unless given)."""
         task = self.task
         if travel is None:
             travel = self.reference_table(world, ctx.motion)

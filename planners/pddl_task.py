@@ -297,38 +297,41 @@ class PddlTaskType(TaskType):
         """Plan the suspension of the state now, while ``exeTsk`` runs, once per symbolic state
         (``ctx.memory[PREPLAN_KEY]``): a ``susp`` that arrives in the same state then finds its
         plan made and takes the static strategy's ``static_time_s``, not ``planning_time_s``.
-        Not journalled: only the suspension genSusp uses is (:meth:`_preplanned`)."""
+        Planned as the estimates plan (:meth:`Estimator.plan <planners.estimates.Estimator.plan>`:
+        travel times with nobody in the way, a cache shared with the other agents' estimates
+        of this task's suspension); journalled only if genSusp uses it (:meth:`_preplanned`)."""
         world, goal, branch = self.suspension_inputs(ctx)
         extra = self.suspension_facts(ctx, world)
         key = self._suspension_key(world, goal, extra, branch.label)
         held = ctx.memory.get(PREPLAN_KEY)
         if held is not None and held[0] == key:
             return
-        text, init, _ = self.problem_text(ctx, world, goal, extra)
-        if holds(init, goal):
-            ctx.memory[PREPLAN_KEY] = (key, None)
-            return
-        result = self.planner.solve(text, timeout=self.timeout)
-        ctx.memory[PREPLAN_KEY] = (key, result) if result.solved and result.plan is not None else None
+        steps, status, _ = estimator_for(self).plan(ctx, world, goal, extra)
+        ctx.memory[PREPLAN_KEY] = (key, steps) if status is PlanStatus.SOLVED else None
 
     def _preplanned(self, ctx: TaskContext, world: WorldState, goal: list[Literal], extra: list[Literal],
                     label: str) -> StagePlan | None:
-        """genSusp's plan if :meth:`_preplan_suspension` made it for this very symbolic state."""
+        """genSusp's plan if :meth:`_preplan_suspension` made it for this very symbolic state,
+        re-timed with the travel times of the moment."""
         held = ctx.memory.get(PREPLAN_KEY)
         if held is None or held[0] != self._suspension_key(world, goal, extra, label):
             return None
         text, init, travel = self.problem_text(ctx, world, goal, extra)
-        result: PlanResult | None = held[1]
-        self._record(ctx, Purpose.GEN_SUSP, label, text, result)
-        if result is None:
+        steps: tuple[tuple[str, ...], ...] = held[1]
+        if not steps:  # the goal held in this very state
+            self._record(ctx, Purpose.GEN_SUSP, label, text, None)
             return StagePlan((), Purpose.GEN_SUSP, strategy="planned", sim_time=self.spec.static_time_s,
                              note="goal already holds" + (f" ({label})" if label else ""))
-        assert result.plan is not None
-        stages = self.builder.from_steps(result.plan, travel, ctx.args)
+        journal = _journal.get()
+        if journal is not None:
+            journal.append(PlanningRecord(
+                ctx.now, ctx.agent, self.name, Purpose.GEN_SUSP.value, label,
+                portable(self.domain, text.domain, text.problem), PlanStatus.SOLVED.value, steps, None,
+                "planned ahead, during exeTsk"))
+        stages = self.builder.from_steps(steps, travel, ctx.args)
         return StagePlan(stages, Purpose.GEN_SUSP, strategy="planned", sim_time=self.spec.static_time_s,
                          note=(label + "; " if label else "") + "planned ahead, during exeTsk",
-                         info={"planner": result.planner, "cost": result.cost, "cached": True,
-                               "planner_time_s": result.wall_time_s, "planned_ahead": True})
+                         info={"planner": self.planner.name, "planned_ahead": True})
 
     def _record(self, ctx: TaskContext, purpose: Purpose, label: str, text: PddlText,
                 result: PlanResult | None) -> None:
