@@ -43,8 +43,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from robot.drive import DriveLimits  # noqa: E402
 from robot.estimator import MotionEstimator  # noqa: E402
-from robot.motion import BasePlanner, DriveLimits  # noqa: E402
+from robot.motion import BasePlanner  # noqa: E402
 from robot.roadmap import ompl_setup, path_length  # noqa: E402
 from robot.scene import Scene  # noqa: E402
 from robot.sim import Simulation  # noqa: E402

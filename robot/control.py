@@ -16,7 +16,7 @@ import math
 from dataclasses import dataclass
 from enum import StrEnum
 
-from robot.motion import DriveLimits, wrap
+from robot.drive import DriveLimits, wrap
 
 Point = tuple[float, float]
 

@@ -1,7 +1,7 @@
 """Motion-cost estimates for the base: :class:`MotionEstimator`, travel matrices.
 
 :class:`MotionEstimator` implements :class:`tasker.world.MotionModel` over a
-:class:`robot.motion.BasePlanner`: paths timed with :class:`robot.motion.DriveLimits`, the
+:class:`robot.motion.BasePlanner`: paths timed with :class:`robot.drive.DriveLimits`, the
 same stop–turn–drive profile the controller executes (:mod:`robot.control`), so estimates
 match what MuJoCo takes.  A goal at a person means "next to them"
 (:meth:`MotionEstimator.approach`).  :func:`travel_matrix` answers a whole matrix in one
@@ -15,7 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robot.motion import BasePlanner, DriveLimits, Point, open_planner
+from robot.drive import DriveLimits
+from robot.motion import BasePlanner, Point, open_planner
 from robot.roadmap import path_length
 from robot.scene import Scene
 from robot.spec import WorldSpec

@@ -15,7 +15,7 @@
    block, plus rings of milestones around them;
 3. the route is shortened: the shortest chain of mutually visible route points.
 
-Time comes from :class:`DriveLimits` with the same stop–turn–drive profile the controller
+Time comes from :class:`~robot.drive.DriveLimits` with the same stop–turn–drive profile the controller
 executes (:mod:`robot.control`); :mod:`robot.estimator` turns paths into
 :class:`tasker.world.MotionModel` estimates with it.
 
@@ -30,72 +30,17 @@ from __future__ import annotations
 
 import math
 from collections import OrderedDict
-from dataclasses import dataclass
 
 import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from robot.roadmap import Roadmap, heading
+from robot.roadmap import Roadmap
 from robot.scene import Disc, Scene, point_box_distance
-from robot.spec import RobotSpec, WorldSpec
+from robot.spec import WorldSpec
 from robot.visibility import Visibility
 
 Point = tuple[float, float]
-
-
-def wrap(angle: float) -> float:
-    """An angle brought into [-pi, pi)."""
-    return (angle + math.pi) % (2 * math.pi) - math.pi
-
-
-def profile_time(distance: float, v_max: float, accel: float) -> float:
-    """Time to cover ``distance`` from rest to rest with a trapezoidal speed profile."""
-    distance = abs(distance)
-    if distance * accel >= v_max * v_max:
-        return distance / v_max + v_max / accel
-    return 2.0 * math.sqrt(distance / accel)
-
-
-@dataclass(frozen=True, slots=True)
-class DriveLimits:
-    """Speed and acceleration limits of the base (m/s, rad/s, m/s², rad/s²)."""
-
-    v_max: float = 0.5
-    w_max: float = 1.0
-    accel: float = 0.5
-    turn_accel: float = 2.0
-    turn_tolerance: float = 0.02  # radians: a turn smaller than this is skipped
-
-    def __post_init__(self) -> None:
-        for name in ("v_max", "w_max", "accel", "turn_accel"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"DriveLimits.{name} must be > 0, got {getattr(self, name)}")
-
-    @classmethod
-    def of(cls, robot: RobotSpec) -> DriveLimits:
-        return cls(robot.max_speed, robot.max_turn, robot.max_accel, robot.max_turn_accel)
-
-    def turn_time(self, angle: float) -> float:
-        angle = abs(wrap(angle))
-        return 0.0 if angle < self.turn_tolerance else profile_time(angle, self.w_max, self.turn_accel)
-
-    def drive_time(self, distance: float) -> float:
-        return profile_time(distance, self.v_max, self.accel) if distance > 1e-6 else 0.0
-
-    def travel_time(self, path: list[Point], start_yaw: float, goal_yaw: float | None) -> float:
-        """Stop, turn toward the next point, drive to it; at the end turn to ``goal_yaw``."""
-        t, yaw = 0.0, start_yaw
-        for a, b in zip(path, path[1:], strict=False):
-            d = math.hypot(b[0] - a[0], b[1] - a[1])
-            if d < 1e-6:
-                continue
-            h = heading(a, b)
-            t += self.turn_time(h - yaw) + self.drive_time(d)
-            yaw = h
-        if goal_yaw is not None:
-            t += self.turn_time(goal_yaw - yaw)
-        return t
 
 
 Layer = tuple[tuple[str, ...], tuple[Disc, ...]]  # closed doors, people in the way

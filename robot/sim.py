@@ -30,9 +30,10 @@ from pathlib import Path
 import numpy as np
 
 from robot.control import STOP
+from robot.drive import DriveLimits
 from robot.estimator import APPROACH, MotionEstimator
 from robot.mjworld import TIMESTEP, MjApartment
-from robot.motion import BasePlanner, DriveLimits, open_planner
+from robot.motion import BasePlanner, open_planner
 from robot.people import People, Person
 from robot.recording import PersonState, Recorder
 from robot.scene import PERSON_RADIUS, Scene, point_box_distance, segments_clear

@@ -28,8 +28,9 @@ from typing import Protocol
 import numpy as np
 
 from robot.control import STOP, Command, PathFollower
+from robot.drive import DriveLimits
 from robot.estimator import MotionEstimator
-from robot.motion import BasePlanner, DriveLimits
+from robot.motion import BasePlanner
 from robot.people import People
 from robot.scene import Scene, point_box_distance
 from robot.spec import WorldSpec

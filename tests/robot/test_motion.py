@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from robot import roadmap
-from robot.motion import BasePlanner, DriveLimits, profile_time
+from robot.drive import DriveLimits, profile_time
+from robot.motion import BasePlanner
 from robot.scene import Scene
 from robot.tiago import RobotCollision, robot_dimensions
 from tasker.world import UNREACHABLE, MotionModel
