@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from experiments.store import ResultStore, RunRow, Status
-from experiments.sweep import FACTORS, Strategy
+from experiments.strategy import FACTORS, Strategy
 
 HIGHER_IS_BETTER = re.compile(r"(?<!un)finished|completed|success|throughput|reward|real_time_factor")
 """Metric names for which a larger value is better (otherwise smaller is)."""
