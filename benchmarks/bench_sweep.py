@@ -26,7 +26,9 @@ sys.path.insert(0, str(ROOT))
 
 from experiments import synthetic  # noqa: E402
 from experiments.store import ResultStore  # noqa: E402
-from experiments.sweep import Job, Strategy, SweepSpec, run_sweep  # noqa: E402
+from experiments.strategy import Strategy  # noqa: E402
+from experiments.sweep import run_sweep  # noqa: E402
+from experiments.sweepspec import Job, SweepSpec  # noqa: E402
 
 DEMO = ROOT / "experiments" / "scenarios" / "synthetic_demo.toml"
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from experiments.report_metrics import higher_is_better, host_dependent, lookup, numeric_metrics
 from experiments.stats import Estimate, estimate, holm, paired_p
 from experiments.store import RunRow, Status
-from experiments.sweep import FACTORS, Strategy
+from experiments.strategy import FACTORS, Strategy
 
 ALL = "*"
 """The scenario column of rows pooled over every scenario (descriptive summaries only, never a verdict)."""

@@ -157,7 +157,7 @@ class Checker:
                              functools.partial(stores[0].validate, task, task_args))
 
     def _sweep(self, p: Path) -> None:
-        from experiments.sweep import load_spec
+        from experiments.sweepspec import load_spec
 
         specs: list[Any] = []
         if self.attempt(p, "sweep spec", lambda: specs.append(load_spec(p))):

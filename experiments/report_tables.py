@@ -16,7 +16,7 @@ from experiments.analysis import INFEASIBLE, Analysis, MetricSummary, Paired, Pr
 from experiments.report_metrics import headline, higher_is_better, host_dependent, lookup, numeric_metrics
 from experiments.stats import ALPHA, Estimate
 from experiments.store import RunRow, Status
-from experiments.sweep import Strategy
+from experiments.strategy import Strategy
 
 
 def _fmt(x: float) -> str:

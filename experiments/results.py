@@ -27,7 +27,9 @@ from experiments.report import build_report
 from experiments.report_metrics import host_dependent, numeric_metrics
 from experiments.stats import ALPHA, Estimate, estimate, holm
 from experiments.store import ResultStore, RunRow, Status
-from experiments.sweep import Strategy, SweepSpec, load_spec, run_sweep
+from experiments.strategy import Strategy
+from experiments.sweep import run_sweep
+from experiments.sweepspec import SweepSpec, load_spec
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = "experiments/sweeps/factorial.toml"

@@ -95,7 +95,8 @@ def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-    from experiments.sweep import load_spec, run_sweep
+    from experiments.sweep import run_sweep
+    from experiments.sweepspec import load_spec
 
     spec = load_spec(args.spec)
     paths = task_paths(args)

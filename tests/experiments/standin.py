@@ -1,6 +1,6 @@
 """A stand-in ``run_fn`` for sweep tests: a synthetic scenario run, metrics read from its trace.
 
-It returns the same shape as :func:`experiments.sweep.run_job` (a record with the
+It returns the same shape as :func:`experiments.workers.run_job` (a record with the
 scenario, seed, settings, planner, host, date and version; flat numeric metrics)
 without the robot or the planner, so sweep tests stay fast.
 """
@@ -16,7 +16,7 @@ from typing import Any
 
 import tasker
 from experiments import synthetic
-from experiments.sweep import Job
+from experiments.sweepspec import Job
 from tasker.trace import Trace
 
 DEMO = Path(__file__).parents[2] / "experiments" / "scenarios" / "synthetic_demo.toml"

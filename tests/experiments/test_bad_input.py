@@ -13,7 +13,7 @@ from experiments import scenario as scenarios
 from experiments import synthetic
 from experiments.cli import main
 from experiments.fields import ScenarioError
-from experiments.sweep import SpecError, load_spec
+from experiments.sweepspec import SpecError, load_spec
 from robot.spec import WorldFileError, load_world
 from tasker.reader import InputError, InputWarning
 from tests.experiments import standin

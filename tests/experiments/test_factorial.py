@@ -10,7 +10,8 @@ import pytest
 
 from experiments import scenario as scenarios
 from experiments.scenario import InterruptionGrid
-from experiments.sweep import SpecError, Strategy, expand, load_spec
+from experiments.strategy import Strategy, expand
+from experiments.sweepspec import SpecError, load_spec
 from robot.scene import PERSON_RADIUS, Scene
 from robot.spec import load_world
 

@@ -11,7 +11,7 @@ import pytest
 from experiments import results
 from experiments.stats import holm
 from experiments.store import ResultStore, RunRow, Status
-from experiments.sweep import Strategy
+from experiments.strategy import Strategy
 
 STRATEGIES = [Strategy(update="planned", suspension=s, policy=p, hazard_waiting=h).label
               for s, p, h in itertools.product(("static", "planned"), ("strict", "conditional"), (False, True))]
@@ -120,7 +120,7 @@ def test_main_reports_what_the_database_holds(rows: list[RunRow], tmp_path: Path
 
 
 def test_the_shipped_factorial_spec_is_the_declared_design() -> None:
-    from experiments.sweep import load_spec
+    from experiments.sweepspec import load_spec
 
     spec = load_spec(Path(results.ROOT) / results.SPEC)
     assert {Strategy.parse(s.label) for s in spec.strategies} == {Strategy.parse(s) for s in STRATEGIES}

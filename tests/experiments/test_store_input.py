@@ -12,7 +12,9 @@ import pytest
 
 from experiments.report import EmptyDatabase, build_report
 from experiments.store import ResultStore, RunRow, Status, StoreError
-from experiments.sweep import Strategy, SweepSpec, run_sweep
+from experiments.strategy import Strategy
+from experiments.sweep import run_sweep
+from experiments.sweepspec import SweepSpec
 from tests.experiments import standin
 
 

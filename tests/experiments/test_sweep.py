@@ -18,7 +18,9 @@ import pytest
 
 from experiments.report import build_report
 from experiments.store import ResultStore, RunRow, Status, StoreError
-from experiments.sweep import Job, SpecError, Strategy, SweepError, SweepSpec, load_spec, run_sweep
+from experiments.strategy import Strategy
+from experiments.sweep import SweepError, run_sweep
+from experiments.sweepspec import Job, SpecError, SweepSpec, load_spec
 from tests.experiments import standin
 
 ROOT = Path(__file__).parents[2]
@@ -237,7 +239,9 @@ def test_sweep_on_dask_stopped_half_way_and_resumed(tmp_path: Path, small_spec: 
 
 _KILLED_SWEEP = """
 import sys
-from experiments.sweep import SweepSpec, Strategy, run_sweep
+from experiments.strategy import Strategy
+from experiments.sweep import run_sweep
+from experiments.sweepspec import SweepSpec
 from tests.experiments import standin
 
 if __name__ == "__main__":

@@ -12,14 +12,18 @@ from pathlib import Path
 import pytest
 
 from experiments.store import ResultStore, Status
-from experiments.sweep import Job, Strategy, SweepError, SweepSpec, lease, load_spec, run_sweep
+from experiments.strategy import Strategy
+from experiments.sweep import SweepError, lease, run_sweep
+from experiments.sweepspec import Job, SweepSpec, load_spec
 from tests.experiments import standin
 
 ROOT = Path(__file__).parents[2]
 
 _DRIVER = """
 import sys
-from experiments.sweep import SweepSpec, Strategy, run_sweep
+from experiments.strategy import Strategy
+from experiments.sweep import run_sweep
+from experiments.sweepspec import SweepSpec
 from tests.experiments import standin
 
 if __name__ == "__main__":
