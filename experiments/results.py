@@ -22,20 +22,10 @@ import sys
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
-from experiments.report import (
-    ALPHA,
-    INFEASIBLE,
-    Estimate,
-    Paired,
-    PrimaryOutcome,
-    build_report,
-    constant_metrics,
-    estimate,
-    holm,
-    host_dependent,
-    numeric_metrics,
-    paired,
-)
+from experiments.analysis import INFEASIBLE, Paired, PrimaryOutcome, constant_metrics, paired
+from experiments.report import build_report
+from experiments.report_metrics import host_dependent, numeric_metrics
+from experiments.stats import ALPHA, Estimate, estimate, holm
 from experiments.store import ResultStore, RunRow, Status
 from experiments.strategy import Strategy
 from experiments.sweep import run_sweep

@@ -10,7 +10,7 @@ from typing import Any
 import pytest
 from plotly.offline import get_plotlyjs
 
-from experiments import report_html, synthetic
+from experiments import html_timeline, html_world, report_html, synthetic
 from experiments.runner import run_scenario
 from robot.spec import load_world
 
@@ -53,7 +53,7 @@ def test_timeline_separates_costs_rates_roles_and_hazards(events: list[dict[str,
     trace = [*events, {"t": 3.0, **HAZARD, "status": "on"}, {"t": 9.0, **HAZARD, "status": "off"}]
     hazards = report_html.hazards_of(trace, None)
     assert hazards == [("d1", "device_on cooker", 3.0, 9.0)]
-    fig = report_html.timeline_figure(trace, hazards)
+    fig = html_timeline.timeline_figure(trace, hazards)
     by_axis: dict[str, set[str]] = {}
     for t in fig.data:
         by_axis.setdefault(t.yaxis or "y", set()).add(t.name)
@@ -71,7 +71,7 @@ def test_timeline_without_cost_decisions_shows_the_decisions() -> None:
     trace = [{"t": 0.0, "event": "request", "agent": "d1", "task_type": "a", "args": {}, "requester": "x"},
              {"t": 1.0, "event": "decision", "algorithm": "priority", "rule": "priority", "dac": "d2",
               "exeDA": "d1", "switch": True}]
-    fig = report_html.timeline_figure(trace)
+    fig = html_timeline.timeline_figure(trace)
     other = next(t for t in fig.data if t.name == "other decisions")
     assert list(other.x) == [1.0] and list(other.y) == ["priority"]
 
@@ -83,7 +83,7 @@ def test_hazards_fall_back_to_metric_episodes() -> None:
 
 
 def test_gantt_names_every_stage(events: list[dict[str, Any]]) -> None:
-    fig = report_html.gantt_figure(events)
+    fig = html_timeline.gantt_figure(events)
     names = next(t for t in fig.data if t.name == "stage names")
     begun = [e["action"] for e in events if e["event"] == "stage" and e["status"] == "begin"]
     assert sorted(names.text) == sorted(begun)
@@ -95,7 +95,7 @@ def test_world_slider_follows_the_trajectory(events: list[dict[str, Any]]) -> No
     robot = [(float(t), 1.0 + 0.1 * t, 1.0, 0.0) for t in range(60)]
     people = {"peter": [(0.0, 8.0, 5.0, "standing"), (30.0, 8.0, 5.0, "fallen")]}
     trace = [*events, {"t": 10.0, **HAZARD, "status": "on"}]
-    fig = report_html.world_figure(world, robot, people, trace, report_html.hazards_of(trace, None))
+    fig = html_world.world_figure(world, robot, people, trace, report_html.hazards_of(trace, None))
     frames = fig["frames"]
     assert len(frames) == len(fig["layout"]["sliders"][0]["steps"]) >= 2
     last = frames[-1]
@@ -117,7 +117,7 @@ def test_recorded_trajectory_of_the_robot_recorder_is_read(tmp_path: Path) -> No
              {"t": 0.1, "mark": "manipulated", "object": "pan", "action": "pick_pan", "at": [1.0, 2.0]},
              {"t": 0.1, "robot": [1.5, 2.0, 0.5], "people": {"peter": [3.0, 4.0, 0.0, "fallen"]}}]
     (tmp_path / "trajectory.jsonl").write_text("".join(json.dumps(r) + "\n" for r in lines))
-    assert report_html.read_trajectory(tmp_path) == (
+    assert html_world.read_trajectory(tmp_path) == (
         [(0.0, 1.0, 2.0, 0.5), (0.1, 1.5, 2.0, 0.5)],
         {"peter": [(0.0, 3.0, 4.0, "standing"), (0.1, 3.0, 4.0, "fallen")]})
 
@@ -131,7 +131,7 @@ def test_recorded_trajectory_files_are_read(kind: str, tmp_path: Path) -> None:
         (tmp_path / "trajectory.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
     else:
         (tmp_path / "trajectory.csv").write_text("t,x,y,yaw\n0.0,1.0,2.0,0.5\n1.0,1.5,2.0,0.5\n")
-    got = report_html.read_trajectory(tmp_path)
+    got = html_world.read_trajectory(tmp_path)
     assert got is not None
     robot, people = got
     assert robot == [(0.0, 1.0, 2.0, 0.5), (1.0, 1.5, 2.0, 0.5)]
@@ -140,6 +140,6 @@ def test_recorded_trajectory_files_are_read(kind: str, tmp_path: Path) -> None:
 
 
 def test_unknown_trajectory_format_falls_back(tmp_path: Path) -> None:
-    assert report_html.read_trajectory(tmp_path) is None
+    assert html_world.read_trajectory(tmp_path) is None
     (tmp_path / "trajectory.jsonl").write_text('{"time": 1}\n')
-    assert report_html.read_trajectory(tmp_path) is None
+    assert html_world.read_trajectory(tmp_path) is None

@@ -1,4 +1,4 @@
-"""The sweep report: confidence intervals, paired planned-vs-static comparison, files written."""
+"""The sweep report: summaries, paired comparisons per factor, the tables and files it writes."""
 
 from __future__ import annotations
 
@@ -7,10 +7,22 @@ import math
 from pathlib import Path
 
 import pytest
-from scipy import stats
 
-from experiments import report
-from experiments.report import ALL, build_report, comparisons, estimate, numeric_metrics, paired, summarise
+from experiments import report_tables
+from experiments.analysis import (
+    ALL,
+    PrimaryOutcome,
+    analyse,
+    comparisons,
+    constant_metrics,
+    paired,
+    primary_cells,
+    summarise,
+)
+from experiments.report import build_report
+from experiments.report_metrics import higher_is_better, host_dependent, numeric_metrics
+from experiments.report_plots import plot_frontier
+from experiments.stats import holm
 from experiments.store import ResultStore, RunRow, Status, StoreError
 
 STATIC = "update=static,suspension=static"
@@ -39,16 +51,6 @@ def rows() -> list[RunRow]:
     return out
 
 
-def test_estimate_is_the_student_t_interval() -> None:
-    values = [1.0, 2.0, 4.0, 7.0]
-    e = estimate(values)
-    low, high = stats.t.interval(0.95, len(values) - 1, loc=sum(values) / 4, scale=stats.sem(values))
-    assert (e.n, e.low, e.high) == (4, pytest.approx(low), pytest.approx(high))
-    one = estimate([3.0])
-    assert one.mean == 3.0 and math.isnan(one.half)
-    assert estimate([]).n == 0
-
-
 def test_numeric_metrics_flatten_and_skip_what_is_not_a_number() -> None:
     flat = numeric_metrics({"totals": {"failed": 1, "duration_s": {"mean": 2.5}}, "run": {"seed": 3, "ok": True},
                             "note": "hello", "list": [1, 2], "inf_metric": "inf", "tasks": {"d1": {"x": 1}}})
@@ -65,9 +67,9 @@ def test_summaries_per_strategy_pooled_and_per_scenario(rows: list[RunRow]) -> N
 
 
 def test_direction_of_better() -> None:
-    assert report.higher_is_better("totals.finished")
-    assert not report.higher_is_better("totals.unfinished")
-    assert not report.higher_is_better("safety.violations_at_switch")
+    assert higher_is_better("totals.finished")
+    assert not higher_is_better("totals.unfinished")
+    assert not higher_is_better("safety.violations_at_switch")
 
 
 def test_comparisons_pair_strategies_that_differ_in_one_factor() -> None:
@@ -85,44 +87,30 @@ def test_comparisons_pair_strategies_that_differ_in_one_factor() -> None:
     ]
 
 
-def test_holm_against_a_hand_computed_example() -> None:
-    # sorted: 0.005*4 = 0.02, 0.01*3 = 0.03, 0.03*2 = 0.06, 0.04*1 = 0.04 -> kept monotone at 0.06
-    adjusted = report.holm([0.01, 0.04, 0.03, 0.005, math.nan])
-    assert adjusted[:4] == [pytest.approx(0.03), pytest.approx(0.06), pytest.approx(0.06), pytest.approx(0.02)]
-    assert math.isnan(adjusted[4])  # no test, not in the family
-    assert report.holm([0.5, 0.9]) == [pytest.approx(1.0), pytest.approx(1.0)]  # capped at 1
-
-
 def test_paired_is_per_scenario_never_pooled_and_holm_corrected(rows: list[RunRow]) -> None:
     pairs = {(p.scenario, p.metric): p for p in paired(rows)}
     assert not any(sc == ALL for sc, _ in pairs)  # opposite effects in a and b are never pooled
     assert ("a", "totals.duration_s.mean") not in pairs  # replaced by the finished-only duration
     a = pairs[("a", "x_s")]
     assert (a.wins, a.ties, a.losses, a.diff.mean, a.diff.n) == (5, 0, 0, pytest.approx(-2.0), 5)
-    assert report._verdict(a) == "suspension=planned better"
+    assert report_tables._verdict(a) == "suspension=planned better"
     b = pairs[("b", "x_s")]
-    assert (b.wins, b.ties, b.losses) == (0, 0, 5) and report._verdict(b) == "suspension=static better"
+    assert (b.wins, b.ties, b.losses) == (0, 0, 5) and report_tables._verdict(b) == "suspension=static better"
     tests = [p for p in pairs.values() if not math.isnan(p.p)]
-    assert [p.p_holm for p in tests] == pytest.approx(report.holm([p.p for p in tests]))
+    assert [p.p_holm for p in tests] == pytest.approx(holm([p.p for p in tests]))
     assert all(p.p_holm >= p.p for p in tests)
     failed = pairs[("a", "totals.failed")]
-    assert (failed.ties, report._verdict(failed)) == (5, "identical")
-
-
-def test_paired_p_is_the_paired_t_test() -> None:
-    d = [1.0, 2.0, 0.5, 3.0, -0.2]
-    assert report.paired_p(d) == pytest.approx(stats.ttest_1samp(d, 0.0).pvalue)
-    assert report.paired_p([1.0, 1.0]) == 0.0 and math.isnan(report.paired_p([0.0, 0.0]))
+    assert (failed.ties, report_tables._verdict(failed)) == (5, "identical")
 
 
 def test_constant_metrics_are_dropped_with_a_note(tmp_path: Path, rows: list[RunRow]) -> None:
     const = [RunRow(r.scenario, r.seed, r.strategy, r.status, r.record, {**r.metrics, "resumption_s": 2.0})
              for r in rows]
-    assert report.constant_metrics(const)["resumption_s"] == 2.0
-    analysis = report.analyse(const)
+    assert constant_metrics(const)["resumption_s"] == 2.0
+    analysis = analyse(const)
     assert "resumption_s" not in {s.metric for s in analysis.summaries}
     assert "resumption_s" not in {p.metric for p in analysis.pairs}
-    assert "`resumption_s` = 2" in report.markdown(analysis)
+    assert "`resumption_s` = 2" in report_tables.markdown(analysis)
 
 
 def test_non_finite_values_are_counted_and_shown(rows: list[RunRow]) -> None:
@@ -133,7 +121,7 @@ def test_non_finite_values_are_counted_and_shown(rows: list[RunRow]) -> None:
     assert (by[("a", PLANNED, "y_s")].nonfinite, by[("a", PLANNED, "y_s")].estimate.n) == (1, 4)
     pairs = {(p.scenario, p.metric): p for p in paired(bad)}
     assert (pairs[("a", "y_s")].nonfinite, pairs[("a", "y_s")].diff.n) == (1, 4)
-    assert "1 non-finite" in report.markdown(report.analyse(bad))
+    assert "1 non-finite" in report_tables.markdown(analyse(bad))
 
 
 def test_failed_and_unfinished_tasks_are_out_of_the_duration_mean_and_counted() -> None:
@@ -144,7 +132,7 @@ def test_failed_and_unfinished_tasks_are_out_of_the_duration_mean_and_counted() 
     assert flat["derived.finished_duration_s.mean"] == 10.0 and "totals.duration_s.mean" not in flat
     rows = [RunRow("s", 1, STATIC, Status.OK, {}, m), RunRow("s", 2, STATIC, Status.ERROR, {}, {}, error="x: crash"),
             RunRow("s", 3, STATIC, Status.ERROR, {}, {}, error="PlanningFailed: unsolvable")]
-    md = report.markdown(report.analyse(rows))
+    md = report_tables.markdown(analyse(rows))
     assert "3 runs: 1 ok, 1 infeasible, 1 failed" in md
     assert f"| s | {STATIC} | 1 | 1 | 1 | 1 | 1 |" in md
 
@@ -153,11 +141,11 @@ def test_primary_outcome_reads_configured_paths(tmp_path: Path) -> None:
     rows = [RunRow("s", seed, st, Status.OK, {}, {"safety": {"unattended_s": h}, "people": {"time_to_help_s":
                                                                                               {"mean": w}}})
             for seed in range(4) for st, h, w in ((STATIC, 10.0 + seed, 30.0), (PLANNED, 1.0, 40.0 + seed))]
-    cells = report.primary_cells(rows, report.PrimaryOutcome())
+    cells = primary_cells(rows, PrimaryOutcome())
     assert cells[("s", STATIC)][0].mean == pytest.approx(11.5) and cells[("s", PLANNED)][1].mean == 41.5
-    custom = report.PrimaryOutcome(hazard=("people.time_to_help_s.mean",), help=("safety.unattended_s",))
-    assert report.primary_cells(rows, custom)[("s", STATIC)][0].mean == 30.0
-    assert report.plot_frontier(rows, custom, tmp_path) == tmp_path / "primary_frontier.png"
+    custom = PrimaryOutcome(hazard=("people.time_to_help_s.mean",), help=("safety.unattended_s",))
+    assert primary_cells(rows, custom)[("s", STATIC)][0].mean == 30.0
+    assert plot_frontier(rows, custom, tmp_path) == tmp_path / "primary_frontier.png"
 
 
 def test_errors_and_unpaired_runs_are_left_out_of_the_comparison(rows: list[RunRow]) -> None:
@@ -199,8 +187,8 @@ def test_host_dependent_metrics_are_reported_without_a_verdict(tmp_path: Path, r
              for r in rows]
     pairs = {(p.scenario, p.metric): p for p in paired(timed)}
     wall = pairs[("a", "wall_time_s")]
-    assert wall.diff.mean == pytest.approx(1.0) and report.host_dependent("wall_time_s") and math.isnan(wall.p)
-    assert report._verdict(wall) == "host-dependent: no verdict" and wall.better == "–"
+    assert wall.diff.mean == pytest.approx(1.0) and host_dependent("wall_time_s") and math.isnan(wall.p)
+    assert report_tables._verdict(wall) == "host-dependent: no verdict" and wall.better == "–"
     db = tmp_path / "r.db"
     with ResultStore(db) as store:
         for row in timed:

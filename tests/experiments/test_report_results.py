@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from experiments import results
-from experiments.report import holm
+from experiments.stats import holm
 from experiments.store import ResultStore, RunRow, Status
 from experiments.strategy import Strategy
 
