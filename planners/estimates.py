@@ -332,9 +332,10 @@ class Estimator:
         return check
 
     def plan(self, ctx: TaskContext, world: WorldState, goal: list[Literal], extra: list[Literal],
-             travel: Travel | None = None) -> tuple[tuple[PlanStep, ...], PlanStatus, str]:
+             travel: Travel | None = None, *, solve: bool = True) -> tuple[tuple[PlanStep, ...], PlanStatus, str]:
         """Steps reaching ``goal`` from ``world``, through the cache of symbolic problems
-        (travel times from :meth:`reference_table` unless given)."""
+        (travel times from :meth:`reference_table` unless given).  ``solve=False``: only what
+        the cache holds (an unsolved problem answers ``PlanStatus.ERROR``, "not planned yet")."""
         task = self.task
         if travel is None:
             travel = self.reference_table(world, ctx.motion)
@@ -343,6 +344,12 @@ class Estimator:
         text, init = render_problem(task.domain, world, goal, extra_facts=extra, travel=travel, name=task.name)
         if holds(init, goal):
             return (), PlanStatus.SOLVED, ""
+        if not solve:
+            with self._lock:
+                cached = self._cache.get(text) if self.cache_size else None
+            if cached is None:
+                return (), PlanStatus.ERROR, "not planned yet"
+            return cached.steps, cached.status, ""
         with self._lock:
             hit = self._cache.get(text) if self.cache_size else None
             if hit is not None:

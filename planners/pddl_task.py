@@ -297,9 +297,16 @@ class PddlTaskType(TaskType):
         """Plan the suspension of the state now, while ``exeTsk`` runs, once per symbolic state
         (``ctx.memory[PREPLAN_KEY]``): a ``susp`` that arrives in the same state then finds its
         plan made and takes the static strategy's ``static_time_s``, not ``planning_time_s``.
+        During a blocking stage, the state planned for is the one that stage leaves (its
+        ``add``/``delete``): a ``susp`` is honoured only when it ends.
         Planned as the estimates plan (:meth:`Estimator.plan <planners.estimates.Estimator.plan>`:
         travel times with nobody in the way, a cache shared with the other agents' estimates
         of this task's suspension); journalled only if genSusp uses it (:meth:`_preplanned`)."""
+        cur = ctx.current
+        if cur is not None and cur.blocking and isinstance(ctx.world, WorldState):
+            # a susp now is honoured only when this stage ends (eq. 25): plan for what it leaves
+            ctx = replace(ctx, world=ctx.world.updated(add=[tuple(f) for f in cur.data.get("add", ())],
+                                                       delete=[tuple(f) for f in cur.data.get("delete", ())]))
         world, goal, branch = self.suspension_inputs(ctx)
         extra = self.suspension_facts(ctx, world)
         key = self._suspension_key(world, goal, extra, branch.label)
@@ -311,13 +318,17 @@ class PddlTaskType(TaskType):
 
     def _preplanned(self, ctx: TaskContext, world: WorldState, goal: list[Literal], extra: list[Literal],
                     label: str) -> StagePlan | None:
-        """genSusp's plan if :meth:`_preplan_suspension` made it for this very symbolic state,
-        re-timed with the travel times of the moment."""
+        """genSusp's plan if it was made already for this very symbolic state — by
+        :meth:`_preplan_suspension`, or by an estimate of this suspension for another agent
+        (:meth:`leaves`, the handover) — re-timed with the travel times of the moment."""
         held = ctx.memory.get(PREPLAN_KEY)
-        if held is None or held[0] != self._suspension_key(world, goal, extra, label):
-            return None
+        if held is not None and held[0] == self._suspension_key(world, goal, extra, label):
+            steps: tuple[tuple[str, ...], ...] = held[1]
+        else:  # planned already for another agent's estimate of this very suspension (handover)?
+            steps, status, _ = estimator_for(self).plan(ctx, world, goal, extra, solve=False)
+            if status is not PlanStatus.SOLVED:
+                return None
         text, init, travel = self.problem_text(ctx, world, goal, extra)
-        steps: tuple[tuple[str, ...], ...] = held[1]
         if not steps:  # the goal held in this very state
             self._record(ctx, Purpose.GEN_SUSP, label, text, None)
             return StagePlan((), Purpose.GEN_SUSP, strategy="planned", sim_time=self.spec.static_time_s,
@@ -327,10 +338,10 @@ class PddlTaskType(TaskType):
             journal.append(PlanningRecord(
                 ctx.now, ctx.agent, self.name, Purpose.GEN_SUSP.value, label,
                 portable(self.domain, text.domain, text.problem), PlanStatus.SOLVED.value, steps, None,
-                "planned ahead, during exeTsk"))
+                "planned ahead"))
         stages = self.builder.from_steps(steps, travel, ctx.args)
         return StagePlan(stages, Purpose.GEN_SUSP, strategy="planned", sim_time=self.spec.static_time_s,
-                         note=(label + "; " if label else "") + "planned ahead, during exeTsk",
+                         note=(label + "; " if label else "") + "planned ahead",
                          info={"planner": self.planner.name, "planned_ahead": True})
 
     def _record(self, ctx: TaskContext, purpose: Purpose, label: str, text: PddlText,

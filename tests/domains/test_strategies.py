@@ -151,21 +151,42 @@ def test_cook_suspension_policy_is_the_same_factor_for_both_strategies(tasks: di
 
 
 def test_a_suspension_planned_ahead_takes_the_static_time(task: PddlTaskType) -> None:
-    """While exeTsk runs under the planned strategy, compSP plans the suspension of the state
-    now; a susp in that same symbolic state finds it made (static_time_s, the same stages as
-    planning then), a susp after the state changed plans again (planning_time_s)."""
+    """While exeTsk runs under the planned strategy, compSP plans the suspension ahead — for
+    the state now, or during a blocking stage for the state that stage leaves (a susp waits
+    for its end).  A susp in that state finds the plan made (static_time_s, the stages a
+    planning then would give); in a state nobody planned for, genSusp plans (planning_time_s)."""
+    from planners.estimates import estimator_for
+
     ctx = make_ctx(task)
     exe = task.update_task(ctx)
+    last = exe.stages[-1]
     ctx.plan, ctx.stage_index, ctx.stage_started = exe, len(exe.stages) - 1, 0.0  # running its last stage
-    ctx.world = apply(ctx.world, exe.stages[: len(exe.stages) - 1])
+    ctx.world = apply(ctx.world, exe.stages[:-1])
+    estimator_for(task).clear()
     task.compute_params(ctx)
+    if last.blocking:
+        ctx.world = apply(ctx.world, [last])  # the susp is honoured when the blocking stage ends
     ahead = task.generate_suspension(ctx)
-    fresh = task.generate_suspension(make_ctx(task, world=ctx.world))
-    assert fresh.sim_time == task.spec.planning_time_s and "planned ahead" not in (fresh.note or "")
+    estimator_for(task).clear()
+    fresh = task.generate_suspension(make_ctx(task, world=ctx.world))  # nothing planned for it
     assert ahead.sim_time == task.spec.static_time_s and ahead.strategy == "planned"
     assert [s.action for s in ahead.stages] == [s.action for s in fresh.stages]
-    if ahead.stages:
+    if fresh.stages:
         assert "planned ahead" in (ahead.note or "")
-    ctx.world = apply(ctx.world, exe.stages[-1:])  # the state changed since compSP: plan again
-    again = task.generate_suspension(ctx)
-    assert "planned ahead" not in (again.note or "")
+        assert fresh.sim_time == task.spec.planning_time_s and "planned ahead" not in (fresh.note or "")
+
+
+def test_a_suspension_another_agent_estimated_is_planned_already(task: PddlTaskType) -> None:
+    """The handover: a waiting agent's estimate asks what this task's suspension leaves
+    (``leaves``), which plans that suspension into the shared cache; a susp in the same
+    state then finds it planned (static_time_s), although this agent never planned ahead."""
+    from planners.estimates import estimator_for
+
+    ctx = make_ctx(task, world=_mid_world(task))
+    estimator_for(task).clear()
+    task.leaves(ctx, "suspend")  # what another agent's estimate asks
+    plan = task.generate_suspension(ctx)
+    if plan.stages:
+        assert plan.sim_time == task.spec.static_time_s and "planned ahead" in (plan.note or "")
+    estimator_for(task).clear()
+    assert "planned ahead" not in (task.generate_suspension(make_ctx(task, world=ctx.world)).note or "")
