@@ -42,10 +42,14 @@ class MotionEstimator:
         self.open_planner = open_planner
 
     def estimate(self, start: Pose, goal: Pose) -> MotionEstimate:
+        """Time to drive from ``start`` to ``goal`` (to the person there, if any), with everyone
+        who is stepping aside already where they are going (:meth:`Scene.as_expected
+        <robot.scene.Scene.as_expected>`): they will be by the time the robot gets there."""
         person = self.planner.scene.person_at(goal[0], goal[1])
         if person is not None:
             return self.approach(start, person)[1]
-        return self._estimate(self.planner, start, goal)
+        with self.planner.scene.as_expected():
+            return self._estimate(self.planner, start, goal)
 
     def estimate_ignoring_doors(self, start: Pose, goal: Pose) -> MotionEstimate:
         """As :meth:`estimate` with every door open and nobody in the way.
@@ -73,12 +77,15 @@ class MotionEstimator:
         the first direction (east, then counter-clockwise), so the choice is deterministic.
         When no pose of that ring is reachable (a person lying between furniture and a
         wall, someone else standing beside them), the next ring of ``APPROACH_RINGS`` is
-        tried, nearest first.  ``(None, UNREACHABLE)`` when no candidate is reachable.
+        tried, nearest first.  ``(None, UNREACHABLE)`` when no candidate is reachable.  People
+        stepping aside count where they are going, as in :meth:`estimate`; the ``navigate``
+        skill drives to this pose once the way there is clear.
         """
-        for radius in APPROACH_RINGS:
-            best = self._approach_ring(start, person, radius)
-            if best[0] is not None:
-                return best
+        with self.planner.scene.as_expected():  # people stepping aside: where they are going
+            for radius in APPROACH_RINGS:
+                best = self._approach_ring(start, person, radius)
+                if best[0] is not None:
+                    return best
         return None, UNREACHABLE
 
     def _approach_ring(self, start: Pose, person: str, radius: float) -> tuple[Pose | None, MotionEstimate]:

@@ -133,11 +133,18 @@ class Person:
 
     def stepping_aside(self) -> bool:
         """Not yet where :attr:`giving_room` or, waiting, :attr:`aside` says to stand."""
+        return self.stepping_to() is not None
+
+    def stepping_to(self) -> tuple[float, float] | None:
+        """Where the person is stepping aside to (:attr:`giving_room` or, waiting,
+        :attr:`aside`), while not there yet; None otherwise."""
         if self.posture == "fallen":
-            return False
+            return None
         spot = self.giving_room[1] if self.giving_room is not None else None
         spot = spot if spot is not None else (self.aside if self.waiting else None)
-        return spot is not None and math.hypot(spot[0] - self.x, spot[1] - self.y) > 1e-9
+        if spot is None or math.hypot(spot[0] - self.x, spot[1] - self.y) <= 1e-9:
+            return None
+        return spot
 
     def _stand_up(self) -> None:
         if self.posture == "sitting":

@@ -16,7 +16,9 @@ and vectorised over obstacles and segments with numpy.
 
 from __future__ import annotations
 
+import contextlib
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -228,6 +230,7 @@ class Scene:
         self.door_open: dict[str, bool] = {n: d.open for n, d in spec.doors.items()}
         self.people: dict[str, Disc] = {}
         self.making_way: set[str] = set()  # people who follow the robot: never in its way
+        self.stepping_to: dict[str, tuple[float, float]] = {}  # people stepping aside: where to
         self.version = 0
         self._closed = np.zeros((0, 4))
         self._refresh_doors()
@@ -259,6 +262,32 @@ class Scene:
         no obstacle to anything the robot plans or drives: :meth:`discs` leaves them out."""
         if (name in self.making_way) != yes:
             (self.making_way.add if yes else self.making_way.discard)(name)
+            self.version += 1
+
+    def set_stepping_to(self, name: str, spot: tuple[float, float] | None) -> None:
+        """Person ``name`` is stepping aside to ``spot`` (None: not, or arrived)."""
+        if spot is None:
+            self.stepping_to.pop(name, None)
+        else:
+            self.stepping_to[name] = (float(spot[0]), float(spot[1]))
+
+    @contextlib.contextmanager
+    def as_expected(self) -> Iterator[None]:
+        """The scene with everyone who is stepping aside already where they are going
+        (:meth:`set_stepping_to`): what an estimate of the robot's motion should see, since by
+        the time the robot gets there they stand at their spot.  Restored on exit."""
+        moved = {n: self.people[n] for n in sorted(self.stepping_to) if n in self.people}
+        if not moved:
+            yield
+            return
+        for n, d in moved.items():
+            x, y = self.stepping_to[n]
+            self.people[n] = Disc(n, round(x, 3), round(y, 3), d.r)
+        self.version += 1
+        try:
+            yield
+        finally:
+            self.people.update(moved)
             self.version += 1
 
     def closed_doors(self) -> np.ndarray:

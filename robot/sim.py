@@ -114,6 +114,7 @@ class Simulation:
 
     def _sync_people(self) -> None:
         for p in self.people:
+            self.scene.set_stepping_to(p.name, p.stepping_to())
             state = (p.x, p.y, p.yaw, p.posture)
             if self._synced.get(p.name) != state:  # only who moved: the scene and MuJoCo follow
                 self._synced[p.name] = state
@@ -270,6 +271,7 @@ class Simulation:
             person = self.people[obj]
             person.waiting = value
             person.aside = self._aside_spot(person) if value else None
+            self.scene.set_stepping_to(person.name, person.stepping_to())  # estimates see it at once
         return True
 
     def _room_clear(self) -> float:

@@ -200,3 +200,29 @@ def test_a_door_closed_from_the_doorway_is_closed_from_the_stage_s_side(flat) ->
     x, y, _ = sim.robot_pose()
     assert y < 3.45 and point_box_distance(np.asarray([x]), np.asarray([y]), box).min() >= sim.scene.radius
     assert run(sim, nav("kitchen"), now)[0].state is SkillState.SUCCEEDED  # not walled in
+
+
+def test_a_person_stepping_aside_is_estimated_where_they_are_going(paper) -> None:
+    """Told to wait in the living/kitchen doorway, John steps aside; the very moment he is
+    told, the estimate through the door already counts him at his spot (he will be there
+    before the robot is), while the planner the robot drives with still sees him in the
+    way.  Once he stands there, estimate and plan agree."""
+    import dataclasses
+
+    from robot.roadmap import path_length
+    from robot.spec import PersonSpec
+
+    people = {"john": PersonSpec("john", (2.27, 4.96, 0.0), "standing", 1.0, (), ())}
+    sim = Simulation(dataclasses.replace(paper, people=people))
+    sim.bind([Binding("waiting", ("told_to_wait", "?h"), "?h")])
+    living, kitchen = paper.places["living"], paper.places["kitchen"]
+    blocked = sim.motion.estimate(living, kitchen)
+    sim.apply(add=[["told_to_wait", "john"]])  # he has not moved yet
+    assert sim.people["john"].pose[:2] == (2.27, 4.96) and sim.scene.stepping_to["john"] is not None
+    expected = sim.motion.estimate(living, kitchen)
+    assert expected.time_s < blocked.time_s - 1.0  # through the door, not round through the hall
+    assert path_length(sim.planner.plan(living[:2], kitchen[:2])) > expected.distance_m + 1.0  # driving: not yet
+    assert sim.scene.people["john"].x == 2.27  # the estimate left the scene as it was
+    sim.advance(6.0)
+    assert "john" not in sim.scene.stepping_to
+    assert sim.motion.estimate(living, kitchen).time_s == pytest.approx(expected.time_s, abs=0.5)
