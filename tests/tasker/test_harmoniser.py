@@ -342,3 +342,25 @@ def test_handover_tells_a_waiting_task_what_the_one_before_it_leaves() -> None:
                       Stage("put", data={"add": [["hand_empty"]], "delete": [["holding", "vase"]]})])
     assert net == Effects(add=(("hand_empty",),), delete=(("holding", "vase"),))
     assert not Effects.of([])
+
+
+def test_a_leaves_hook_that_raises_assumes_nothing() -> None:
+    """A task type's broken ``leaves`` must not take down the estimate of another task (or
+    the run): the handover assumes nothing, and both tasks finish."""
+    class Broken(SyntheticTask):
+        def leaves(self, ctx: TaskContext, how):  # type: ignore[no-untyped-def]
+            raise RuntimeError("a bug in a user's task type")
+
+    seen: list = []
+
+    class Asker(SyntheticTask):
+        def compute_params(self, ctx: TaskContext):  # type: ignore[no-untyped-def]
+            seen.append((ctx.handover(None), ctx.handover("d1")))
+            return super().compute_params(ctx)
+
+    loop = make_loop([Broken("broken", [st("carry", 10)]), Asker("ask", [st("x", 1)])], hysteresis=0.5)
+    loop.request(0.0, "broken")
+    loop.request(2.0, "ask")
+    tr = loop.run()
+    assert seen and all(s == (None, None) for s in seen)
+    assert [e["reason"] for e in tr.of("end")] == ["finished", "finished"]
