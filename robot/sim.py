@@ -66,7 +66,6 @@ class Simulation:
         self.rate_hz = float(rate_hz)
         _, _, radius = robot_dimensions()
         self.scene = Scene(self.spec, radius)
-        self._walls = np.array([o.box for o in self.spec.obstacles if o.kind == "wall"], dtype=float).reshape(-1, 4)
         self.people = People(self.spec.people.values())
         self.planner = BasePlanner(self.spec, self.scene, seed=seed, milestones=milestones)
         self.limits = DriveLimits.of(self.spec.robot)
@@ -425,7 +424,7 @@ class Simulation:
                 return nearest(inside)
         names = sorted(spots)
         ends = np.array([spots[n][:2] for n in names], dtype=float)
-        seen = segments_clear(np.repeat([[x, y]], len(names), axis=0), ends, self._walls, 1e-6)
+        seen = segments_clear(np.repeat([[x, y]], len(names), axis=0), ends, self.scene.walls, 1e-6)
         return nearest([n for n, ok in zip(names, seen, strict=True) if ok] or names)
 
     def apply(self, add: Iterable[Iterable[str]] = (), delete: Iterable[Iterable[str]] = ()) -> None:
