@@ -272,9 +272,7 @@ class PddlTaskType(TaskType):
         """A planned StagePlan, or the failed PlanResult for the caller to handle."""
         text, init, travel = self.problem_text(ctx, world, goal, extra)
         if holds(init, goal):
-            self._record(ctx, purpose, label, text, None)
-            note = "goal already holds" + (f" ({label})" if label else "")
-            return StagePlan((), purpose, strategy="planned", sim_time=self.spec.static_time_s, note=note)
+            return self._holds(ctx, purpose, label, text)
         result = self.planner.solve(text, timeout=self.timeout)
         self._record(ctx, purpose, label, text, result)
         if not result.solved:
@@ -330,9 +328,7 @@ class PddlTaskType(TaskType):
                 return None
         text, init, travel = self.problem_text(ctx, world, goal, extra)
         if not steps:  # the goal held in this very state
-            self._record(ctx, Purpose.GEN_SUSP, label, text, None)
-            return StagePlan((), Purpose.GEN_SUSP, strategy="planned", sim_time=self.spec.static_time_s,
-                             note="goal already holds" + (f" ({label})" if label else ""))
+            return self._holds(ctx, Purpose.GEN_SUSP, label, text)
         journal = _journal.get()
         if journal is not None:
             journal.append(PlanningRecord(
@@ -343,6 +339,12 @@ class PddlTaskType(TaskType):
         return StagePlan(stages, Purpose.GEN_SUSP, strategy="planned", sim_time=self.spec.static_time_s,
                          note=(label + "; " if label else "") + "planned ahead",
                          info={"planner": self.planner.name, "planned_ahead": True})
+
+    def _holds(self, ctx: TaskContext, purpose: Purpose, label: str, text: PddlText) -> StagePlan:
+        """The plan when the goal already holds: nothing to do, journalled as such."""
+        self._record(ctx, purpose, label, text, None)
+        note = "goal already holds" + (f" ({label})" if label else "")
+        return StagePlan((), purpose, strategy="planned", sim_time=self.spec.static_time_s, note=note)
 
     def _record(self, ctx: TaskContext, purpose: Purpose, label: str, text: PddlText,
                 result: PlanResult | None) -> None:
