@@ -333,15 +333,32 @@ class Simulation:
             return None
         room = room_of(self.spec, p.x, p.y)
         here = np.array([[p.x, p.y]])
+        door = next((pose[:2] for _, pose in sorted(self.spec.places.items())
+                     if room_of(self.spec, pose[0], pose[1]) == room), None)
         for ring in range(1, round(ASIDE_MAX / ASIDE_STEP) + 1):
             r = ring * ASIDE_STEP
             for k in range(ASIDE_DIRECTIONS):
                 a = 2 * math.pi * k / ASIDE_DIRECTIONS
                 x, y = round(p.x + r * math.cos(a), 3), round(p.y + r * math.sin(a), 3)
                 if (room_of(self.spec, x, y) == room and clear_here(x, y) and self.scene.static_free(x, y)
-                        and segments_clear(here, np.array([[x, y]]), self.scene.static, 1e-9)[0]):
+                        and segments_clear(here, np.array([[x, y]]), self.scene.static, 1e-9)[0]
+                        and self._robot_reaches(p.name, door, (x, y))):
                     return (x, y)
         return None
+
+    def _robot_reaches(self, name: str, place: tuple[float, float] | None, spot: tuple[float, float]) -> bool:
+        """Can the robot drive from the room's place to ``spot`` as the scene stands, less person
+        ``name``?  A person who steps aside must not step into a pocket the robot cannot
+        reach (a dead end behind the one they make room for): they could not be helped or
+        guided there.  True when the room has no place to drive from."""
+        if place is None:
+            return True
+        was = name in self.scene.making_way
+        self.scene.set_making_way(name, True)
+        try:
+            return self.planner.plan((float(place[0]), float(place[1])), spot) is not None
+        finally:
+            self.scene.set_making_way(name, was)
 
     def _bound_facts(self) -> set[Fact]:
         out: set[Fact] = set()

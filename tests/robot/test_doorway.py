@@ -276,3 +276,30 @@ def test_bystanders_make_room_for_help(paper) -> None:
     sim.advance(20.0)
     assert sim.people["q"].giving_room is None
     assert math.dist((sim.people["q"].x, sim.people["q"].y), (9.6, 4.6)) < 1e-6
+
+
+def test_nobody_makes_room_by_stepping_into_a_dead_end() -> None:
+    """Full day, seed 8: people making room for someone fallen at the entrance of the
+    corridor between the bed and the bathroom wall stepped to the nearest free spot — in
+    the corridor's dead end, where the robot could no longer reach them.  An aside spot must
+    be one the robot can drive to."""
+    import dataclasses
+    from pathlib import Path
+
+    from robot.spec import load_world
+
+    world = load_world(Path(__file__).resolve().parents[2] / "experiments" / "protocols" / "tabsa_apartment.toml")
+
+    def person(name: str, x: float, y: float, posture: str = "standing") -> PersonSpec:
+        return PersonSpec(name, (x, y, 0.0), posture, 0.5, (), ())
+
+    sim = Simulation(dataclasses.replace(world, people={"f": person("f", 9.18, 4.62, "fallen"),
+                                                       "b": person("b", 10.2, 4.6)}))
+    sim.advance(0.5)
+    spot = sim.people["b"].giving_room
+    assert spot is not None and spot[0] == "f"
+    if spot[1] is not None:
+        bedroom = world.places["bedroom"]
+        sim.scene.set_making_way("b", True)
+        assert sim.planner.plan(bedroom[:2], spot[1]) is not None, spot
+        assert spot[1][0] < 11.0, spot  # not in the dead end east of the bed
