@@ -32,9 +32,7 @@ from experiments.html_page import Raw, figure_div, page, table
 from experiments.html_timeline import gantt_figure, timeline_figure
 from experiments.html_world import Sample, read_trajectory, world_figure
 from experiments.plots import Event, _agents, _end_time, hazard_spans
-
-HOST_DEPENDENT = ("wall_time_s", "real_time_factor", "planner_wall_time_s", "planner_cache_hits")
-"""Metrics that measure the machine, not the strategy: shown, never compared."""
+from experiments.report_metrics import host_dependent
 
 
 def _fmt(v: Any) -> str:
@@ -131,7 +129,7 @@ def _details(metrics: Mapping[str, Any] | None, problems: Sequence[Mapping[str, 
     if metrics:
         rows = []
         for k, v in _flatten(metrics):
-            host = k in HOST_DEPENDENT
+            host = host_dependent(k)
             rows.append((Raw(f'<span class="host">{html.escape(k)} (host-dependent)</span>') if host else k,
                          _fmt(v)))
         out.append("<h2>Metrics</h2>")
