@@ -70,7 +70,7 @@ def plot(summaries: Sequence[MetricSummary], pairs: Sequence[Paired], out: Path)
         ax.set_xlabel("seed pairs")
         ax.set_title(f"{dim}: {p_label} vs {s_label}", fontsize="small")
         fig.legend(fontsize="x-small", loc="outside lower center", ncol=3)  # never over a bar
-        path = out / f"paired_{_slug(dim)}_{_slug(p_label)}.png"
+        path = out / f"paired_{_slug(dim)}_{_slug(p_label)}_vs_{_slug(s_label)}.png"  # one file per comparison
         fig.savefig(path, dpi=100)
         plt.close(fig)
         files.append(path)

@@ -89,19 +89,23 @@ def sweep_page(markdown_text: str, summaries: Sequence[Any], pairs: Sequence[Any
                           yaxis_title="mean, 95 % CI", legend={"orientation": "h", "y": -0.2},
                           margin={"t": 50, "r": 10})
         sections.append(figure_div(fig, f"metric-{n}"))
-    for n, key in enumerate(sorted({(p.dimension, p.planned, p.static) for p in pairs})):
-        shown = headline({p.metric for p in pairs})
-        mine = sorted((p for p in pairs if (p.dimension, p.planned, p.static) == key and p.scenario == ALL
-                       and p.metric in shown and not host_dependent(p.metric)), key=lambda p: shown.index(p.metric))
+    shown = headline({p.metric for p in pairs})
+    for n, key in enumerate(sorted({(p.dimension, p.treatment, p.baseline) for p in pairs})):
+        # pairs are per scenario, never pooled: one bar per (scenario, metric), as in the PNG charts
+        mine = sorted((p for p in pairs if (p.dimension, p.treatment, p.baseline) == key
+                       and p.metric in shown and not host_dependent(p.metric)),
+                      key=lambda p: (p.scenario, shown.index(p.metric)))
         if not mine:
             continue
+        labels = [f"{Path(p.scenario).stem}: {p.metric}" for p in mine]
         fig = go.Figure()
-        for label, attr, colour in (("planned better", "wins", "#2ca02c"), ("tie", "ties", "#999"),
-                                    ("static better", "losses", "#d62728")):
-            fig.add_trace(go.Bar(name=label, orientation="h", y=[p.metric for p in mine],
+        for label, attr, colour in (("treatment better", "wins", "#2ca02c"), ("tie", "ties", "#999"),
+                                    ("baseline better", "losses", "#d62728")):
+            fig.add_trace(go.Bar(name=label, orientation="h", y=labels,
                                  x=[getattr(p, attr) for p in mine], marker_color=colour))
-        fig.update_layout(title=f"{key[0]}: {key[1]} vs {key[2]}, (scenario, seed) pairs", barmode="stack",
-                          template="plotly_white", height=160 + 34 * len(mine), legend={"orientation": "h", "y": -0.25},
+        fig.update_layout(title=f"{key[0]}: {key[1]} (treatment) vs {key[2]}, seed pairs",
+                          barmode="stack", template="plotly_white", height=160 + 26 * len(mine),
+                          yaxis={"autorange": "reversed"}, legend={"orientation": "h", "y": -0.25},
                           margin={"t": 50, "r": 10})
         sections.append(figure_div(fig, f"paired-{n}"))
     return page(title, sections)

@@ -235,6 +235,12 @@ def test_sweep_on_dask_stopped_half_way_and_resumed(tmp_path: Path, small_spec: 
         paired = list(csv.DictReader(f))
     assert paired and all(int(r["wins"]) + int(r["ties"]) + int(r["losses"]) == int(r["n"]) for r in paired)
     assert files.plots and all(p.stat().st_size > 0 for p in files.plots)
+    # every comparison has its wins/ties/losses chart, in the PNGs and on the page (pairs are per scenario)
+    comparisons = {(r["dimension"], r["treatment"], r["baseline"]) for r in paired}
+    assert len([p for p in files.plots if p.name.startswith("paired_")]) == len(comparisons)
+    assert files.html is not None
+    page = files.html.read_text(encoding="utf-8")
+    assert all(f'id="paired-{n}"' in page for n in range(len(comparisons)))
 
 
 _KILLED_SWEEP = """
