@@ -237,6 +237,8 @@ class DynamicAgent:
             self.ctx.world = self._world()
 
     def _read_inbox(self) -> None:
+        if not self._inbox:
+            return
         for cmd in self._inbox:
             self._ack = cmd.seq
             if cmd.flag is Flag.START:

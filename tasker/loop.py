@@ -232,6 +232,8 @@ class SimulationLoop:
         stop_tick = self._to_tick(until) if until is not None else None
         horizon_tick = self._to_tick(self.horizon)
         harm = self.harmoniser
+        tokens, heap, pop = self._tokens, self._heap, heapq.heappop
+        isfinite, resolution = math.isfinite, self.resolution
         while self._heap:
             if self._pending_events == 0 and not harm.busy and until is None:
                 break
@@ -247,15 +249,16 @@ class SimulationLoop:
             now = tick * self.resolution
             harm.now = now
             timer = False
-            while self._heap and self._heap[0][0] == tick:
-                _, phase, _, item = heapq.heappop(self._heap)
+            while heap and heap[0][0] == tick:
+                _, phase, _, item = pop(heap)
                 if phase == _AGENT:
                     agent, token = item
-                    if token != self._tokens.get(agent.id) or agent.ended:
+                    if token != tokens.get(agent.id) or agent.ended:
                         continue
                     agent.step(now)
-                    if math.isfinite(agent.next_wake):
-                        self._wake(agent, max(tick + 1, self._to_tick(agent.next_wake)))
+                    wake = agent.next_wake
+                    if isfinite(wake):  # the first tick at or after it, never this one (as _to_tick)
+                        self._wake(agent, max(tick + 1, math.ceil(wake / resolution - 1e-6)))
                 elif phase == _EVENT:
                     self._pending_events -= 1
                     item()

@@ -90,7 +90,11 @@ class CostParams(ScheduleParams):
     priority: int | None = None
 
     def __post_init__(self) -> None:
-        for name, value in (("cost", self.cost), ("cps", self.cps), ("c_time", self.c_time)):
+        cost, cps, c_time = self.cost, self.cps, self.c_time
+        if type(cost) is float and type(cps) is float and type(c_time) is float and cost == cost and cps == cps \
+                and c_time >= 0.0:  # the common case, checked without the loop (every report builds one)
+            return
+        for name, value in (("cost", cost), ("cps", cps), ("c_time", c_time)):
             if not isinstance(value, _NUMBERS) or value != value:  # value != value: NaN
                 raise ValueError(f"CostParams.{name} must be a number, got {value!r}")
         if self.c_time < 0:
