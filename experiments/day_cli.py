@@ -15,7 +15,9 @@ from experiments import days
 EXAMPLES = """\
 examples:
   tasker day --protocol tabsa --days 100 --out out/day
-  tasker day --protocol tabsa-short --backend robot --days 20 --out out/day-robot --resume"""
+  tasker day --protocol tabsa-short --backend robot --days 20 --out out/day-robot --resume
+  tasker day --protocol tabsa-short --backend robot --days 10 --schedulers lookahead alg2 \\
+      --strategies suspension=static suspension=planned --out out/day-susp"""
 
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
@@ -27,9 +29,20 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--schedulers", nargs="+", default=["lookahead", "alg2", "simple", "simple2", "distance"])
     ap.add_argument("--workers", type=int, default=None,
                     help="local processes (default: 2 synthetic, 1 robot: a robot day is long, keep it in one)")
-    ap.add_argument("--resume", action="store_true", help="keep OUT/days.jsonl and run only the days it lacks")
-    ap.add_argument("--keep-runs", action="store_true", help="keep each day's files in OUT/runs/SCHEDULER/SEED")
-    ap.add_argument("--out", required=True, type=Path, help="folder for days.jsonl and table.md")
+    ap.add_argument("--strategies", nargs="+", default=None, metavar="STRATEGY",
+                    help="robot backend: strategies to compare under every scheduler, e.g. 'suspension=static' "
+                         "'suspension=planned' (factors update, suspension, policy, hazard_waiting; default: the "
+                         "day's own settings)")
+    ap.add_argument("--dask", default=None, metavar="ADDRESS",
+                    help="run the days on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786) "
+                         "instead of local processes")
+    ap.add_argument("--resume", action="store_true",
+                    help="keep OUT/days.db and run only the days it lacks (an older OUT/days.jsonl is read in)")
+    ap.add_argument("--keep-runs", action="store_true",
+                    help="keep each day's files in OUT/runs/[STRATEGY/]SCHEDULER/SEED")
+    ap.add_argument("--out", required=True, type=Path,
+                    help="folder for days.db (the results database), days.jsonl (its days, one per line) and "
+                         "table.md")
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -41,8 +54,10 @@ def _run(args: argparse.Namespace) -> int:
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("day", help="run a day protocol: N days x schedulers on a backend, and its table",
                        description="Run N seeded days of a protocol under each scheduler on the synthetic or the "
-                                   "robot backend; write OUT/days.jsonl (each day as it ends) and OUT/table.md "
-                                   "(95 % CIs, paired comparisons of lookahead against each baseline).",
+                                   "robot backend (and, there, each strategy), on local processes or Dask; store each "
+                                   "day in OUT/days.db as it ends (--resume goes on), write OUT/days.jsonl and "
+                                   "OUT/table.md (95 % CIs, paired comparisons of lookahead against each baseline, "
+                                   "and of strategies under each scheduler).",
                        epilog=EXAMPLES)
     add_arguments(p)
     p.set_defaults(func=_run)

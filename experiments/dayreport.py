@@ -17,18 +17,22 @@ confidence intervals and paired comparisons of ``lookahead`` against each baseli
         --schedulers lookahead alg2 simple simple2 distance --out out/day
     python -m experiments.dayreport --protocol tabsa-short --backend robot --days 20 --out out/day-robot
 
-``tasker day`` is the same command.  Each day's metrics are appended to
-``OUT/days.jsonl`` as the day ends, so ``--resume`` goes on where a stopped run stopped.
+``tasker day`` is the same command.  The days are jobs of the sweep runner
+(:func:`run_days`): local processes or Dask, each day stored in ``OUT/days.db`` as it
+ends (so ``--resume`` goes on where a stopped run stopped), a failed day stored and
+listed while the others go on; ``--strategies`` compares strategies on the robot backend.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import functools
 import json
 import math
 import sys
+import tempfile
 from collections.abc import Iterable, Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -37,6 +41,8 @@ from scipy import stats
 
 from experiments import days as day_pipeline
 from experiments import protocol as protocols
+from experiments.strategy import Strategy
+from experiments.sweepspec import Job
 from tasker.errors import ConfigError
 from tasker.trace import number
 
@@ -150,15 +156,20 @@ def scheduler_options(proto: protocols.Protocol, name: str, backend: str = "synt
 
 
 def run_day(protocol: str, seed: int, scheduler: str, backend: str = "synthetic",
-            keep: str | None = None) -> dict[str, Any]:
+            keep: str | None = None, strategy: Strategy | None = None) -> dict[str, Any]:
     """One day under one scheduler: its metrics (a top-level function, so processes can run it).
 
-    ``keep``: a folder to keep the run's files in (trace; robot: trajectory, run.json)."""
+    ``keep``: a folder to keep the run's files in (trace; robot: trajectory, run.json).
+    ``strategy``: its update/suspension/policy/hazard-waiting factors (robot backend only;
+    its scheduler, if any, must be ``scheduler``)."""
+    settings = {k: v for k, v in (strategy.items() if strategy else []) if k != "scheduler"}
+    if strategy is not None and strategy.scheduler not in (None, scheduler):
+        raise ConfigError(f"run_day: strategy {strategy.label!r} names another scheduler than {scheduler!r}")
     day = day_pipeline.make(protocol, seed, backend=backend, scheduler=scheduler)
-    run = day.run(out=keep)
+    run = day.run(out=keep, **settings)
     proto = day.protocol
     kinds = {v: k for k, v in day_pipeline.task_names(proto, backend).items()}
-    out = {"scheduler": scheduler, "seed": seed, "backend": backend,
+    out = {"scheduler": scheduler, "seed": seed, "backend": backend, "strategy": Strategy(**settings).label,
            **day_metrics(run.events, day_end=proto.length_s, kinds=kinds)}
     if backend == "robot":
         from experiments.pathmetrics import path_metrics
@@ -168,41 +179,73 @@ def run_day(protocol: str, seed: int, scheduler: str, backend: str = "synthetic"
     return out
 
 
+def day_job(job: Job, *, backend: str, keep: str | None = None) -> tuple[dict[str, Any], dict[str, Any]]:
+    """A sweep's ``run_fn`` for days: the job's scenario is ``PROTOCOL@BACKEND``, its source the
+    protocol, its strategy's scheduler the day's.  Returns ``(record, metrics)``; the metrics are
+    :func:`run_day`'s."""
+    st = job.strategy
+    if st.scheduler is None:
+        raise ConfigError(f"day job {job.key}: its strategy names no scheduler")
+    rest = dataclasses.replace(st, scheduler=None)
+    where = None if keep is None else str(Path(keep) / _folder(rest) / st.scheduler / str(job.seed))
+    metrics = run_day(job.source, job.seed, st.scheduler, backend, where, strategy=rest)
+    record = {"protocol": job.source, "backend": backend, "seed": job.seed, "scheduler": st.scheduler,
+              "strategy": rest.label, "wall_time_s": metrics.get("wall_time_s")}
+    return record, metrics
+
+
+def _folder(strategy: Strategy) -> str:
+    """Where ``--keep-runs`` puts a strategy's days: nowhere extra for the day's own settings."""
+    return "" if strategy.label == "default" else strategy.label.replace(",", "_").replace("=", "-")
+
+
+def scenario_key(protocol: str | Path, backend: str) -> str:
+    """The scenario column of a day in the results database: ``PROTOCOL@BACKEND``."""
+    return f"{protocol}@{backend}"
+
+
 def run_days(protocol: str | Path, days: int, names: Sequence[str], *, first_seed: int = 1,
-             workers: int = 2, backend: str = "synthetic", log: Path | None = None,
-             keep: Path | None = None) -> list[dict[str, Any]]:
-    """Every (day, scheduler) pair; results sorted by scheduler then seed.
+             workers: int = 2, backend: str = "synthetic", db: Path | None = None,
+             keep: Path | None = None, strategies: Sequence[Strategy] = (Strategy(),),
+             address: str | None = None, progress: bool = False) -> list[dict[str, Any]]:
+    """Every (day, scheduler, strategy); results sorted by strategy, scheduler, then seed.
 
-    ``workers`` local processes (1: in this process).  ``log``: a JSON-lines file each
-    result is appended to as it ends; results already there (same backend, scheduler and
-    seed) are not run again.  ``keep``: keep each run's files in ``keep/SCHEDULER/SEED``."""
+    The days are the jobs of a sweep (:func:`experiments.sweep.run_sweep`, ``run_fn`` =
+    :func:`day_job`): ``workers`` local processes, or the Dask cluster at ``address``;
+    each day is stored in the results database ``db`` (a temporary one if ``None``) as it
+    ends, and days already there are not run again (resumption).  A day that raises, or
+    kills its worker, is stored as an ``error`` and the others go on: it comes back as
+    ``{"scheduler", "seed", "strategy", "error"}`` (no metrics), which :func:`table` lists
+    apart.  ``keep``: keep each run's files in ``keep/[STRATEGY/]SCHEDULER/SEED``."""
+    from experiments.store import ResultStore, Status
+    from experiments.sweep import run_sweep
+
     day_pipeline.load(protocol)  # a bad protocol fails here, once, with its file and line
-    done: dict[tuple[str, int], dict[str, Any]] = {}
-    if log is not None and log.is_file():
-        for line in log.read_text(encoding="utf-8").splitlines():
-            r = json.loads(line)
-            if r.get("backend", "synthetic") == backend:
-                done[r["scheduler"], r["seed"]] = r
-    jobs = [(str(protocol), seed, name, backend, None if keep is None else str(keep / name / str(seed)))
-            for seed in range(first_seed, first_seed + days) for name in names if (name, seed) not in done]
+    scenario = scenario_key(protocol, backend)
+    jobs = [Job(scenario, str(protocol), seed, dataclasses.replace(st, scheduler=name))
+            for seed in range(first_seed, first_seed + days) for st in strategies for name in names]
     # seed-major: a run stopped early leaves every scheduler with (nearly) as many days
-    results = [done[n, s] for n in names for s in range(first_seed, first_seed + days) if (n, s) in done]
-
-    def record(r: dict[str, Any]) -> None:
-        results.append(r)
-        if log is not None:
-            with log.open("a", encoding="utf-8") as f:
-                f.write(json.dumps(r, sort_keys=True) + "\n")
-
-    if workers <= 1 or len(jobs) <= 1:
-        for j in jobs:
-            record(run_day(*j))
-    else:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            for r in pool.map(run_day, *zip(*jobs, strict=True), chunksize=8 if backend == "synthetic" else 1):
-                record(r)
+    run_fn = functools.partial(day_job, backend=backend, keep=None if keep is None else str(keep))
+    with tempfile.TemporaryDirectory(prefix="tasker-days-") as tmp:
+        path = db if db is not None else Path(tmp) / "days.db"
+        run_sweep(jobs, path, workers=workers, scheduler_address=address, run_fn=run_fn, progress=progress)
+        with ResultStore(path, readonly=True) as store:
+            rows = {r.key: r for r in store.rows()}
+    results = []
+    for job in jobs:
+        row = rows.get(job.key)
+        if row is None:  # not run (e.g. Dask cancelled it): left for a resumption
+            continue
+        st = dataclasses.replace(job.strategy, scheduler=None)
+        if row.status is Status.OK:
+            results.append(dict(row.metrics))
+        else:
+            results.append({"scheduler": job.strategy.scheduler, "seed": job.seed, "backend": backend,
+                            "strategy": st.label, "error": row.error or "failed"})
+    s_order = {st.label: k for k, st in enumerate(strategies)}
     order = {n: k for k, n in enumerate(names)}
-    return sorted(results, key=lambda r: (order[r["scheduler"]], r["seed"]))
+    return sorted(results, key=lambda r: (s_order.get(r.get("strategy", "default"), 0), order[r["scheduler"]],
+                                          r["seed"]))
 
 
 # -- the table -------------------------------------------------------------------------------------------
@@ -296,36 +339,71 @@ def table(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead",
         out += ["", f"Paired over days: {reference} − baseline (mean ± 95 % CI; negative is fewer/earlier); "
                 "Wilcoxon signed-rank, Holm-corrected over every test in this table.", "",
                 "| metric | baseline | difference | p (Holm) |", "|---|---|---|---|"]
-        tests = []
-        getters = {key: (label, get) for label, key, get in rows}
-        for key in PAIRED:
-            label, get = getters[key]
-            for n in names:
-                if n == reference:
-                    continue
-                ref = {r["seed"]: get(r) for r in by[reference]}
-                pairs = [(ref[r["seed"]], get(r)) for r in by[n] if ref.get(r["seed"]) is not None
-                         and get(r) is not None]
-                if not pairs:
-                    continue
-                diff = np.array([a - b for a, b in pairs], dtype=float)
-                tests.append((label, n, diff, _wilcoxon(diff)))
-        adjusted = holm([p for *_, p in tests])
-        for (label, n, diff, _), p in zip(tests, adjusted, strict=True):
-            out.append(f"| {label} | {n} | {_fmt(*_ci(list(diff)))} | {p:.3g} |")
+        out += _paired(rows, [(n, by[reference], by[n]) for n in names if n != reference])
     return "\n".join(line for line in out if line is not None).lstrip("\n") + "\n"
+
+
+def _paired(rows: Sequence[tuple[str, str, Any]],
+            groups: Sequence[tuple[str, Sequence[Mapping[str, Any]], Sequence[Mapping[str, Any]]]]) -> list[str]:
+    """Table lines ``| metric | name | a − b | p (Holm) |`` for each :data:`PAIRED` metric and each
+    ``(name, a days, b days)``, paired by seed; Holm over every line."""
+    tests = []
+    getters = {key: (label, get) for label, key, get in rows}
+    for key in PAIRED:
+        label, get = getters[key]
+        for name, a_days, b_days in groups:
+            ref = {r["seed"]: get(r) for r in a_days}
+            pairs = [(ref[r["seed"]], get(r)) for r in b_days if ref.get(r["seed"]) is not None and get(r) is not None]
+            if not pairs:
+                continue
+            diff = np.array([a - b for a, b in pairs], dtype=float)
+            tests.append((label, name, diff, _wilcoxon(diff)))
+    adjusted = holm([p for *_, p in tests])
+    return [f"| {label} | {n} | {_fmt(*_ci(list(diff)))} | {p:.3g} |"
+            for (label, n, diff, _), p in zip(tests, adjusted, strict=True)]
+
+
+def report(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead", title: str = "") -> str:
+    """:func:`table` per strategy; with several strategies, each against the first under every
+    scheduler (paired by seed); and the days that failed to run, listed, never dropped silently."""
+    ok = [r for r in results if "error" not in r]
+    failed = [r for r in results if "error" in r]
+    labels = list(dict.fromkeys(r.get("strategy", "default") for r in ok))
+    if len(labels) <= 1:
+        text = table(ok, reference=reference, title=title) if ok else f"## {title}\nNo day ran to its end.\n"
+    else:
+        parts = [table([r for r in ok if r.get("strategy", "default") == label], reference=reference,
+                       title=f"{title}, strategy `{label}`") for label in labels]
+        first = labels[0]
+        names = list(dict.fromkeys(r["scheduler"] for r in ok))
+        of = {(lb, n): [r for r in ok if r.get("strategy", "default") == lb and r["scheduler"] == n]
+              for lb in labels for n in names}
+        types = sorted({t for r in ok for t in r["per_type"]})
+        lines = [f"## Strategies compared: each − `{first}`, under the same scheduler",
+                 "Paired over days (mean ± 95 % CI; negative is fewer/earlier); Wilcoxon signed-rank, "
+                 "Holm-corrected over every test in this table.", "",
+                 "| metric | strategy, scheduler | difference | p (Holm) |", "|---|---|---|---|"]
+        lines += _paired(_metric_rows(types), [(f"`{lb}`, {n}", of[lb, n], of[first, n])
+                                               for lb in labels[1:] for n in names])
+        text = "\n".join(parts) + "\n" + "\n".join(lines) + "\n"
+    if failed:
+        text += ("\nDays that did not run to their end (not in the tables above; stored with their error):\n\n"
+                 + "\n".join(f"- `{r.get('strategy', 'default')}`, {r['scheduler']}, seed {r['seed']}: {r['error']}"
+                             for r in failed) + "\n")
+    return text
 
 
 from experiments.day_cli import add_arguments  # noqa: E402  (the options live with the light CLI module)
 
 
 def run(a: argparse.Namespace) -> int:
-    """Run the days, write ``days.jsonl`` and ``table.md``; print the table.
+    """Run the days into ``OUT/days.db``; write ``days.jsonl`` and ``table.md``; print the table.
 
     Bad input raises :class:`tasker.cliargs.UsageError` (or the protocol's
-    :class:`tasker.reader.InputError`) before the first day runs."""
+    :class:`tasker.reader.InputError`) before the first day runs.  Returns 1 if a day failed
+    to run (it is listed under the table), else 0."""
     from tasker import schedulers
-    from tasker.cliargs import UsageError
+    from tasker.cliargs import UsageError, show_progress
     from tasker.reader import suggest
 
     unknown = [n for n in a.schedulers if n not in schedulers.names()]
@@ -334,6 +412,22 @@ def run(a: argparse.Namespace) -> int:
                                          f"known: {', '.join(schedulers.names())}")
     if a.days < 1:
         raise UsageError("--days", f"expected >= 1, got {a.days}")
+    if a.workers is not None and a.workers < 1:
+        raise UsageError("--workers", f"expected >= 1, got {a.workers}")
+    strategies = []
+    for text in a.strategies or ["default"]:
+        try:
+            st = Strategy.parse(text)
+        except ValueError as exc:
+            raise UsageError("--strategies", str(exc)) from exc
+        if st.scheduler is not None:
+            raise UsageError("--strategies", f"{text!r} names a scheduler: schedulers are --schedulers")
+        strategies.append(st)
+    if len({st.label for st in strategies}) != len(strategies):
+        raise UsageError("--strategies", "a strategy is given twice")
+    if a.backend == "synthetic" and any(st.items() for st in strategies):
+        raise UsageError("--strategies", "the synthetic backend runs timed stages that no strategy changes: "
+                                         "compare strategies with --backend robot")
     try:
         proto = day_pipeline.load(a.protocol)
     except ConfigError as exc:
@@ -341,20 +435,41 @@ def run(a: argparse.Namespace) -> int:
     if a.backend == "robot" and proto.robot is None:
         raise UsageError("--backend", f"{proto.source} has no [robot_backend]: it runs on the synthetic backend only")
     workers = a.workers if a.workers is not None else (2 if a.backend == "synthetic" else 1)
-    log = a.out / "days.jsonl"
     a.out.mkdir(parents=True, exist_ok=True)
-    if not a.resume and log.exists():
-        log.unlink()
+    db, log = a.out / "days.db", a.out / "days.jsonl"
+    if not a.resume:
+        for old in (db, log):
+            old.unlink(missing_ok=True)
+    elif not db.exists() and log.is_file():
+        _import_log(log, db, a.protocol, a.backend)
     results = run_days(a.protocol, a.days, a.schedulers, first_seed=a.first_seed, workers=workers,
-                       backend=a.backend, log=log, keep=a.out / "runs" if a.keep_runs else None)
+                       backend=a.backend, db=db, keep=a.out / "runs" if a.keep_runs else None,
+                       strategies=strategies, address=a.dask, progress=show_progress(a))
+    log.write_text("".join(json.dumps(r, sort_keys=True) + "\n" for r in results), encoding="utf-8")
     backend = "" if a.backend == "synthetic" else f" --backend {a.backend}"
+    chosen = "" if not a.strategies else " --strategies " + " ".join(st.label for st in strategies)
     cmd = (f"python -m experiments.dayreport --protocol {a.protocol}{backend} --days {a.days} "
-           f"--first-seed {a.first_seed} --schedulers {' '.join(a.schedulers)} --out {a.out}")
+           f"--first-seed {a.first_seed} --schedulers {' '.join(a.schedulers)}{chosen} --out {a.out}")
     title = f"{proto.name} ({a.backend} backend): seeds {a.first_seed}–{a.first_seed + a.days - 1}"
-    text = table(results, title=title)
+    text = report(results, title=title)
     (a.out / "table.md").write_text(text + f"\nGenerated by `{cmd}`.\n", encoding="utf-8")
     print(text)
-    return 0
+    return 1 if any("error" in r for r in results) else 0
+
+
+def _import_log(log: Path, db: Path, protocol: str, backend: str) -> None:
+    """Days of an older ``days.jsonl`` (before the database) into ``db``, so ``--resume`` keeps them."""
+    from experiments.store import ResultStore, RunRow, Status
+
+    with ResultStore(db) as store:
+        for line in log.read_text(encoding="utf-8").splitlines():
+            r = json.loads(line)
+            if r.get("backend", "synthetic") != backend or "error" in r:
+                continue
+            st = Strategy.parse(r.get("strategy", "default"))
+            label = dataclasses.replace(st, scheduler=r["scheduler"]).label
+            store.add(RunRow(scenario_key(protocol, backend), int(r["seed"]), label, Status.OK,
+                             {"imported_from": str(log)}, r, None, 0.0, ""))
 
 
 def main(argv: Sequence[str] | None = None) -> int:

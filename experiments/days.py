@@ -39,6 +39,8 @@ from tasker.reader import suggest
 
 PROTOCOLS_DIR = Path(__file__).resolve().parent / "protocols"
 BACKENDS = ("synthetic", "robot")
+STRATEGY_SETTINGS = ("update", "suspension", "policy", "hazard_waiting")
+"""What :meth:`Day.run` lets a strategy set (the scheduler is the day's own, given to :func:`make`)."""
 
 _registry: dict[str, Path] = {}
 
@@ -215,10 +217,23 @@ class Day:
     scheduler: str
     scenario: Any
 
-    def run(self, out: str | Path | None = None) -> DayRun:
+    def run(self, out: str | Path | None = None, **settings: Any) -> DayRun:
         """Run the day.  ``out``: keep the run's files there (robot: ``trace.jsonl``,
-        ``trajectory.jsonl``, ``run.json``, ``metrics.json``; no pictures)."""
+        ``trajectory.jsonl``, ``run.json``, ``metrics.json``; no pictures).
+
+        ``settings``: the strategy's factors for the robot backend's task folders
+        (``update``, ``suspension``, ``policy``, ``hazard_waiting``, as
+        :func:`experiments.runner.run_scenario` takes them; ``None`` keeps the day's own).
+        The synthetic backend's tasks are timed templates that no strategy changes, so
+        a setting there is a :class:`ConfigError` rather than a comparison of equals."""
+        settings = {k: v for k, v in settings.items() if v is not None}
+        unknown = sorted(set(settings) - set(STRATEGY_SETTINGS))
+        if unknown:
+            raise ConfigError(f"Day.run: unknown setting {unknown[0]!r}; known: {', '.join(STRATEGY_SETTINGS)}")
         if self.backend == "synthetic":
+            if settings:
+                raise ConfigError(f"the synthetic backend runs timed stages that {', '.join(sorted(settings))} "
+                                  "cannot change: compare strategies on the robot backend")
             loop = self.build()
             trace = loop.run()
             if out is not None:
@@ -230,7 +245,8 @@ class Day:
 
         with tempfile.TemporaryDirectory(prefix="tasker-day-") as tmp:
             where = Path(out) if out is not None else Path(tmp)
-            result = run_scenario(self.scenario, seed=self.seed, out=where, pictures=False, request_fields=True)
+            result = run_scenario(self.scenario, seed=self.seed, out=where, pictures=False, request_fields=True,
+                                  **settings)
             _, samples, _ = read_trajectory(where / "trajectory.jsonl")
         return DayRun(list(result.trace.events), tuple(samples), result.record)
 

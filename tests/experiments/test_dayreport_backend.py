@@ -3,10 +3,15 @@ resumable logs."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
+from typing import Any
+
+import pytest
 
 from experiments import dayreport
+from experiments.sweepspec import Job
 
 EVENTS = [
     {"t": 0.0, "event": "request", "agent": "d1", "task_type": "folder_a", "args": {"deadline": 10.0}},
@@ -33,12 +38,76 @@ def test_path_rows_appear_only_with_path_metrics() -> None:
     assert "| travel distance (m) | 15.00 ± 63.53 | 15.00 ± 63.53 |" in robot
 
 
-def test_a_stopped_run_resumes_from_its_log(tmp_path: Path) -> None:
-    log = tmp_path / "days.jsonl"
-    first = dayreport.run_days("tabsa-short", 1, ["fifo"], workers=1, log=log)
-    assert len(log.read_text().splitlines()) == 1
-    marked = {**first[0], "completed": -1}  # a result already logged is read back, not run again
-    log.write_text(json.dumps(marked) + "\n")
-    again = dayreport.run_days("tabsa-short", 2, ["fifo"], workers=1, log=log)
+def test_a_stopped_run_resumes_from_its_database(tmp_path: Path) -> None:
+    from experiments.store import ResultStore
+
+    db = tmp_path / "days.db"
+    first = dayreport.run_days("tabsa-short", 1, ["fifo"], workers=1, db=db)
+    with ResultStore(db) as store:
+        (row,) = store.rows()
+        assert row.key == ("tabsa-short@synthetic", 1, "scheduler=fifo") and row.metrics == first[0]
+        # a day already stored is read back, not run again
+        store.forget({row.key})
+        store.add(dataclasses.replace(row, metrics={**row.metrics, "completed": -1}))
+    again = dayreport.run_days("tabsa-short", 2, ["fifo"], workers=1, db=db)
     assert [r["seed"] for r in again] == [1, 2] and again[0]["completed"] == -1
-    assert len(log.read_text().splitlines()) == 2
+    with ResultStore(db) as store:
+        assert store.count() == 2
+
+
+def _crash_on_seed_2(job: Job, **kw: Any) -> tuple[dict[str, Any], dict[str, Any]]:
+    if job.seed == 2:
+        raise RuntimeError("a broken day")
+    return dayreport.day_job(job, **kw)
+
+
+def test_a_day_that_fails_is_listed_and_the_others_go_on(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(dayreport, "day_job", _crash_on_seed_2)  # the worker imports it from this module
+    results = dayreport.run_days("tabsa-short", 3, ["fifo"], workers=1, db=tmp_path / "d.db")
+    assert [(r["seed"], "error" in r) for r in results] == [(1, False), (2, True), (3, False)]
+    assert "a broken day" in results[1]["error"]
+    text = dayreport.report(results, title="t")
+    assert "2 days per scheduler" in text
+    assert "- `default`, fifo, seed 2: " in text and "a broken day" in text
+
+
+def test_the_command_writes_database_log_and_table(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "out"
+    assert dayreport.main(["--protocol", "tabsa-short", "--days", "2", "--schedulers", "lookahead", "fifo",
+                           "--workers", "1", "--out", str(out)]) == 0
+    assert (out / "days.db").is_file() and (out / "table.md").is_file()
+    lines = (out / "days.jsonl").read_text().splitlines()
+    assert [(json.loads(x)["scheduler"], json.loads(x)["seed"]) for x in lines] == [
+        ("lookahead", 1), ("lookahead", 2), ("fifo", 1), ("fifo", 2)]
+    assert "| metric | lookahead | fifo |" in capsys.readouterr().out
+
+
+def test_an_older_days_log_is_kept_by_resume(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    old = {**dayreport.run_day("tabsa-short", 1, "fifo"), "completed": -1}
+    old.pop("strategy")  # written before strategies were a field
+    out.mkdir()
+    (out / "days.jsonl").write_text(json.dumps(old) + "\n")
+    args = ["--protocol", "tabsa-short", "--days", "2", "--schedulers", "fifo", "--workers", "1", "--resume",
+            "--out", str(out)]
+    assert dayreport.main(args) == 0
+    rows = [json.loads(x) for x in (out / "days.jsonl").read_text().splitlines()]
+    assert [r["seed"] for r in rows] == [1, 2] and rows[0]["completed"] == -1
+
+
+def test_strategies_are_compared_under_each_scheduler() -> None:
+    a = [{**result(n, s, travel_m=10.0 * s), "strategy": "suspension=static"} for n in ("lookahead", "alg2")
+         for s in (1, 2, 3)]
+    b = [{**result(n, s, travel_m=10.0 * s + 1.0), "strategy": "suspension=planned"} for n in ("lookahead", "alg2")
+         for s in (1, 2, 3)]
+    text = dayreport.report(a + b, title="t")
+    assert "## t, strategy `suspension=static`" in text and "## t, strategy `suspension=planned`" in text
+    assert "| travel distance (m) | `suspension=planned`, lookahead | 1.00 ± 0.00 |" in text
+    assert "| travel distance (m) | `suspension=planned`, alg2 | 1.00 ± 0.00 |" in text
+
+
+def test_strategies_on_the_synthetic_backend_are_refused(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    assert dayreport.main(["--days", "1", "--strategies", "suspension=static", "--out", str(tmp_path)]) == 2
+    assert "--strategies" in capsys.readouterr().err
+    assert dayreport.main(["--days", "1", "--strategies", "suspension=maybe", "--out", str(tmp_path)]) == 2
+    assert "suspension" in capsys.readouterr().err

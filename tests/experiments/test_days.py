@@ -7,6 +7,7 @@ fast; the shipped protocols' days are run by ``python -m experiments.dayreport``
 from __future__ import annotations
 
 import itertools
+import json
 from pathlib import Path
 
 import pytest
@@ -95,6 +96,18 @@ def test_every_scheduler_runs_every_task_type_robot(tiny_protocol: protocol.Prot
     m = dayreport.run_day(tiny_protocol.source, 1, name, "robot")
     assert {t: v["completed"] for t, v in m["per_type"].items()} == {"transport": 1, "fall": 1, "pick_place": 1}
     assert m["dead_falls"] == 0 and m["travel_m"] > 0
+
+
+def test_a_robot_day_runs_under_the_strategy_it_is_given(tiny_protocol: protocol.Protocol, tmp_path: Path) -> None:
+    from experiments.strategy import Strategy
+
+    m = dayreport.run_day(tiny_protocol.source, 1, "alg2", "robot", keep=str(tmp_path),
+                          strategy=Strategy(update="static", suspension="static"))
+    assert m["strategy"] == "update=static,suspension=static"
+    run = json.loads((tmp_path / "trace.jsonl").read_text().splitlines()[0])
+    assert (run["event"], run["update"], run["suspension"]) == ("run", "static", "static")
+    with pytest.raises(ConfigError, match="synthetic backend"):
+        days.make("tabsa-short", 1).run(suspension="static")
 
 
 @pytest.mark.parametrize("name", ["tabsa", "tabsa-short"])
