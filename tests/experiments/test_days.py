@@ -9,6 +9,7 @@ from __future__ import annotations
 import itertools
 import json
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -128,6 +129,22 @@ def test_every_spot_and_place_of_the_robot_world_is_clear(name: str) -> None:
     assert set(proto.robot.places.values()) <= set(world.places)
 
 
+def _spot_world(name: str) -> tuple[Any, Any, list[str], list[tuple[str, int, tuple[float, ...]]]]:
+    """A protocol's robot world without people, its motion model, the places the robot can
+    reach at all (a protocol may ground where idle people wait in a room it cannot enter),
+    and every spot as ``(site, index, xy)``."""
+    from robot.spec import load_world
+
+    backend = days.load(name).robot
+    assert backend is not None
+    spec = load_world(backend.world)
+    motion = motion_model(spec, people=False)
+    places = [p for p in spec.places
+              if any(motion.estimate(spec.places[p], spec.places[q]).reachable for q in spec.places if q != p)]
+    spots = [(site, k, tuple(xy)) for site, xys in backend.spots.items() for k, xy in enumerate(xys)]
+    return spec, motion, places, spots
+
+
 def _unreachable(motion, places, spec) -> list[tuple[str, str]]:  # type: ignore[no-untyped-def]
     return [(a, b) for a, b in itertools.permutations(places, 2)
             if not motion.estimate(spec.places[a], spec.places[b]).reachable]
@@ -140,19 +157,9 @@ def test_no_spot_walls_the_robot_in(name: str) -> None:
     widest posture), and with every spot held by a standing person at once, every place the
     robot can reach in the empty apartment stays reachable from every other.  (Seed 5 of
     the full day stranded the robot: the hall's spots lay on the 2 m hall's centre line.)"""
-    from robot.spec import load_world
-
-    backend = days.load(name).robot
-    assert backend is not None
-    spec = load_world(backend.world)
-    motion = motion_model(spec, people=False)
+    spec, motion, places, spots = _spot_world(name)
     scene = motion.planner.scene
-    # places the robot can reach at all (a protocol may ground where idle people wait in
-    # a room it cannot enter)
-    places = [p for p in spec.places
-              if any(motion.estimate(spec.places[p], spec.places[q]).reachable for q in spec.places if q != p)]
     assert len(places) >= 2 and not _unreachable(motion, places, spec)
-    spots = [(site, k, xy) for site, xys in backend.spots.items() for k, xy in enumerate(xys)]
     walls = []
     for (site, k, xy), posture in itertools.product(spots, ("standing", "fallen")):
         scene.set_person("someone", xy[0], xy[1], posture)
@@ -176,16 +183,8 @@ def test_a_person_at_any_spot_can_be_reached(name: str) -> None:
     the bathroom wall, one in its dead end; a person there, with others at the spots by its
     entrance, could be approached only through the wall, and once approach poses had to see
     the person, guides and a fall failed under every scheduler.)"""
-    from robot.spec import load_world
-
-    backend = days.load(name).robot
-    assert backend is not None
-    spec = load_world(backend.world)
-    motion = motion_model(spec, people=False)
+    spec, motion, places, spots = _spot_world(name)
     scene = motion.planner.scene
-    places = [p for p in spec.places
-              if any(motion.estimate(spec.places[p], spec.places[q]).reachable for q in spec.places if q != p)]
-    spots = [(site, k, xy) for site, xys in backend.spots.items() for k, xy in enumerate(xys)]
     shut = []
     for i, (site, k, xy) in enumerate(spots):
         for j, (_, _, other) in enumerate(spots):
