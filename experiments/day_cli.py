@@ -33,11 +33,12 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="robot backend: strategies to compare under every scheduler, e.g. 'suspension=static' "
                          "'suspension=planned' (factors update, suspension, policy, hazard_waiting; default: the "
                          "day's own settings)")
-    ap.add_argument("--dask", default=None, metavar="ADDRESS",
-                    help="run the days on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786) "
-                         "instead of local processes")
+    ap.add_argument("--scheduler-address", default=None, metavar="ADDRESS",
+                    help="run the days on this Dask scheduler (e.g. tcp://host:8786) instead of local processes, "
+                         "as tasker sweep does")
     ap.add_argument("--resume", action="store_true",
                     help="keep OUT/days.db and run only the days it lacks (an older OUT/days.jsonl is read in)")
+    ap.add_argument("--retry-errors", action="store_true", help="with --resume: run again the days stored as errors")
     ap.add_argument("--keep-runs", action="store_true",
                     help="keep each day's files in OUT/runs/[STRATEGY/]SCHEDULER/SEED")
     ap.add_argument("--out", required=True, type=Path,

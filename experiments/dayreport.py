@@ -207,7 +207,8 @@ def scenario_key(protocol: str | Path, backend: str) -> str:
 def run_days(protocol: str | Path, days: int, names: Sequence[str], *, first_seed: int = 1,
              workers: int = 2, backend: str = "synthetic", db: Path | None = None,
              keep: Path | None = None, strategies: Sequence[Strategy] = (Strategy(),),
-             address: str | None = None, progress: bool = False) -> list[dict[str, Any]]:
+             address: str | None = None, progress: bool = False,
+             retry_errors: bool = False) -> list[dict[str, Any]]:
     """Every (day, scheduler, strategy); results sorted by strategy, scheduler, then seed.
 
     The days are the jobs of a sweep (:func:`experiments.sweep.run_sweep`, ``run_fn`` =
@@ -216,7 +217,8 @@ def run_days(protocol: str | Path, days: int, names: Sequence[str], *, first_see
     ends, and days already there are not run again (resumption).  A day that raises, or
     kills its worker, is stored as an ``error`` and the others go on: it comes back as
     ``{"scheduler", "seed", "strategy", "error"}`` (no metrics), which :func:`table` lists
-    apart.  ``keep``: keep each run's files in ``keep/[STRATEGY/]SCHEDULER/SEED``."""
+    apart (``retry_errors``: run those again).  ``keep``: keep each run's files in
+    ``keep/[STRATEGY/]SCHEDULER/SEED``."""
     from experiments.store import ResultStore, Status
     from experiments.sweep import run_sweep
 
@@ -228,7 +230,8 @@ def run_days(protocol: str | Path, days: int, names: Sequence[str], *, first_see
     run_fn = functools.partial(day_job, backend=backend, keep=None if keep is None else str(keep))
     with tempfile.TemporaryDirectory(prefix="tasker-days-") as tmp:
         path = db if db is not None else Path(tmp) / "days.db"
-        run_sweep(jobs, path, workers=workers, scheduler_address=address, run_fn=run_fn, progress=progress)
+        run_sweep(jobs, path, workers=workers, scheduler_address=address, run_fn=run_fn, progress=progress,
+                  retry_errors=retry_errors)
         with ResultStore(path, readonly=True) as store:
             rows = {r.key: r for r in store.rows()}
     results = []
@@ -442,9 +445,19 @@ def run(a: argparse.Namespace) -> int:
             old.unlink(missing_ok=True)
     elif not db.exists() and log.is_file():
         _import_log(log, db, a.protocol, a.backend)
-    results = run_days(a.protocol, a.days, a.schedulers, first_seed=a.first_seed, workers=workers,
-                       backend=a.backend, db=db, keep=a.out / "runs" if a.keep_runs else None,
-                       strategies=strategies, address=a.dask, progress=show_progress(a))
+    if a.scheduler_address:
+        from experiments.sweep_cli import check_scheduler
+
+        check_scheduler(a.scheduler_address)
+    try:
+        results = run_days(a.protocol, a.days, a.schedulers, first_seed=a.first_seed, workers=workers,
+                           backend=a.backend, db=db, keep=a.out / "runs" if a.keep_runs else None,
+                           strategies=strategies, address=a.scheduler_address, progress=show_progress(a),
+                           retry_errors=a.retry_errors)
+    except (OSError, TimeoutError) as exc:
+        if not a.scheduler_address:
+            raise
+        raise UsageError("--scheduler-address", f"lost the Dask scheduler at {a.scheduler_address}: {exc}") from None
     log.write_text("".join(json.dumps(r, sort_keys=True) + "\n" for r in results), encoding="utf-8")
     backend = "" if a.backend == "synthetic" else f" --backend {a.backend}"
     chosen = "" if not a.strategies else " --strategies " + " ".join(st.label for st in strategies)

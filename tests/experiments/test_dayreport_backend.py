@@ -111,3 +111,18 @@ def test_strategies_on_the_synthetic_backend_are_refused(capsys: pytest.CaptureF
     assert "--strategies" in capsys.readouterr().err
     assert dayreport.main(["--days", "1", "--strategies", "suspension=maybe", "--out", str(tmp_path)]) == 2
     assert "suspension" in capsys.readouterr().err
+
+
+def test_days_run_on_a_dask_cluster(tmp_path: Path) -> None:
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        on_dask = dayreport.run_days("tabsa-short", 2, ["fifo", "lookahead"], db=tmp_path / "d.db",
+                                     address=cluster.scheduler_address)
+    local = dayreport.run_days("tabsa-short", 2, ["fifo", "lookahead"], workers=1)
+    assert on_dask == local and len(local) == 4
+
+
+def test_an_unreachable_dask_scheduler_is_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert dayreport.main(["--days", "1", "--scheduler-address", "tcp://127.0.0.1:1", "--out", str(tmp_path)]) == 2
+    assert "--scheduler-address" in capsys.readouterr().err
