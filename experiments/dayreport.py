@@ -297,6 +297,8 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
 
 
 PAIRED = ("dead", "abandonments", "lateness", "gap", "completed", "interruptions", "travel")
+STRATEGY_PAIRED = (*PAIRED, "suspensions", "susp_time")
+"""Strategies differ in how a task suspends: their comparison adds what the suspensions cost."""
 
 
 def holm(pvalues: Sequence[float]) -> list[float]:
@@ -347,12 +349,13 @@ def table(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead",
 
 
 def _paired(rows: Sequence[tuple[str, str, Any]],
-            groups: Sequence[tuple[str, Sequence[Mapping[str, Any]], Sequence[Mapping[str, Any]]]]) -> list[str]:
-    """Table lines ``| metric | name | a − b | p (Holm) |`` for each :data:`PAIRED` metric and each
+            groups: Sequence[tuple[str, Sequence[Mapping[str, Any]], Sequence[Mapping[str, Any]]]],
+            keys: Sequence[str] = PAIRED) -> list[str]:
+    """Table lines ``| metric | name | a − b | p (Holm) |`` for each metric of ``keys`` and each
     ``(name, a days, b days)``, paired by seed; Holm over every line."""
     tests = []
     getters = {key: (label, get) for label, key, get in rows}
-    for key in PAIRED:
+    for key in keys:
         label, get = getters[key]
         for name, a_days, b_days in groups:
             ref = {r["seed"]: get(r) for r in a_days}
@@ -387,7 +390,7 @@ def report(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead"
                  "Holm-corrected over every test in this table.", "",
                  "| metric | strategy, scheduler | difference | p (Holm) |", "|---|---|---|---|"]
         lines += _paired(_metric_rows(types), [(f"`{lb}`, {n}", of[lb, n], of[first, n])
-                                               for lb in labels[1:] for n in names])
+                                               for lb in labels[1:] for n in names], STRATEGY_PAIRED)
         text = "\n".join(parts) + "\n" + "\n".join(lines) + "\n"
     if failed:
         text += ("\nDays that did not run to their end (not in the tables above; stored with their error):\n\n"

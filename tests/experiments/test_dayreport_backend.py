@@ -104,6 +104,7 @@ def test_strategies_are_compared_under_each_scheduler() -> None:
     assert "## t, strategy `suspension=static`" in text and "## t, strategy `suspension=planned`" in text
     assert "| travel distance (m) | `suspension=planned`, lookahead | 1.00 ± 0.00 |" in text
     assert "| travel distance (m) | `suspension=planned`, alg2 | 1.00 ± 0.00 |" in text
+    assert "| time suspending (s, ours) | `suspension=planned`, alg2 |" in text  # what strategies differ in
 
 
 def test_strategies_on_the_synthetic_backend_are_refused(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
