@@ -216,7 +216,7 @@ def run_days(protocol: str | Path, days: int, names: Sequence[str], *, first_see
     each day is stored in the results database ``db`` (a temporary one if ``None``) as it
     ends, and days already there are not run again (resumption).  A day that raises, or
     kills its worker, is stored as an ``error`` and the others go on: it comes back as
-    ``{"scheduler", "seed", "strategy", "error"}`` (no metrics), which :func:`table` lists
+    ``{"scheduler", "seed", "strategy", "error"}`` (no metrics), which :func:`report` lists
     apart (``retry_errors``: run those again).  ``keep``: keep each run's files in
     ``keep/[STRATEGY/]SCHEDULER/SEED``."""
     from experiments.store import ResultStore, Status
