@@ -431,9 +431,11 @@ def run(a: argparse.Namespace) -> int:
         strategies.append(st)
     if len({st.label for st in strategies}) != len(strategies):
         raise UsageError("--strategies", "a strategy is given twice")
-    if a.backend == "synthetic" and any(st.items() for st in strategies):
-        raise UsageError("--strategies", "the synthetic backend runs timed stages that no strategy changes: "
-                                         "compare strategies with --backend robot")
+    for st in strategies:
+        try:
+            day_pipeline.check_settings(a.backend, dict(st.items()))
+        except ConfigError as exc:
+            raise UsageError("--strategies", str(exc)) from exc
     try:
         proto = day_pipeline.load(a.protocol)
     except ConfigError as exc:
@@ -448,19 +450,13 @@ def run(a: argparse.Namespace) -> int:
             old.unlink(missing_ok=True)
     elif not db.exists() and log.is_file():
         _import_log(log, db, a.protocol, a.backend)
-    if a.scheduler_address:
-        from experiments.sweep_cli import check_scheduler
+    from experiments.sweep_cli import dask_scheduler
 
-        check_scheduler(a.scheduler_address)
-    try:
+    with dask_scheduler(a.scheduler_address):
         results = run_days(a.protocol, a.days, a.schedulers, first_seed=a.first_seed, workers=workers,
                            backend=a.backend, db=db, keep=a.out / "runs" if a.keep_runs else None,
                            strategies=strategies, address=a.scheduler_address, progress=show_progress(a),
                            retry_errors=a.retry_errors)
-    except (OSError, TimeoutError) as exc:
-        if not a.scheduler_address:
-            raise
-        raise UsageError("--scheduler-address", f"lost the Dask scheduler at {a.scheduler_address}: {exc}") from None
     log.write_text("".join(json.dumps(r, sort_keys=True) + "\n" for r in results), encoding="utf-8")
     backend = "" if a.backend == "synthetic" else f" --backend {a.backend}"
     chosen = "" if not a.strategies else " --strategies " + " ".join(st.label for st in strategies)

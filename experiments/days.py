@@ -33,14 +33,25 @@ from typing import Any
 from experiments import protocol as protocols
 from experiments.actions import TimedAction
 from experiments.protocol import DayRequest, Protocol
+from experiments.strategy import FACTORS
 from experiments.synthetic import SyntheticScenario
 from tasker.errors import ConfigError
 from tasker.reader import suggest
 
 PROTOCOLS_DIR = Path(__file__).resolve().parent / "protocols"
 BACKENDS = ("synthetic", "robot")
-STRATEGY_SETTINGS = ("update", "suspension", "policy", "hazard_waiting")
+STRATEGY_SETTINGS = tuple(f for f in FACTORS if f != "scheduler")
 """What :meth:`Day.run` lets a strategy set (the scheduler is the day's own, given to :func:`make`)."""
+
+
+def check_settings(backend: str, settings: Mapping[str, Any]) -> None:
+    """The strategy settings ``backend`` can run (see :meth:`Day.run`), or a :class:`ConfigError`."""
+    unknown = sorted(set(settings) - set(STRATEGY_SETTINGS))
+    if unknown:
+        raise ConfigError(f"unknown setting {unknown[0]!r}; known: {', '.join(STRATEGY_SETTINGS)}")
+    if backend == "synthetic" and settings:
+        raise ConfigError(f"the synthetic backend runs timed stages that {', '.join(sorted(settings))} "
+                          "cannot change: compare strategies on the robot backend")
 
 _registry: dict[str, Path] = {}
 
@@ -227,13 +238,8 @@ class Day:
         The synthetic backend's tasks are timed templates that no strategy changes, so
         a setting there is a :class:`ConfigError` rather than a comparison of equals."""
         settings = {k: v for k, v in settings.items() if v is not None}
-        unknown = sorted(set(settings) - set(STRATEGY_SETTINGS))
-        if unknown:
-            raise ConfigError(f"Day.run: unknown setting {unknown[0]!r}; known: {', '.join(STRATEGY_SETTINGS)}")
+        check_settings(self.backend, settings)
         if self.backend == "synthetic":
-            if settings:
-                raise ConfigError(f"the synthetic backend runs timed stages that {', '.join(sorted(settings))} "
-                                  "cannot change: compare strategies on the robot backend")
             loop = self.build()
             trace = loop.run()
             if out is not None:

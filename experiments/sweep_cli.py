@@ -12,6 +12,8 @@ import argparse
 import dataclasses
 import socket
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from urllib.parse import urlsplit
 
@@ -94,6 +96,20 @@ def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
                                                 f"{exc.strerror or type(exc).__name__}") from None
 
 
+@contextmanager
+def dask_scheduler(address: str | None) -> Iterator[None]:
+    """Around a run on the Dask scheduler at ``address`` (``None``: local workers, nothing to do):
+    probe it first (:func:`check_scheduler`), and word losing it as bad ``--scheduler-address``."""
+    if not address:
+        yield
+        return
+    check_scheduler(address)
+    try:
+        yield
+    except (OSError, TimeoutError) as exc:
+        raise UsageError("--scheduler-address", f"lost the Dask scheduler at {address}: {exc}") from None
+
+
 def _sweep(args: argparse.Namespace) -> int:
     from experiments.sweep import run_sweep
     from experiments.sweepspec import load_spec
@@ -106,16 +122,9 @@ def _sweep(args: argparse.Namespace) -> int:
         task_types(paths)  # every task folder checked here, before any job
         spec = dataclasses.replace(spec, task_paths=tuple(paths))
     writable_file(args.db, "--db")
-    if args.scheduler_address:
-        check_scheduler(args.scheduler_address)
-    try:
+    with dask_scheduler(args.scheduler_address):
         summary = run_sweep(spec, args.db, workers=args.workers, scheduler_address=args.scheduler_address,
                             retry_errors=args.retry_errors, progress=show_progress(args) and not args.no_progress)
-    except (OSError, TimeoutError) as exc:
-        if not args.scheduler_address:
-            raise
-        raise UsageError("--scheduler-address", f"lost the Dask scheduler at {args.scheduler_address}: "
-                                                f"{exc}") from None
     print(f"{spec.name}: {summary.total} jobs; {summary.skipped} already stored, {summary.ran} run "
           f"({summary.ok} ok, {summary.errors} errors) in {summary.wall:.1f} s on {summary.backend} workers")
     if summary.errors:
