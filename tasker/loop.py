@@ -233,7 +233,7 @@ class SimulationLoop:
         horizon_tick = self._to_tick(self.horizon)
         harm = self.harmoniser
         tokens, heap, pop = self._tokens, self._heap, heapq.heappop
-        isfinite, resolution = math.isfinite, self.resolution
+        isfinite = math.isfinite
         while self._heap:
             if self._pending_events == 0 and not harm.busy and until is None:
                 break
@@ -256,9 +256,8 @@ class SimulationLoop:
                     if token != tokens.get(agent.id) or agent.ended:
                         continue
                     agent.step(now)
-                    wake = agent.next_wake
-                    if isfinite(wake):  # the first tick at or after it, never this one (as _to_tick)
-                        self._wake(agent, max(tick + 1, math.ceil(wake / resolution - 1e-6)))
+                    if isfinite(agent.next_wake):
+                        self._wake(agent, max(tick + 1, self._to_tick(agent.next_wake)))
                 elif phase == _EVENT:
                     self._pending_events -= 1
                     item()
