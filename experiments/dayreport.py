@@ -41,6 +41,7 @@ from scipy import stats
 
 from experiments import days as day_pipeline
 from experiments import protocol as protocols
+from experiments.stats import estimate, holm
 from experiments.strategy import Strategy
 from experiments.sweepspec import Job
 from tasker.errors import ConfigError
@@ -254,12 +255,9 @@ def run_days(protocol: str | Path, days: int, names: Sequence[str], *, first_see
 # -- the table -------------------------------------------------------------------------------------------
 
 def _ci(values: Sequence[float]) -> tuple[float, float]:
-    """Mean and the half-width of its 95 % t confidence interval."""
-    x = np.asarray(values, dtype=float)
-    if len(x) < 2:
-        return float(x.mean()) if len(x) else math.nan, math.nan
-    half = float(stats.t.ppf(0.975, len(x) - 1) * x.std(ddof=1) / math.sqrt(len(x)))
-    return float(x.mean()), half
+    """Mean and the half-width of its 95 % t confidence interval (:func:`experiments.stats.estimate`)."""
+    e = estimate([float(v) for v in values])
+    return e.mean, e.half
 
 
 def _fmt(mean: float, half: float) -> str:
@@ -299,18 +297,6 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
 PAIRED = ("dead", "abandonments", "lateness", "gap", "completed", "interruptions", "travel")
 STRATEGY_PAIRED = (*PAIRED, "suspensions", "susp_time")
 """Strategies differ in how a task suspends: their comparison adds what the suspensions cost."""
-
-
-def holm(pvalues: Sequence[float]) -> list[float]:
-    """Holm–Bonferroni adjusted p-values, in the input order."""
-    m = len(pvalues)
-    order = sorted(range(m), key=lambda i: pvalues[i])
-    out = [0.0] * m
-    running = 0.0
-    for rank, i in enumerate(order):
-        running = max(running, min(1.0, (m - rank) * pvalues[i]))
-        out[i] = running
-    return out
 
 
 def _wilcoxon(diff: np.ndarray) -> float:
