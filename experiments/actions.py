@@ -9,6 +9,7 @@ a task type takes) are checked by :mod:`experiments.crossref`.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Collection
 from dataclasses import dataclass, field
 from typing import Any
@@ -18,7 +19,7 @@ from tasker.reader import Table, check_name, suggest
 
 __all__ = ["TABLES", "WORLD_EVENT_KINDS", "ScenarioError", "TimedAction", "located", "read_actions"]
 
-WORLD_EVENT_KINDS = ("posture", "door", "add", "delete")
+WORLD_EVENT_KINDS = ("posture", "door", "walk", "add", "delete")
 
 TABLES = (("requests", "request"), ("terminations", "terminate"), ("changes", "change"),
           ("mode_changes", "mode"), ("world_events", "world"))
@@ -85,7 +86,7 @@ def _read(f: Table, kind: str, task_names: Collection[str] | None) -> dict[str, 
         return {"mode": f.string("mode", choices=MODES)}
     given = [k for k in WORLD_EVENT_KINDS if k in f]
     if len(given) != 1:
-        others = [k for k in f.keys() if k not in ("t", "note")]
+        others = [k for k in f.keys() if k not in ("t", "note", "after")]
         hint = suggest(others[0], WORLD_EVENT_KINDS) if others and not given else ""
         raise f.error(None, f"a world event has exactly one of {list(WORLD_EVENT_KINDS)}, got "
                             f"{given or others or 'none'}{hint}")
@@ -95,10 +96,16 @@ def _read(f: Table, kind: str, task_names: Collection[str] | None) -> dict[str, 
         raise f.error(what, f"expected [person, posture], got {value!r}")
     if what == "door" and (len(value) != 2 or not isinstance(value[0], str) or not isinstance(value[1], bool)):
         raise f.error(what, f"expected [door, true|false], got {value!r}")
+    if what == "walk" and (len(value) != 3 or not isinstance(value[0], str) or not value[0] or not all(
+            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) for v in value[1:])):
+        raise f.error(what, f"expected [person, x, y] (x and y in metres), got {value!r}")
     if what in ("add", "delete") and not (value and all(
             isinstance(x, list) and x and all(isinstance(a, str) and a for a in x) for x in value)):
         raise f.error(what, f"expected a non-empty list of facts (lists of non-empty strings), got {value!r}")
-    return {"what": what, "value": value, "note": f.string("note", "", empty=True)}
+    out = {"what": what, "value": value, "note": f.string("note", "", empty=True)}
+    if "after" in f:
+        out["after"] = f.string("after")
+    return out
 
 
 def _check_agents(top: Table, actions: tuple[TimedAction, ...]) -> None:
@@ -106,14 +113,17 @@ def _check_agents(top: Table, actions: tuple[TimedAction, ...]) -> None:
     request_times = [a.t for a in actions if a.kind == "request"]
     agents = [f"d{k}" for k in range(1, len(request_times) + 1)]
     for a in actions:
-        if a.kind not in ("terminate", "change"):
+        key = "after" if a.kind == "world" else "agent"
+        if a.kind not in ("terminate", "change") and key not in a.fields:
             continue
-        agent = a.fields["agent"]
+        agent = a.fields[key]
         f = located(top, a)
         k = int(agent[1:]) if agent[:1] == "d" and agent[1:].isdigit() else 0
         if not 1 <= k <= len(request_times):
-            raise f.error("agent", f"no agent {agent!r}{suggest(agent, agents)}: agents are d1..d{len(agents)} "
-                                   "in request order")
+            raise f.error(key, f"no agent {agent!r}{suggest(agent, agents)}: agents are d1..d{len(agents)} "
+                               "in request order")
+        if a.kind == "world":
+            continue  # it waits for the agent's task to finish, whenever that is
         if request_times[k - 1] > a.t:
             raise f.error("agent", f"agent {agent!r} at t={a.t:g} is requested only at t={request_times[k - 1]:g}: "
                                    "a task must be requested before it is changed or terminated")

@@ -263,6 +263,11 @@ class _Checker:
                     check_name(f, what, value[1], POSTURES, "posture")
                 elif what == "door":
                     check_name(f, what, value[0], self.world.doors, f"door of world {self.world.name!r}")
+                elif what == "walk":
+                    from robot.spec import check_point
+
+                    check_name(f, what, value[0], self.world.people, f"person of world {self.world.name!r}")
+                    check_point(self.world, f, what, float(value[1]), float(value[2]))
                 else:
                     for fact in value:
                         self.fact(f, what, fact)

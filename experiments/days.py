@@ -10,7 +10,8 @@ backend runs, built from the one draw of :func:`experiments.protocol.draw`:
 * ``robot``: a :class:`experiments.scenario.RobotScenario` in the protocol's world
   (``[robot_backend]``): each protocol task type is a task folder with its arguments,
   a person of the world per request is scripted to walk to the request's site before
-  the call (and, for a fall, lies down at the call and is taken away at ``death_at``),
+  the call (and, for a fall, lies down at the call and is taken away — gets up and walks
+  home — once the robot's task for them has finished, or at ``death_at`` if it has not),
   each pick-and-place gets its own object at its site.
 
 Either way every request carries ``deadline`` and ``priority`` (and a fall its
@@ -139,24 +140,26 @@ def _robot(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) 
     people: dict[str, dict[str, Any]] = {}
     objects: dict[str, dict[str, Any]] = {}
     held: dict[tuple[str, int], float] = {}  # (site, spot) -> until when someone stands there
+    submitted: dict[int, TimedAction] = {}  # id(request) -> its request action (agents are d1.. in their order)
+    taken: list[tuple[DayRequest, str, tuple[float, ...]]] = []  # who lies down, to be taken away when helped
     for r in requests:
         rt = backend.tasks[r.kind]
         values = {"$site": backend.places[r.site], "$dest": backend.places[r.dest]}
         if "$person" in rt.args.values():
             person = pool.pop(0)
             values["$person"] = person
-            release = r.death_at if rt.posture else None
+            release = r.death_at if rt.posture else None  # the spot is held until then at most
             spot = _free_spot(held, r.site, len(backend.spots[r.site]), r.t - backend.lead_s,
                               math.inf if release is None else release + backend.lead_s)
-            people[person] = _script(world.people[person].pose, backend.spots[r.site][spot], r, backend.lead_s,
-                                     release=release)
+            home = world.people[person].pose
+            people[person] = _script(home, backend.spots[r.site][spot], r, backend.lead_s)
             if rt.posture:
                 actions.append(TimedAction(r.t, "world", {"what": "posture", "value": [person, rt.posture],
                                                                 "note": f"{person}: {rt.posture}"}))
+                # taken away once the robot's help is done, or at death_at if it never is
+                taken.append((r, person, home))
                 if r.death_at is not None and r.death_at < proto.length_s:
-                    actions.append(TimedAction(r.death_at, "world", {
-                        "what": "posture", "value": [person, "standing"],
-                        "note": f"{person} is taken away (death_at)"}))
+                    actions += _taken_away(r.death_at, person, home, "death_at")
         if "$object" in rt.args.values():
             obj = f"o{len(objects) + 1:02d}"
             values["$object"] = obj
@@ -166,8 +169,13 @@ def _robot(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) 
         args |= {"deadline": r.deadline, "priority": r.priority}
         if r.death_at is not None:
             args["death_at"] = r.death_at
-        actions.append(TimedAction(r.t, "request", {"task": rt.task, "args": args}))
+        submitted[id(r)] = TimedAction(r.t, "request", {"task": rt.task, "args": args})
+        actions.append(submitted[id(r)])
     actions.sort(key=lambda a: a.t)  # stable: a posture change comes before its request
+    agents = {id(a): f"d{k}" for k, a in enumerate((a for a in actions if a.kind == "request"), 1)}
+    for r, person, home in taken:
+        actions += _taken_away(r.t, person, home, "help done", after=agents[id(submitted[id(r)])])
+    actions.sort(key=lambda a: a.t)
     rate = 1.0 / proto.step_s
     return RobotScenario(
         name=f"{proto.name}-day{seed}", source=proto.source, world=backend.world, actions=tuple(actions),
@@ -184,9 +192,18 @@ def _free_spot(held: dict[tuple[str, int], float], site: str, n: int, start: flo
     return k
 
 
-def _script(home: tuple[float, ...], spot: tuple[float, ...], r: DayRequest, lead: float,
-            release: float | None) -> dict[str, Any]:
-    """A person's pose and walk: from home to ``spot`` by the call; home again after ``release``."""
+def _taken_away(t: float, person: str, home: tuple[float, ...], why: str,
+                after: str | None = None) -> list[TimedAction]:
+    """Someone who lay down gets up and walks home: at ``t``, or once agent ``after`` has finished."""
+    when = {"after": after} if after is not None else {}
+    note = f"{person} is taken away ({why})"
+    return [TimedAction(t, "world", {"what": "posture", "value": [person, "standing"], "note": note, **when}),
+            TimedAction(t, "world", {"what": "walk", "value": [person, home[0], home[1]], "note": note, **when})]
+
+
+def _script(home: tuple[float, ...], spot: tuple[float, ...], r: DayRequest, lead: float) -> dict[str, Any]:
+    """A person's pose and walk: from home to ``spot`` by the call (:func:`_taken_away` takes
+    them home again)."""
     entry: dict[str, Any] = {}
     walk: list[list[float]] = []
     if r.t >= lead:
@@ -194,8 +211,6 @@ def _script(home: tuple[float, ...], spot: tuple[float, ...], r: DayRequest, lea
     else:  # called before they could walk there: they start at the spot, and the script holds them there
         entry["pose"] = [spot[0], spot[1], 0.0]
         walk += [[0.0, spot[0], spot[1]], [max(r.t, 1.0), spot[0], spot[1]]]
-    if release is not None:
-        walk += [[release + 1.0, spot[0], spot[1]], [release + 1.0 + lead, home[0], home[1]]]
     if walk:
         entry["walk"] = walk
     if r.walk_speed is not None:

@@ -159,6 +159,8 @@ def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: TimedAction
         what, value = f["what"], f["value"]
         if what == "posture":
             sim.people[value[0]].set_posture(value[1])
+        elif what == "walk":
+            sim.people[value[0]].go_to(loop.now, float(value[1]), float(value[2]))
         elif what == "door":
             sim.set_door(value[0], value[1])
         elif what == "add":
@@ -167,7 +169,30 @@ def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: TimedAction
             sim.apply(delete=value)
         loop.trace.emit(loop.now, "world", what=what, value=value, note=f.get("note", ""))
 
-    return world_event
+    if "after" not in f:
+        return world_event
+    return _after(loop, f["after"], world_event)
+
+
+def _after(loop: SimulationLoop, agent: str, event: Callable[[], None]) -> Callable[[], None]:
+    """``event`` at its time if agent ``agent`` has finished its task by then, else as soon as it
+    does (in the tick its ``end`` event with cause ``finished`` is traced); never if it ends otherwise."""
+    state = {"finished": False, "due": False}
+
+    def watch(e: dict[str, Any]) -> None:
+        if e["event"] == "end" and e.get("agent") == agent and e.get("cause") == "finished" and not state["finished"]:
+            state["finished"] = True
+            if state["due"]:
+                loop.at(loop.now, event)
+
+    loop.trace.subscribe(watch)
+
+    def at_time() -> None:
+        state["due"] = True
+        if state["finished"]:
+            event()
+
+    return at_time
 
 
 def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | None = None,

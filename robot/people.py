@@ -15,6 +15,7 @@ randomness).  What a person does in a step, in order of precedence:
 5. otherwise the **script**: ``walk`` waypoints ``(t, x, y)`` say where the person is
    at time ``t``; the person heads for the scripted position of *now* at their walking
    speed, so after a reaction ends they walk back onto the script instead of jumping.
+   A scenario's ``walk`` world event replaces the script from then on (:meth:`Person.go_to`).
 
 Posture changes come from the script's ``events`` ``(t, posture)`` or from
 :meth:`Person.set_posture`; and a sitting person asked to follow the robot stands up
@@ -45,6 +46,7 @@ class Person:
         self.name = spec.name
         self.x, self.y, self.yaw = spec.pose
         self.posture = spec.posture
+        self.walk = spec.walk  # the script's waypoints; :meth:`go_to` replaces them
         self._event = 0
         self._trail: list[tuple[float, float]] = []
         self.following = False
@@ -62,7 +64,7 @@ class Person:
 
     def scripted(self, t: float) -> tuple[float, float] | None:
         """Where the script wants the person at time ``t`` (None: no walk scripted)."""
-        walk = self.spec.walk
+        walk = self.walk
         if not walk:
             return None
         if t <= walk[0][0]:
@@ -72,6 +74,12 @@ class Person:
                 f = (t - t0) / (t1 - t0)
                 return (x0 + f * (x1 - x0), y0 + f * (y1 - y0))
         return walk[-1][1], walk[-1][2]
+
+    def go_to(self, t: float, x: float, y: float) -> None:
+        """From time ``t`` the script is a walk from here to ``(x, y)`` at the person's speed,
+        and standing there (a scenario's ``walk`` world event)."""
+        d = math.hypot(x - self.x, y - self.y)
+        self.walk = ((t, self.x, self.y), (t + d / self.spec.speed, x, y)) if d > 1e-9 else ((t, x, y),)
 
     def _walk_to(self, tx: float, ty: float, dt: float, stop_at: float = 0.0) -> None:
         dx, dy = tx - self.x, ty - self.y

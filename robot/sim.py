@@ -128,9 +128,9 @@ class Simulation:
             return self.time
         if p.giving_room is not None and p.giving_room[1] is not None:
             return nxt  # standing clear of someone fallen until a posture changes
-        if p.posture == "fallen" or ("told_to_wait", p.name) in self.facts or not p.spec.walk:
+        if p.posture == "fallen" or ("told_to_wait", p.name) in self.facts or not p.walk:
             return nxt
-        walk = p.spec.walk
+        walk = p.walk
         if self.time < walk[0][0]:
             return min(nxt, walk[0][0])
         if self.time >= walk[-1][0] and math.hypot(p.x - walk[-1][1], p.y - walk[-1][2]) <= 1e-9:

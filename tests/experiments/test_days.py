@@ -15,6 +15,7 @@ import pytest
 
 from experiments import dayreport, days, protocol
 from robot.estimator import motion_model
+from robot.spec import load_world
 from tasker import schedulers
 from tasker.errors import ConfigError
 
@@ -70,8 +71,20 @@ def test_both_backends_are_built_from_one_draw() -> None:
     # every request carries its deadline and priority; a fall its death time, and its person falls at the call
     falls = [a for a in rob.actions if a.kind == "request" and a.fields["task"] == folder["fall"]]
     assert len(falls) == 12 and all(a.fields["args"]["death_at"] == a.fields["args"]["deadline"] + 900 for a in falls)
-    postures = {(a.t, a.fields["value"][0]): a.fields["value"][1] for a in rob.actions if a.kind == "world"}
+    timed = [a for a in rob.actions if a.kind == "world" and "after" not in a.fields]
+    postures = {(a.t, a.fields["value"][0]): a.fields["value"][1] for a in timed if a.fields["what"] == "posture"}
     assert all(postures[a.t, a.fields["args"]["person"]] == "fallen" for a in falls)
+    # and is taken away (stands up, walks home) once their own request's agent has finished
+    agents = {f"d{k}": a for k, a in enumerate((a for a in rob.actions if a.kind == "request"), 1)}
+    helped = [a for a in rob.actions if a.kind == "world" and "after" in a.fields]
+    assert len(helped) == 2 * len(falls)
+    assert proto.robot is not None
+    world = load_world(proto.robot.world)
+    for a in helped:
+        person = a.fields["value"][0]
+        assert agents[a.fields["after"]].fields["args"].get("person") == person
+        assert a.fields["value"][1:] == (["standing"] if a.fields["what"] == "posture"
+                                         else list(world.people[person].pose[:2]))
     people = [v for a in rob.actions if a.kind == "request" for v in a.fields["args"].values() if v in rob.people]
     assert len(people) == len(set(people)) == 24  # one person per escort and per fall
     assert len(rob.objects) == 12
