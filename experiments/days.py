@@ -173,8 +173,8 @@ def _robot(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) 
         actions.append(submitted[id(r)])
     actions.sort(key=lambda a: a.t)  # stable: a posture change comes before its request
     agents = {id(a): f"d{k}" for k, a in enumerate((a for a in actions if a.kind == "request"), 1)}
-    for r, person, home in taken:
-        actions += _taken_away(r.t, person, home, "help done", after=agents[id(submitted[id(r)])])
+    for r, person, back in taken:
+        actions += _taken_away(r.t, person, back, "help done", after=agents[id(submitted[id(r)])])
     actions.sort(key=lambda a: a.t)
     rate = 1.0 / proto.step_s
     return RobotScenario(
