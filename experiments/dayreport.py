@@ -6,7 +6,8 @@ interruptions per type and per task, oscillation, how the day ended — plus our
 suspensions (interruptions that needed an ``exeSusp``), time spent suspending,
 switches, and for whole-queue schedulers the longest queue ordered and the decisions
 whose search hit its budget.  On the robot backend, :mod:`experiments.pathmetrics` adds
-abandonment and travel distance from the recorded trajectory.
+abandonment and travel distance from the recorded trajectory, and :func:`hazard_metrics`
+the task folders' hazards as every run counts them (``safety`` of :mod:`experiments.metrics`).
 
 :func:`run_days` runs N days x schedulers on a backend (days made by
 :func:`experiments.days.make`) and :func:`table` writes the Markdown table with 95 %
@@ -41,6 +42,7 @@ from scipy import stats
 
 from experiments import days as day_pipeline
 from experiments import protocol as protocols
+from experiments.metrics import HazardCollector
 from experiments.stats import estimate, holm
 from experiments.strategy import Strategy
 from experiments.sweepspec import Job
@@ -137,6 +139,18 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
     }
 
 
+def hazard_metrics(events: Iterable[Mapping[str, Any]]) -> dict[str, Any]:
+    """Ours, robot backend: the hazards the task folders declare, as :mod:`experiments.metrics`
+    counts them for every run (``safety``): time unattended (including what a task left on
+    when it ended, to the day's end), budget overruns, hazards left on at a switch."""
+    c = HazardCollector()
+    for e in events:
+        c.on_event(e)
+    h = c.result()
+    return {"hazard_unattended_s": h["unattended_s"], "hazard_overruns": h["budget_overruns"],
+            "hazards_left_at_switch": h["violations_at_switch"]}
+
+
 def _mean(values: Sequence[float]) -> float | None:
     return sum(values) / len(values) if values else None
 
@@ -176,6 +190,7 @@ def run_day(protocol: str, seed: int, scheduler: str, backend: str = "synthetic"
         from experiments.pathmetrics import path_metrics
 
         out |= path_metrics(run.events, run.samples)
+        out |= hazard_metrics(run.events)
         out["wall_time_s"] = run.record.get("wall_time_s")  # not in the table: how long the day took here
     return out
 
@@ -282,6 +297,9 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
         ("suspensions with exeSusp (ours)", "suspensions", lambda r: r["suspensions"]),
         ("time suspending (s, ours)", "susp_time", lambda r: r["suspension_time_s"]),
         ("switches (ours)", "switches", lambda r: r["switches"]),
+        ("hazard time unattended (s, ours)", "hazard_s", lambda r: r.get("hazard_unattended_s")),
+        ("hazard budget overruns (ours)", "overruns", lambda r: r.get("hazard_overruns")),
+        ("hazards left on at a switch (ours)", "left_on", lambda r: r.get("hazards_left_at_switch")),
         ("abandonments (robot leaves a fallen person's 2 m circle)", "abandonments", lambda r: r.get("abandonments")),
         ("falls abandoned at least once", "abandoned", lambda r: r.get("abandoned_falls")),
         ("abandonments for another task (ours: not while driving to the person)", "abandon_other",
@@ -295,7 +313,7 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
 
 
 PAIRED = ("dead", "abandonments", "lateness", "gap", "completed", "interruptions", "travel")
-STRATEGY_PAIRED = (*PAIRED, "suspensions", "susp_time")
+STRATEGY_PAIRED = (*PAIRED, "suspensions", "susp_time", "hazard_s", "overruns", "left_on")
 """Strategies differ in how a task suspends: their comparison adds what the suspensions cost."""
 
 

@@ -120,6 +120,14 @@ def test_a_robot_day_runs_under_the_strategy_it_is_given(tiny_protocol: protocol
     assert m["strategy"] == "update=static,suspension=static"
     run = json.loads((tmp_path / "trace.jsonl").read_text().splitlines()[0])
     assert (run["event"], run["update"], run["suspension"]) == ("run", "static", "static")
+    # the day's hazard rows are the run metrics' safety section, one definition
+    from experiments.metrics import compute_file
+
+    safety = compute_file(tmp_path / "trace.jsonl")["safety"]
+    assert m["hazard_unattended_s"] == pytest.approx(safety["unattended_s"], abs=1e-6)
+    assert (m["hazard_overruns"], m["hazards_left_at_switch"]) == (safety["budget_overruns"],
+                                                                   safety["violations_at_switch"])
+    assert safety["episodes"]  # the carry held its object: the day has hazards to count
     with pytest.raises(ConfigError, match="synthetic backend"):
         days.make("tabsa-short", 1).run(suspension="static")
 
