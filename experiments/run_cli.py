@@ -79,16 +79,23 @@ def _run(args: argparse.Namespace) -> int:
                                         f"known: {', '.join(schedulers.names())}")
     paths = task_paths(args)
     path = scenarios.resolve(args.scenario)
-    out = writable_dir(Path(args.out) if args.out else Path("out") / path.stem, "--out")
-    if paths:
-        from planners.bundled import task_types
+    want = Path(args.out) if args.out else Path("out") / path.stem
+    made = not want.exists()
+    out = writable_dir(want, "--out")
+    try:
+        if paths:
+            from planners.bundled import task_types
 
-        task_types(paths)  # every folder checked now, before the run
-    result = run_scenario(path, seed=args.seed, update=args.update, suspension=args.suspension,
-                          scheduler=args.scheduler, mode=args.mode, out=out, randomize=args.randomize,
-                          progress=show_progress(args), pictures=not args.no_pictures,
-                          task_paths=tuple(paths), policy=args.policy,
-                          hazard_waiting=args.hazard_waiting)
+            task_types(paths)  # every folder checked now, before the run
+        result = run_scenario(path, seed=args.seed, update=args.update, suspension=args.suspension,
+                              scheduler=args.scheduler, mode=args.mode, out=out, randomize=args.randomize,
+                              progress=show_progress(args), pictures=not args.no_pictures,
+                              task_paths=tuple(paths), policy=args.policy,
+                              hazard_waiting=args.hazard_waiting)
+    except Exception:  # bad input refused before the run: no empty output folder left behind
+        if made and out.is_dir() and not any(out.iterdir()):
+            out.rmdir()
+        raise
     ends = result.trace.of("end")
     causes: dict[str, int] = {}
     for e in ends:

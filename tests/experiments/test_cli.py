@@ -97,7 +97,11 @@ def _ids(case: tuple[list[str], str]) -> str:
 
 @pytest.mark.parametrize("argv, names", BAD, ids=[_ids(c) for c in BAD])
 def test_bad_arguments_exit_nonzero_with_a_message_naming_them(
-        argv: list[str], names: str, files: dict[str, str], capsys: pytest.CaptureFixture[str]) -> None:
+        argv: list[str], names: str, files: dict[str, str], capsys: pytest.CaptureFixture[str],
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    here = tmp_path / "cwd"
+    here.mkdir()
+    monkeypatch.chdir(here)  # default output folders land here, not in the checkout
     status = main([a.format(**files) for a in argv])
     err = capsys.readouterr().err
     assert status == 2, err
@@ -105,6 +109,7 @@ def test_bad_arguments_exit_nonzero_with_a_message_naming_them(
     assert names in err
     last = err.strip().splitlines()[-1]
     assert last.startswith(("tasker: error:", f"tasker {argv[0]}: error:")), last
+    assert not list((here / "out").rglob("*")), "bad input left an output folder behind"
 
 
 def test_every_subcommand_has_a_bad_argument_case() -> None:
