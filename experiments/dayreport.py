@@ -142,13 +142,14 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
 def hazard_metrics(events: Iterable[Mapping[str, Any]]) -> dict[str, Any]:
     """Ours, robot backend: the hazards the task folders declare, as :mod:`experiments.metrics`
     counts them for every run (``safety``): time unattended (including what a task left on
-    when it ended, to the day's end), budget overruns, hazards left on at a switch."""
+    when it ended, to the day's end) and the part of it after the task ended, budget
+    overruns, hazards left on at a switch."""
     c = HazardCollector()
     for e in events:
         c.on_event(e)
     h = c.result()
-    return {"hazard_unattended_s": h["unattended_s"], "hazard_overruns": h["budget_overruns"],
-            "hazards_left_at_switch": h["violations_at_switch"]}
+    return {"hazard_unattended_s": h["unattended_s"], "hazard_after_end_s": h["after_end_s"],
+            "hazard_overruns": h["budget_overruns"], "hazards_left_at_switch": h["violations_at_switch"]}
 
 
 def _mean(values: Sequence[float]) -> float | None:
@@ -298,6 +299,7 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
         ("time suspending (s, ours)", "susp_time", lambda r: r["suspension_time_s"]),
         ("switches (ours)", "switches", lambda r: r["switches"]),
         ("hazard time unattended (s, ours)", "hazard_s", lambda r: r.get("hazard_unattended_s")),
+        ("… of it after its task ended (s, ours)", "hazard_after", lambda r: r.get("hazard_after_end_s")),
         ("hazard budget overruns (ours)", "overruns", lambda r: r.get("hazard_overruns")),
         ("hazards left on at a switch (ours)", "left_on", lambda r: r.get("hazards_left_at_switch")),
         ("abandonments (robot leaves a fallen person's 2 m circle)", "abandonments", lambda r: r.get("abandonments")),
@@ -313,7 +315,7 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
 
 
 PAIRED = ("dead", "abandonments", "lateness", "gap", "completed", "interruptions", "travel")
-STRATEGY_PAIRED = (*PAIRED, "suspensions", "susp_time", "hazard_s", "overruns", "left_on")
+STRATEGY_PAIRED = (*PAIRED, "suspensions", "susp_time", "hazard_s", "hazard_after", "overruns", "left_on")
 """Strategies differ in how a task suspends: their comparison adds what the suspensions cost."""
 
 

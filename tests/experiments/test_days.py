@@ -125,6 +125,7 @@ def test_a_robot_day_runs_under_the_strategy_it_is_given(tiny_protocol: protocol
 
     safety = compute_file(tmp_path / "trace.jsonl")["safety"]
     assert m["hazard_unattended_s"] == pytest.approx(safety["unattended_s"], abs=1e-6)
+    assert m["hazard_after_end_s"] == pytest.approx(safety["after_end_s"], abs=1e-6)
     assert (m["hazard_overruns"], m["hazards_left_at_switch"]) == (safety["budget_overruns"],
                                                                    safety["violations_at_switch"])
     assert safety["episodes"]  # the carry held its object: the day has hazards to count
