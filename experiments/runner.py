@@ -107,7 +107,7 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
     )
     monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning,
                       lambda: sim.snapshot().facts, task_types=store.names(),
-                      version=lambda: (sim.time, sim.version))
+                      version=sim.facts_key)
     loop.observers.append(monitor.observe)
     loop.harmoniser.hazards = monitor.active  # hazard-aware waiting learns of hazards from the monitor
     requester = Requester(store, loop.harmoniser, "scenario")

@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -49,6 +50,7 @@ CONTROL_DT = 0.02  # seconds: the base controller and the people run at 50 Hz
 AT_TOLERANCE = 0.3  # metres: the robot starts "at" a place this close
 TOGETHER = 1.5  # metres: a person this close to the robot is symbolically at the robot's place
 WAIT_MARGIN = 0.05  # metres beyond a standing person's radius and the robot's width (Simulation._aside_spot)
+PLACE_MEMO = 4096  # points whose place is remembered (Simulation._memo_place), then forgotten all at once
 ASIDE_STEP, ASIDE_MAX, ASIDE_DIRECTIONS = 0.1, 3.0, 16  # where a person stepping aside looks for a spot
 
 
@@ -93,6 +95,7 @@ class Simulation:
         self._ticks = 0
         self._last_cmd = STOP
         self._synced: dict[str, tuple[float, float, float, str]] = {}
+        self._places_memo: dict[tuple[str, float, float], str] = {}
         self._fallen: tuple[str, ...] = ()  # who lay fallen at the last look (Simulation._give_room)
         self.physics_ticks = 0  # control ticks that stepped MuJoCo (the rest: robot at rest, nothing to do)
         self._sync_people()
@@ -410,16 +413,40 @@ class Simulation:
                 poses[name] = self.spec.places[place]
         return WorldState(frozenset(facts | self.people.facts()), poses, self.objects(), self.time)
 
+    def facts_key(self) -> tuple[Any, ...]:
+        """What the facts of :meth:`snapshot` are made of, cheaply: equal keys, equal facts.
+
+        The symbolic state, devices, doors, what is held and who follows or waits all bump
+        :attr:`version` when they change; the rest is where the robot and the people are and
+        the people's postures.  A monitor that asks only when this changes misses nothing
+        and skips the ticks in which nobody moved."""
+        x, y, _ = self.mj.pose()
+        return (self.version, x, y, tuple((p.x, p.y, p.posture) for p in self.people))
+
     def person_place(self, x: float, y: float) -> str:
         """Where a person is, symbolically: :meth:`place_of` among the places that are not
         the places of devices (people are not "at the stove"), or among all places if none."""
-        device_places = {d.place for d in self.spec.devices.values()}
-        spots = {n: p for n, p in self.spec.places.items() if n not in device_places} or dict(self.spec.places)
-        return self.place_of(x, y, spots)
+        return self._memo_place("person", x, y)
 
     def nearest_place(self, x: float, y: float) -> str:
         """Where the robot (or anything) at ``(x, y)`` is: :meth:`place_of` among all places."""
-        return self.place_of(x, y, self.spec.places)
+        return self._memo_place("any", x, y)
+
+    def _memo_place(self, who: str, x: float, y: float) -> str:
+        """:meth:`place_of` remembered per point: walls, rooms and places never change during
+        a run, and every snapshot grounds everyone, most of whom stand where they stood."""
+        key = (who, x, y)
+        hit = self._places_memo.get(key)
+        if hit is None:
+            if who == "any":
+                spots: Mapping[str, Pose] = self.spec.places
+            else:
+                device_places = {d.place for d in self.spec.devices.values()}
+                spots = {n: p for n, p in self.spec.places.items() if n not in device_places} or self.spec.places
+            if len(self._places_memo) >= PLACE_MEMO:
+                self._places_memo.clear()
+            hit = self._places_memo[key] = self.place_of(x, y, spots)
+        return hit
 
     def room_of(self, x: float, y: float) -> str | None:
         """The smallest room whose box holds ``(x, y)`` (ties by name), or None (:func:`robot.spec.room_of`)."""

@@ -39,3 +39,20 @@ def test_nested_rooms_use_the_smallest(flat) -> None:
     sim = Simulation(flat)
     assert sim.room_of(0.7, 5.2) == "storage"  # the smallest room holding the point
     assert sim.nearest_place(0.7, 5.2) == "storage"
+
+
+def test_remembered_places_are_the_places_computed_afresh(paper, monkeypatch: pytest.MonkeyPatch) -> None:
+    import random
+
+    import robot.sim as sim_module
+
+    monkeypatch.setattr(sim_module, "PLACE_MEMO", 16)  # forgotten and remembered again along the way
+    sim = Simulation(paper)
+    device_places = {d.place for d in paper.devices.values()}
+    people_spots = {n: p for n, p in paper.places.items() if n not in device_places}
+    (x0, y0), (x1, y1) = paper.bounds
+    rng = random.Random(7)
+    points = [(round(rng.uniform(x0, x1), 2), round(rng.uniform(y0, y1), 2)) for _ in range(40)]
+    for x, y in points * 2:  # the second pass hits the memo where it still holds them
+        assert sim.nearest_place(x, y) == sim.place_of(x, y, paper.places)
+        assert sim.person_place(x, y) == sim.place_of(x, y, people_spots)

@@ -226,3 +226,35 @@ def test_a_person_stepping_aside_is_estimated_where_they_are_going(paper) -> Non
     sim.advance(6.0)
     assert "john" not in sim.scene.stepping_to
     assert sim.motion.estimate(living, kitchen).time_s == pytest.approx(expected.time_s, abs=0.5)
+
+
+def test_equal_facts_keys_mean_equal_facts(paper) -> None:
+    """A monitor asks for the facts only when ``facts_key`` changes: along a drive with people
+    walking, following, falling and facts applied, equal keys always came with equal facts."""
+    sim = Simulation(paper)
+    sim.bind([Binding("follower", ("following", "?h"), "?h", ("person",))])
+    seen: dict[object, frozenset] = {}
+    keys = 0
+
+    def look() -> None:
+        nonlocal keys
+        key, facts = sim.facts_key(), sim.snapshot().facts
+        keys += key not in seen
+        assert seen.setdefault(key, facts) == facts
+
+    stage = nav("john", add=[["met", "robot", "john"]])
+    sim.begin("d1", stage, 0.0)
+    t = 0.0
+    while sim.poll("d1", stage, t).state is SkillState.RUNNING and t < 60.0:
+        t = round(t + 0.5, 6)
+        sim.advance(t)
+        look()
+    sim.apply(add=[["following", "john"]])
+    look()
+    sim.people["peter"].set_posture("sitting")
+    look()
+    for _ in range(20):
+        t = round(t + 0.5, 6)
+        sim.advance(t)
+        look()
+    assert keys > 10  # the key did change along the way
