@@ -140,10 +140,10 @@ def _robot(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) 
     people: dict[str, dict[str, Any]] = {}
     objects: dict[str, dict[str, Any]] = {}
     held: dict[tuple[str, int], float] = {}  # (site, spot) -> until when someone stands there
-    submitted: dict[int, TimedAction] = {}  # id(request) -> its request action (agents are d1.. in their order)
-    taken: list[tuple[DayRequest, str, tuple[float, ...]]] = []  # who lies down, to be taken away when helped
+    taken: list[tuple[TimedAction, str, tuple[float, ...]]] = []  # (request, who lies down for it, their home)
     for r in requests:
         rt = backend.tasks[r.kind]
+        lies_down: tuple[str, tuple[float, ...]] | None = None
         values = {"$site": backend.places[r.site], "$dest": backend.places[r.dest]}
         if "$person" in rt.args.values():
             person = pool.pop(0)
@@ -156,8 +156,7 @@ def _robot(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) 
             if rt.posture:
                 actions.append(TimedAction(r.t, "world", {"what": "posture", "value": [person, rt.posture],
                                                                 "note": f"{person}: {rt.posture}"}))
-                # taken away once the robot's help is done, or at death_at if it never is
-                taken.append((r, person, home))
+                lies_down = (person, home)  # taken away once the robot's help is done, or at death_at
                 if r.death_at is not None and r.death_at < proto.length_s:
                     actions += _taken_away(r.death_at, person, home, "death_at")
         if "$object" in rt.args.values():
@@ -169,12 +168,13 @@ def _robot(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) 
         args |= {"deadline": r.deadline, "priority": r.priority}
         if r.death_at is not None:
             args["death_at"] = r.death_at
-        submitted[id(r)] = TimedAction(r.t, "request", {"task": rt.task, "args": args})
-        actions.append(submitted[id(r)])
+        actions.append(TimedAction(r.t, "request", {"task": rt.task, "args": args}))
+        if lies_down is not None:
+            taken.append((actions[-1], *lies_down))
     actions.sort(key=lambda a: a.t)  # stable: a posture change comes before its request
     agents = {id(a): f"d{k}" for k, a in enumerate((a for a in actions if a.kind == "request"), 1)}
-    for r, person, back in taken:
-        actions += _taken_away(r.t, person, back, "help done", after=agents[id(submitted[id(r)])])
+    for req, person, back in taken:  # agents are d1, d2, … in the order requests are made
+        actions += _taken_away(req.t, person, back, "help done", after=agents[id(req)])
     actions.sort(key=lambda a: a.t)
     rate = 1.0 / proto.step_s
     return RobotScenario(

@@ -96,6 +96,7 @@ class Simulation:
         self._last_cmd = STOP
         self._synced: dict[str, tuple[float, float, float, str]] = {}
         self._places_memo: dict[tuple[str, float, float], str] = {}
+        self._person_spots: dict[str, Pose] | None = None  # the places people can be at (person_place)
         self._fallen: tuple[str, ...] = ()  # who lay fallen at the last look (Simulation._give_room)
         self.physics_ticks = 0  # control ticks that stepped MuJoCo (the rest: robot at rest, nothing to do)
         self._sync_people()
@@ -426,23 +427,23 @@ class Simulation:
     def person_place(self, x: float, y: float) -> str:
         """Where a person is, symbolically: :meth:`place_of` among the places that are not
         the places of devices (people are not "at the stove"), or among all places if none."""
-        return self._memo_place("person", x, y)
+        if self._person_spots is None:
+            device_places = {d.place for d in self.spec.devices.values()}
+            self._person_spots = {n: p for n, p in self.spec.places.items()
+                                  if n not in device_places} or dict(self.spec.places)
+        return self._memo_place("person", self._person_spots, x, y)
 
     def nearest_place(self, x: float, y: float) -> str:
         """Where the robot (or anything) at ``(x, y)`` is: :meth:`place_of` among all places."""
-        return self._memo_place("any", x, y)
+        return self._memo_place("any", self.spec.places, x, y)
 
-    def _memo_place(self, who: str, x: float, y: float) -> str:
-        """:meth:`place_of` remembered per point: walls, rooms and places never change during
-        a run, and every snapshot grounds everyone, most of whom stand where they stood."""
-        key = (who, x, y)
+    def _memo_place(self, which: str, spots: Mapping[str, Pose], x: float, y: float) -> str:
+        """:meth:`place_of` among ``spots`` (named ``which``) remembered per point: walls, rooms
+        and places never change during a run, and every snapshot grounds everyone, most of whom
+        stand where they stood."""
+        key = (which, x, y)
         hit = self._places_memo.get(key)
         if hit is None:
-            if who == "any":
-                spots: Mapping[str, Pose] = self.spec.places
-            else:
-                device_places = {d.place for d in self.spec.devices.values()}
-                spots = {n: p for n, p in self.spec.places.items() if n not in device_places} or self.spec.places
             if len(self._places_memo) >= PLACE_MEMO:
                 self._places_memo.clear()
             hit = self._places_memo[key] = self.place_of(x, y, spots)
