@@ -13,20 +13,28 @@
   handed to MuJoCo as assets, non-positive-definite inertias are repaired, the arm,
   torso and head are locked in the tucked posture (their joints removed) and the
   casters are made frictionless (``priority=1, condim=1, friction=0``) so the
-  differential-drive base can roll.  The converted source is cached in-process.
+  differential-drive base can roll.  The converted source (URDF text and mesh assets,
+:func:`mujoco_source`) is cached in-process and on disk (kind ``tiago-mujoco``, same
+key as the dimensions less Pinocchio's version), so a cached process imports no coal.
+
+Mesh files are keyed by the example-robot-data version that installed them, not hashed
+(5 MB read per process would cost a third of what the cache saves): after editing them
+in place, clear the cache (``docs/cli.md``).
 
 Nothing is downloaded.
 """
 
 from __future__ import annotations
 
+import io
 import json
 import logging
 import math
 import re
+import zipfile
 from functools import lru_cache
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -42,7 +50,8 @@ TUCK = {"torso_lift_joint": 0.15, "arm_1_joint": 0.20, "arm_2_joint": -1.34, "ar
 
 WHEELS = ("wheel_left_joint", "wheel_right_joint")
 PLANNING_MARGIN = 0.03  # metres added to the footprint for the 2-D planner
-DIMENSIONS_KIND = "robot-dimensions"  # the on-disk cache's kind (tasker.diskcache)
+DIMENSIONS_KIND = "robot-dimensions"  # the on-disk caches' kinds (tasker.diskcache)
+SOURCE_KIND = "tiago-mujoco"
 _DIMENSIONS = ("wheel_radius", "wheel_separation", "planning_radius")
 log = logging.getLogger(__name__)
 
@@ -71,6 +80,18 @@ def urdf_path() -> Path:
     import example_robot_data as erd
 
     return (Path(erd.getModelPath("tiago_description")) / _URDF).resolve()
+
+
+def _version(*dists: str) -> str:
+    """The installed version of the first of ``dists`` found (distribution names differ by installer)."""
+    from importlib import metadata
+
+    for dist in dists:
+        try:
+            return f"{dist} {metadata.version(dist)}"
+        except metadata.PackageNotFoundError:
+            continue
+    return f"{dists[0]} absent"
 
 
 @lru_cache(maxsize=1)
@@ -185,9 +206,52 @@ def _fix_inertia(match: re.Match[str]) -> str:
     return f'<inertia ixx="{d[0]}" ixy="0" ixz="0" iyy="{d[1]}" iyz="0" izz="{d[2]}"/>'
 
 
+MjSource = tuple[str, tuple[tuple[str, bytes], ...]]
+
+
+def source_key() -> str:
+    """The on-disk cache key of :func:`mujoco_source`: the URDF (bytes and place), this module, coal."""
+    urdf = urdf_path()
+    return content_key(SOURCE_KIND, [urdf.read_bytes(), str(urdf), Path(__file__).read_bytes(),
+                                     _version("coal", "hpp-fcl"), _version("example-robot-data")])
+
+
+def _source_to_npz(source: MjSource) -> bytes:
+    text, assets = source
+    buf = io.BytesIO()
+    arrays: dict[str, Any] = {f"asset{k}": np.frombuffer(b, dtype=np.uint8) for k, (_, b) in enumerate(assets)}
+    np.savez(buf, text=np.frombuffer(text.encode(), dtype=np.uint8), names=np.array([n for n, _ in assets]), **arrays)
+    return buf.getvalue()
+
+
+def _source_from_npz(data: bytes) -> MjSource | None:
+    try:
+        with np.load(io.BytesIO(data), allow_pickle=False) as z:
+            raw, names = z["text"], [str(n) for n in z["names"]]
+            blobs, files = [z[f"asset{k}"] for k in range(len(names))], len(z.files)
+        if not all(b.dtype == np.uint8 and b.ndim == 1 for b in [raw, *blobs]) or files != len(names) + 2:
+            raise ValueError("arrays of the wrong type, or more arrays than names")
+        text = raw.tobytes().decode()
+    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as exc:
+        log.debug("TIAGo MuJoCo source cache entry unusable, converted again: %s", exc)
+        return None
+    return text, tuple((n, b.tobytes()) for n, b in zip(names, blobs, strict=True))
+
+
 @lru_cache(maxsize=1)
-def mujoco_source() -> tuple[str, tuple[tuple[str, bytes], ...]]:
-    """The URDF rewritten for MuJoCo and its mesh assets (name, bytes); cached in-process."""
+def mujoco_source() -> MjSource:
+    """The URDF rewritten for MuJoCo and its mesh assets (name, bytes); cached in-process and on disk."""
+    path = entry_path(SOURCE_KIND, source_key(), ".npz")
+    data = read_entry(path)
+    source = None if data is None else _source_from_npz(data)
+    if source is None:
+        source = _convert_source()
+        if path is not None:
+            write_atomic(path, _source_to_npz(source))
+    return source
+
+
+def _convert_source() -> MjSource:
     urdf = urdf_path()
     robots_dir = urdf.parents[2]
     text = urdf.read_text(encoding="utf-8").replace("package://example-robot-data/robots/", f"{robots_dir}/")
@@ -248,18 +312,6 @@ def tiago_mjspec() -> mujoco.MjSpec:
         act.set_to_velocity(kv=20.0)
         act.ctrlrange, act.ctrllimited = [-12, 12], True
     return spec
-
-
-def _version(*dists: str) -> str:
-    """The installed version of the first of ``dists`` found (distribution names differ by installer)."""
-    from importlib import metadata
-
-    for dist in dists:
-        try:
-            return f"{dist} {metadata.version(dist)}"
-        except metadata.PackageNotFoundError:
-            continue
-    return f"{dists[0]} absent"
 
 
 def dimensions_key() -> str:

@@ -1,4 +1,5 @@
-"""The robot's on-disk caches: the dimensions read from Pinocchio and the grown roadmap.
+"""The robot's on-disk caches: the dimensions read from Pinocchio, TIAGo's MuJoCo source
+(URDF text and converted meshes) and the grown roadmap.
 
 A hit gives what a fresh build gives (bit for bit), an entry that cannot be used is built
 again and rewritten, ``TASKER_CACHE=off`` writes nothing, and every input is in the key.
@@ -36,8 +37,10 @@ def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
     monkeypatch.setenv("TASKER_CACHE", str(tmp_path / "c"))
     monkeypatch.setattr(roadmap_module, "_CACHE", {})
     tiago.robot_dimensions.cache_clear()
+    tiago.mujoco_source.cache_clear()
     yield tmp_path / "c"
     tiago.robot_dimensions.cache_clear()
+    tiago.mujoco_source.cache_clear()
 
 
 @pytest.fixture(scope="module")
@@ -167,20 +170,38 @@ def test_concurrent_roadmap_writers_leave_one_whole_entry(cache: Path, paper: Wo
 # -- the robot's dimensions ----------------------------------------------------------------------
 
 
-def test_dimensions_from_disk_are_the_measured_ones_without_pinocchio(cache: Path) -> None:
-    code = ("import json, sys\nfrom robot.tiago import robot_dimensions\n"
-            "print(json.dumps([robot_dimensions(), 'pinocchio' in sys.modules]))")
+def test_robot_from_disk_is_the_measured_one_without_pinocchio_or_coal(cache: Path) -> None:
+    code = ("import hashlib, json, sys\nfrom robot.tiago import mujoco_source, robot_dimensions\n"
+            "text, assets = mujoco_source()\n"
+            "h = hashlib.sha256(text.encode() + repr(assets).encode()).hexdigest()\n"
+            "print(json.dumps([robot_dimensions(), h, 'pinocchio' in sys.modules, 'coal' in sys.modules]))")
     env = {**os.environ, "TASKER_CACHE": str(cache), "PYTHONPATH": str(ROOT)}
 
-    def run() -> tuple[list[float], bool]:
+    def run() -> tuple[list[float], str, bool, bool]:
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env)
-        dims, pinocchio = json.loads(out.stdout)
-        return dims, pinocchio
+        dims, digest, pinocchio, coal = json.loads(out.stdout)
+        return dims, digest, pinocchio, coal
 
-    measured, imported = run()
-    assert imported and len(_entries(cache, "robot-dimensions")) == 1
-    cached, imported = run()
-    assert cached == measured == list(tiago._measure_dimensions()) and not imported
+    measured, converted, pinocchio, coal = run()
+    assert pinocchio and coal
+    assert len(_entries(cache, "robot-dimensions")) == len(_entries(cache, "tiago-mujoco")) == 1
+    cached, loaded, pinocchio, coal = run()
+    assert cached == measured == list(tiago._measure_dimensions()) and loaded == converted
+    assert not pinocchio and not coal
+
+
+def test_mujoco_source_from_disk_is_the_converted_one(cache: Path) -> None:
+    converted = tiago._convert_source()
+    assert tiago.mujoco_source() == converted  # converted and written
+    tiago.mujoco_source.cache_clear()
+    assert tiago.mujoco_source() == converted  # loaded
+    (entry,) = _entries(cache, "tiago-mujoco")
+    good = entry.read_bytes()
+    for damage in (good[: len(good) // 2], b"junk", b""):
+        entry.write_bytes(damage)
+        tiago.mujoco_source.cache_clear()
+        assert tiago.mujoco_source() == converted
+        assert entry.read_bytes() == good
 
 
 @pytest.mark.parametrize("content", [b"", b"{not json", b'{"wheel_radius": 1}', b"[1, 2, 3]",
@@ -216,6 +237,32 @@ def test_dimensions_key_has_every_input(tmp_path: Path, monkeypatch: pytest.Monk
     assert len({key, *others}) == len(others) + 1
 
 
+def test_mujoco_source_key_has_every_input(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    key = tiago.source_key()
+    urdf = tmp_path / "tiago.urdf"
+    urdf.write_bytes(tiago.urdf_path().read_bytes())
+    others = []
+    with monkeypatch.context() as m:  # the same bytes elsewhere: paths in the text differ
+        m.setattr(tiago, "urdf_path", lambda: urdf)
+        others.append(tiago.source_key())
+        urdf.write_bytes(urdf.read_bytes() + b" ")
+        others.append(tiago.source_key())
+    from importlib import metadata
+
+    real = metadata.version
+    for dist in ("coal", "example-robot-data"):
+        with monkeypatch.context() as m:
+            m.setattr(metadata, "version", lambda d, dist=dist: "0.0.0" if d == dist else real(d))
+            others.append(tiago.source_key())
+    with monkeypatch.context() as m:
+        m.setattr(tasker.diskcache, "__version__", "9.9.9")
+        others.append(tiago.source_key())
+    with monkeypatch.context() as m:
+        m.setattr(tiago, "__file__", str(ROOT / "robot" / "spec.py"))
+        others.append(tiago.source_key())
+    assert len({key, *others}) == len(others) + 1
+
+
 # -- off means off -------------------------------------------------------------------------------
 
 
@@ -226,11 +273,14 @@ def test_cache_off_writes_nothing(tmp_path: Path, monkeypatch: pytest.MonkeyPatc
     monkeypatch.setenv("HOME", str(tmp_path / "home"))
     monkeypatch.setattr(roadmap_module, "_CACHE", {})
     tiago.robot_dimensions.cache_clear()
+    tiago.mujoco_source.cache_clear()
     try:
         assert tiago.robot_dimensions()[2] == scene.radius
+        assert tiago.mujoco_source() == tiago._convert_source()
         Roadmap.for_world(paper, scene, 1, SMALL)
     finally:
         tiago.robot_dimensions.cache_clear()
+        tiago.mujoco_source.cache_clear()
     assert list(tmp_path.rglob("*")) == []
 
 
