@@ -6,8 +6,8 @@ Runs the scenario once in a fresh process (its on-disk cache, :mod:`tasker.diskc
 fresh folder: ``--first`` leaves it empty, as on a first run — no task folder's checks, no
 robot dimensions, MuJoCo source or roadmap remembered; otherwise a first run primes it) and
 prints the wall seconds of ``run_scenario`` split by what ran: loading the scenario (of
-which the task folders; the robot's dimensions and roadmap are made there too), Fast
-Downward (translator in-process, ``downward`` binary), the robot's motion estimates, the
+which the task folders; the robot's dimensions are read there too, the roadmap is grown or
+loaded in the rest), Fast Downward (translator in-process, ``downward`` binary), the robot's motion estimates, the
 simulation's physics, and the rest (the TaskER loop, problem rendering, metrics).
 Phases are timed by wrapping the functions named below, so nested time is counted once,
 in the outermost phase that lists it.  Not a ``bench_*`` script: it prints no ratio, only
