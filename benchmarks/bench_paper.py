@@ -5,18 +5,20 @@
 Prints real-time factors (simulated seconds / wall seconds of ``run_scenario``), each
 cold figure the median of three fresh processes:
 
-* the paper scenario **cold**: a fresh process, so roadmap growth, the TIAGo conversion,
-  the task folders and every plan are paid (target >= 60x).  Its check cache
-  (:mod:`planners.cache`, ``$TASKER_CACHE``) is a fresh folder of this run, never the
-  user's: first with it **empty** (a first run: unified-planning checks every task folder
-  and solves its example), then as that first run left it (every later run: the folders'
-  checks are remembered; plans are never cached on disk).  The **baseline**, measured in
-  the same run, is the previous path with the same remembered checks: unified-planning
-  still imported to read every domain (now Fast Downward's own parser reads them,
-  :mod:`planners.schema`);
+* the paper scenario **cold**: a fresh process, so the task folders and every plan are
+  paid (target >= 60x).  Its on-disk cache (:mod:`tasker.diskcache`, ``$TASKER_CACHE``)
+  is a fresh folder of this run, never the user's: first **empty** (a first run:
+  unified-planning checks every task folder and solves its example, Pinocchio builds TIAGo
+  for its dimensions, the DAE meshes are converted for MuJoCo, OMPL grows the roadmap),
+  then as that first run left it (every later run: the folders' checks, the robot's
+  dimensions and MuJoCo source and the roadmap are remembered; plans are never cached on
+  disk).  The **baseline**, measured in the same run with the same primed cache, is the
+  previous path of the domains: unified-planning still imported to read every domain (now
+  Fast Downward's own parser reads them, :mod:`planners.schema`);
 * the paper scenario warm (same process) with planned and static strategies;
 * a **1-hour day** in the paper apartment (36 falls, Peter and Sara in turn, each
-  getting up 70 s later; 3,700 s horizon), cold in a fresh process (target >= 500x),
+  getting up 70 s later; 3,700 s horizon), cold in a fresh process with the primed disk
+  cache (target >= 500x),
   against the same day with every control tick stepped (the still-tick skipping of
   :meth:`robot.sim.Simulation._fast_forward` switched off), measured in the same run.
 """
@@ -70,7 +72,7 @@ print(json.dumps([r.trace.events[-1]["t"], time.perf_counter() - t]))
 
 
 def cold(scenario: str, cache: str | Path, slow: bool = False, legacy: bool = False) -> tuple[float, float]:
-    """(simulated s, wall s) of one run in a fresh process whose check cache is ``cache``."""
+    """(simulated s, wall s) of one run in a fresh process whose on-disk cache is ``cache``."""
     code = _COLD.format(root=str(ROOT), scenario=scenario, slow=slow, legacy=legacy)
     env = {**os.environ, "TASKER_CACHE": str(cache)}
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env)
@@ -96,19 +98,19 @@ def once(**kw: str) -> tuple[float, float]:
 def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         caches = [Path(tmp) / f"cache{k}" for k in range(3)]
-        first = median_cold([cold("paper", c) for c in caches])  # each cache empty: a first run
+        first = median_cold([cold("paper", c) for c in caches])  # each cache empty: a first run, which primes it
         remembered, legacy = [], []
         for c in caches:  # interleaved, so load on the machine hits both alike
             remembered.append(cold("paper", c))
             legacy.append(cold("paper", c, legacy=True))
         now, before = median_cold(remembered), median_cold(legacy)
         sim = now[0]
-        for label, (_, wall) in (("first run (empty check cache)", first),
-                                 ("checks remembered (every later run)", now)):
+        for label, (_, wall) in (("first run (empty disk cache)", first),
+                                 ("disk cache primed (every later run)", now)):
             rtf = sim / wall
             print(f"paper, cold, {label}: {sim:.1f} s simulated in {wall:.2f} s = {rtf:.0f}x   "
                   f"target >= 60x: {'OK' if rtf >= 60 else 'MISS'}")
-        print(f"  baseline, checks remembered but every domain read by unified-planning (the previous path): "
+        print(f"  baseline, disk cache primed but every domain read by unified-planning (the previous path): "
               f"{before[1]:.2f} s = {sim / before[1]:.0f}x; now {before[1] / now[1]:.2f}x faster, "
               f"{before[1] - now[1]:.2f} s less")
         rows = {}
@@ -120,7 +122,7 @@ def main() -> None:
             rows[label] = statistics.median(rtfs)
             print(f"paper, warm, {label:8s} upTsk/genSusp: real-time factor {rows[label]:6.1f}x (median of 3)")
         print(f"planned / static real-time factor: {rows['planned'] / rows['static']:.2f}")
-        print(f"  cold (checks remembered) costs {now[1] - sim / rows['planned']:.2f} s more than a warm run")
+        print(f"  cold (disk cache primed) costs {now[1] - sim / rows['planned']:.2f} s more than a warm run")
         day = str(day_scenario(Path(tmp) / "day.toml"))
         sim, wall = cold(day, caches[0])
         sim_s, wall_s = cold(day, caches[0], slow=True)

@@ -1,15 +1,17 @@
 """Where the seconds of a cold scenario run go.
 
-    python benchmarks/profile_cold.py [SCENARIO] [--first]     # default: paper, checks remembered
+    python benchmarks/profile_cold.py [SCENARIO] [--first]     # default: paper, disk cache primed
 
-Runs the scenario once in a fresh process (its check cache a fresh folder: ``--first``
-leaves it empty, as on a first run; otherwise a first run primes it) and prints the wall
-seconds of ``run_scenario`` split by what ran: loading the scenario (of which the task
-folders), Fast Downward (translator in-process, ``downward`` binary), the robot's motion
-estimates, the simulation's physics, and the rest (the TaskER loop, problem rendering,
-metrics).  Phases are timed by wrapping the functions named below, so nested time is
-counted once, in the outermost phase that lists it.  Not a ``bench_*`` script: it prints
-no ratio, only where to look.
+Runs the scenario once in a fresh process (its on-disk cache, :mod:`tasker.diskcache`, a
+fresh folder: ``--first`` leaves it empty, as on a first run — no task folder's checks, no
+robot dimensions, MuJoCo source or roadmap remembered; otherwise a first run primes it) and
+prints the wall seconds of ``run_scenario`` split by what ran: loading the scenario (of
+which the task folders; the robot's dimensions are read there too, the roadmap is grown or
+loaded in the rest), Fast Downward (translator in-process, ``downward`` binary), the robot's motion estimates, the
+simulation's physics, and the rest (the TaskER loop, problem rendering, metrics).
+Phases are timed by wrapping the functions named below, so nested time is counted once,
+in the outermost phase that lists it.  Not a ``bench_*`` script: it prints no ratio, only
+where to look.
 """
 
 from __future__ import annotations
@@ -95,7 +97,7 @@ def main(argv: list[str]) -> int:
     spent: dict[str, float] = r["spent"]  # type: ignore[assignment]
     calls: dict[str, int] = r["calls"]  # type: ignore[assignment]
     wall, sim = float(r["wall"]), float(r["sim"])  # type: ignore[arg-type]
-    state = "first run (empty check cache)" if first else "checks remembered"
+    state = "first run (empty disk cache)" if first else "disk cache primed"
     print(f"{scenario}, cold, {state}: {sim:.1f} s simulated in {wall:.2f} s = {sim / wall:.0f}x "
           f"(imports before run_scenario: {float(r['imports']):.2f} s, not counted)")
     top = 0.0

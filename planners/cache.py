@@ -9,8 +9,9 @@ process skips it: a changed file, or another tasker version, is a different key.
 Only successes are recorded; a failing input is checked again (and fails again with
 its message) every time.
 
-The folder is ``$TASKER_CACHE``, else ``$XDG_CACHE_HOME/tasker``, else
-``~/.cache/tasker``.  Markers are written to a temporary file and renamed into place
+The folder, the key and the atomic write are :mod:`tasker.diskcache`'s, shared with the
+robot's caches: ``$TASKER_CACHE``, else ``$XDG_CACHE_HOME/tasker``, else
+``~/.cache/tasker``; markers are written to a temporary file and renamed into place
 (atomic on POSIX), so concurrent processes — sweep workers — never see half a marker.
 The cache is an optimisation: a folder that cannot be written just means no cache.
 ``TASKER_CACHE=off`` disables it.
@@ -18,37 +19,14 @@ The cache is an optimisation: a folder that cannot be written just means no cach
 
 from __future__ import annotations
 
-import hashlib
 import json
-import logging
-import os
-import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 
 from tasker import __version__
+from tasker.diskcache import ENV_VAR, cache_dir, content_key, entry_path, write_atomic
 
-ENV_VAR = "TASKER_CACHE"
-log = logging.getLogger(__name__)
-
-
-def cache_dir() -> Path | None:
-    """Where markers go (see the module docstring); ``None`` when disabled."""
-    explicit = os.environ.get(ENV_VAR)
-    if explicit:
-        return None if explicit.lower() in ("off", "0", "none") else Path(explicit).expanduser()
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    return (Path(xdg) if xdg else Path.home() / ".cache") / "tasker"
-
-
-def content_key(kind: str, parts: Iterable[str | bytes]) -> str:
-    """SHA-256 over the check's kind, tasker's version and every part (length-prefixed)."""
-    h = hashlib.sha256()
-    for part in (kind, __version__, *parts):
-        data = part.encode() if isinstance(part, str) else part
-        h.update(len(data).to_bytes(8, "little"))
-        h.update(data)
-    return h.hexdigest()
+__all__ = ["ENV_VAR", "cache_dir", "content_key", "file_parts", "passed", "record"]
 
 
 def file_parts(files: Iterable[Path]) -> list[str | bytes]:
@@ -59,27 +37,14 @@ def file_parts(files: Iterable[Path]) -> list[str | bytes]:
     return parts
 
 
-def _marker(kind: str, key: str) -> Path | None:
-    root = cache_dir()
-    return None if root is None else root / kind / key[:2] / f"{key}.json"
-
-
 def passed(kind: str, key: str) -> bool:
     """Whether a check of ``kind`` with this content key passed before."""
-    m = _marker(kind, key)
+    m = entry_path(kind, key, ".json")
     return m is not None and m.is_file()
 
 
 def record(kind: str, key: str, info: dict[str, object] | None = None) -> None:
     """Remember that a check passed (atomically; silently nothing when the folder is unwritable)."""
-    m = _marker(kind, key)
-    if m is None:
-        return
-    try:
-        m.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=m.parent, prefix=".tmp-", suffix=".json")
-        with os.fdopen(fd, "w") as f:
-            json.dump({"kind": kind, "tasker": __version__, **(info or {})}, f)
-        os.replace(tmp, m)
-    except OSError as exc:
-        log.debug("cache not written (%s): %s", m, exc)
+    m = entry_path(kind, key, ".json")
+    if m is not None:
+        write_atomic(m, json.dumps({"kind": kind, "tasker": __version__, **(info or {})}).encode())

@@ -22,23 +22,37 @@ the build (no nanobind leaks at exit), and completed:
   never depends on what the process ran before.
 
 Shortest paths are searched per source and scene state by :mod:`robot.motion`
-(Dijkstra, scipy).  Roadmaps are cached in-process by (world, radius, seed, size).
+(Dijkstra, scipy).  Roadmaps are cached in-process by (world, radius, seed, size), and
+on disk (:mod:`tasker.diskcache`, kind ``roadmap``, an ``.npz`` of the nodes, edges,
+lengths, corner nodes and stats) under the SHA-256 of the world's ``repr``, the robot's
+radius, the seed, the size, the OMPL and numpy versions and the source of this module and
+of :mod:`robot.scene` (whose exact tests complete the roadmap): a process that finds it
+there grows nothing and loads the same arrays, bit for bit.  An entry that cannot be read
+(truncated, corrupt, inconsistent) is grown again and rewritten.
 """
 
 from __future__ import annotations
 
+import io
+import logging
 import math
+import zipfile
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from scipy.sparse import csr_matrix
 
+from robot import scene as scene_module
 from robot.scene import Scene
 from robot.spec import WorldSpec
+from tasker.diskcache import content_key, entry_path, read_entry, write_atomic
 
 DEFAULT_DENSITY = 13.0  # milestones per square metre of the bounding box
+DISK_KIND = "roadmap"  # the on-disk cache's kind (tasker.diskcache)
 _CACHE: dict[tuple[object, ...], Roadmap] = {}
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True, slots=True)
@@ -143,6 +157,19 @@ def _door_points(spec: WorldSpec) -> list[tuple[float, float]]:
     return pts
 
 
+def disk_key(spec: WorldSpec, scene: Scene, seed: int, milestones: int | None) -> str:
+    """The on-disk cache key of the roadmap :meth:`Roadmap.for_world` returns: everything it is grown from."""
+    from importlib import metadata
+
+    try:
+        ompl = metadata.version("ompl")
+    except metadata.PackageNotFoundError:
+        ompl = "unknown"
+    return content_key(DISK_KIND, [repr(spec), repr(float(scene.radius)), str(seed), repr(milestones),
+                                   f"ompl {ompl}", f"numpy {np.__version__}", Path(__file__).read_bytes(),
+                                   Path(scene_module.__file__).read_bytes()])
+
+
 class Roadmap:
     """The roadmap graph over the static layer: nodes ``(N, 2)``, undirected edges, lengths.
 
@@ -166,12 +193,16 @@ class Roadmap:
         ok = scene.segments_free(self.nodes[edge_arr[:, 0]], self.nodes[edge_arr[:, 1]], dynamic=False)
         self.edges = np.unique(np.sort(edge_arr[ok], axis=1), axis=0)
         self.lengths = np.hypot(*(self.nodes[self.edges[:, 0]] - self.nodes[self.edges[:, 1]]).T)
+        self.stats = RoadmapStats(len(self.nodes), len(self.edges), seed, "ompl.geometric.PRM", ompl_n,
+                                  int((~ok).sum()))
+        self._finish()
+
+    def _finish(self) -> None:
+        """The search graph (both directions of every edge) and the empty table cache."""
         n = len(self.nodes)
         self.graph = csr_matrix((np.concatenate([self.lengths, self.lengths]),
                                  (np.concatenate([self.edges[:, 0], self.edges[:, 1]]),
                                   np.concatenate([self.edges[:, 1], self.edges[:, 0]]))), shape=(n, n))
-        self.stats = RoadmapStats(n, len(self.edges), seed, "ompl.geometric.PRM", ompl_n,
-                                  int((~ok).sum()))
         self._tables: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
 
     def _visibility(self, scene: Scene) -> np.ndarray:
@@ -198,11 +229,52 @@ class Roadmap:
 
     @classmethod
     def for_world(cls, spec: WorldSpec, scene: Scene, seed: int = 1, milestones: int | None = None) -> Roadmap:
-        """The roadmap of ``spec`` for a robot of ``scene.radius``; grown once per process."""
+        """The roadmap of ``spec`` for a robot of ``scene.radius``: grown once per process, or
+        loaded from the on-disk cache (see the module docstring) when a process grew it before."""
         key = (repr(spec), round(scene.radius, 4), seed, milestones)
         if key not in _CACHE:
-            _CACHE[key] = cls(spec, scene, seed, milestones)
+            path = entry_path(DISK_KIND, disk_key(spec, scene, seed, milestones), ".npz")
+            data = read_entry(path)
+            roadmap = None if data is None else cls.from_npz(data)
+            if roadmap is None:
+                roadmap = cls(spec, scene, seed, milestones)
+                if path is not None:
+                    write_atomic(path, roadmap.to_npz())
+            _CACHE[key] = roadmap
         return _CACHE[key]
+
+    def to_npz(self) -> bytes:
+        """The roadmap as ``.npz`` bytes (uncompressed, no pickles): what :meth:`from_npz` reads."""
+        buf = io.BytesIO()
+        s = self.stats
+        np.savez(buf, nodes=self.nodes, edges=self.edges, lengths=self.lengths, corner_nodes=self.corner_nodes,
+                 stats=np.array([s.nodes, s.edges, s.seed, s.ompl_milestones, s.dropped_edges], dtype=np.int64),
+                 planner=np.array(s.planner))
+        return buf.getvalue()
+
+    @classmethod
+    def from_npz(cls, data: bytes) -> Roadmap | None:
+        """The roadmap saved by :meth:`to_npz`; ``None`` (and a debug log) when ``data`` is not a
+        whole, consistent one."""
+        try:
+            with np.load(io.BytesIO(data), allow_pickle=False) as z:
+                nodes, edges, lengths, corners = z["nodes"], z["edges"], z["lengths"], z["corner_nodes"]
+                n_nodes, n_edges, seed, ompl_n, dropped = (int(v) for v in z["stats"])
+                planner = str(z["planner"])
+            n = len(nodes)
+            if not (nodes.shape == (n, 2) and edges.shape == (n_edges, 2) and lengths.shape == (n_edges,)
+                    and corners.ndim == 1 and n == n_nodes and nodes.dtype.kind == lengths.dtype.kind == "f"
+                    and edges.dtype.kind == corners.dtype.kind == "i"
+                    and (not edges.size or (edges.min() >= 0 and edges.max() < n))):
+                raise ValueError("arrays of inconsistent shapes, types or indices")
+        except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as exc:
+            log.debug("roadmap cache entry unusable, grown again: %s", exc)
+            return None
+        roadmap = cls.__new__(cls)
+        roadmap.nodes, roadmap.edges, roadmap.lengths, roadmap.corner_nodes = nodes, edges, lengths, corners
+        roadmap.stats = RoadmapStats(n_nodes, n_edges, seed, planner, ompl_n, dropped)
+        roadmap._finish()
+        return roadmap
 
     def nearest(self, x: float, y: float, k: int) -> tuple[np.ndarray, np.ndarray]:
         """The ``k`` nodes closest to ``(x, y)`` and their distances, nearest first."""

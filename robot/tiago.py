@@ -2,27 +2,43 @@
 
 * **Pinocchio** (with coal geometry) builds the robot on a ``JointModelPlanar`` root
   for kinematics and the full mesh collision model.  It gives the footprint radius the
-  2-D planner uses and checks planned paths against the real geometry
-  (:class:`RobotCollision`).
+  2-D planner uses and the wheels' radius and separation (:func:`robot_dimensions`), and
+  checks planned paths against the real geometry (:class:`RobotCollision`).  Building it
+  from the URDF takes about 0.4 s, so the dimensions are kept on disk
+  (:mod:`tasker.diskcache`, kind ``robot-dimensions``) under the SHA-256 of the URDF, this
+  module's source and the versions of Pinocchio, coal and example-robot-data: a process
+  that finds them there imports no Pinocchio at all.
 * **MuJoCo** compiles the same URDF at load time: ``package://`` paths are resolved,
   the DAE collision meshes are converted to STL **in memory** (coal reads them) and
   handed to MuJoCo as assets, non-positive-definite inertias are repaired, the arm,
   torso and head are locked in the tucked posture (their joints removed) and the
   casters are made frictionless (``priority=1, condim=1, friction=0``) so the
-  differential-drive base can roll.  The converted source is cached in-process.
+  differential-drive base can roll.  The converted source (URDF text and mesh assets,
+:func:`mujoco_source`) is cached in-process and on disk (kind ``tiago-mujoco``, same
+key as the dimensions less Pinocchio's version), so a cached process imports no coal.
+
+Mesh files are keyed by the example-robot-data version that installed them, not hashed
+(5 MB read per process would cost a third of what the cache saves): after editing them
+in place, clear the cache (``docs/cli.md``).
 
 Nothing is downloaded.
 """
 
 from __future__ import annotations
 
+import io
+import json
+import logging
 import math
 import re
+import zipfile
 from functools import lru_cache
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from tasker.diskcache import content_key, entry_path, read_entry, write_atomic
 
 if TYPE_CHECKING:  # imported lazily at run time; neither library ships type stubs, so these are Any to mypy
     import mujoco
@@ -34,13 +50,48 @@ TUCK = {"torso_lift_joint": 0.15, "arm_1_joint": 0.20, "arm_2_joint": -1.34, "ar
 
 WHEELS = ("wheel_left_joint", "wheel_right_joint")
 PLANNING_MARGIN = 0.03  # metres added to the footprint for the 2-D planner
+DIMENSIONS_KIND = "robot-dimensions"  # the on-disk caches' kinds (tasker.diskcache)
+SOURCE_KIND = "tiago-mujoco"
+_DIMENSIONS = ("wheel_radius", "wheel_separation", "planning_radius")
+log = logging.getLogger(__name__)
+
+
+_URDF = Path("tiago_description") / "robots" / "tiago.urdf"
 
 
 @lru_cache(maxsize=1)
 def urdf_path() -> Path:
+    """TIAGo's URDF in the installed example-robot-data.
+
+    Found where ``example_robot_data.getModelPath`` looks for an installed package
+    (``<site-packages>/../../../share/example-robot-data/robots``) without importing it:
+    its loaders import Pinocchio (0.15 s), which a cached :func:`robot_dimensions` avoids.
+    Any other layout falls back to ``getModelPath`` itself.
+    """
+    import importlib.util
+    import sys
+
+    found = importlib.util.find_spec("example_robot_data")
+    roots = [str(Path(found.origin).parents[1])] if found is not None and found.origin else []
+    for root in [*roots, *sys.path]:
+        candidate = Path(root, "../../../share/example-robot-data/robots") / _URDF
+        if candidate.is_file():
+            return candidate.resolve()
     import example_robot_data as erd
 
-    return (Path(erd.getModelPath("tiago_description")) / "tiago_description" / "robots" / "tiago.urdf").resolve()
+    return (Path(erd.getModelPath("tiago_description")) / _URDF).resolve()
+
+
+def _version(*dists: str) -> str:
+    """The installed version of the first of ``dists`` found (distribution names differ by installer)."""
+    from importlib import metadata
+
+    for dist in dists:
+        try:
+            return f"{dist} {metadata.version(dist)}"
+        except metadata.PackageNotFoundError:
+            continue
+    return f"{dists[0]} absent"
 
 
 @lru_cache(maxsize=1)
@@ -155,9 +206,52 @@ def _fix_inertia(match: re.Match[str]) -> str:
     return f'<inertia ixx="{d[0]}" ixy="0" ixz="0" iyy="{d[1]}" iyz="0" izz="{d[2]}"/>'
 
 
+MjSource = tuple[str, tuple[tuple[str, bytes], ...]]
+
+
+def source_key() -> str:
+    """The on-disk cache key of :func:`mujoco_source`: the URDF (bytes and place), this module, coal."""
+    urdf = urdf_path()
+    return content_key(SOURCE_KIND, [urdf.read_bytes(), str(urdf), Path(__file__).read_bytes(),
+                                     _version("coal", "hpp-fcl"), _version("example-robot-data")])
+
+
+def _source_to_npz(source: MjSource) -> bytes:
+    text, assets = source
+    buf = io.BytesIO()
+    arrays: dict[str, Any] = {f"asset{k}": np.frombuffer(b, dtype=np.uint8) for k, (_, b) in enumerate(assets)}
+    np.savez(buf, text=np.frombuffer(text.encode(), dtype=np.uint8), names=np.array([n for n, _ in assets]), **arrays)
+    return buf.getvalue()
+
+
+def _source_from_npz(data: bytes) -> MjSource | None:
+    try:
+        with np.load(io.BytesIO(data), allow_pickle=False) as z:
+            raw, names = z["text"], [str(n) for n in z["names"]]
+            blobs, files = [z[f"asset{k}"] for k in range(len(names))], len(z.files)
+        if not all(b.dtype == np.uint8 and b.ndim == 1 for b in [raw, *blobs]) or files != len(names) + 2:
+            raise ValueError("arrays of the wrong type, or more arrays than names")
+        text = raw.tobytes().decode()
+    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as exc:
+        log.debug("TIAGo MuJoCo source cache entry unusable, converted again: %s", exc)
+        return None
+    return text, tuple((n, b.tobytes()) for n, b in zip(names, blobs, strict=True))
+
+
 @lru_cache(maxsize=1)
-def mujoco_source() -> tuple[str, tuple[tuple[str, bytes], ...]]:
-    """The URDF rewritten for MuJoCo and its mesh assets (name, bytes); cached in-process."""
+def mujoco_source() -> MjSource:
+    """The URDF rewritten for MuJoCo and its mesh assets (name, bytes); cached in-process and on disk."""
+    path = entry_path(SOURCE_KIND, source_key(), ".npz")
+    data = read_entry(path)
+    source = None if data is None else _source_from_npz(data)
+    if source is None:
+        source = _convert_source()
+        if path is not None:
+            write_atomic(path, _source_to_npz(source))
+    return source
+
+
+def _convert_source() -> MjSource:
     urdf = urdf_path()
     robots_dir = urdf.parents[2]
     text = urdf.read_text(encoding="utf-8").replace("package://example-robot-data/robots/", f"{robots_dir}/")
@@ -220,9 +314,41 @@ def tiago_mjspec() -> mujoco.MjSpec:
     return spec
 
 
-@lru_cache(maxsize=1)
-def robot_dimensions() -> tuple[float, float, float]:
-    """``(wheel radius, wheel separation, planning radius)`` from the Pinocchio model; cached."""
+def dimensions_key() -> str:
+    """The on-disk cache key of :func:`robot_dimensions`: everything the Pinocchio model is built from."""
+    return content_key(DIMENSIONS_KIND, [urdf_path().read_bytes(), Path(__file__).read_bytes(),
+                                         _version("pin", "pinocchio"), _version("coal", "hpp-fcl"),
+                                         _version("example-robot-data")])
+
+
+def _measure_dimensions() -> tuple[float, float, float]:
     model = TiagoModel()
     radius, separation = model.wheel_geometry()
     return radius, separation, model.planning_radius()
+
+
+def _cached_dimensions(data: bytes) -> tuple[float, float, float] | None:
+    try:
+        entry = json.loads(data)
+        dims = tuple(float(entry[k]) for k in _DIMENSIONS)
+    except (ValueError, TypeError, KeyError) as exc:
+        log.debug("robot dimensions cache entry unusable, measured again: %s", exc)
+        return None
+    if not all(math.isfinite(d) and d > 0 for d in dims):
+        log.debug("robot dimensions cache entry unusable, measured again: %s", dims)
+        return None
+    return dims[0], dims[1], dims[2]
+
+
+@lru_cache(maxsize=1)
+def robot_dimensions() -> tuple[float, float, float]:
+    """``(wheel radius, wheel separation, planning radius)`` from the Pinocchio model; cached in
+    the process and on disk (a hit imports no Pinocchio; floats round-trip exactly through JSON)."""
+    path = entry_path(DIMENSIONS_KIND, dimensions_key(), ".json")
+    data = read_entry(path)
+    dims = None if data is None else _cached_dimensions(data)
+    if dims is None:
+        dims = _measure_dimensions()
+        if path is not None:
+            write_atomic(path, json.dumps(dict(zip(_DIMENSIONS, dims, strict=True))).encode())
+    return dims

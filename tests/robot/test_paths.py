@@ -126,7 +126,7 @@ def _fingerprint_cmd(seeds: list[int]) -> list[str]:
 def test_seed_zero_roadmap_never_depends_on_what_ran_before() -> None:
     def run(seeds: list[int]) -> list[str]:
         done = subprocess.run(_fingerprint_cmd(seeds), capture_output=True, text=True, cwd=ROOT, check=True,
-                              env={"PYTHONPATH": str(ROOT), "PATH": ""})
+                              env={"PYTHONPATH": str(ROOT), "PATH": "", "TASKER_CACHE": "off"})  # grown, not loaded
         return json.loads(done.stdout)
 
     fresh = run([0])
