@@ -448,6 +448,10 @@ def run(a: argparse.Namespace) -> int:
         raise UsageError("--protocol", str(exc)) from exc
     if a.backend == "robot" and proto.robot is None:
         raise UsageError("--backend", f"{proto.source} has no [robot_backend]: it runs on the synthetic backend only")
+    try:  # what only a drawn day shows (e.g. more people than the world has): once, before any day runs
+        day_pipeline.make(a.protocol, a.first_seed, backend=a.backend, scheduler=a.schedulers[0])
+    except ConfigError as exc:
+        raise UsageError("--protocol", str(exc)) from exc
     workers = a.workers if a.workers is not None else (2 if a.backend == "synthetic" else 1)
     a.out.mkdir(parents=True, exist_ok=True)
     db, log = a.out / "days.db", a.out / "days.jsonl"

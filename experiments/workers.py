@@ -33,6 +33,7 @@ from typing import Any
 
 from experiments.store import JobKey, Status
 from experiments.sweepspec import Job
+from tasker.errors import TaskerError
 
 _PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 
@@ -73,8 +74,10 @@ def execute(run_fn: RunFn, job: Job) -> Outcome:
     try:
         record, metrics = run_fn(job)
     except (Exception, SystemExit) as exc:  # a failing run is a result, and the sweep goes on
-        tb = traceback.format_exc(limit=-3)
-        return Outcome(job.key, Status.ERROR, {}, {}, f"{type(exc).__name__}: {exc}\n{tb}",
+        # a mistake in the input (a TaskerError: bad scenario, protocol, world) is its message,
+        # as on the command line; anything else is a bug and keeps the end of its traceback
+        tb = "" if isinstance(exc, TaskerError) else "\n" + traceback.format_exc(limit=-3)
+        return Outcome(job.key, Status.ERROR, {}, {}, f"{type(exc).__name__}: {exc}{tb}",
                        time.perf_counter() - start, worker)
     return Outcome(job.key, Status.OK, dict(record), dict(metrics), None, time.perf_counter() - start, worker)
 

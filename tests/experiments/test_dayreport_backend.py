@@ -12,6 +12,7 @@ import pytest
 
 from experiments import dayreport
 from experiments.sweepspec import Job
+from tasker.errors import ConfigError
 
 EVENTS = [
     {"t": 0.0, "event": "request", "agent": "d1", "task_type": "folder_a", "args": {"deadline": 10.0}},
@@ -69,6 +70,38 @@ def test_a_day_that_fails_is_listed_and_the_others_go_on(tmp_path: Path, monkeyp
     text = dayreport.report(results, title="t")
     assert "2 days per scheduler" in text
     assert "- `default`, fifo, seed 2: " in text and "a broken day" in text
+
+
+def _bad_input_on_seed_2(job: Job, **kw: Any) -> tuple[dict[str, Any], dict[str, Any]]:
+    if job.seed == 2:
+        raise ConfigError("day.toml:3: tasks.fall.count: a mistake of the user's")
+    return _crash_on_seed_2(job, **kw)
+
+
+def test_a_day_failing_on_bad_input_lists_its_message_and_a_bug_its_traceback(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(dayreport, "day_job", _bad_input_on_seed_2)
+    bad = dayreport.run_days("tabsa-short", 2, ["fifo"], workers=1, db=tmp_path / "a.db")[1]["error"]
+    assert bad == "ConfigError: day.toml:3: tasks.fall.count: a mistake of the user's"
+    monkeypatch.setattr(dayreport, "day_job", _crash_on_seed_2)
+    bug = dayreport.run_days("tabsa-short", 2, ["fifo"], workers=1, db=tmp_path / "b.db")[1]["error"]
+    assert bug.startswith("RuntimeError: a broken day\n") and "Traceback" in bug
+
+
+def test_a_protocol_whose_days_cannot_be_drawn_fails_before_any_day(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """More people asked for than the world has: one line naming the protocol, no day run."""
+    protocols = Path(dayreport.__file__).parent / "protocols"
+    text = (protocols / "tabsa_short.toml").read_text(encoding="utf-8").replace("count = 3", "count = 4")
+    text = text.replace('world = "tabsa_apartment_short.toml"', f'world = "{protocols / "tabsa_apartment_short.toml"}"')
+    proto = tmp_path / "crowded.toml"
+    proto.write_text(text, encoding="utf-8")
+    out = tmp_path / "out"
+    assert dayreport.main(["--protocol", str(proto), "--backend", "robot", "--days", "2", "--schedulers", "fifo",
+                           "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "--protocol" in err and "crowded.toml" in err and "needs 8 people" in err and "Traceback" not in err
+    assert not (out / "days.db").exists()
 
 
 def test_the_command_writes_database_log_and_table(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
