@@ -22,11 +22,14 @@ examples:
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--protocol", default="tabsa",
-                    help=f"a registered protocol ({', '.join(days.names())}) or a protocol file (.toml)")
-    ap.add_argument("--backend", default="synthetic", choices=days.BACKENDS)
-    ap.add_argument("--days", type=int, default=100, help="days per scheduler (seeds first-seed, first-seed + 1, ...)")
-    ap.add_argument("--first-seed", type=int, default=1)
-    ap.add_argument("--schedulers", nargs="+", default=["lookahead", "alg2", "simple", "simple2", "distance"])
+                    help=f"a registered protocol ({', '.join(days.names())}) or a protocol file (.toml); default tabsa")
+    ap.add_argument("--backend", default="synthetic", choices=days.BACKENDS,
+                    help="timed stages or TIAGo in MuJoCo (default synthetic)")
+    ap.add_argument("--days", type=int, default=100,
+                    help="days per scheduler (seeds first-seed, first-seed + 1, ...; default 100)")
+    ap.add_argument("--first-seed", type=int, default=1, help="seed of the first day (default 1)")
+    ap.add_argument("--schedulers", nargs="+", default=["lookahead", "alg2", "simple", "simple2", "distance"],
+                    help="registered schedulers to compare (default: lookahead alg2 simple simple2 distance)")
     ap.add_argument("--workers", type=int, default=None,
                     help="local processes (default: 2 synthetic, 1 robot: a robot day is long, keep it in one)")
     ap.add_argument("--strategies", nargs="+", default=None, metavar="STRATEGY",

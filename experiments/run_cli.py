@@ -42,8 +42,9 @@ def task_paths(args: argparse.Namespace) -> list[str]:
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("run", help="run a scenario: trace.jsonl, metrics.json, run.json and pictures in DIR",
                        description="Run a scenario (a shipped name such as 'paper', or a .toml file) on the "
-                                   "simulated clock and write trace.jsonl, run.json, metrics.json, timeline.png, "
-                                   "gantt.png and (robot scenarios) world.png.",
+                                   "simulated clock and write trace.jsonl, run.json, metrics.json, problems/ (the "
+                                   "PDDL of every planning call, for 'tasker explain'), report.html, timeline.png, "
+                                   "gantt.png and (robot scenarios) trajectory.jsonl and world.png.",
                        epilog=EXAMPLES)
     p.add_argument("scenario", help="shipped scenario name or scenario file")
     p.add_argument("--out", default=None, metavar="DIR", help="output folder (default: out/NAME)")
@@ -62,7 +63,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
                    help="a waiting task secures its declared hazard before its budget runs out (docs/model.md)")
     p.add_argument("--mode", choices=("IT", "CT"), default=None, help="interruptible or constant-task harmonisation")
     p.add_argument("--randomize", action="store_true", help="draw a randomised variant of the scenario from --seed")
-    p.add_argument("--no-pictures", action="store_true", help="skip the PNG figures")
+    p.add_argument("--no-pictures", action="store_true", help="skip report.html and the PNG figures")
     p.add_argument("--strict", action="store_true", help="exit 1 when a task failed (default: 0 once the run ends)")
     add_path_option(p)
     p.set_defaults(func=_run)

@@ -66,8 +66,8 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
                        epilog=REPORT_EXAMPLES)
     r.add_argument("--db", required=True, help="results database written by 'tasker sweep'")
     r.add_argument("--out", required=True, metavar="DIR",
-                   help="output folder (report.md, summary.csv, paired.csv, plots/)")
-    r.add_argument("--no-plots", action="store_true", help="tables only")
+                   help="output folder (report.md, summary.csv, paired.csv, plots/, report.html)")
+    r.add_argument("--no-plots", action="store_true", help="tables only: no plots/, no report.html")
     r.set_defaults(func=_report)
 
 

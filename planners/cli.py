@@ -316,10 +316,13 @@ def register(subparsers: Any) -> None:
                "  tasker fsm guide_human\n"
                "  tasker fsm cook --purpose genSusp --after 3 --format dot | dot -Tpng > cook.png\n"
                "  tasker fsm my_task --path ~/my_tasks --strategy static")
-    f.add_argument("task_type", metavar="TASK_TYPE")
-    f.add_argument("--purpose", choices=["upTsk", "genSusp"], default="upTsk")
-    f.add_argument("--format", choices=["mermaid", "dot"], default="mermaid")
-    f.add_argument("--strategy", choices=["planned", "static"], default="planned")
+    f.add_argument("task_type", metavar="TASK_TYPE", help="a task type with an [example] (tasker domains lists them)")
+    f.add_argument("--purpose", choices=["upTsk", "genSusp"], default="upTsk",
+                   help="upTsk: the exeTsk FSM; genSusp: the exeSusp FSM after --after stages (default upTsk)")
+    f.add_argument("--format", choices=["mermaid", "dot"], default="mermaid",
+                   help="Mermaid or Graphviz (default mermaid)")
+    f.add_argument("--strategy", choices=["planned", "static"], default="planned",
+                   help="build the stages by planning or from the task.toml templates (default planned)")
     f.add_argument("--after", type=non_negative_int, default=None, metavar="K",
                    help="genSusp: interrupt after K stages of exeTsk, 0 <= K <= its length (default: half way)")
     _path_option(f)

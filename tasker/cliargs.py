@@ -44,7 +44,7 @@ EXIT_EPILOG = """\
 exit status:
   0    ok
   1    the work ran but failed: a task failed (run --strict), the run aborted, no plan,
-       an unreachable pair (cost), problems found (check), sweep jobs failed
+       an unreachable pair (cost), problems found (check), sweep jobs failed, a day failed (day)
   2    bad input: an argument, a file or a name; nothing was run
   3    internal error: a bug in tasker (--verbose shows the traceback)
   130  interrupted (Ctrl-C)"""

@@ -1,14 +1,15 @@
 """Where tasker's on-disk caches live, how their keys are made, how entries are written.
 
 Every on-disk cache of tasker — the check cache (:mod:`planners.cache`), the robot's
-dimensions (:func:`robot.tiago.robot_dimensions`), the grown roadmap
+dimensions (:func:`robot.tiago.robot_dimensions`), TIAGo's MuJoCo source
+(:func:`robot.tiago.mujoco_source`), the grown roadmap
 (:meth:`robot.roadmap.Roadmap.for_world`) — stores results that are pure functions of
 their inputs under the SHA-256 of those inputs plus ``tasker.__version__``
 (:func:`content_key`), so a changed input, or another tasker version, is another key and
 nothing is ever invalidated by hand.
 
 The folder is ``$TASKER_CACHE``, else ``$XDG_CACHE_HOME/tasker``, else
-``~/.cache/tasker`` (:func:`cache_dir`); ``TASKER_CACHE=off`` disables every cache.  An
+``~/.cache/tasker`` (:func:`cache_dir`); ``TASKER_CACHE=off`` (or ``0``, ``none``) disables every cache.  An
 entry is written to a temporary file in its own folder and renamed into place
 (:func:`write_atomic`; atomic on POSIX), so concurrent processes — sweep workers — never
 see half an entry.  A cache is an optimisation: a folder that cannot be written just means
