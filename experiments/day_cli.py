@@ -11,6 +11,7 @@ import argparse
 from pathlib import Path
 
 from experiments import days
+from tasker.cliargs import seed
 
 EXAMPLES = """\
 examples:
@@ -27,7 +28,7 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="timed stages or TIAGo in MuJoCo (default synthetic)")
     ap.add_argument("--days", type=int, default=100,
                     help="days per scheduler (seeds first-seed, first-seed + 1, ...; default 100)")
-    ap.add_argument("--first-seed", type=int, default=1, help="seed of the first day (default 1)")
+    ap.add_argument("--first-seed", type=seed, default=1, help="seed of the first day (default 1)")
     ap.add_argument("--schedulers", nargs="+", default=["lookahead", "alg2", "simple", "simple2", "distance"],
                     help="registered schedulers to compare (default: lookahead alg2 simple simple2 distance)")
     ap.add_argument("--workers", type=int, default=None,

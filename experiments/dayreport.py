@@ -47,7 +47,7 @@ from experiments.stats import estimate, holm
 from experiments.strategy import Strategy
 from experiments.sweepspec import Job
 from tasker.errors import ConfigError
-from tasker.trace import number
+from tasker.trace import FAILED, number
 
 OSCILLATION_SWITCHES = 3
 OSCILLATION_WINDOW_S = 180.0
@@ -87,7 +87,7 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
             args[e["agent"]] = e["args"]
         elif ev == "end" and e.get("cause") == "finished":
             finished[e["agent"]] = e["t"]
-        elif ev == "end" and e.get("cause") == "failed":  # a plan or a skill failed: not the scheduler's choice
+        elif ev == "end" and e.get("cause") in FAILED:  # a plan, a skill or a hook failed: not the scheduler's choice
             failed.add(e["agent"])
         elif ev == "command" and e.get("flag") == "start":
             starts.setdefault(e["agent"], []).append(e["t"])
@@ -415,7 +415,7 @@ def run(a: argparse.Namespace) -> int:
     :class:`tasker.reader.InputError`) before the first day runs.  Returns 1 if a day failed
     to run (it is listed under the table), else 0."""
     from tasker import schedulers
-    from tasker.cliargs import UsageError, show_progress
+    from tasker.cliargs import SEED_LIMIT, UsageError, show_progress
     from tasker.reader import suggest
 
     unknown = [n for n in a.schedulers if n not in schedulers.names()]
@@ -424,6 +424,8 @@ def run(a: argparse.Namespace) -> int:
                                          f"known: {', '.join(schedulers.names())}")
     if a.days < 1:
         raise UsageError("--days", f"expected >= 1, got {a.days}")
+    if a.first_seed + a.days > SEED_LIMIT:
+        raise UsageError("--days", f"the last day's seed would be {a.first_seed + a.days - 1}: seeds are < 2**32")
     if a.workers is not None and a.workers < 1:
         raise UsageError("--workers", f"expected >= 1, got {a.workers}")
     strategies = []

@@ -20,7 +20,7 @@ from typing import Any, Protocol
 
 from experiments.calibration import CalibrationCollector
 from tasker.meaning import CMD_STATES as CMD
-from tasker.trace import read
+from tasker.trace import FAILED, read
 
 Event = Mapping[str, Any]
 
@@ -108,11 +108,11 @@ class TaskCollector:
         totals = {
             "requested": len(tasks), "ended": len(ended), "unfinished": len(tasks) - len(ended),
             # a task that ended itself (ic_term: "Peter is fine") or was cancelled did not fail
-            "finished": causes.get("finished", 0), "failed": causes.get("failed", 0) + causes.get("other", 0),
+            "finished": causes.get("finished", 0), "failed": sum(causes.get(c, 0) for c in FAILED),
             "ended_by_itself": causes.get("self", 0), "terminated": causes.get("term", 0),
             "by_cause": dict(sorted(causes.items())),
             "failure_reasons": [f"{a}: {v['reason']}" for a, v in tasks.items()
-                                if v["end_t"] is not None and v["cause"] in ("failed", "other")],
+                                if v["end_t"] is not None and v["cause"] in FAILED],
             "duration_s": _stats(durations), "makespan_s": last - first if tasks else 0.0,
             "suspensions": sum(v["suspensions"] for v in tasks.values()),
             "suspended_s": math.fsum(v["suspended_s"] for v in tasks.values()),

@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 from tasker.cliargs import EXIT_FAILED, EXIT_OK, UsageError, did_you_mean, note, seed, show_progress, writable_dir
+from tasker.trace import FAILED
 
 EXAMPLES = """\
 examples:
@@ -80,7 +81,8 @@ def _run(args: argparse.Namespace) -> int:
                                         f"known: {', '.join(schedulers.names())}")
     paths = task_paths(args)
     path = scenarios.resolve(args.scenario)
-    want = Path(args.out) if args.out else Path("out") / path.stem
+    label = scenarios.name_of(path)
+    want = Path(args.out) if args.out else Path("out") / label
     made = not want.exists()
     out = writable_dir(want, "--out")
     try:
@@ -103,14 +105,14 @@ def _run(args: argparse.Namespace) -> int:
         causes[e["cause"]] = causes.get(e["cause"], 0) + 1
     last = result.trace.events[-1]["t"] if result.trace.events else 0.0
     suspensions = sum(1 for e in result.trace.of("command") if e["flag"] == "susp")
-    print(f"{path.stem}: {len(result.trace.of('request'))} tasks, {len(ends)} ended "
+    print(f"{label}: {len(result.trace.of('request'))} tasks, {len(ends)} ended "
           f"({', '.join(f'{n} {c}' for c, n in sorted(causes.items()))}), {suspensions} suspensions, "
           f"{last:.1f} s simulated in {result.record['wall_time_s']:.1f} s")
     if not args.quiet:
         for e in ends:
             print(f"  {e['agent']} {e['task_type']}: {e['reason']} at t={e['t']:.1f}")
     note(args, f"wrote {out}/")
-    failed = [e for e in ends if e["cause"] in ("failed", "other")]
+    failed = [e for e in ends if e["cause"] in FAILED]
     if args.strict and failed:
         print(f"tasker run: {len(failed)} task(s) failed: "
               + "; ".join(f"{e['agent']}: {e['reason']}" for e in failed), file=sys.stderr)

@@ -16,6 +16,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import random
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -86,6 +87,18 @@ def resolve(name_or_path: str | Path) -> Path:
     known = sorted(q.stem for q in SCENARIOS.glob("*.toml"))
     raise ScenarioError(str(name_or_path), f"no such scenario: not a file, and not a shipped one"
                                            f"{reader.suggest(str(name_or_path), known)} (shipped: {', '.join(known)})")
+
+
+def name_of(path: Path) -> str:
+    """The scenario's ``name``, which names its default output folder (``out/NAME``); the file's
+    stem when the name is missing or is not a plain folder name (``scenario.toml`` files of
+    different task folders differ by their names, not their file names)."""
+    try:
+        name = reader.load(path, ScenarioError).raw("name", None)
+    except ScenarioError:
+        return path.stem  # the run itself reports what is wrong with the file
+    ok = isinstance(name, str) and re.fullmatch(r"[A-Za-z0-9_.-]+", name) and name not in (".", "..")
+    return name if ok else path.stem
 
 
 def kind_of(path: Path) -> str:

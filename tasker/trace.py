@@ -19,6 +19,10 @@ EVENTS = (
     "stage", "mode", "change", "world", "hazard", "role", "secure", "end",
 )
 
+FAILED = frozenset({"failed", "error"})
+"""``end`` causes of an agent that did not do its task and was not stopped on purpose: a plan
+or a skill failed (``failed``), or an exception ended it (``error``); ``docs/trace.md``."""
+
 
 def _norm(value: Any) -> Any:
     if isinstance(value, bool) or value is None or isinstance(value, str | int):

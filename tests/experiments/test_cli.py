@@ -301,3 +301,20 @@ def test_run_takes_the_policy_and_hazard_waiting_factors(tmp_path: Path) -> None
     assert main(["run", "synthetic_demo", "--out", str(out), "--hazard-waiting", "--no-pictures", "--quiet"]) == 0
     assert json.loads((out / "run.json").read_text())["settings"]["hazard_waiting"] is True
     assert main(["run", "synthetic_demo", "--policy", "lenient", "--out", str(out)]) == 2
+
+
+def test_a_task_ended_by_an_exception_counts_as_failed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    """Cause ``error`` is a failure (``tasker.trace.FAILED``): ``--strict`` exits 1 and the
+    metrics count it with its reason; the default output folder is named by the scenario's
+    ``name``, not its file's (every ``tasker new`` folder has a ``scenario.toml``)."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["new", "fetch", "mine/fetch"]) == 0
+    (tmp_path / "mine" / "fetch" / "task.py").write_text(
+        "def check_terminate(ctx, world):\n    raise ValueError('boom')\n")
+    capsys.readouterr()
+    assert main(["run", "mine/fetch/scenario.toml", "--path", "mine", "--strict", "--no-pictures"]) == 1
+    assert "d1: check_terminate() raised ValueError: boom" in capsys.readouterr().err
+    totals = json.loads((tmp_path / "out" / "fetch_demo" / "metrics.json").read_text())["totals"]
+    assert totals["failed"] == 1 and totals["by_cause"] == {"error": 1}
+    assert totals["failure_reasons"][0].startswith("d1: check_terminate() raised ValueError: boom")

@@ -160,3 +160,15 @@ def test_days_run_on_a_dask_cluster(tmp_path: Path) -> None:
 def test_an_unreachable_dask_scheduler_is_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert dayreport.main(["--days", "1", "--scheduler-address", "tcp://127.0.0.1:1", "--out", str(tmp_path)]) == 2
     assert "--scheduler-address" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("args", "fragment"), [(["--first-seed", "-1"], "--first-seed"),
+                                                (["--first-seed", "4294967295", "--days", "2"], "--days")])
+def test_day_seeds_outside_the_seed_range_are_refused(args: list[str], fragment: str, tmp_path: Path,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    from experiments.cli import main
+
+    assert main(["day", *args, "--schedulers", "fifo", "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert fragment in err and "2**32" in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()

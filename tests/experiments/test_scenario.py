@@ -100,3 +100,14 @@ def test_cli_runs_a_synthetic_scenario(tmp_path: Path, capsys: pytest.CaptureFix
         assert key in record
     assert record["seed"] == 3
     assert "4 tasks" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(("line", "name"), [('name = "fetch_demo"', "fetch_demo"), ('name = "../up"', "mine"),
+                                            ("name = 3", "mine"), ("", "mine"), ('name = "', "mine")])
+def test_a_scenario_names_its_output_folder_when_its_name_is_a_plain_folder_name(
+        line: str, name: str, tmp_path: Path) -> None:
+    from experiments.scenario import name_of
+
+    path = tmp_path / "mine.toml"
+    path.write_text(f'kind = "robot"\n{line}\n')
+    assert name_of(path) == name
