@@ -355,14 +355,14 @@ class DynamicAgent:
         status = self.core.poll(self.id, stage, now)
         if status.state is SkillState.FAILED:
             self._close_stage(now, "failed", reason=status.reason)
-            why = f"stage {stage.label} failed: {status.reason}"
+            failure = f"stage {stage.label} failed: {status.reason}"
             if not in_task:  # a suspension's own stage: nothing safer to fall back on
                 if self._pending_term is not None and self._pending_term[1] == "failed":
-                    why = f"{self._pending_term[0]}; then {why}"
-                self._end(now, why, cause="failed", event="stage_failed")
+                    failure = f"{self._pending_term[0]}; then {failure}"
+                self._end(now, failure, cause="failed", event="stage_failed")
                 return
             # the task cannot go on, but what it leaves must be safe: genSusp, exeSusp, then end
-            self._pending_term = (why, "failed")
+            self._pending_term = (failure, "failed")
             self.ctx.interrupted = stage
             self.ctx.stage_started = None
             self._start_gen_susp(now, event="stage_failed")
