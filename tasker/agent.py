@@ -355,7 +355,17 @@ class DynamicAgent:
         status = self.core.poll(self.id, stage, now)
         if status.state is SkillState.FAILED:
             self._close_stage(now, "failed", reason=status.reason)
-            self._end(now, f"stage {stage.label} failed: {status.reason}", cause="failed", event="stage_failed")
+            failure = f"stage {stage.label} failed: {status.reason}"
+            if not in_task:  # a suspension's own stage: nothing safer to fall back on
+                if self._pending_term is not None and self._pending_term[1] == "failed":
+                    failure = f"{self._pending_term[0]}; then {failure}"
+                self._end(now, failure, cause="failed", event="stage_failed")
+                return
+            # the task cannot go on, but what it leaves must be safe: genSusp, exeSusp, then end
+            self._pending_term = (failure, "failed")
+            self.ctx.interrupted = stage
+            self.ctx.stage_started = None
+            self._start_gen_susp(now, event="stage_failed")
             return
         if status.state is SkillState.SUCCEEDED:
             self._close_stage(now, "done")
@@ -390,16 +400,19 @@ class DynamicAgent:
         self.ctx.stage_started = None
         self._start_gen_susp(now)
 
-    def _start_gen_susp(self, now: float) -> None:
+    def _start_gen_susp(self, now: float, event: str = "suspend") -> None:
         self._pending_susp = False
         self.ctx.suspended = True
         self.ctx.terminating = self._pending_term is not None
-        self._fire("suspend", now)
+        self._fire(event, now)
         self._refresh(now)  # the stage that just ended may have changed the world (a pan put on the cooker)
         try:
             plan = self.task.generate_suspension(self.ctx)
         except PlanningFailed as exc:
-            self._end(now, f"genSusp {exc.status}: {exc}", cause="failed", event="plan_failed")
+            why = f"genSusp {exc.status}: {exc}"
+            if self._pending_term is not None and self._pending_term[1] == "failed":
+                why = f"{self._pending_term[0]}; then {why}"  # the failure that started it comes first
+            self._end(now, why, cause="failed", event="plan_failed")
             return
         self._run_suspension(now, plan)
 

@@ -101,7 +101,9 @@ TRANSITIONS: tuple[Transition, ...] = (
     Transition(S.UP_TSK, "plan_failed", S.END, condition="planning failed"),
     Transition(S.EXE_TSK, "suspend", S.GEN_SUSP, condition="ic_susp | ic_term at a suspendable stage"),
     Transition(S.EXE_TSK, "finished", S.END, condition="ic_taskFinished"),
-    Transition(S.EXE_TSK, "stage_failed", S.END, condition="stage failed"),
+    # not in Fig. 5, where a failed stage ends the task as it stands: it is first made safe
+    # (docs/model.md, departures), then exeSusp --finished [terminating]--> end
+    Transition(S.EXE_TSK, "stage_failed", S.GEN_SUSP, condition="stage failed: suspend safely, then end"),
     Transition(S.GEN_SUSP, "planned", S.EXE_SUSP, condition="exeSusp built"),
     Transition(S.GEN_SUSP, "plan_failed", S.END, condition="suspension planning failed"),
     Transition(S.EXE_SUSP, "finished", S.WAIT, guard="not_terminating", condition="exeSusp finished"),

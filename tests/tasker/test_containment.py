@@ -16,7 +16,7 @@ import pytest
 from tasker import schedulers
 from tasker.errors import RunAborted
 from tasker.messages import SPRequest
-from tasker.protocols import SkillStatus
+from tasker.protocols import SkillStatus, failed
 from tasker.schedulers.base import Decision, Scheduler, ScheduleView
 from tasker.stage import Stage, StagePlan
 from tasker.synthetic import SyntheticTask, TimedExecutor
@@ -247,3 +247,44 @@ def test_a_run_with_contained_errors_is_reproducible() -> None:
         return loop.run().dumps()
 
     assert run() == run()
+
+
+class FailingCore(TimedExecutor):
+    """A core agent whose skill reports failure (no exception) a second into a stage marked ``fail``."""
+
+    def poll(self, agent: str, stage: Stage, now: float) -> SkillStatus:
+        if stage.data.get("fail") and now >= 1.0 + self._running[agent][1] - stage.duration:
+            del self._running[agent]  # a skill that reports failure has ended
+            return failed("path to 'office' blocked")
+        return super().poll(agent, stage, now)
+
+
+@pytest.mark.parametrize("safe_stage_fails", [False, True])
+def test_a_failed_stage_ends_its_task_after_a_safe_suspension(safe_stage_fails: bool) -> None:
+    """A skill failure in exeTsk does not leave the task's state as it stands (an object held):
+    the task suspends safely (genSusp, exeSusp) and then ends, cause ``failed``, with the
+    stage's reason first; the other task goes on."""
+    put_down = st("put_down", 2, BLOCK, fail=safe_stage_fails)
+    tasks = [SyntheticTask("carry", [st("pick", 1, BLOCK), st("drive", 4, fail=True), st("place", 1, BLOCK)],
+                           suspension={"drive": [put_down]}),
+             SyntheticTask("other", [st("a", 1)])]
+    loop = make_loop(tasks, scheduler="fifo", core=FailingCore())
+    loop.request(0.0, "carry")
+    loop.request(0.0, "other")
+    tr = loop.run()
+    path = [(e["from"], e["trigger"], e["to"]) for e in tr.of("transition", agent="d1")]
+    assert ("exeTsk", "stage_failed", "genSusp") in path and ("genSusp", "planned", "exeSusp") in path
+    end = tr.of("end", agent="d1")[0]
+    assert end["cause"] == "failed" and end["reason"].startswith("stage drive failed: path to 'office' blocked")
+    ran = [(e["fsm"], e["action"], e["status"]) for e in tr.of("stage", agent="d1") if e["status"] != "begin"]
+    if safe_stage_fails:  # nothing safer to fall back on: the task ends, both failures in its reason
+        assert ran[-1] == ("exeSusp", "put_down", "failed") and path[-1] == ("exeSusp", "stage_failed", "end")
+        assert end["reason"].count("path to 'office' blocked") == 2 and "; then stage put_down" in end["reason"]
+    else:
+        assert ran[-1] == ("exeSusp", "put_down", "done") and path[-1] == ("exeSusp", "finished", "end")
+    assert tr.of("end", agent="d2")[0]["cause"] == "finished"
+    closed_stages(tr.events)
+    from tasker import fsm
+
+    table = {(t.source.value, t.event, t.target.value) for t in fsm.TRANSITIONS}
+    assert all((e["from"], e["trigger"], e["to"]) in table for e in tr.of("transition"))
