@@ -1,9 +1,9 @@
 """One scenario pipeline for day protocols: (protocol, seed, backend) → a scenario → a run.
 
 The shape is Gymnasium's ``EnvSpec`` + ``make``: protocols are registered by name
-(:func:`register`; ``tabsa`` and ``tabsa-short`` are shipped), and :func:`make` turns a
-name (or a protocol file), a seed and a backend into a :class:`Day` — the scenario that
-backend runs, built from the one draw of :func:`experiments.protocol.draw`:
+(:func:`register`; ``tabsa``, ``tabsa-short`` and ``tabsa-rush`` are shipped), and
+:func:`make` turns a name (or a protocol file), a seed and a backend into a :class:`Day` —
+the scenario that backend runs, built from the one draw of :func:`experiments.protocol.draw`:
 
 * ``synthetic``: a :class:`experiments.synthetic.SyntheticScenario` of timed stages
   (:class:`experiments.protocol.DayTask`);
@@ -71,6 +71,7 @@ def names() -> list[str]:
 
 register("tabsa", PROTOCOLS_DIR / "tabsa.toml")
 register("tabsa-short", PROTOCOLS_DIR / "tabsa_short.toml")
+register("tabsa-rush", PROTOCOLS_DIR / "tabsa_rush.toml")
 
 
 def resolve(name_or_path: str | Path) -> Path:

@@ -40,7 +40,7 @@ def tiny_protocol(tmp_path_factory: pytest.TempPathFactory) -> protocol.Protocol
 
 
 def test_protocols_are_registered_by_name() -> None:
-    assert {"tabsa", "tabsa-short"} <= set(days.names())
+    assert {"tabsa", "tabsa-short", "tabsa-rush"} <= set(days.names())
     assert days.load("tabsa").name == "tabsa" and days.load("tabsa-short").name == "tabsa-short"
     with pytest.raises(ConfigError, match="did you mean 'tabsa'"):
         days.make("tabsaa", 1)
@@ -48,6 +48,17 @@ def test_protocols_are_registered_by_name() -> None:
         days.make("tabsa", 1, backend="robt")
     with pytest.raises(ConfigError, match="did you mean 'alg2'"):
         days.make("tabsa", 1, scheduler="alg")
+
+
+def test_the_rush_is_the_full_day_called_in_half_an_hour() -> None:
+    """tabsa-rush changes one thing of tabsa: when the requests come (and so the day's length)."""
+    full, rush = days.load("tabsa"), days.load("tabsa-rush")
+    assert (rush.last_call_s, rush.length_s) == (1800.0, 7200.0)
+    same = ("step_s", "robot_speed", "start_site", "planning_time_s", "sites", "tasks", "robot")
+    assert all(getattr(rush, f) == getattr(full, f) for f in same)
+    calls = [r.t for r in protocol.draw(rush, 3)]
+    assert len(calls) == 36 and max(calls) < 1800.0
+    assert days.make("tabsa-rush", 3, backend="robot").scenario.horizon == 7200.0
 
 
 @pytest.mark.parametrize("backend", days.BACKENDS)
