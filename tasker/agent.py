@@ -249,7 +249,8 @@ class DynamicAgent:
                 if "expected_s" in cmd.data:  # how long the interruption is expected to last
                     self.ctx.memory["interruption_s"] = float(cmd.data["expected_s"])
             elif cmd.flag is Flag.TERM:
-                if self._pending_term is None or self._pending_term[1] != "term":
+                # a term overrides the task's own ic_term, not a failure already being made safe
+                if self._pending_term is None or self._pending_term[1] == "self":
                     self._pending_term = (str(cmd.data.get("reason", "terminated by the harmoniser")), "term")
         self._inbox.clear()
 

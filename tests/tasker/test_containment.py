@@ -288,3 +288,14 @@ def test_a_failed_stage_ends_its_task_after_a_safe_suspension(safe_stage_fails: 
 
     table = {(t.source.value, t.event, t.target.value) for t in fsm.TRANSITIONS}
     assert all((e["from"], e["trigger"], e["to"]) in table for e in tr.of("transition"))
+
+
+def test_a_term_during_a_failed_tasks_safe_suspension_keeps_the_failure() -> None:
+    """A requester's term that arrives while a failed task is being made safe does not turn the
+    failure into a cancellation: the task still ends ``failed``, with its stage's reason."""
+    tasks = [SyntheticTask("carry", [st("drive", 4, fail=True)], suspension={"drive": [st("put_down", 5, BLOCK)]})]
+    loop = make_loop(tasks, scheduler="fifo", core=FailingCore())
+    loop.request(0.0, "carry")
+    loop.terminate(3.0, "d1", "cancelled")  # drive fails at about 1 s; put_down runs until about 6 s
+    end = loop.run().of("end", agent="d1")[0]
+    assert end["cause"] == "failed" and end["reason"].startswith("stage drive failed")
