@@ -94,7 +94,8 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
         elif ev == "transition":
             a, to = e["agent"], e["to"]
             if to == "genSusp":
-                interruptions[a] = interruptions.get(a, 0) + 1
+                if e.get("trigger") != "stage_failed":  # a failed task making itself safe was not interrupted
+                    interruptions[a] = interruptions.get(a, 0) + 1
                 entered[a] = e["t"]
             elif e["from"] == "exeSusp" or (e["from"] == "genSusp" and to != "exeSusp"):
                 suspension_time += e["t"] - entered.pop(a, e["t"])

@@ -158,3 +158,20 @@ def test_table_has_every_scheduler_and_the_paired_tests(tabsa: protocol.Protocol
     text = dayreport.table(results)
     assert "| metric | lookahead | simple2 |" in text
     assert "| dead falls | simple2 |" in text and "Holm" in text
+
+
+def test_a_failed_tasks_own_safe_suspension_is_not_an_interruption() -> None:
+    """Departure 11: a failed stage leads to genSusp; the task was not interrupted, it failed
+    (and its safe suspension is still a suspension, with its time)."""
+    events = [
+        ev(0, "request", agent="d1", task_type="pick_place", args={"deadline": 100.0}),
+        ev(0, "command", agent="d1", flag="start"),
+        ev(5, "transition", agent="d1", trigger="stage_failed", **{"from": "exeTsk", "to": "genSusp"}),
+        ev(5, "plan", agent="d1", purpose="genSusp", stages=[{"action": "place"}]),
+        ev(5, "transition", agent="d1", trigger="planned", **{"from": "genSusp", "to": "exeSusp"}),
+        ev(9, "transition", agent="d1", trigger="finished", **{"from": "exeSusp", "to": "end"}),
+        ev(9, "end", agent="d1", task_type="pick_place", cause="failed"),
+    ]
+    m = dayreport.day_metrics(events, day_end=100.0)
+    assert m["interruptions"] == 0 and m["suspensions"] == 1 and m["suspension_time_s"] == pytest.approx(4.0)
+    assert m["failed"] == 1 and m["completed"] == 0
