@@ -47,7 +47,7 @@ from scipy.sparse import csr_matrix
 from robot import scene as scene_module
 from robot.scene import Scene
 from robot.spec import WorldSpec
-from tasker.diskcache import content_key, entry_path, read_entry, write_atomic
+from tasker.diskcache import content_key, remembered
 
 DEFAULT_DENSITY = 13.0  # milestones per square metre of the bounding box
 DISK_KIND = "roadmap"  # the on-disk cache's kind (tasker.diskcache)
@@ -233,14 +233,8 @@ class Roadmap:
         loaded from the on-disk cache (see the module docstring) when a process grew it before."""
         key = (repr(spec), round(scene.radius, 4), seed, milestones)
         if key not in _CACHE:
-            path = entry_path(DISK_KIND, disk_key(spec, scene, seed, milestones), ".npz")
-            data = read_entry(path)
-            roadmap = None if data is None else cls.from_npz(data)
-            if roadmap is None:
-                roadmap = cls(spec, scene, seed, milestones)
-                if path is not None:
-                    write_atomic(path, roadmap.to_npz())
-            _CACHE[key] = roadmap
+            _CACHE[key] = remembered(DISK_KIND, disk_key(spec, scene, seed, milestones), ".npz",
+                                     lambda: cls(spec, scene, seed, milestones), Roadmap.to_npz, cls.from_npz)
         return _CACHE[key]
 
     def to_npz(self) -> bytes:

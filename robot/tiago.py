@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from tasker.diskcache import content_key, entry_path, read_entry, write_atomic
+from tasker.diskcache import content_key, remembered
 
 if TYPE_CHECKING:  # imported lazily at run time; neither library ships type stubs, so these are Any to mypy
     import mujoco
@@ -241,14 +241,7 @@ def _source_from_npz(data: bytes) -> MjSource | None:
 @lru_cache(maxsize=1)
 def mujoco_source() -> MjSource:
     """The URDF rewritten for MuJoCo and its mesh assets (name, bytes); cached in-process and on disk."""
-    path = entry_path(SOURCE_KIND, source_key(), ".npz")
-    data = read_entry(path)
-    source = None if data is None else _source_from_npz(data)
-    if source is None:
-        source = _convert_source()
-        if path is not None:
-            write_atomic(path, _source_to_npz(source))
-    return source
+    return remembered(SOURCE_KIND, source_key(), ".npz", _convert_source, _source_to_npz, _source_from_npz)
 
 
 def _convert_source() -> MjSource:
@@ -344,11 +337,5 @@ def _cached_dimensions(data: bytes) -> tuple[float, float, float] | None:
 def robot_dimensions() -> tuple[float, float, float]:
     """``(wheel radius, wheel separation, planning radius)`` from the Pinocchio model; cached in
     the process and on disk (a hit imports no Pinocchio; floats round-trip exactly through JSON)."""
-    path = entry_path(DIMENSIONS_KIND, dimensions_key(), ".json")
-    data = read_entry(path)
-    dims = None if data is None else _cached_dimensions(data)
-    if dims is None:
-        dims = _measure_dimensions()
-        if path is not None:
-            write_atomic(path, json.dumps(dict(zip(_DIMENSIONS, dims, strict=True))).encode())
-    return dims
+    return remembered(DIMENSIONS_KIND, dimensions_key(), ".json", _measure_dimensions,
+                      lambda dims: json.dumps(dict(zip(_DIMENSIONS, dims, strict=True))).encode(), _cached_dimensions)

@@ -24,12 +24,14 @@ import hashlib
 import logging
 import os
 import tempfile
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
+from typing import TypeVar
 
 from tasker import __version__
 
 ENV_VAR = "TASKER_CACHE"
+T = TypeVar("T")
 log = logging.getLogger(__name__)
 
 
@@ -88,3 +90,17 @@ def read_entry(path: Path | None) -> bytes | None:
     except OSError as exc:
         log.debug("cache entry not read (%s): %s", path, exc)
         return None
+
+
+def remembered(kind: str, key: str, suffix: str, compute: Callable[[], T], encode: Callable[[T], bytes],
+               decode: Callable[[bytes], T | None]) -> T:
+    """The value of the entry of ``kind`` with ``key``, if there is one ``decode`` can use
+    (``None``: it cannot); else ``compute()``, written (``encode``) for the next process."""
+    path = entry_path(kind, key, suffix)
+    data = read_entry(path)
+    value = None if data is None else decode(data)
+    if value is None:
+        value = compute()
+        if path is not None:
+            write_atomic(path, encode(value))
+    return value
