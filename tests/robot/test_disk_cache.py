@@ -14,7 +14,7 @@ import multiprocessing
 import os
 import subprocess
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -216,6 +216,23 @@ def test_unusable_dimensions_entry_is_measured_again_and_rewritten(cache: Path, 
     assert entry.read_bytes() == good
 
 
+
+def _keys_under_other_versions(key: Callable[[], str], dists: tuple[str, ...],
+                               monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """``key()`` with each of ``dists``' installed versions changed in turn, then tasker's."""
+    from importlib import metadata
+
+    real = metadata.version
+    keys = []
+    for dist in dists:
+        with monkeypatch.context() as m:
+            m.setattr(metadata, "version", lambda d, dist=dist: "0.0.0" if d == dist else real(d))
+            keys.append(key())
+    with monkeypatch.context() as m:
+        m.setattr(tasker.diskcache, "__version__", "9.9.9")
+        keys.append(key())
+    return keys
+
 def test_dimensions_key_has_every_input(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     key = tiago.dimensions_key()
     urdf = tmp_path / "tiago.urdf"
@@ -224,16 +241,7 @@ def test_dimensions_key_has_every_input(tmp_path: Path, monkeypatch: pytest.Monk
     with monkeypatch.context() as m:
         m.setattr(tiago, "urdf_path", lambda: urdf)
         others.append(tiago.dimensions_key())
-    from importlib import metadata
-
-    real = metadata.version
-    for dist in ("pin", "coal", "example-robot-data"):
-        with monkeypatch.context() as m:
-            m.setattr(metadata, "version", lambda d, dist=dist: "0.0.0" if d == dist else real(d))
-            others.append(tiago.dimensions_key())
-    with monkeypatch.context() as m:
-        m.setattr(tasker.diskcache, "__version__", "9.9.9")
-        others.append(tiago.dimensions_key())
+    others += _keys_under_other_versions(tiago.dimensions_key, ("pin", "coal", "example-robot-data"), monkeypatch)
     assert len({key, *others}) == len(others) + 1
 
 
@@ -247,16 +255,7 @@ def test_mujoco_source_key_has_every_input(tmp_path: Path, monkeypatch: pytest.M
         others.append(tiago.source_key())
         urdf.write_bytes(urdf.read_bytes() + b" ")
         others.append(tiago.source_key())
-    from importlib import metadata
-
-    real = metadata.version
-    for dist in ("coal", "example-robot-data"):
-        with monkeypatch.context() as m:
-            m.setattr(metadata, "version", lambda d, dist=dist: "0.0.0" if d == dist else real(d))
-            others.append(tiago.source_key())
-    with monkeypatch.context() as m:
-        m.setattr(tasker.diskcache, "__version__", "9.9.9")
-        others.append(tiago.source_key())
+    others += _keys_under_other_versions(tiago.source_key, ("coal", "example-robot-data"), monkeypatch)
     with monkeypatch.context() as m:
         m.setattr(tiago, "__file__", str(ROOT / "robot" / "spec.py"))
         others.append(tiago.source_key())
