@@ -406,7 +406,6 @@ def report(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead"
     return text
 
 
-from experiments.day_cli import add_arguments  # noqa: E402  (the options live with the light CLI module)
 
 
 def run(a: argparse.Namespace) -> int:
@@ -498,18 +497,11 @@ def _import_log(log: Path, db: Path, protocol: str, backend: str) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    from experiments.day_cli import EXAMPLES
+    """``python -m experiments.dayreport ARGS`` is ``tasker day ARGS``: one command, with the same
+    options (``-v``/``-q`` too), messages and exit statuses."""
+    from experiments.cli import main as tasker
 
-    ap = argparse.ArgumentParser(prog="python -m experiments.dayreport", description=__doc__.splitlines()[0],
-                                 epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_arguments(ap)
-    from tasker.errors import TaskerError
-
-    try:
-        return run(ap.parse_args(argv))
-    except TaskerError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    return tasker(["day", *(sys.argv[1:] if argv is None else argv)])
 
 
 if __name__ == "__main__":
