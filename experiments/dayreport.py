@@ -406,8 +406,6 @@ def report(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead"
     return text
 
 
-
-
 def run(a: argparse.Namespace) -> int:
     """Run the days into ``OUT/days.db``; write ``days.jsonl`` and ``table.md``; print the table.
 
