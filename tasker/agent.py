@@ -358,15 +358,11 @@ class DynamicAgent:
             self._close_stage(now, "failed", reason=status.reason)
             failure = f"stage {stage.label} failed: {status.reason}"
             if not in_task:  # a suspension's own stage: nothing safer to fall back on
-                if self._pending_term is not None and self._pending_term[1] == "failed":
-                    failure = f"{self._pending_term[0]}; then {failure}"
-                self._end(now, failure, cause="failed", event="stage_failed")
+                self._end(now, self._after_failure(failure), cause="failed", event="stage_failed")
                 return
             # the task cannot go on, but what it leaves must be safe: genSusp, exeSusp, then end
             self._pending_term = (failure, "failed")
-            self.ctx.interrupted = stage
-            self.ctx.stage_started = None
-            self._start_gen_susp(now, event="stage_failed")
+            self._suspend_now(now, stage, event="stage_failed")  # the stage is closed: nothing to stop
             return
         if status.state is SkillState.SUCCEEDED:
             self._close_stage(now, "done")
@@ -394,12 +390,19 @@ class DynamicAgent:
         if runner.running:
             self.next_wake = _next_tick_of(now, self.rates.task_exe_rate)
 
-    def _suspend_now(self, now: float, stage: Stage) -> None:
-        """A suspendable stage of exeTsk ends at once for a pending susp or term (eq. 26)."""
+    def _suspend_now(self, now: float, stage: Stage, event: str = "suspend") -> None:
+        """A suspendable stage of exeTsk ends at once for a pending susp or term (eq. 26), or a
+        failed one (``event`` ``stage_failed``) before its task ends."""
         self._stop_stage(now, "stopped")
         self.ctx.interrupted = stage
         self.ctx.stage_started = None
-        self._start_gen_susp(now)
+        self._start_gen_susp(now, event)
+
+    def _after_failure(self, why: str) -> str:
+        """``why``, after the failure whose safe suspension it interrupted, if it did."""
+        if self._pending_term is not None and self._pending_term[1] == "failed":
+            return f"{self._pending_term[0]}; then {why}"
+        return why
 
     def _start_gen_susp(self, now: float, event: str = "suspend") -> None:
         self._pending_susp = False
@@ -410,10 +413,7 @@ class DynamicAgent:
         try:
             plan = self.task.generate_suspension(self.ctx)
         except PlanningFailed as exc:
-            why = f"genSusp {exc.status}: {exc}"
-            if self._pending_term is not None and self._pending_term[1] == "failed":
-                why = f"{self._pending_term[0]}; then {why}"  # the failure that started it comes first
-            self._end(now, why, cause="failed", event="plan_failed")
+            self._end(now, self._after_failure(f"genSusp {exc.status}: {exc}"), cause="failed", event="plan_failed")
             return
         self._run_suspension(now, plan)
 

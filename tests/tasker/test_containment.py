@@ -299,3 +299,18 @@ def test_a_term_during_a_failed_tasks_safe_suspension_keeps_the_failure() -> Non
     loop.terminate(3.0, "d1", "cancelled")  # drive fails at about 1 s; put_down runs until about 6 s
     end = loop.run().of("end", agent="d1")[0]
     assert end["cause"] == "failed" and end["reason"].startswith("stage drive failed")
+
+
+def test_a_failed_task_whose_safe_suspension_cannot_be_planned_ends_with_both_reasons() -> None:
+    from tasker.errors import PlanningFailed
+
+    def no_way(ctx: TaskContext) -> list[Stage]:
+        raise PlanningFailed("unsolvable", "no place to put it down")
+
+    tasks = [SyntheticTask("carry", [st("drive", 4, fail=True)], suspension=no_way)]
+    loop = make_loop(tasks, scheduler="fifo", core=FailingCore())
+    loop.request(0.0, "carry")
+    end = loop.run().of("end", agent="d1")[0]
+    assert end["cause"] == "failed"
+    assert end["reason"] == ("stage drive failed: path to 'office' blocked; "
+                             "then genSusp unsolvable: no place to put it down")
