@@ -47,7 +47,7 @@ from scipy.sparse import csr_matrix
 from robot import scene as scene_module
 from robot.scene import Scene
 from robot.spec import WorldSpec
-from tasker.diskcache import content_key, remembered
+from tasker.diskcache import content_key, installed_version, remembered
 
 DEFAULT_DENSITY = 13.0  # milestones per square metre of the bounding box
 DISK_KIND = "roadmap"  # the on-disk cache's kind (tasker.diskcache)
@@ -159,14 +159,8 @@ def _door_points(spec: WorldSpec) -> list[tuple[float, float]]:
 
 def disk_key(spec: WorldSpec, scene: Scene, seed: int, milestones: int | None) -> str:
     """The on-disk cache key of the roadmap :meth:`Roadmap.for_world` returns: everything it is grown from."""
-    from importlib import metadata
-
-    try:
-        ompl = metadata.version("ompl")
-    except metadata.PackageNotFoundError:
-        ompl = "unknown"
     return content_key(DISK_KIND, [repr(spec), repr(float(scene.radius)), str(seed), repr(milestones),
-                                   f"ompl {ompl}", f"numpy {np.__version__}", Path(__file__).read_bytes(),
+                                   installed_version("ompl"), f"numpy {np.__version__}", Path(__file__).read_bytes(),
                                    Path(scene_module.__file__).read_bytes()])
 
 

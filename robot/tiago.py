@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from tasker.diskcache import content_key, remembered
+from tasker.diskcache import content_key, installed_version, remembered
 
 if TYPE_CHECKING:  # imported lazily at run time; neither library ships type stubs, so these are Any to mypy
     import mujoco
@@ -80,18 +80,6 @@ def urdf_path() -> Path:
     import example_robot_data as erd
 
     return (Path(erd.getModelPath("tiago_description")) / _URDF).resolve()
-
-
-def _version(*dists: str) -> str:
-    """The installed version of the first of ``dists`` found (distribution names differ by installer)."""
-    from importlib import metadata
-
-    for dist in dists:
-        try:
-            return f"{dist} {metadata.version(dist)}"
-        except metadata.PackageNotFoundError:
-            continue
-    return f"{dists[0]} absent"
 
 
 @lru_cache(maxsize=1)
@@ -213,7 +201,7 @@ def source_key() -> str:
     """The on-disk cache key of :func:`mujoco_source`: the URDF (bytes and place), this module, coal."""
     urdf = urdf_path()
     return content_key(SOURCE_KIND, [urdf.read_bytes(), str(urdf), Path(__file__).read_bytes(),
-                                     _version("coal", "hpp-fcl"), _version("example-robot-data")])
+                                     installed_version("coal", "hpp-fcl"), installed_version("example-robot-data")])
 
 
 def _source_to_npz(source: MjSource) -> bytes:
@@ -310,8 +298,8 @@ def tiago_mjspec() -> mujoco.MjSpec:
 def dimensions_key() -> str:
     """The on-disk cache key of :func:`robot_dimensions`: everything the Pinocchio model is built from."""
     return content_key(DIMENSIONS_KIND, [urdf_path().read_bytes(), Path(__file__).read_bytes(),
-                                         _version("pin", "pinocchio"), _version("coal", "hpp-fcl"),
-                                         _version("example-robot-data")])
+                                         installed_version("pin", "pinocchio"), installed_version("coal", "hpp-fcl"),
+                                         installed_version("example-robot-data")])
 
 
 def _measure_dimensions() -> tuple[float, float, float]:

@@ -104,3 +104,16 @@ def remembered(kind: str, key: str, suffix: str, compute: Callable[[], T], encod
         if path is not None:
             write_atomic(path, encode(value))
     return value
+
+
+def installed_version(*dists: str) -> str:
+    """``"name version"`` of the first of ``dists`` installed (a distribution's name differs by
+    installer: ``pin`` or ``pinocchio``), for a key; ``"name absent"`` when none is."""
+    from importlib import metadata
+
+    for dist in dists:
+        try:
+            return f"{dist} {metadata.version(dist)}"
+        except metadata.PackageNotFoundError:
+            continue
+    return f"{dists[0]} absent"
