@@ -17,6 +17,14 @@ randomness).  What a person does in a step, in order of precedence:
    speed, so after a reaction ends they walk back onto the script instead of jumping.
    A scenario's ``walk`` world event replaces the script from then on (:meth:`Person.go_to`).
 
+People walk around walls and furniture, never through them: given a :data:`Route` (the
+world's, :meth:`robot.sim.Simulation.person_route`), every leg of the script whose
+straight line crosses a wall or furniture is walked along the route instead (each leg
+keeps its scripted start and end times; its corners are timed in proportion to the
+distance walked), a ``walk`` event's walk follows the route at the person's speed, and a
+person who has to catch up with the script (after making room, or behind a script faster
+than they walk) goes round what stands between them and it.
+
 Posture changes come from the script's ``events`` ``(t, posture)`` or from
 :meth:`Person.set_posture`; and a sitting person asked to follow the robot stands up
 first — nobody follows seated, and a standing person takes less room in a doorway
@@ -29,7 +37,7 @@ task's predicate names.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 
 from robot.spec import PersonSpec
 from tasker.world import Fact, Pose
@@ -37,16 +45,23 @@ from tasker.world import Fact, Pose
 FOLLOW_GAP = 0.9  # metres behind the robot, along its trail
 TRAIL_STEP = 0.05  # metres between recorded trail points
 
+Point = tuple[float, float]
+Route = Callable[[Point, Point], tuple[Point, ...]]
+"""How a person gets from one point to another: the polyline they walk, both ends included
+(just the two when the straight line is clear)."""
+
 
 class Person:
     """One person's state: pose, posture, where the script and the reactions put them."""
 
-    def __init__(self, spec: PersonSpec) -> None:
+    def __init__(self, spec: PersonSpec, route: Route | None = None) -> None:
         self.spec = spec
         self.name = spec.name
         self.x, self.y, self.yaw = spec.pose
         self.posture = spec.posture
-        self.walk = spec.walk  # the script's waypoints; :meth:`go_to` replaces them
+        self._route = route
+        self.walk = self._routed(spec.walk)  # the script's waypoints; :meth:`go_to` replaces them
+        self._detour: list[Point] = []  # corners to walk round before heading for the script again
         self._event = 0
         self._trail: list[tuple[float, float]] = []
         self.following = False
@@ -75,11 +90,37 @@ class Person:
                 return (x0 + f * (x1 - x0), y0 + f * (y1 - y0))
         return walk[-1][1], walk[-1][2]
 
+    def _routed(self, walk: tuple[tuple[float, float, float], ...]) -> tuple[tuple[float, float, float], ...]:
+        """``walk`` with each leg along the :data:`Route`: the leg's start and end times kept,
+        its corners timed in proportion to the distance walked along it."""
+        if self._route is None or len(walk) < 2:
+            return walk
+        out = [walk[0]]
+        for (t0, x0, y0), (t1, x1, y1) in zip(walk, walk[1:], strict=False):
+            pts = self._route((x0, y0), (x1, y1))
+            steps = [math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(pts, pts[1:], strict=False)]
+            total = sum(steps)
+            if len(pts) > 2 and total > 1e-9:
+                walked = 0.0
+                for (cx, cy), d in zip(pts[1:-1], steps, strict=False):
+                    walked += d
+                    out.append((t0 + (t1 - t0) * walked / total, cx, cy))
+            out.append((t1, x1, y1))
+        return tuple(out)
+
     def go_to(self, t: float, x: float, y: float) -> None:
-        """From time ``t`` the script is a walk from here to ``(x, y)`` at the person's speed,
-        and standing there (a scenario's ``walk`` world event)."""
-        d = math.hypot(x - self.x, y - self.y)
-        self.walk = ((t, self.x, self.y), (t + d / self.spec.speed, x, y)) if d > 1e-9 else ((t, x, y),)
+        """From time ``t`` the script is a walk from here to ``(x, y)`` at the person's speed
+        (along the :data:`Route`), and standing there (a scenario's ``walk`` world event)."""
+        pts = self._route((self.x, self.y), (x, y)) if self._route is not None else ((self.x, self.y), (x, y))
+        walk = [(t, self.x, self.y)]
+        walked = 0.0
+        for a, b in zip(pts, pts[1:], strict=False):
+            d = math.hypot(b[0] - a[0], b[1] - a[1])
+            if d > 1e-9:
+                walked += d
+                walk.append((t + walked / self.spec.speed, b[0], b[1]))
+        self.walk = tuple(walk) if len(walk) > 1 else ((t, x, y),)
+        self._detour = []
 
     def _walk_to(self, tx: float, ty: float, dt: float, stop_at: float = 0.0) -> None:
         dx, dy = tx - self.x, ty - self.y
@@ -122,6 +163,10 @@ class Person:
             self._event += 1
         if not self.following:
             self._trail = []
+        target = self.scripted(t)
+        if self.posture == "fallen" or self.giving_room is not None and self.giving_room[1] is not None \
+                or self.waiting or self.following or target is None:
+            self._detour = []  # a reaction (or no script): the way back is found afresh
         if self.posture == "fallen":
             return
         if self.giving_room is not None and self.giving_room[1] is not None:
@@ -135,9 +180,32 @@ class Person:
             self._stand_up()
             self._follow(robot, dt)
             return
-        target = self.scripted(t)
         if target is not None:
+            self._head_for(target, dt)
+
+    def _head_for(self, target: Point, dt: float) -> None:
+        """Walk toward the script's point of now: straight when it is within this step or
+        nothing stands between, else round the corners of the :data:`Route` to it."""
+        budget = self.spec.speed * dt
+        if not self._detour and self._route is not None \
+                and math.hypot(target[0] - self.x, target[1] - self.y) > budget + 1e-9:
+            self._detour = list(self._route((self.x, self.y), target)[1:-1])
+        if not self._detour:
             self._walk_to(target[0], target[1], dt)
+            return
+        while self._detour and budget > 1e-9:
+            cx, cy = self._detour[0]
+            d = math.hypot(cx - self.x, cy - self.y)
+            if d > budget:
+                self._walk_to(cx, cy, budget / self.spec.speed)
+                return
+            if d > 1e-9:
+                self.yaw = math.atan2(cy - self.y, cx - self.x)
+            self.x, self.y = cx, cy
+            budget -= d
+            self._detour.pop(0)
+        if budget > 1e-9:
+            self._walk_to(target[0], target[1], budget / self.spec.speed)
 
     def stepping_aside(self) -> bool:
         """Not yet where :attr:`giving_room` or, waiting, :attr:`aside` says to stand."""
@@ -162,8 +230,8 @@ class Person:
 class People:
     """Everyone in the world, stepped together in name order (deterministic)."""
 
-    def __init__(self, specs: Iterable[PersonSpec]) -> None:
-        self.by_name = {p.name: Person(p) for p in sorted(specs, key=lambda s: s.name)}
+    def __init__(self, specs: Iterable[PersonSpec], route: Route | None = None) -> None:
+        self.by_name = {p.name: Person(p, route) for p in sorted(specs, key=lambda s: s.name)}
 
     def __getitem__(self, name: str) -> Person:
         return self.by_name[name]

@@ -68,10 +68,11 @@ class Simulation:
         self.rate_hz = float(rate_hz)
         _, _, radius = robot_dimensions()
         self.scene = Scene(self.spec, radius)
-        self.people = People(self.spec.people.values())
         self.planner = BasePlanner(self.spec, self.scene, seed=seed, milestones=milestones)
         self.limits = DriveLimits.of(self.spec.robot)
-        self.motion = MotionEstimator(self.planner, self.limits, open_planner(self.spec, radius, seed, milestones))
+        self._open = open_planner(self.spec, radius, seed, milestones)
+        self.motion = MotionEstimator(self.planner, self.limits, self._open)
+        self.people = People(self.spec.people.values(), route=self.person_route)
         self.mj = MjApartment(self.spec)
         self.time = 0.0
         self.facts: set[Fact] = set(self.spec.facts)
@@ -114,6 +115,27 @@ class Simulation:
         out |= {n: "door" for n in self.spec.doors}
         out |= dict(self.spec.objects)
         return out
+
+    def person_route(self, a: tuple[float, float], b: tuple[float, float]) -> tuple[tuple[float, float], ...]:
+        """How a person walks from ``a`` to ``b`` (:data:`robot.people.Route`): straight when
+        that line crosses no wall and no furniture; otherwise along the base's shortest way
+        with every door open (people open doors; where the base fits, a person fits),
+        between the nearest points the base may stand on; straight when there is no such way.
+        People in the way are not considered: they step round each other."""
+        if segments_clear(np.array([a], float), np.array([b], float), self.scene.static, 1e-9)[0]:
+            return (a, b)
+        s, g = self._open.snap((round(a[0], 4), round(a[1], 4))), self._open.snap((round(b[0], 4), round(b[1], 4)))
+        path = None if s is None or g is None else self._open.plan_ignoring_people(s, g)
+        if path is None:
+            return (a, b)
+        out = [a]
+        for p in (*path, b):
+            if math.hypot(p[0] - out[-1][0], p[1] - out[-1][1]) > 1e-9:
+                out.append((float(p[0]), float(p[1])))
+        if len(out) == 1:
+            out.append(b)
+        out[-1] = b
+        return tuple(out)
 
     def _sync_people(self) -> None:
         for p in self.people:
