@@ -140,6 +140,21 @@ def test_a_robot_day_runs_under_the_strategy_it_is_given(tiny_protocol: protocol
     assert (m["hazard_overruns"], m["hazards_left_at_switch"]) == (safety["budget_overruns"],
                                                                    safety["violations_at_switch"])
     assert safety["episodes"]  # the carry held its object: the day has hazards to count
+    # people walked to their sites and home round walls, not through them (docs/robot.md)
+    import numpy as np
+
+    from robot.recording import read_trajectory
+    from robot.scene import segments_clear
+    from robot.spec import load_world
+
+    world = load_world(tiny_protocol.robot.world)
+    walls = np.array([o.box for o in world.obstacles if o.kind == "wall"], dtype=float)
+    _, samples, _ = read_trajectory(tmp_path / "trajectory.jsonl")
+    steps = [((p.x, p.y), (q.x, q.y)) for s0, s1 in zip(samples, samples[1:], strict=False)
+             for p, q in zip(s0.people, s1.people, strict=True) if (p.x, p.y) != (q.x, q.y)]
+    assert steps  # people walked
+    a, b = np.array([u for u, _ in steps]), np.array([v for _, v in steps])
+    assert segments_clear(a, b, walls, 1e-9).all()
     with pytest.raises(ConfigError, match="synthetic backend"):
         days.make("tabsa-short", 1).run(suspension="static")
 
