@@ -21,8 +21,11 @@ Each decision solves a single-machine sequencing problem over the executing task
   depth-first branch and bound over orders, children tried best first, pruned by the
   lower bound ``C_j >= t + min_i d(i, j)`` for every job not yet placed.  It is exact
   when it ends within ``node_budget`` (moves evaluated + nodes expanded), and anytime
-  otherwise: the best order found so far.  The budget counts work, never wall time, so
-  traces are reproducible.
+  otherwise: then a second pass improves Smith's order (shortest duration per cost rate
+  first) by insertion moves, with as much budget again, and the better order wins — on
+  long queues the greedy start is far from the best order and the branch and bound runs
+  out long before it gets near one.  The budget counts work, never wall time, so traces
+  are reproducible.
 
 The executing task keeps the robot unless the best order that starts with another
 task beats the best order that continues it by the factor ``hysteresis``.
@@ -127,8 +130,9 @@ def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
 
     A greedy order, improved by insertion moves with up to half the budget, is the
     incumbent of a depth-first branch and bound that uses the rest; ``exact`` is true
-    when that search ended on its own.  Every evaluated move and every expanded node
-    counts against ``node_budget``.  ``fixed_first`` forces the first job;
+    when that search ended on its own.  When it did not, :func:`_smith`'s order improved
+    by insertion moves (up to ``node_budget`` more) replaces the result if it is better.
+    Every evaluated move and every expanded node counts against ``node_budget``.  ``fixed_first`` forces the first job;
     ``exclude_first`` forbids one as first.
     """
     n = p.n
@@ -173,7 +177,23 @@ def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
                 return
 
     dfs(-1, p.now, 0.0)
+    if exhausted:  # not proven optimal: a second pass from Smith's order, with as much budget again
+        order2, value2, used = _improve(p, _smith(p, allowed), set(allowed), node_budget)
+        nodes += used
+        if value2 < best - 1e-9 * max(1.0, abs(best)):
+            best_order, best = order2, value2
     return best_order, best, nodes, not exhausted
+
+
+def _smith(p: Problem, allowed_first: list[int]) -> list[int]:
+    """Smith's rule: shortest (fastest possible) duration per unit of cost rate first — the
+    optimal order of ``sum cps_j C_j`` without travel or deadlines, and a strong start with
+    them (``benchmarks/bench_lookahead.py``, part 3).  The first job is one allowed first."""
+    def key(j: int) -> tuple[float, int]:
+        return (p.dmin[j] / p.weight[j] if p.weight[j] > 0 else math.inf, j)
+
+    first = min(allowed_first, key=key)
+    return [first, *sorted((j for j in range(p.n) if j != first), key=key)]
 
 
 class LookAhead(Scheduler):
@@ -224,17 +244,23 @@ class LookAhead(Scheduler):
         return Problem(view.now, first, after, [p.cps for p in params], deadline, budget, has_exe=has_exe,
                        lateness_weight=self.lateness_weight, hazard_weight=self.hazard_weight), jobs
 
+    def solve(self, prob: Problem, budget: int, *, fixed_first: int | None = None,
+              exclude_first: int | None = None) -> tuple[list[int], float, int, bool]:
+        """The search one decision runs (:func:`solve`); a subclass may put another solver
+        behind the same problem, budget split and record (``experiments.cpsat``)."""
+        return solve(prob, node_budget=budget, fixed_first=fixed_first, exclude_first=exclude_first)
+
     def schedule(self, view: ScheduleView) -> Decision:
         if not view.candidates:
             return NO_CHANGE
         prob, jobs = self.problem(view)
         if view.exe is None:
-            order, obj, nodes, exact = solve(prob, node_budget=self.node_budget)
+            order, obj, nodes, exact = self.solve(prob, self.node_budget)
             keep_obj = math.inf
         else:  # two searches share the budget: continue exeDA, or start with someone else
             half = max(1, self.node_budget // 2)
-            keep, keep_obj, n1, e1 = solve(prob, node_budget=half, fixed_first=0)
-            alt, alt_obj, n2, e2 = solve(prob, node_budget=self.node_budget - n1, exclude_first=0)
+            keep, keep_obj, n1, e1 = self.solve(prob, half, fixed_first=0)
+            alt, alt_obj, n2, e2 = self.solve(prob, self.node_budget - n1, exclude_first=0)
             nodes, exact = n1 + n2, e1 and e2
             switch = alt_obj < self.hysteresis * keep_obj
             order, obj = (alt, alt_obj) if switch else (keep, keep_obj)
