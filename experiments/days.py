@@ -108,7 +108,7 @@ def scheduler_options(proto: Protocol, name: str, backend: str = "synthetic") ->
     if name == "alg2":  # priority classes, highest first
         prios = sorted({s.priority for s in proto.tasks.values()}, reverse=True)
         return {"classes": [[to[k] for k, s in proto.tasks.items() if s.priority == p] for p in prios]}
-    if name == "lookahead":
+    if name in ("lookahead", "lookahead-cpsat"):
         budgets = {to[k]: s.death_after_s for k, s in proto.tasks.items() if s.death_after_s is not None}
         penalty = max((s.suspend_s for s in proto.tasks.values()), default=0.0) + proto.planning_time_s
         return {"switch_penalty_s": penalty, "budgets": budgets}
