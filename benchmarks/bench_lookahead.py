@@ -8,6 +8,11 @@
    ``reqSP`` answers from straight-line travel at 0.5 m/s, like a synthetic day task.
 2. Anytime quality: on queues of 6 to 9, the objective the default budget reaches over
    the optimum (the same search with an unlimited budget).  1.000 means optimal.
+3. Long queues (12, 16 and 24 jobs, 5 queues each), where neither search can prove its
+   order optimal: the objective of ``lookahead`` at its default node budget and of
+   ``lookahead-cpsat`` (:mod:`experiments.cpsat`, OR-Tools CP-SAT) at its default time
+   limit, over the best order known (the better of CP-SAT with 10x its limit and the
+   branch and bound with 100x its budget), and the wall time of one search of each.
 """
 
 from __future__ import annotations
@@ -17,6 +22,7 @@ import random
 import statistics
 import time
 
+from experiments.cpsat import LookAheadCpSat, solve_cpsat
 from tasker import schedulers
 from tasker.messages import CompletionCost, CostParams, SPRequest
 from tasker.schedulers.base import Candidate, Scheduler, ScheduleView
@@ -84,6 +90,27 @@ def main() -> None:
             exact_share += exact
         print(f"{n:>6} jobs: {statistics.mean(gaps):.4f} (worst {max(gaps):.4f}); "
               f"search complete within budget in {exact_share}/10")
+    cpsat = LookAheadCpSat()
+    print(f"3. long queues: objective / best order known (mean, worst of 5 queues), median ms per search; "
+          f"lookahead node budget {look.node_budget}, lookahead-cpsat time limit {cpsat.time_limit}")
+    print(f"{'jobs':>6} {'lookahead':>18} {'ms':>7} {'lookahead-cpsat':>18} {'ms':>7}")
+    for n in (12, 16, 24):
+        bb, cp, t_bb, t_cp = [], [], [], []
+        for seed in range(5):
+            prob, _ = look.problem(make_view(n - 1, seed))
+            t0 = time.perf_counter()
+            v_bb = solve(prob, node_budget=look.node_budget)[1]
+            t1 = time.perf_counter()
+            v_cp = solve_cpsat(prob, cpsat.time_limit)[1]
+            t2 = time.perf_counter()
+            best = min(v_bb, v_cp, solve_cpsat(prob, 10 * cpsat.time_limit)[1],
+                       solve(prob, node_budget=100 * look.node_budget)[1])
+            bb.append(v_bb / best)
+            cp.append(v_cp / best)
+            t_bb.append(t1 - t0)
+            t_cp.append(t2 - t1)
+        print(f"{n:>6} {statistics.mean(bb):>8.3f} ({max(bb):.3f}) {statistics.median(t_bb) * 1e3:>7.1f} "
+              f"{statistics.mean(cp):>8.3f} ({max(cp):.3f}) {statistics.median(t_cp) * 1e3:>7.1f}")
 
 
 if __name__ == "__main__":
