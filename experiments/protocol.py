@@ -187,7 +187,7 @@ def load(path: str | Path) -> Protocol:
         raise tasks_t.error(None, f"expected at least one of {', '.join(KINDS)}")
     tasks_t.done()
     backend = _robot_backend(top.table("robot_backend"), Path(path), sites, tasks) if "robot_backend" in top else None
-    top.done()
+    top.done(also=("robot_backend",))  # optional: listed among the valid keys even when absent
     return Protocol(name=top.data["name"], source=str(path), start=start, length_s=length, step_s=step,
                     robot_speed=speed, start_site=start_site, planning_time_s=planning, sites=sites,
                     last_call_s=last_call, tasks=tasks, robot=backend)

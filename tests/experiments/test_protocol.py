@@ -70,6 +70,9 @@ def test_bad_protocols_name_file_line_and_field(tmp_path: Path) -> None:
         protocol.load(write(tmp_path, text.replace('start_site = "hall"', 'start_site = "hal"')))
     with pytest.raises(InputError, match=r"robot\.planing_time_s: unknown key .*did you mean 'planning_time_s'"):
         protocol.load(write(tmp_path, text.replace("planning_time_s =", "planing_time_s =")))
+    with pytest.raises(InputError, match=r"robot_backnd: unknown key .*did you mean 'robot_backend'.*"
+                                         r"\(valid keys: .*robot_backend"):  # optional, yet named
+        protocol.load(write(tmp_path, text.replace("[robot_backend", "[robot_backnd")))
 
 
 
