@@ -231,6 +231,10 @@ def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str
     sites_t.done()
     tasks_t = t.table("tasks")
     out: dict[str, RobotTask] = {}
+    from experiments.crossref import check_template
+    from planners.bundled import task_types  # what a robot day runs: the bundled task folders and $TASKER_TASKS
+
+    types = {tt.name: tt for tt in task_types()}
     for kind, _ in tasks_t.items():
         check_name(tasks_t, kind, kind, sorted(tasks), "task type of [tasks]")
         tt = tasks_t.table(kind)
@@ -246,7 +250,16 @@ def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str
         posture = tt.string("posture", None, choices=("fallen", "sitting", "standing"))
         if posture is not None and "$person" not in args.values():
             raise tt.error("posture", "needs a $person argument (whose posture changes)")
-        out[kind] = RobotTask(kind, str(tt.string("task")), args, obj, posture)
+        name = str(tt.string("task"))
+        check_name(tt, "task", name, types, "task type", "a robot day runs the bundled task types and those of "
+                                                         "$TASKER_TASKS (see 'tasker domains')")
+        domain = getattr(types[name], "domain", None)
+        if obj is not None and getattr(domain, "types", None):
+            check_name(tt, "object_type", obj, domain.types, "object type",  # type: ignore[union-attr]
+                       f"a type of task type {name!r}'s domain")
+        variables = {"$site": "place", "$dest": "place", "$person": "person", **({"$object": obj} if obj else {})}
+        check_template(tt, types[name], args, variables, spec)  # names, required ones, each of its PDDL type
+        out[kind] = RobotTask(kind, name, args, obj, posture)
         tt.done()
     missing = sorted(set(tasks) - set(out))
     if missing:
