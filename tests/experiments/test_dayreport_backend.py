@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -126,6 +127,28 @@ def test_an_older_days_log_is_kept_by_resume(tmp_path: Path) -> None:
     assert dayreport.main(args) == 0
     rows = [json.loads(x) for x in (out / "days.jsonl").read_text().splitlines()]
     assert [r["seed"] for r in rows] == [1, 2] and rows[0]["completed"] == -1
+
+
+@pytest.mark.parametrize(("line", "message"), [
+    ("garbage", r"days\.jsonl:2: not a JSON object: Expecting value"),
+    ("[1]", r"days\.jsonl:2: expected a day \(a JSON object\), got \[1\]"),
+    ('{"scheduler": "fifo", "seed": "x"}', r"days\.jsonl:2: seed: expected an integer >= 0"),
+    ('{"scheduler": "fifo", "seed": 3, "completed": "lots"}', r"days\.jsonl:2: completed: expected a number"),
+])
+def test_a_damaged_older_days_log_is_an_error_naming_its_line(tmp_path: Path, line: str, message: str,
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
+    """--resume imports an older days.jsonl; a damaged one is refused whole, at its line (exit 2),
+    where it was an internal error (JSONDecodeError, KeyError) once some days had been imported."""
+    out = tmp_path / "out"
+    out.mkdir()
+    good = dayreport.run_day("tabsa-short", 1, "fifo")
+    (out / "days.jsonl").write_text(json.dumps(good) + "\n" + line + "\n")
+    args = ["--protocol", "tabsa-short", "--days", "2", "--schedulers", "fifo", "--workers", "1", "--resume",
+            "--out", str(out)]
+    assert dayreport.main(args) == 2
+    err = capsys.readouterr().err
+    assert re.search(message, err) and "internal error" not in err, err
+    assert not (out / "days.db").exists()  # nothing imported: the fixed log is read in whole next time
 
 
 def test_strategies_are_compared_under_each_scheduler() -> None:
