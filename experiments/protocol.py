@@ -37,6 +37,9 @@ from tasker.task import ArgSpec, TaskContext
 Pose = tuple[float, ...]
 KINDS = ("transport", "fall", "pick_place")
 SUSP, BLOCK = StageKind.SUSPENDABLE, StageKind.BLOCKING
+MAX_REQUESTS = 10_000
+"""A protocol whose counts add up to more requests a day than this is refused (a typo such as
+``count = 1200000`` would otherwise run for hours; 9 000 take a minute on the synthetic backend)."""
 _RESUME_STAGES = ("go_back", "apologise", "pick_again")
 
 
@@ -164,6 +167,8 @@ def load(path: str | Path) -> Protocol:
     arrivals, tasks_t = top.table("arrivals"), top.table("tasks")
     length = day.number("length_s", positive=True)
     step = day.number("step_s", positive=True)
+    if step > length:
+        raise day.error("step_s", f"expected at most the day's length_s ({length:g} s), got {step:g}")
     start = day.string("start", "00:00")
     day.done()
     sites_t = apartment.table("sites")
@@ -185,6 +190,11 @@ def load(path: str | Path) -> Protocol:
         tasks[kind] = _task(tasks_t.table(kind), kind)
     if not tasks:
         raise tasks_t.error(None, f"expected at least one of {', '.join(KINDS)}")
+    total = sum(spec.count for spec in tasks.values())
+    if total > MAX_REQUESTS:
+        kind = max(tasks, key=lambda k: tasks[k].count)
+        raise tasks_t.at(kind, tasks_t.data[kind]).error(
+            "count", f"the day's counts add up to {total} requests, more than the {MAX_REQUESTS} a day may have")
     tasks_t.done()
     backend = _robot_backend(top.table("robot_backend"), Path(path), sites, tasks) if "robot_backend" in top else None
     top.done(also=("robot_backend",))  # optional: listed among the valid keys even when absent

@@ -70,6 +70,10 @@ def test_bad_protocols_name_file_line_and_field(tmp_path: Path) -> None:
         protocol.load(write(tmp_path, text.replace('start_site = "hall"', 'start_site = "hal"')))
     with pytest.raises(InputError, match=r"robot\.planing_time_s: unknown key .*did you mean 'planning_time_s'"):
         protocol.load(write(tmp_path, text.replace("planning_time_s =", "planing_time_s =")))
+    with pytest.raises(InputError, match=r"day\.step_s: expected at most the day's length_s \(14400 s\), got 20000"):
+        protocol.load(write(tmp_path, text.replace("step_s = 5.0", "step_s = 20000.0")))
+    with pytest.raises(InputError, match=r"tasks\.fall\.count: the day's counts add up to 1200024 requests, more than"):
+        protocol.load(write(tmp_path, text.replace("count = 12\npriority = 3", "count = 1200000\npriority = 3")))
     with pytest.raises(InputError, match=r"robot_backnd: unknown key .*did you mean 'robot_backend'.*"
                                          r"\(valid keys: .*robot_backend"):  # optional, yet named
         protocol.load(write(tmp_path, text.replace("[robot_backend", "[robot_backnd")))
