@@ -413,13 +413,16 @@ def run(a: argparse.Namespace) -> int:
     :class:`tasker.reader.InputError`) before the first day runs.  Returns 1 if a day failed
     to run (it is listed under the table), else 0."""
     from tasker import schedulers
-    from tasker.cliargs import SEED_LIMIT, UsageError, show_progress
+    from tasker.cliargs import SEED_LIMIT, UsageError, show_progress, writable_dir
     from tasker.reader import suggest
 
     unknown = [n for n in a.schedulers if n not in schedulers.names()]
     if unknown:
         raise UsageError("--schedulers", f"unknown scheduler {unknown[0]!r}{suggest(unknown[0], schedulers.names())}; "
                                          f"known: {', '.join(schedulers.names())}")
+    twice = sorted({n for n in a.schedulers if a.schedulers.count(n) > 1})
+    if twice:
+        raise UsageError("--schedulers", f"{twice[0]!r} is given twice")
     if a.days < 1:
         raise UsageError("--days", f"expected >= 1, got {a.days}")
     if a.first_seed + a.days > SEED_LIMIT:
@@ -453,7 +456,7 @@ def run(a: argparse.Namespace) -> int:
     except ConfigError as exc:
         raise UsageError("--protocol", str(exc)) from exc
     workers = a.workers if a.workers is not None else (2 if a.backend == "synthetic" else 1)
-    a.out.mkdir(parents=True, exist_ok=True)
+    writable_dir(a.out, "--out")
     db, log = a.out / "days.db", a.out / "days.jsonl"
     if not a.resume:
         for old in (db, log):

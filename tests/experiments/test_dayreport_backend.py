@@ -195,3 +195,15 @@ def test_day_seeds_outside_the_seed_range_are_refused(args: list[str], fragment:
     err = capsys.readouterr().err
     assert fragment in err and "2**32" in err and "Traceback" not in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_scheduler_given_twice_or_an_out_that_is_a_file_names_the_argument(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Both were refused only by what they broke: 'two jobs have the same key (scenario, seed,
+    strategy)' and '...: File exists', neither naming the argument at fault."""
+    base = ["--protocol", "tabsa-short", "--days", "1", "--workers", "1"]
+    assert dayreport.main([*base, "--schedulers", "fifo", "alg2", "fifo", "--out", str(tmp_path / "o")]) == 2
+    assert "argument --schedulers: 'fifo' is given twice" in capsys.readouterr().err
+    (tmp_path / "file").write_text("")
+    assert dayreport.main([*base, "--schedulers", "fifo", "--out", str(tmp_path / "file")]) == 2
+    assert f"argument --out: {tmp_path / 'file'} exists and is not a folder" in capsys.readouterr().err
