@@ -161,8 +161,10 @@ class Checker:
 
         specs: list[Any] = []
         if self.attempt(p, "sweep spec", lambda: specs.append(load_spec(p))):
-            for sc in specs[0].scenarios:
-                self.check(specs[0].sources.get(sc, sc))
+            from experiments import scenario as scenarios
+
+            for sc in specs[0].scenarios:  # a file (absolute in sources), or a shipped scenario's name
+                self.check(specs[0].sources.get(sc) or str(scenarios.resolve(sc)))
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
