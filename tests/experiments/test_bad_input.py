@@ -373,6 +373,12 @@ def test_a_scenario_on_a_bad_world_names_the_world_file(tmp_path: Path) -> None:
     ('scenarios = ["paper", "paper"]\nseeds = 2\nstrategies = ["default"]', "scenarios[1]", "listed twice"),
     ('scenarios = ["paper"]\nseds = 2\nstrategies = ["default"]', "seeds", "missing"),
     ('scenarios = "paper"\nseeds = 2\nstrategies = ["default"]', "scenarios", "expected an array"),
+    ('scenarios = ["paper"]\nseeds = 2\nstrategies = ["default"]\n[variants.paper]\ninterrupt = "requests[9]"\n'
+     'times = { start = 0.0, stop = 60.0, step = 20.0 }', "variants.paper.interrupt",
+     "no requests[9] in 'paper': it has 4 requests, requests[0]..requests[3]"),
+    (f'scenarios = ["{standin.DEMO.as_posix()}"]\nseeds = 2\nstrategies = ["default"]\n'
+     f'[variants."{standin.DEMO.as_posix()}"]\ninterrupt = "requests[1]"\ntimes = {{ start = 0.0, stop = 60.0, '
+     'step = 20.0 }', "variants.", "is a synthetic scenario: only robot scenarios are randomised"),
 ])
 def test_bad_sweep_spec_field_is_named(tmp_path: Path, body: str, field: str, fragment: str) -> None:
     _fails(_write(tmp_path, body, "spec.toml"), load_spec, field, fragment, SpecError)
