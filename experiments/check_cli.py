@@ -1,11 +1,13 @@
-"""``tasker check PATH…``: every load-time check, on task folders, scenarios, worlds and sweep specs.
+"""``tasker check PATH…``: every load-time check, on task folders, scenarios, worlds, sweep specs and day
+protocols.
 
 Each PATH is recognised by what it holds: a task folder (``task.toml``), a folder of
 task folders, a folder of ``.toml`` files, or one file — a scenario (``kind = …``),
-a sweep spec (``scenarios`` and ``seeds``), a world (``places``), a ``task.toml`` or a
-PDDL domain.  Every problem is listed (not only the first), one line each, and the
-command exits 1 when there is any (2 for bad arguments).  A task folder's
-``[example]`` is solved again even when the check cache says it passed before.
+a sweep spec (``scenarios`` and ``seeds``), a day protocol (``[day]`` and ``[tasks]``),
+a world (``places``), a ``task.toml`` or a PDDL domain.  Every problem is listed (not
+only the first), one line each, and the command exits 1 when there is any (2 for bad
+arguments).  A task folder's ``[example]`` is solved again even when the check cache
+says it passed before.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ EXAMPLES = """\
 examples:
   tasker check domains/cook                          # a task folder: PDDL, task.toml, the example solved
   tasker check ~/my_tasks                            # a folder of task folders
-  tasker check experiments/scenarios experiments/sweeps robot/worlds
+  tasker check experiments/scenarios experiments/sweeps robot/worlds experiments/protocols
   tasker check my_scenario.toml --path ~/my_tasks    # a scenario that requests your own task types"""
 
 
@@ -108,13 +110,18 @@ class Checker:
             self._scenario(p, also or [])
         elif "scenarios" in raw and "seeds" in raw:
             self._sweep(p)
+        elif "day" in raw and "tasks" in raw:
+            from experiments import protocol
+
+            self.attempt(p, "day protocol", lambda: protocol.load(p))
         elif "places" in raw or "bounds" in raw:
             from robot.spec import load_world
 
             self.attempt(p, "world", lambda: load_world(p))
         else:
             self.problems.append((str(p), "cannot tell what this is: a scenario has 'kind', a sweep spec "
-                                          "'scenarios' and 'seeds', a world 'places', a task.toml '[task]'"))
+                                          "'scenarios' and 'seeds', a day protocol '[day]' and '[tasks]', a world "
+                                          "'places', a task.toml '[task]'"))
 
     # -- scenarios and sweeps -----------------------------------------------------------------
 
@@ -161,15 +168,19 @@ class Checker:
 
         specs: list[Any] = []
         if self.attempt(p, "sweep spec", lambda: specs.append(load_spec(p))):
-            for sc in specs[0].scenarios:
-                self.check(specs[0].sources.get(sc, sc))
+            from experiments import scenario as scenarios
+
+            for sc in specs[0].scenarios:  # a file (absolute in sources), or a shipped scenario's name
+                self.check(specs[0].sources.get(sc) or str(scenarios.resolve(sc)))
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    p = sub.add_parser("check", help="check task folders, scenarios, worlds and sweep specs; list every problem",
+    p = sub.add_parser("check", help="check task folders, scenarios, worlds, sweep specs and day protocols; list "
+                                     "every problem",
                        description="Run every load-time check on each PATH (task folders with their examples "
                                    "solved, scenarios with their requests, worlds, sweep specs with their "
-                                   "scenarios) and list every problem found. Exits 1 if there is any.",
+                                   "scenarios, day protocols with their robot backend) and list every problem "
+                                   "found. Exits 1 if there is any.",
                        epilog=EXAMPLES)
     p.add_argument("targets", metavar="PATH", nargs="+", help="a task folder, a folder, or a .toml / .pddl file")
     add_path_option(p)

@@ -122,6 +122,50 @@ def _most_specific(domain: Any, wanted: set[str]) -> set[str]:
     return out or {""}
 
 
+def _fits(domain: Any, obj_type: str, wanted: Iterable[str]) -> bool:
+    if domain is None:
+        return True
+    return all(domain.has_type(obj_type, w) for w in wanted)
+
+
+def arg_problem(task: TaskType, name: str, value: Any, types: Mapping[str, set[str]], objects: Mapping[str, str],
+                world: str, default: bool = False) -> str | None:
+    """Why argument ``name`` = ``value`` of ``task`` does not name an object of ``objects`` (name ->
+    type) of a type its task uses it as (:func:`arg_types`), or ``None``."""
+    wanted = types.get(name)
+    if wanted is None:
+        return None
+    domain = getattr(task, "domain", None)
+    wanted = _most_specific(domain, wanted)
+    what = f"{'default of ' if default else ''}argument {name!r} of task type {task.name!r}"
+    if not isinstance(value, str):
+        return f"expected the name of an object of the world (the {what}), got {value!r}"
+    if value in objects and _fits(domain, objects[value], wanted):
+        return None
+    known = sorted(n for n, ty in objects.items() if _fits(domain, ty, wanted))
+    if value not in objects:
+        return (f"no {' or '.join(sorted(w for w in wanted if w)) or 'object'} {value!r} in world "
+                f"{world!r}{suggest(value, known)} (the {what}; known: {', '.join(known) or 'none'})")
+    return (f"{value!r} is a {objects[value]}, expected a {' and '.join(sorted(wanted))} "
+            f"(the {what}){suggest(value, known)} (known: {', '.join(known) or 'none'})")
+
+
+def check_template(t: Table, task: TaskType, args: Mapping[str, str], variables: Mapping[str, str],
+                   world: WorldSpec) -> None:
+    """The arguments of a request template (``t.args``, e.g. a day protocol's robot task), checked
+    like a request's: names, required ones, and each one a task uses as a PDDL object naming an
+    object of its type, where a variable (a key of ``variables``, e.g. ``$person``) stands for an
+    object of the type ``variables`` gives it."""
+    validate_request(t, task, args)
+    objects = {**world_objects(world), **variables}
+    types = arg_types(task)
+    at = t.table("args", {})
+    for name, value in args.items():
+        problem = arg_problem(task, name, value, types, objects, world.name)
+        if problem is not None:
+            raise at.error(name, problem)
+
+
 class _Checker:
     """Checks one scenario; collects its warnings."""
 
@@ -192,35 +236,13 @@ class _Checker:
     def arg(self, t: Table, task: TaskType, name: str, value: Any, types: Mapping[str, set[str]],
             default: bool = False) -> None:
         """One argument used as a PDDL object must name a world object of its type."""
-        wanted = types.get(name)
-        if wanted is None:
-            return
-        domain = getattr(task, "domain", None)
-        wanted = _most_specific(domain, wanted)
-        what = f"{'default of ' if default else ''}argument {name!r} of task type {task.name!r}"
-        problem = None
-        if not isinstance(value, str):
-            problem = f"expected the name of an object of the world (the {what}), got {value!r}"
-        elif value not in self.objects:
-            known = sorted(n for n, ty in self.objects.items() if self._fits(domain, ty, wanted))
-            problem = (f"no {' or '.join(sorted(w for w in wanted if w)) or 'object'} {value!r} in world "
-                       f"{self.world.name!r}{suggest(value, known)} (the {what}; known: {', '.join(known) or 'none'})")
-        elif not self._fits(domain, self.objects[value], wanted):
-            known = sorted(n for n, ty in self.objects.items() if self._fits(domain, ty, wanted))
-            problem = (f"{value!r} is a {self.objects[value]}, expected a {' and '.join(sorted(wanted))} "
-                       f"(the {what}){suggest(value, known)} (known: {', '.join(known) or 'none'})")
+        problem = arg_problem(task, name, value, types, self.objects, self.world.name, default)
         if problem is None:
             return
         if default:
             self.warn(t, None, problem)
         else:
             raise t.error(name, problem)
-
-    @staticmethod
-    def _fits(domain: Any, obj_type: str, wanted: Iterable[str]) -> bool:
-        if domain is None:
-            return True
-        return all(domain.has_type(obj_type, w) for w in wanted)
 
     def args(self, f: Table, task: TaskType, given: Mapping[str, Any], checked: Mapping[str, Any]) -> None:
         types = arg_types(task)

@@ -413,13 +413,16 @@ def run(a: argparse.Namespace) -> int:
     :class:`tasker.reader.InputError`) before the first day runs.  Returns 1 if a day failed
     to run (it is listed under the table), else 0."""
     from tasker import schedulers
-    from tasker.cliargs import SEED_LIMIT, UsageError, show_progress
+    from tasker.cliargs import SEED_LIMIT, UsageError, show_progress, writable_dir
     from tasker.reader import suggest
 
     unknown = [n for n in a.schedulers if n not in schedulers.names()]
     if unknown:
         raise UsageError("--schedulers", f"unknown scheduler {unknown[0]!r}{suggest(unknown[0], schedulers.names())}; "
                                          f"known: {', '.join(schedulers.names())}")
+    twice = sorted({n for n in a.schedulers if a.schedulers.count(n) > 1})
+    if twice:
+        raise UsageError("--schedulers", f"{twice[0]!r} is given twice")
     if a.days < 1:
         raise UsageError("--days", f"expected >= 1, got {a.days}")
     if a.first_seed + a.days > SEED_LIMIT:
@@ -453,7 +456,7 @@ def run(a: argparse.Namespace) -> int:
     except ConfigError as exc:
         raise UsageError("--protocol", str(exc)) from exc
     workers = a.workers if a.workers is not None else (2 if a.backend == "synthetic" else 1)
-    a.out.mkdir(parents=True, exist_ok=True)
+    writable_dir(a.out, "--out")
     db, log = a.out / "days.db", a.out / "days.jsonl"
     if not a.resume:
         for old in (db, log):
@@ -479,15 +482,64 @@ def run(a: argparse.Namespace) -> int:
     return 1 if any("error" in r for r in results) else 0
 
 
-def _import_log(log: Path, db: Path, protocol: str, backend: str) -> None:
-    """Days of an older ``days.jsonl`` (before the database) into ``db``, so ``--resume`` keeps them."""
-    from experiments.store import ResultStore, RunRow, Status
+_DAY_NUMBERS = ("completed", "lateness_s", "dead_falls", "interruptions", "suspensions", "suspension_time_s",
+                "switches", "longest_order", "anytime_decisions")
+"""Numbers every day of a ``days.jsonl`` carries (the table reads them); ``completion_minus_deadline_s``
+may also be null."""
 
-    with ResultStore(db) as store:
-        for line in log.read_text(encoding="utf-8").splitlines():
+
+def _day_problem(r: Any) -> tuple[str, str] | None:
+    """``(field, why)`` when ``r`` (a line of ``days.jsonl``) is not a day the table can read."""
+    if not isinstance(r, dict):
+        return "", f"expected a day (a JSON object), got {json.dumps(r)[:40]}"
+    if "error" in r:  # a day that failed to run: skipped, so only where it belongs is read
+        return None
+    if not isinstance(r.get("scheduler"), str):
+        return "scheduler", "expected a scheduler name"
+    seed = r.get("seed")
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        return "seed", f"expected an integer >= 0, got {json.dumps(seed)}"
+    try:
+        Strategy.parse(r.get("strategy", "default"))
+    except (ValueError, TypeError) as exc:
+        return "strategy", str(exc)
+    for key in (*_DAY_NUMBERS, "completion_minus_deadline_s"):
+        v = r.get(key)
+        if (isinstance(v, bool) or not isinstance(v, int | float)) and not (
+                v is None and key == "completion_minus_deadline_s" and key in r):
+            return key, f"expected a number, got {json.dumps(v) if key in r else 'nothing'}"
+    if not isinstance(r.get("per_type"), dict) or not all(isinstance(v, dict) for v in r["per_type"].values()):
+        return "per_type", "expected an object of task type -> its metrics"
+    if not isinstance(r.get("ending"), str):
+        return "ending", "expected a string"
+    return None
+
+
+def _import_log(log: Path, db: Path, protocol: str, backend: str) -> None:
+    """Days of an older ``days.jsonl`` (before the database) into ``db``, so ``--resume`` keeps them.
+
+    The whole file is checked first: a damaged line is an :class:`~tasker.reader.InputError`
+    naming it (and nothing is imported)."""
+    from experiments.store import ResultStore, RunRow, Status
+    from tasker.reader import InputError, read_text
+
+    days = []
+    for n, line in enumerate(read_text(log).splitlines(), start=1):
+        if not line.strip():
+            continue
+        try:
             r = json.loads(line)
-            if r.get("backend", "synthetic") != backend or "error" in r:
-                continue
+        except json.JSONDecodeError as exc:
+            raise InputError(log, f"not a JSON object: {exc.msg} (a days.jsonl that tasker day wrote, or "
+                                  "resume without it)", line=n) from None
+        why = _day_problem(r)
+        if why:
+            raise InputError(log, f"{why[1]} (a days.jsonl that tasker day wrote, or resume without it)", line=n,
+                             field=why[0])
+        if r.get("backend", "synthetic") == backend and "error" not in r:
+            days.append(r)
+    with ResultStore(db) as store:
+        for r in days:
             st = Strategy.parse(r.get("strategy", "default"))
             label = dataclasses.replace(st, scheduler=r["scheduler"]).label
             store.add(RunRow(scenario_key(protocol, backend), int(r["seed"]), label, Status.OK,

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from tasker.cliargs import non_negative_seconds
 from tasker.errors import TaskerError
 from tasker.trace import number, read
 
@@ -157,8 +158,39 @@ def load_index(run_dir: Path) -> list[dict[str, Any]]:
     except json.JSONDecodeError as exc:
         raise ExplainError(f"{path}:{exc.lineno}: not valid JSON: {exc.msg}") from None
     if not isinstance(index, list):
-        raise ExplainError(f"{path}: expected a list of planning records, got {type(index).__name__}")
+        raise ExplainError(f"{path}: expected a list of planning records, got {_json_kind(index)}")
+    for i, entry in enumerate(index):
+        why = _record_problem(entry)
+        if why:
+            raise ExplainError(f"{path}: record [{i}]: {why} (the file is damaged: run the scenario again)")
     return index
+
+
+_RECORD_STRINGS = ("agent", "task_type", "purpose", "status", "domain", "problem")
+
+
+def _record_problem(entry: Any) -> str | None:
+    """Why ``entry`` is not a planning record :func:`write_problems` writes, or ``None``."""
+    if not isinstance(entry, dict):
+        return f"expected a planning record (an object), got {_json_kind(entry)}"
+    for key in _RECORD_STRINGS:
+        if not isinstance(entry.get(key), str):
+            return f"{key}: expected a string, got {_json_kind(entry.get(key)) if key in entry else 'nothing'}"
+    t = entry.get("t")
+    if isinstance(t, bool) or not isinstance(t, int | float) or not math.isfinite(t):
+        return f"t: expected a finite number, got {_json_kind(t) if 't' in entry else 'nothing'}"
+    if entry.get("plan_file") is not None and not isinstance(entry["plan_file"], str):
+        return f"plan_file: expected a string, got {_json_kind(entry['plan_file'])}"
+    return None
+
+
+def _json_kind(value: Any) -> str:
+    """A JSON value as the file shows it: ``null``, ``5``, ``"x"``, an array, an object."""
+    if isinstance(value, dict):
+        return "an object"
+    if isinstance(value, list):
+        return "an array"
+    return json.dumps(value)
 
 
 def load_trace(run_dir: Path) -> list[dict[str, Any]]:
@@ -250,7 +282,8 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("run_dir", metavar="RUN_DIR", help="the output folder of `tasker run`")
     p.add_argument("--agent", required=True, help="agent id: d1, d2, ...")
-    p.add_argument("--at", type=float, default=None, help="simulated time in s (default: the agent's last plan)")
+    p.add_argument("--at", type=non_negative_seconds, default=None,
+                   help="simulated time in s (default: the agent's last plan)")
     p.add_argument("--out", default=None, help="write domain.pddl, problem.pddl, plan and explain.txt here")
 
 

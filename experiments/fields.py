@@ -32,6 +32,10 @@ def scheduler_options(s: Table, name: str, task_names: list[str] | None = None) 
     ``classes`` (alg2) or ``priorities`` (priority) must be known when ``task_names`` is given."""
     opts = s.table("scheduler_options", {})
     options = dict(opts.items())
+    for key in options:
+        why = schedulers.unknown_option(name, key)
+        if why:
+            raise opts.error(key, why)
     if task_names is not None:
         for key, value in options.items():
             named: list[str] = []

@@ -37,6 +37,9 @@ from tasker.task import ArgSpec, TaskContext
 Pose = tuple[float, ...]
 KINDS = ("transport", "fall", "pick_place")
 SUSP, BLOCK = StageKind.SUSPENDABLE, StageKind.BLOCKING
+MAX_REQUESTS = 10_000
+"""A protocol whose counts add up to more requests a day than this is refused (a typo such as
+``count = 1200000`` would otherwise run for hours; 9 000 take a minute on the synthetic backend)."""
 _RESUME_STAGES = ("go_back", "apologise", "pick_again")
 
 
@@ -164,6 +167,8 @@ def load(path: str | Path) -> Protocol:
     arrivals, tasks_t = top.table("arrivals"), top.table("tasks")
     length = day.number("length_s", positive=True)
     step = day.number("step_s", positive=True)
+    if step > length:
+        raise day.error("step_s", f"expected at most the day's length_s ({length:g} s), got {step:g}")
     start = day.string("start", "00:00")
     day.done()
     sites_t = apartment.table("sites")
@@ -185,9 +190,14 @@ def load(path: str | Path) -> Protocol:
         tasks[kind] = _task(tasks_t.table(kind), kind)
     if not tasks:
         raise tasks_t.error(None, f"expected at least one of {', '.join(KINDS)}")
+    total = sum(spec.count for spec in tasks.values())
+    if total > MAX_REQUESTS:
+        kind = max(tasks, key=lambda k: tasks[k].count)
+        raise tasks_t.at(kind, tasks_t.data[kind]).error(
+            "count", f"the day's counts add up to {total} requests, more than the {MAX_REQUESTS} a day may have")
     tasks_t.done()
     backend = _robot_backend(top.table("robot_backend"), Path(path), sites, tasks) if "robot_backend" in top else None
-    top.done()
+    top.done(also=("robot_backend",))  # optional: listed among the valid keys even when absent
     return Protocol(name=top.data["name"], source=str(path), start=start, length_s=length, step_s=step,
                     robot_speed=speed, start_site=start_site, planning_time_s=planning, sites=sites,
                     last_call_s=last_call, tasks=tasks, robot=backend)
@@ -231,6 +241,10 @@ def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str
     sites_t.done()
     tasks_t = t.table("tasks")
     out: dict[str, RobotTask] = {}
+    from experiments.crossref import check_template
+    from planners.bundled import task_types  # what a robot day runs: the bundled task folders and $TASKER_TASKS
+
+    types = {tt.name: tt for tt in task_types()}
     for kind, _ in tasks_t.items():
         check_name(tasks_t, kind, kind, sorted(tasks), "task type of [tasks]")
         tt = tasks_t.table(kind)
@@ -246,7 +260,16 @@ def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str
         posture = tt.string("posture", None, choices=("fallen", "sitting", "standing"))
         if posture is not None and "$person" not in args.values():
             raise tt.error("posture", "needs a $person argument (whose posture changes)")
-        out[kind] = RobotTask(kind, str(tt.string("task")), args, obj, posture)
+        name = str(tt.string("task"))
+        check_name(tt, "task", name, types, "task type", "a robot day runs the bundled task types and those of "
+                                                         "$TASKER_TASKS (see 'tasker domains')")
+        domain = getattr(types[name], "domain", None)
+        if obj is not None and getattr(domain, "types", None):
+            check_name(tt, "object_type", obj, domain.types, "object type",  # type: ignore[union-attr]
+                       f"a type of task type {name!r}'s domain")
+        variables = {"$site": "place", "$dest": "place", "$person": "person", **({"$object": obj} if obj else {})}
+        check_template(tt, types[name], args, variables, spec)  # names, required ones, each of its PDDL type
+        out[kind] = RobotTask(kind, name, args, obj, posture)
         tt.done()
     missing = sorted(set(tasks) - set(out))
     if missing:

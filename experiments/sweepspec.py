@@ -187,7 +187,7 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
     if n > limit:
         raise top.error("seeds", f"the spec expands to {len(scenario_list)} scenarios x {len(seeds)} seeds x "
                                  f"{len(strategies)} strategies = {n} jobs, more than the {limit} a sweep may have")
-    variants = _variants(top.table("variants", {}), scenario_list)
+    variants = _variants(top.table("variants", {}), scenario_list, sources)
     return SweepSpec(tuple(scenario_list), seeds, tuple(strategies), name=name, sources=sources, variants=variants)
 
 
@@ -227,8 +227,11 @@ def _grid(t: reader.Table) -> list[Strategy]:
     return expand(factors)
 
 
-def _variants(t: reader.Table, scenario_list: Sequence[str]) -> dict[str, InterruptionGrid]:
-    """``[variants.NAME]`` tables: where the variants of scenario NAME place its interruption."""
+def _variants(t: reader.Table, scenario_list: Sequence[str], sources: Mapping[str, str]) -> dict[str, InterruptionGrid]:
+    """``[variants.NAME]`` tables: where the variants of scenario NAME place its interruption.
+
+    NAME must be a robot scenario (only those are randomised) with the request ``interrupt``
+    names; its file is read for that (its own faults are left to the scenario's loader)."""
     out: dict[str, InterruptionGrid] = {}
     for sc, value in t.items():
         vt = t.at(sc, value)
@@ -250,4 +253,24 @@ def _variants(t: reader.Table, scenario_list: Sequence[str]) -> dict[str, Interr
         except ValueError as exc:
             key = "interrupt" if str(exc).startswith("interrupt") else "times"
             raise vt.error(key, str(exc).partition(": ")[2]) from None
+        _check_interrupt(t, vt, sc, sources.get(sc, sc), out[sc])
     return out
+
+
+def _check_interrupt(t: reader.Table, vt: reader.Table, sc: str, source: str, grid: InterruptionGrid) -> None:
+    """The scenario of ``[variants.NAME]`` is a robot scenario that has the request ``interrupt`` names."""
+    from experiments import scenario as scenarios
+
+    try:
+        top = reader.load(scenarios.resolve(source), scenarios.ScenarioError)
+        kind = top.raw("kind", "synthetic")
+        requests = top.raw("requests", [])
+    except reader.InputError:
+        return  # the scenario's own fault: its loader names it (sweep.precheck, before any job runs)
+    if kind != "robot":
+        raise t.error(sc, f"{sc!r} is a {kind} scenario: only robot scenarios are randomised, so variants "
+                          f"would be ignored")
+    n = len(requests) if isinstance(requests, list) else 0
+    if grid.index >= n:
+        raise vt.error("interrupt", f"no {grid.interrupt} in {sc!r}: it has {n} requests"
+                                    + (f", requests[0]..requests[{n - 1}]" if n else ""))

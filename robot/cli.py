@@ -40,6 +40,11 @@ def _pose(spec: WorldSpec, text: str, argument: str = "PLACE") -> Pose:
     if len(values) not in (2, 3) or not all(math.isfinite(v) for v in values):
         raise BadInput(argument, f"{text!r} is neither a place of {spec.name}{did_you_mean(text, spec.places)} "
                                  f"({', '.join(sorted(spec.places))}) nor x,y[,yaw]")
+    from robot.spec import point_problem
+
+    why = point_problem(spec, values[0], values[1])  # where no robot can be: not "unreachable", a wrong point
+    if why:
+        raise BadInput(argument, f"{text!r} is {why} of world {spec.name}; expected a point in free space")
     return (values[0], values[1], values[2] if len(values) == 3 else 0.0)
 
 

@@ -179,20 +179,22 @@ class Table:
     def keys(self) -> list[str]:
         return list(self.data)
 
-    def raw(self, key: str, default: Any = _MISSING) -> Any:
-        """The value as written (checked for non-finite numbers), or ``default``."""
+    def raw(self, key: str, default: Any = _MISSING, *, finite: bool = True) -> Any:
+        """The value as written (checked for non-finite numbers unless ``finite`` is false: the
+        caller then refuses every number, so ``settings = inf`` reads "expected a table"), or ``default``."""
         self.used.add(key)
         if key not in self.data:
             if default is _MISSING:
                 raise self.error(key, "missing (required)")
             return default
         value = self.data[key]
-        _check_finite(self, key, value)
+        if finite:
+            _check_finite(self, key, value)
         return value
 
     def string(self, key: str, default: Any = _MISSING, *, choices: Sequence[str] | None = None,
                empty: bool = False) -> Any:
-        value = self.raw(key, default)
+        value = self.raw(key, default, finite=False)
         if value is default and key not in self.data:
             return value
         if not isinstance(value, str):
@@ -204,7 +206,7 @@ class Table:
         return value
 
     def boolean(self, key: str, default: Any = _MISSING) -> Any:
-        value = self.raw(key, default)
+        value = self.raw(key, default, finite=False)
         if key in self.data and not isinstance(value, bool):
             raise self.error(key, f"expected true or false, got {_show(value)}")
         return value
@@ -218,7 +220,7 @@ class Table:
 
     def table(self, key: str, default: Any = _MISSING) -> Table:
         """A sub-table; a missing optional one reads as empty."""
-        value = self.raw(key, default)
+        value = self.raw(key, default, finite=False)
         return Table(self.file, {} if value is None else value, (*self.path, key), self._index, self.error_class)
 
     def tables(self, key: str, default: Any = _MISSING) -> list[Table]:

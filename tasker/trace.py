@@ -95,14 +95,30 @@ class Trace:
 
 
 def read(path: str | Path) -> list[dict[str, Any]]:
-    """Read a ``trace.jsonl`` back (infinities stay as the strings ``"inf"``)."""
+    """Read a ``trace.jsonl`` back (infinities stay as the strings ``"inf"``).
+
+    Every line must be an event: a JSON object with ``t`` (a number) and ``event`` (a
+    string).  A damaged file (cut short, a stray byte, a line that is no event) is a
+    ``ValueError`` naming the file and the line."""
+    data = Path(path).read_bytes()
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        at = data[: exc.start].count(b"\n") + 1
+        raise ValueError(f"{path}:{at}: not UTF-8 text (byte {data[exc.start]:#04x})") from None
     out = []
-    for n, line in enumerate(Path(path).read_text(encoding="utf-8").splitlines(), start=1):
+    for n, line in enumerate(text.splitlines(), start=1):
         if line.strip():
             try:
-                out.append(json.loads(line))
+                event = json.loads(line)
             except json.JSONDecodeError as exc:
                 raise ValueError(f"{path}:{n}: not a JSON object: {exc.msg}") from None
+            if not isinstance(event, dict):
+                raise ValueError(f"{path}:{n}: not a JSON object: {line.strip()[:40]}")
+            t = event.get("t")
+            if not isinstance(event.get("event"), str) or isinstance(t, bool) or not isinstance(t, int | float):
+                raise ValueError(f"{path}:{n}: not an event: expected \"t\" (a number) and \"event\" (a string)")
+            out.append(event)
     return out
 
 

@@ -13,13 +13,16 @@ An unknown name is an error that lists the known ones.
 from __future__ import annotations
 
 import importlib
+import inspect
 from collections.abc import Callable
 from typing import Any
 
-from tasker.errors import UnknownName
+from tasker.errors import ConfigError, UnknownName
+from tasker.reader import suggest
 from tasker.schedulers.base import Candidate, Decision, Scheduler, ScheduleView
 
-__all__ = ["Candidate", "Decision", "Scheduler", "ScheduleView", "create", "names", "register"]
+__all__ = ["Candidate", "Decision", "Scheduler", "ScheduleView", "create", "names", "options", "register",
+           "unknown_option"]
 
 _BUILTIN = {
     "alg2": "tasker.schedulers.alg2:Alg2",
@@ -58,8 +61,7 @@ def names() -> list[str]:
     return sorted(_registry)
 
 
-def create(name: str, **options: Any) -> Scheduler:
-    """Instantiate the scheduler ``name`` with its options; unknown names list the known ones."""
+def _factory(name: str) -> Callable[..., Scheduler]:
     _load_entry_points()
     try:
         factory = _registry[name]
@@ -68,4 +70,37 @@ def create(name: str, **options: Any) -> Scheduler:
     if isinstance(factory, str):
         module, _, attr = factory.partition(":")
         factory = getattr(importlib.import_module(module), attr)  # an ImportError here is raised, never hidden
+    return factory
+
+
+def options(name: str) -> tuple[str, ...] | None:
+    """The options scheduler ``name`` takes (its factory's keyword parameters), or ``None`` when
+    its factory takes any keyword (``**kwargs``) or does not say."""
+    try:
+        sig = inspect.signature(_factory(name))
+    except (TypeError, ValueError):  # a builtin or C factory without a signature
+        return None
+    params = sig.parameters.values()
+    if any(p.kind is p.VAR_KEYWORD for p in params):
+        return None
+    return tuple(p.name for p in params if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY))
+
+
+def unknown_option(name: str, option: str) -> str | None:
+    """Why ``option`` is not an option of scheduler ``name`` (with "did you mean"), or ``None``."""
+    known = options(name)
+    if known is None or option in known:
+        return None
+    listing = f"its options: {', '.join(known)}" if known else "it takes no options"
+    return f"scheduler {name!r} has no option {option!r}{suggest(option, known)} ({listing})"
+
+
+def create(name: str, **options: Any) -> Scheduler:
+    """Instantiate the scheduler ``name`` with its options; unknown names list the known ones,
+    an unknown option is a :class:`~tasker.errors.ConfigError` naming the valid ones."""
+    factory = _factory(name)
+    for option in options:
+        why = unknown_option(name, option)
+        if why:
+            raise ConfigError(why)
     return factory(**options)

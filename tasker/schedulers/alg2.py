@@ -61,10 +61,14 @@ class Alg2(Scheduler):
     def __init__(self, classes: Sequence[Sequence[str]] = DEFAULT_CLASSES, hysteresis: float = 1.0) -> None:
         if not isinstance(hysteresis, int | float) or not 0 < hysteresis <= 1:
             raise ConfigError(f"alg2: hysteresis must be in (0, 1], got {hysteresis!r}")
+        if isinstance(classes, str | bytes) or not isinstance(classes, Sequence):
+            raise ConfigError(f"alg2: classes must be a list of classes (lists of task types), got {classes!r}")
         rank: dict[str, int] = {}
         for k, cls in enumerate(classes):
             if isinstance(cls, str):
                 raise ConfigError(f"alg2: classes[{k}] must be a list of task types, got the string {cls!r}")
+            if not isinstance(cls, Sequence) or not all(isinstance(t, str) for t in cls):
+                raise ConfigError(f"alg2: classes[{k}] must be a list of task types (strings), got {cls!r}")
             for t in cls:
                 if t in rank:
                     raise ConfigError(f"alg2: task type {t!r} appears in two priority classes")

@@ -217,6 +217,12 @@ class LookAhead(Scheduler):
         self.switch_penalty_s = float(switch_penalty_s)
         self.lateness_weight = float(lateness_weight)
         self.hazard_weight = float(hazard_weight)
+        if budgets is not None and not isinstance(budgets, Mapping):
+            raise ConfigError(f"lookahead: budgets must be a table of task type = seconds, got {budgets!r}")
+        for key, value in (budgets or {}).items():
+            if isinstance(value, bool) or not isinstance(value, int | float) or not 0 <= value < math.inf:
+                raise ConfigError(f"lookahead: budgets[{key!r}] must be a finite number of seconds >= 0, "
+                                  f"got {value!r}")
         self.budgets = {str(k): float(v) for k, v in (budgets or {}).items()}
         self.hysteresis = float(hysteresis)
 

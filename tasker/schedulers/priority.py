@@ -7,8 +7,10 @@ earlier request.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 
+from tasker.errors import ConfigError
 from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, ScheduleView
 
 
@@ -18,6 +20,12 @@ class FixedPriority(Scheduler):
     indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
 
     def __init__(self, priorities: Mapping[str, int] | None = None, default: int = 0) -> None:
+        if priorities is not None and not isinstance(priorities, Mapping):
+            raise ConfigError(f"priority: priorities must be a table of task type = priority, got {priorities!r}")
+        for key, value in [*(priorities or {}).items(), ("default", default)]:
+            if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+                what = "default" if key == "default" else f"priorities[{key!r}]"
+                raise ConfigError(f"priority: {what} must be a number, got {value!r}")
         self.priorities = dict(priorities or {})
         self.default = default
 

@@ -95,6 +95,22 @@ ROBOT_CASES = [
     ('scheduler = "alg2"', 'scheduler = "alg"', "settings.scheduler", "did you mean 'alg2'"),
     ('scheduler = "alg2"', 'scheduler = "alg2"\nscheduler_options = { hysteresis = -3 }',
      "settings.scheduler_options", "hysteresis"),
+    ('scheduler = "alg2"', 'scheduler = "alg2"\nscheduler_options = { cclasses = [["human_fell"]] }',
+     "settings.scheduler_options.cclasses", "scheduler 'alg2' has no option 'cclasses'; did you mean 'classes'?"),
+    ('scheduler = "alg2"', 'scheduler = "fifo"\nscheduler_options = { hysteresis = 0.5 }',
+     "settings.scheduler_options.hysteresis", "scheduler 'fifo' has no option 'hysteresis' (it takes no options)"),
+    ('scheduler = "alg2"', 'scheduler = "alg2"\nscheduler_options = { classes = false }',
+     "settings.scheduler_options", "alg2: classes must be a list of classes"),
+    ('scheduler = "alg2"', 'scheduler = "alg2"\nscheduler_options = { classes = [[1]] }',
+     "settings.scheduler_options", "alg2: classes[0] must be a list of task types (strings)"),
+    ('scheduler = "alg2"', 'scheduler = "priority"\nscheduler_options = { priorities = { human_fell = "high" } }',
+     "settings.scheduler_options", "priority: priorities['human_fell'] must be a number"),
+    ('scheduler = "alg2"', 'scheduler = "priority"\nscheduler_options = { default = "low" }',
+     "settings.scheduler_options", "priority: default must be a number"),
+    ('scheduler = "alg2"', 'scheduler = "lookahead"\nscheduler_options = { budgets = 5 }',
+     "settings.scheduler_options", "lookahead: budgets must be a table"),
+    ('scheduler = "alg2"', 'scheduler = "lookahead"\nscheduler_options = { budgets = { human_fell = "soon" } }',
+     "settings.scheduler_options", "lookahead: budgets['human_fell'] must be a finite number"),
     # cross-references: task types, people, places, doors, postures, agents
     ('task = "guide_human"', 'task = "guide_humans"', "requests[0].task", "did you mean 'guide_human'"),
     ('person = "peter"', 'person = "bob"', "requests[1].args.person", "no person 'bob'"),
@@ -357,6 +373,12 @@ def test_a_scenario_on_a_bad_world_names_the_world_file(tmp_path: Path) -> None:
     ('scenarios = ["paper", "paper"]\nseeds = 2\nstrategies = ["default"]', "scenarios[1]", "listed twice"),
     ('scenarios = ["paper"]\nseds = 2\nstrategies = ["default"]', "seeds", "missing"),
     ('scenarios = "paper"\nseeds = 2\nstrategies = ["default"]', "scenarios", "expected an array"),
+    ('scenarios = ["paper"]\nseeds = 2\nstrategies = ["default"]\n[variants.paper]\ninterrupt = "requests[9]"\n'
+     'times = { start = 0.0, stop = 60.0, step = 20.0 }', "variants.paper.interrupt",
+     "no requests[9] in 'paper': it has 4 requests, requests[0]..requests[3]"),
+    (f'scenarios = ["{standin.DEMO.as_posix()}"]\nseeds = 2\nstrategies = ["default"]\n'
+     f'[variants."{standin.DEMO.as_posix()}"]\ninterrupt = "requests[1]"\ntimes = {{ start = 0.0, stop = 60.0, '
+     'step = 20.0 }', "variants.", "is a synthetic scenario: only robot scenarios are randomised"),
 ])
 def test_bad_sweep_spec_field_is_named(tmp_path: Path, body: str, field: str, fragment: str) -> None:
     _fails(_write(tmp_path, body, "spec.toml"), load_spec, field, fragment, SpecError)

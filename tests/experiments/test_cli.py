@@ -237,7 +237,8 @@ def test_check_lists_every_problem(tmp_path: Path, capsys: pytest.CaptureFixture
 
 def test_check_passes_the_shipped_files(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["check", str(ROOT / "domains"), str(ROOT / "experiments" / "scenarios"),
-                 str(ROOT / "robot" / "worlds"), "-q"]) == 0
+                 str(ROOT / "robot" / "worlds"), str(ROOT / "experiments" / "sweeps"),
+                 str(ROOT / "experiments" / "protocols"), "-q"]) == 0
     assert "0 problems" in capsys.readouterr().out
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -128,6 +129,28 @@ def test_an_older_days_log_is_kept_by_resume(tmp_path: Path) -> None:
     assert [r["seed"] for r in rows] == [1, 2] and rows[0]["completed"] == -1
 
 
+@pytest.mark.parametrize(("line", "message"), [
+    ("garbage", r"days\.jsonl:2: not a JSON object: Expecting value"),
+    ("[1]", r"days\.jsonl:2: expected a day \(a JSON object\), got \[1\]"),
+    ('{"scheduler": "fifo", "seed": "x"}', r"days\.jsonl:2: seed: expected an integer >= 0"),
+    ('{"scheduler": "fifo", "seed": 3, "completed": "lots"}', r"days\.jsonl:2: completed: expected a number"),
+])
+def test_a_damaged_older_days_log_is_an_error_naming_its_line(tmp_path: Path, line: str, message: str,
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
+    """--resume imports an older days.jsonl; a damaged one is refused whole, at its line (exit 2),
+    where it was an internal error (JSONDecodeError, KeyError) once some days had been imported."""
+    out = tmp_path / "out"
+    out.mkdir()
+    good = dayreport.run_day("tabsa-short", 1, "fifo")
+    (out / "days.jsonl").write_text(json.dumps(good) + "\n" + line + "\n")
+    args = ["--protocol", "tabsa-short", "--days", "2", "--schedulers", "fifo", "--workers", "1", "--resume",
+            "--out", str(out)]
+    assert dayreport.main(args) == 2
+    err = capsys.readouterr().err
+    assert re.search(message, err) and "internal error" not in err, err
+    assert not (out / "days.db").exists()  # nothing imported: the fixed log is read in whole next time
+
+
 def test_strategies_are_compared_under_each_scheduler() -> None:
     a = [{**result(n, s, travel_m=10.0 * s), "strategy": "suspension=static"} for n in ("lookahead", "alg2")
          for s in (1, 2, 3)]
@@ -172,3 +195,15 @@ def test_day_seeds_outside_the_seed_range_are_refused(args: list[str], fragment:
     err = capsys.readouterr().err
     assert fragment in err and "2**32" in err and "Traceback" not in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_scheduler_given_twice_or_an_out_that_is_a_file_names_the_argument(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Both were refused only by what they broke: 'two jobs have the same key (scenario, seed,
+    strategy)' and '...: File exists', neither naming the argument at fault."""
+    base = ["--protocol", "tabsa-short", "--days", "1", "--workers", "1"]
+    assert dayreport.main([*base, "--schedulers", "fifo", "alg2", "fifo", "--out", str(tmp_path / "o")]) == 2
+    assert "argument --schedulers: 'fifo' is given twice" in capsys.readouterr().err
+    (tmp_path / "file").write_text("")
+    assert dayreport.main([*base, "--schedulers", "fifo", "--out", str(tmp_path / "file")]) == 2
+    assert f"argument --out: {tmp_path / 'file'} exists and is not a folder" in capsys.readouterr().err

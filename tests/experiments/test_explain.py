@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -130,6 +131,36 @@ def test_explain_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixtu
     (tmp_path / "problems" / "index.json").write_text("[{")
     assert explain.main([str(tmp_path), "--agent", "d1"]) == 2
     assert "index.json:1: not valid JSON" in capsys.readouterr().err
+
+
+GOOD_RECORD = {"n": 1, "t": 1.0, "agent": "d1", "task_type": "cook", "purpose": "upTsk", "label": "",
+               "status": "solved", "domain": "cook.domain.pddl", "problem": "1.pddl", "message": ""}
+
+
+@pytest.mark.parametrize(("record", "message"), [
+    (None, r"record \[1\]: expected a planning record \(an object\), got null"),
+    ({k: v for k, v in GOOD_RECORD.items() if k != "agent"}, r"record \[1\]: agent: expected a string, got nothing"),
+    ({**GOOD_RECORD, "t": "x"}, r"record \[1\]: t: expected a finite number, got \"x\""),
+    ({**GOOD_RECORD, "plan_file": 5}, r"record \[1\]: plan_file: expected a string, got 5"),
+])
+def test_a_damaged_index_or_trace_is_a_clean_error(tmp_path: Path, record: object, message: str,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    """A damaged problems/index.json names the file and the record; a damaged trace its line;
+    --at is a finite time >= 0.  Each is one line and exit status 2, never an internal error."""
+    (tmp_path / "problems").mkdir()
+    (tmp_path / "problems" / "cook.domain.pddl").write_text("; domain\n")
+    (tmp_path / "problems" / "1.pddl").write_text("; problem\n")
+    (tmp_path / "problems" / "index.json").write_text(json.dumps([GOOD_RECORD, record]))
+    assert cli_main(["explain", str(tmp_path), "--agent", "d1"]) == 2
+    err = capsys.readouterr().err
+    assert re.search(r"problems/index\.json: " + message, err), err
+    (tmp_path / "problems" / "index.json").write_text(json.dumps([GOOD_RECORD]))
+    (tmp_path / "trace.jsonl").write_text('{"t":0.0,"event":"run"}\n[1, 2]\n')
+    assert cli_main(["explain", str(tmp_path), "--agent", "d1"]) == 2
+    assert "trace.jsonl:2: not a JSON object: [1, 2]" in capsys.readouterr().err
+    for at in ("nan", "inf", "-1"):
+        assert cli_main(["explain", str(tmp_path), "--agent", "d1", "--at", at]) == 2
+        assert "argument --at: expected a finite number of seconds >= 0" in capsys.readouterr().err
 
 
 def test_repeated_decisions_are_folded() -> None:

@@ -70,6 +70,13 @@ def test_bad_protocols_name_file_line_and_field(tmp_path: Path) -> None:
         protocol.load(write(tmp_path, text.replace('start_site = "hall"', 'start_site = "hal"')))
     with pytest.raises(InputError, match=r"robot\.planing_time_s: unknown key .*did you mean 'planning_time_s'"):
         protocol.load(write(tmp_path, text.replace("planning_time_s =", "planing_time_s =")))
+    with pytest.raises(InputError, match=r"day\.step_s: expected at most the day's length_s \(14400 s\), got 20000"):
+        protocol.load(write(tmp_path, text.replace("step_s = 5.0", "step_s = 20000.0")))
+    with pytest.raises(InputError, match=r"tasks\.fall\.count: the day's counts add up to 1200024 requests, more than"):
+        protocol.load(write(tmp_path, text.replace("count = 12\npriority = 3", "count = 1200000\npriority = 3")))
+    with pytest.raises(InputError, match=r"robot_backnd: unknown key .*did you mean 'robot_backend'.*"
+                                         r"\(valid keys: .*robot_backend"):  # optional, yet named
+        protocol.load(write(tmp_path, text.replace("[robot_backend", "[robot_backnd")))
 
 
 
@@ -94,6 +101,34 @@ def test_a_robot_backend_names_its_world_and_its_spots_stand_in_it(tmp_path: Pat
             protocol.load(write(tmp_path, text.replace(hall, bad)))
     with pytest.raises(InputError, match=r"robot_backend\.world: no world file"):
         protocol.load(write(tmp_path, text.replace((TABSA.parent / "tabsa_apartment.toml").as_posix(), "nope.toml")))
+
+def test_a_robot_backends_tasks_are_checked_against_the_task_types(tmp_path: Path) -> None:
+    """Each robot task names a task type, gives its arguments (each variable standing for an
+    object of its type) and an object type of its domain: refused at load, not in every day run."""
+    text = TABSA.read_text(encoding="utf-8")
+    text = text.replace('world = "tabsa_apartment.toml"',
+                        f'world = "{(TABSA.parent / "tabsa_apartment.toml").as_posix()}"')
+    guide = 'args = { person = "$person", destination = "$dest" }'
+    assert guide in text and 'task = "guide_human"' in text and 'object_type = "item"' in text
+    cases = [
+        ('task = "guide_human"', 'task = "guide_humn"',
+         r"robot_backend\.tasks\.transport\.task: no task type 'guide_humn'; did you mean 'guide_human'"),
+        (guide, 'args = { destination = "$dest" }',
+         r"robot_backend\.tasks\.transport\.args.*missing required argument 'person'"),
+        (guide, 'args = { person = "$person", destinaton = "$dest" }',
+         r"robot_backend\.tasks\.transport\.args\.destinaton: .*did you mean 'destination'"),
+        (guide, 'args = { person = "$person", destination = "$person" }',
+         r"robot_backend\.tasks\.transport\.args\.destination: '\$person' is a person, expected a place"),
+        (guide, 'args = { person = "$person", destination = "kitchn" }',
+         r"robot_backend\.tasks\.transport\.args\.destination: no place 'kitchn'.*did you mean 'kitchen'"),
+        ('object_type = "item"', 'object_type = "itme"',
+         r"robot_backend\.tasks\.pick_place\.object_type: no object type 'itme'; did you mean 'item'"),
+    ]
+    for old, new, message in cases:
+        with pytest.raises(InputError, match=r"p\.toml:\d+: " + message):
+            protocol.load(write(tmp_path, text.replace(old, new)))
+    protocol.load(write(tmp_path, text.replace(guide, 'args = { person = "$person", destination = "kitchen" }')))
+
 
 # -- metrics on a hand-made day -----------------------------------------------------------------------
 

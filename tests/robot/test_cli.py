@@ -100,3 +100,17 @@ def test_cost_suggests_a_place_and_a_world(capsys: pytest.CaptureFixture[str]) -
     assert "did you mean 'kitchen'?" in capsys.readouterr().err
     assert cli(["cost", "flta", "living", "kitchen"]) == 2
     assert "did you mean 'flat'?" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("point", "why"), [
+    ("50,50", "is outside the world's bounds"),
+    ("0.05,3", "is inside wall"),
+    ("1.5,0.5", "is inside furniture 'sofa'"),
+    ("1e308,2", "is outside the world's bounds"),
+])
+def test_cost_refuses_a_point_where_no_robot_can_be(point: str, why: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """Such a point is a wrong argument (exit 2, saying why), not an 'unreachable' pair (exit 1)."""
+    assert cli(["cost", "paper", point, "kitchen", "--json"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.startswith(f"tasker cost: error: argument PLACE: {point!r} {why}"), captured.err

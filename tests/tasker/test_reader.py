@@ -110,3 +110,17 @@ def test_not_a_table() -> None:
     t = reader.loads("task = 3\n", "f.toml")
     with pytest.raises(InputError, match="f.toml:1: task: expected a table, got an integer"):
         t.table("task")
+
+
+@pytest.mark.parametrize(("read", "expected"), [
+    (lambda t: t.table("x"), "f.toml:1: x: expected a table, got a number"),
+    (lambda t: t.string("x"), "f.toml:1: x: expected a string, got a number inf"),
+    (lambda t: t.boolean("x"), "f.toml:1: x: expected true or false, got a number inf"),
+    (lambda t: t.number("x"), "f.toml:1: x: expected a finite number, got inf"),
+])
+def test_a_non_finite_number_where_no_number_belongs_says_what_was_expected(read, expected: str) -> None:  # type: ignore[no-untyped-def]
+    """``settings = inf`` was 'expected a finite number', as if a number were wanted there."""
+    t = reader.loads("x = inf\n", "f.toml")
+    with pytest.raises(InputError) as info:
+        read(t)
+    assert str(info.value) == expected

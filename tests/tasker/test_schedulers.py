@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from tasker import schedulers
-from tasker.errors import UnknownName
+from tasker.errors import ConfigError, UnknownName
 from tasker.messages import CompletionCost, CostParams, SPRequest
 from tasker.schedulers.base import Candidate, Decision, ScheduleView
 
@@ -89,3 +89,23 @@ def test_registering_a_scheduler() -> None:
         assert "never" in schedulers.names()
     finally:
         schedulers._registry.pop("never")
+
+
+@pytest.mark.parametrize(("name", "options", "fragment"), [
+    ("alg2", {"cclasses": [["a"]]}, "scheduler 'alg2' has no option 'cclasses'; did you mean 'classes'?"),
+    ("fifo", {"hysteresis": 0.5}, "scheduler 'fifo' has no option 'hysteresis' (it takes no options)"),
+    ("alg2", {"classes": False}, "alg2: classes must be a list"),
+    ("alg2", {"classes": [[1]]}, "alg2: classes[0] must be a list of task types (strings)"),
+    ("priority", {"priorities": ["a"]}, "priority: priorities must be a table"),
+    ("priority", {"priorities": {"a": "high"}}, "priority: priorities['a'] must be a number"),
+    ("priority", {"default": float("nan")}, "priority: default must be a number"),
+    ("lookahead", {"budgets": 5}, "lookahead: budgets must be a table"),
+    ("lookahead", {"budgets": {"a": -1}}, "lookahead: budgets['a'] must be a finite number of seconds >= 0"),
+])
+def test_bad_options_are_config_errors_naming_the_option(name: str, options: dict[str, object],
+                                                         fragment: str) -> None:
+    """A user's scheduler_options reach create(): an unknown option or a value of the wrong
+    type is a ConfigError that says which, never a TypeError from Python's call machinery."""
+    with pytest.raises(ConfigError) as info:
+        schedulers.create(name, **options)
+    assert fragment in str(info.value)

@@ -32,6 +32,21 @@ def test_trace_round_trips_through_a_file(tmp_path: Path) -> None:
     assert all(e["event"] in EVENTS for e in back)
 
 
+@pytest.mark.parametrize(("content", "message"), [
+    (b'{"t":0.0,"event":"run"}\n{"t":1.0,"ev', r"trace\.jsonl:2: not a JSON object: Unterminated string"),
+    (b'{"t":0.0,"event":"run"}\n5\n', r"trace\.jsonl:2: not a JSON object: 5"),
+    (b'{"t":0.0,"event":"run"}\n{"event":"end"}\n', r"trace\.jsonl:2: not an event: expected \"t\" \(a number\)"),
+    (b'{"t":"soon","event":"run"}\n', r"trace\.jsonl:1: not an event"),
+    (b'{"t":0.0,"event":"run"}\n{"t":1.0,"event":"x\xff"}\n', r"trace\.jsonl:2: not UTF-8 text \(byte 0xff\)"),
+])
+def test_a_damaged_trace_names_its_line(tmp_path: Path, content: bytes, message: str) -> None:
+    """A trace cut short, with a stray byte or a line that is no event, is a ValueError at its
+    line (which commands report), not a TypeError or KeyError in whatever reads it next."""
+    (tmp_path / "trace.jsonl").write_bytes(content)
+    with pytest.raises(ValueError, match=message):
+        read(tmp_path / "trace.jsonl")
+
+
 def test_every_event_kind_is_documented() -> None:
     text = DOC.read_text(encoding="utf-8")
     documented = set(re.findall(r'^### `(\w+)`', text, flags=re.M))
