@@ -23,6 +23,7 @@ finite one, so that the model stays feasible and avoids it.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 from tasker.errors import ConfigError
@@ -38,8 +39,12 @@ class LookAheadCpSat(LookAhead):
 
     name = "lookahead-cpsat"
 
-    def __init__(self, time_limit: float = 0.2, **options: Any) -> None:
-        super().__init__(**options)
+    def __init__(self, time_limit: float = 0.2, node_budget: int = 2000, switch_penalty_s: float = 0.0,
+                 lateness_weight: float = 1.0, hazard_weight: float = 1e4, budgets: Mapping[str, float] | None = None,
+                 hysteresis: float = 1.0) -> None:
+        # the look-ahead's options, spelled out so that a misspelt one is named (tasker.schedulers.options)
+        super().__init__(node_budget=node_budget, switch_penalty_s=switch_penalty_s, lateness_weight=lateness_weight,
+                         hazard_weight=hazard_weight, budgets=budgets, hysteresis=hysteresis)
         if isinstance(time_limit, bool) or not isinstance(time_limit, int | float) \
                 or not 0 < time_limit < math.inf:
             raise ConfigError(f"{self.name}: time_limit must be a finite number > 0, got {time_limit!r}")

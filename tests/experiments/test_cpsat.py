@@ -64,6 +64,8 @@ def test_an_unreachable_job_goes_last_and_scores_infinite() -> None:
 def test_registered_with_the_look_ahead_s_options() -> None:
     s = schedulers.create("lookahead-cpsat", time_limit=0.1, switch_penalty_s=5.0, budgets={"fall": 900.0})
     assert isinstance(s, LookAheadCpSat) and s.switch_penalty_s == 5.0
+    assert schedulers.unknown_option("lookahead-cpsat", "tme_limit") is not None
+    assert schedulers.unknown_option("lookahead-cpsat", "node_budget") is None
     for bad in (0, -1.0, math.inf, True, "1"):
         with pytest.raises(ConfigError, match="time_limit"):
             LookAheadCpSat(time_limit=bad)  # type: ignore[arg-type]
