@@ -56,7 +56,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
                    help="upTsk strategy for every task (default: the scenario's)")
     p.add_argument("--scheduler", default=None,
                    help="schedule algorithm (tasker.schedulers: alg2, lookahead, priority, fifo, sjf, srtf, edf, "
-                        "simple, simple2, distance)")
+                        "simple, simple2, distance; lookahead-cpsat and any other entry point of tasker.schedulers)")
     p.add_argument("--policy", choices=("strict", "conditional"), default=None,
                    help="suspension policy for both strategies: conditional branches (e.g. leave the cooker on for "
                         "a short interruption) are eligible only under 'conditional' (default: the scenario's)")
