@@ -90,6 +90,19 @@ class Person:
                 return (x0 + f * (x1 - x0), y0 + f * (y1 - y0))
         return walk[-1][1], walk[-1][2]
 
+    def _way(self, a: Point, b: Point) -> list[tuple[Point, float]]:
+        """The points of the way from ``a`` to ``b`` after ``a`` (the :data:`Route`'s, else the
+        straight line), each with the distance walked to it."""
+        pts = self._route(a, b) if self._route is not None else (a, b)
+        out: list[tuple[Point, float]] = []
+        walked = 0.0
+        for p, q in zip(pts, pts[1:], strict=False):
+            d = math.hypot(q[0] - p[0], q[1] - p[1])
+            if d > 1e-9:
+                walked += d
+                out.append(((q[0], q[1]), walked))
+        return out
+
     def _routed(self, walk: tuple[tuple[float, float, float], ...]) -> tuple[tuple[float, float, float], ...]:
         """``walk`` with each leg along the :data:`Route`: the leg's start and end times kept,
         its corners timed in proportion to the distance walked along it."""
@@ -97,28 +110,17 @@ class Person:
             return walk
         out = [walk[0]]
         for (t0, x0, y0), (t1, x1, y1) in zip(walk, walk[1:], strict=False):
-            pts = self._route((x0, y0), (x1, y1))
-            steps = [math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(pts, pts[1:], strict=False)]
-            total = sum(steps)
-            if len(pts) > 2 and total > 1e-9:
-                walked = 0.0
-                for (cx, cy), d in zip(pts[1:-1], steps, strict=False):
-                    walked += d
-                    out.append((t0 + (t1 - t0) * walked / total, cx, cy))
+            way = self._way((x0, y0), (x1, y1))
+            for (cx, cy), walked in way[:-1]:
+                out.append((t0 + (t1 - t0) * walked / way[-1][1], cx, cy))
             out.append((t1, x1, y1))
         return tuple(out)
 
     def go_to(self, t: float, x: float, y: float) -> None:
         """From time ``t`` the script is a walk from here to ``(x, y)`` at the person's speed
         (along the :data:`Route`), and standing there (a scenario's ``walk`` world event)."""
-        pts = self._route((self.x, self.y), (x, y)) if self._route is not None else ((self.x, self.y), (x, y))
         walk = [(t, self.x, self.y)]
-        walked = 0.0
-        for a, b in zip(pts, pts[1:], strict=False):
-            d = math.hypot(b[0] - a[0], b[1] - a[1])
-            if d > 1e-9:
-                walked += d
-                walk.append((t + walked / self.spec.speed, b[0], b[1]))
+        walk += [(t + walked / self.spec.speed, q[0], q[1]) for q, walked in self._way((self.x, self.y), (x, y))]
         self.walk = tuple(walk) if len(walk) > 1 else ((t, x, y),)
         self._detour = []
 
