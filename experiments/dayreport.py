@@ -8,6 +8,10 @@ switches, and for whole-queue schedulers the longest queue ordered and the decis
 whose search hit its budget.  On the robot backend, :mod:`experiments.pathmetrics` adds
 abandonment and travel distance from the recorded trajectory, and :func:`hazard_metrics`
 the task folders' hazards as every run counts them (``safety`` of :mod:`experiments.metrics`).
+Tasks are counted as needs: a request made again after its task failed (``renews`` in the
+trace, :func:`tasker.trace.needs`) is the same need, served when any of its tasks finishes;
+``failed`` counts the needs whose tasks failed and were never served, ``renewals`` the
+requests made again.
 
 :func:`run_days` runs N days x schedulers on a backend (days made by
 :func:`experiments.days.make`) and :func:`table` writes the Markdown table with 95 %
@@ -47,7 +51,7 @@ from experiments.stats import estimate, holm
 from experiments.strategy import Strategy
 from experiments.sweepspec import Job
 from tasker.errors import ConfigError
-from tasker.trace import FAILED, number
+from tasker.trace import FAILED, needs, number
 
 OSCILLATION_SWITCHES = 3
 OSCILLATION_WINDOW_S = 180.0
@@ -104,21 +108,29 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
         elif ev == "decision" and "order" in e:  # whole-queue decisions (lookahead)
             longest_order = max(longest_order, len(e["order"]))
             anytime += e.get("rule") == "anytime"
+    first = needs(events)  # a renewed request (a failed fall asked again) is the same need
+    need_args = {a for a in kind if first[a] == a}
+    served: dict[str, float] = {}
+    for a, when in finished.items():
+        served[first[a]] = min(when, served.get(first[a], math.inf))
+    unserved_failed = {first[a] for a in failed} - set(served)
     types = sorted(set(kind.values()))
     per_type: dict[str, dict[str, Any]] = {}
     dead: list[float] = []
     for t in types:
         agents = [a for a in kind if kind[a] == t]
-        done = [a for a in agents if a in finished]
-        gaps = [finished[a] - number(args[a]["deadline"]) for a in done if args[a].get("deadline") is not None]
+        asked = [a for a in agents if a in need_args]
+        done = [a for a in asked if a in served]
+        gaps = [served[a] - number(args[a]["deadline"]) for a in done if args[a].get("deadline") is not None]
         n_int = sum(interruptions.get(a, 0) for a in agents)
-        per_type[t] = {"requested": len(agents), "completed": len(done), "failed": sum(a in failed for a in agents),
+        per_type[t] = {"requested": len(asked), "completed": len(done),
+                       "failed": sum(a in unserved_failed for a in asked), "renewals": len(agents) - len(asked),
                        "completion_minus_deadline_s": _mean(gaps), "lateness_s": sum(max(0.0, g) for g in gaps),
                        "late": sum(1 for g in gaps if g > 0), "interruptions": n_int,
-                       "interruptions_per_task": n_int / len(agents) if agents else None}
-        for a in agents:
+                       "interruptions_per_task": n_int / len(asked) if asked else None}
+        for a in asked:
             death = args[a].get("death_at")
-            if death is not None and number(death) <= end_t and finished.get(a, math.inf) > number(death):
+            if death is not None and number(death) <= end_t and served.get(a, math.inf) > number(death):
                 dead.append(number(death))
     oscillation = _oscillation(starts)
     first_death = min(dead) if dead else None
@@ -127,10 +139,11 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
     if stops_at:
         ending = min(stops_at)[1]
     else:
-        ending = "all done" if len(finished) == len(kind) else "time ran out"
-    all_gaps = [finished[a] - number(args[a]["deadline"]) for a in finished if args[a].get("deadline") is not None]
+        ending = "all done" if len(served) == len(need_args) else "time ran out"
+    all_gaps = [served[a] - number(args[a]["deadline"]) for a in served if args[a].get("deadline") is not None]
     return {
-        "requested": len(kind), "completed": len(finished), "failed": len(failed),
+        "requested": len(need_args), "completed": len(served), "failed": len(unserved_failed),
+        "renewals": len(kind) - len(need_args),
         "completion_minus_deadline_s": _mean(all_gaps), "lateness_s": sum(max(0.0, g) for g in all_gaps),
         "dead_falls": len(dead), "first_death_t": first_death,
         "interruptions": sum(interruptions.values()), "suspensions": suspensions,
@@ -293,6 +306,8 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
         *((f"completion − deadline: {t} (s)", f"gap_{t}",
            lambda r, t=t: r["per_type"].get(t, {}).get("completion_minus_deadline_s")) for t in types),
         ("dead falls", "dead", lambda r: r["dead_falls"]),
+        ("failed tasks not served by their renewals", "failed", lambda r: r["failed"]),
+        ("requests made again after a failed task", "renewals", lambda r: r.get("renewals")),
         ("interruptions", "interruptions", lambda r: r["interruptions"]),
         *((f"interruptions per task: {t}", f"int_{t}",
            lambda r, t=t: r["per_type"].get(t, {}).get("interruptions_per_task")) for t in types),

@@ -12,7 +12,9 @@ the scenario that backend runs, built from the one draw of :func:`experiments.pr
   a person of the world per request is scripted to walk to the request's site before
   the call (and, for a fall, lies down at the call and is taken away — gets up and walks
   home — once the robot's task for them has finished, or at ``death_at`` if it has not),
-  each pick-and-place gets its own object at its site.
+  each pick-and-place gets its own object at its site.  A task type with
+  ``renew_after_s`` is requested again that long after its task fails, until the
+  request's ``death_at`` (or the day's end): the need stands until served.
 
 Either way every request carries ``deadline`` and ``priority`` (and a fall its
 ``death_at``) as request fields that reach every scheduler through the schedule
@@ -169,7 +171,9 @@ def _robot(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) 
         args |= {"deadline": r.deadline, "priority": r.priority}
         if r.death_at is not None:
             args["death_at"] = r.death_at
-        actions.append(TimedAction(r.t, "request", {"task": rt.task, "args": args}))
+        renew = {} if rt.renew_after_s is None else {"renew": {
+            "after_s": rt.renew_after_s, "until": r.death_at if r.death_at is not None else proto.length_s}}
+        actions.append(TimedAction(r.t, "request", {"task": rt.task, "args": args, **renew}))
         if lies_down is not None:
             taken.append((actions[-1], *lies_down))
     actions.sort(key=lambda a: a.t)  # stable: a posture change comes before its request

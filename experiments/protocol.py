@@ -72,6 +72,9 @@ class RobotTask:
     site) and ``$object`` (an object of ``object_type`` put at the site for this request).
     ``posture``: the person takes it at the call (e.g. ``fallen``) and stands up again at
     the request's ``death_at``.
+    ``renew_after_s``: a request of this type whose task fails (a plan, a skill or a hook
+    failed) is made again this long after, until its ``death_at`` (or the day's end): the
+    need stands until served, as in TaBSA.  ``None``: a failed task stays failed.
     """
 
     kind: str
@@ -79,6 +82,7 @@ class RobotTask:
     args: dict[str, str]
     object_type: str | None = None
     posture: str | None = None
+    renew_after_s: float | None = None
 
 
 @dataclass(frozen=True)
@@ -269,7 +273,8 @@ def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str
                        f"a type of task type {name!r}'s domain")
         variables = {"$site": "place", "$dest": "place", "$person": "person", **({"$object": obj} if obj else {})}
         check_template(tt, types[name], args, variables, spec)  # names, required ones, each of its PDDL type
-        out[kind] = RobotTask(kind, name, args, obj, posture)
+        renew = tt.number("renew_after_s", None, positive=True)
+        out[kind] = RobotTask(kind, name, args, obj, posture, renew)
         tt.done()
     missing = sorted(set(tasks) - set(out))
     if missing:

@@ -39,7 +39,7 @@ from tasker.meaning import Monitor
 from tasker.requester import Requester
 from tasker.store import TaskStore
 from tasker.task import Strategy
-from tasker.trace import Trace
+from tasker.trace import FAILED, Trace
 
 
 @dataclass(frozen=True)
@@ -110,9 +110,10 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
                       version=sim.facts_key)
     loop.observers.append(monitor.observe)
     loop.harmoniser.hazards = monitor.active  # hazard-aware waiting learns of hazards from the monitor
-    requester = Requester(store, loop.harmoniser, "scenario")
+    made = _Made(loop, Requester(store, loop.harmoniser, "scenario"))
+    sids = iter(range(1, len(scn.actions) + 1))
     for a in scn.actions:
-        loop.at(a.t, _action(loop, sim, requester, a, scn))
+        loop.at(a.t, _action(loop, sim, made, a, f"d{next(sids)}" if a.kind == "request" else None))
         if a.kind == "request":
             store.validate(a.fields["task"], a.fields["args"])  # bad requests fail before the run
     return loop, sim
@@ -140,18 +141,55 @@ def _with_objects(scn: scenarios.RobotScenario, spec: Any) -> Any:
     return dataclasses.replace(spec, objects=objects, facts=tuple(dict.fromkeys(facts)))
 
 
-def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: TimedAction,
-            scn: scenarios.RobotScenario) -> Callable[[], None]:
+class _Made:
+    """The scenario's requests as made.  Its K-th request is ``dK`` in the scenario's own
+    terms (``after``, ``terminate``, ``change``); the agents made for it are the one the
+    request made and any that renew it.  A request with ``renew`` (``{"after_s", "until"}``)
+    whose task ends without doing its work (an ``end`` cause in :data:`tasker.trace.FAILED`)
+    is asked for again ``after_s`` later, if that is before ``until``: the need stands until
+    served (a day's fall, until the person is helped or dead).  Without renewals ``dK`` is
+    the K-th agent, as the harmoniser numbers them."""
+
+    def __init__(self, loop: SimulationLoop, requester: Requester) -> None:
+        self.loop, self.requester = loop, requester
+        self.agents: dict[str, list[str]] = {}
+        self._renewable: dict[str, tuple[str, TimedAction]] = {}  # agent -> (its scenario id, its request)
+        loop.trace.subscribe(self._watch)
+
+    def current(self, sid: str) -> str:
+        """The agent now standing for the scenario's ``sid`` (``sid`` itself before it is made)."""
+        made = self.agents.get(sid)
+        return made[-1] if made else sid
+
+    def submit(self, sid: str, a: TimedAction, renews: str | None = None) -> None:
+        agent = self.requester.request(a.fields["task"], a.fields["args"], renews=renews)
+        self.agents.setdefault(sid, []).append(agent)
+        if "renew" in a.fields:
+            self._renewable[agent] = (sid, a)
+
+    def _watch(self, e: dict[str, Any]) -> None:
+        if e["event"] != "end" or e.get("cause") not in FAILED or e.get("agent") not in self._renewable:
+            return
+        sid, a = self._renewable.pop(e["agent"])
+        when = float(e["t"]) + float(a.fields["renew"]["after_s"])
+        if when < float(a.fields["renew"]["until"]):
+            self.loop.at(when, lambda: self.submit(sid, a, renews=e["agent"]))
+
+
+def _action(loop: SimulationLoop, sim: Any, made: _Made, a: TimedAction, sid: str | None) -> Callable[[], None]:
     f = a.fields
+    requester = made.requester
     if a.kind == "request":
+        assert sid is not None
+
         def submit() -> None:  # through the public requester, as any user's requests
-            requester.request(f["task"], f["args"])
+            made.submit(sid, a)
 
         return submit
     if a.kind == "terminate":
-        return lambda: requester.terminate(f["agent"], f["reason"])
+        return lambda: requester.terminate(made.current(f["agent"]), f["reason"])
     if a.kind == "change":
-        return lambda: synthetic._change(loop, requester, f["agent"], f["args"])
+        return lambda: synthetic._change(loop, requester, made.current(f["agent"]), f["args"])
     if a.kind == "mode":
         return lambda: loop.harmoniser.set_mode(f["mode"])
 
@@ -171,16 +209,18 @@ def _action(loop: SimulationLoop, sim: Any, requester: Requester, a: TimedAction
 
     if "after" not in f:
         return world_event
-    return _after(loop, f["after"], world_event)
+    return _after(loop, made, f["after"], world_event)
 
 
-def _after(loop: SimulationLoop, agent: str, event: Callable[[], None]) -> Callable[[], None]:
-    """``event`` at its time if agent ``agent`` has finished its task by then, else as soon as it
-    does (in the tick its ``end`` event with cause ``finished`` is traced); never if it ends otherwise."""
+def _after(loop: SimulationLoop, made: _Made, sid: str, event: Callable[[], None]) -> Callable[[], None]:
+    """``event`` at its time if the scenario's request ``sid`` has been served by then (one of
+    its agents ended with cause ``finished``), else as soon as it is (in the tick that ``end``
+    event is traced); never if it is not."""
     state = {"finished": False, "due": False}
 
     def watch(e: dict[str, Any]) -> None:
-        if e["event"] == "end" and e.get("agent") == agent and e.get("cause") == "finished" and not state["finished"]:
+        if e["event"] == "end" and e.get("cause") == "finished" and e.get("agent") in made.agents.get(sid, ()) \
+                and not state["finished"]:
             state["finished"] = True
             if state["due"]:
                 loop.at(loop.now, event)

@@ -63,11 +63,16 @@ class Mode(StrEnum):
 
 @dataclass(frozen=True, slots=True)
 class Request:
-    """A task request from a requester (tra): a task type and its (validated) arguments."""
+    """A task request from a requester (tra): a task type and its (validated) arguments.
+
+    ``renews``: the agent whose task this request asks for again, after that task ended
+    without doing its work (e.g. a fall detector still sees the person down); traced, so
+    a reader can count needs rather than attempts."""
 
     task_type: str
     args: Mapping[str, Any] = field(default_factory=dict)
     requester: str = "user"
+    renews: str | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -273,8 +278,9 @@ class TaskHarmoniser:
             self.agents[agent_id] = agent
             self._order[agent_id] = len(self._order)
             self._idle[agent_id] = None
+            again = {"renews": request.renews} if request.renews is not None else {}
             self._trace.emit(now, "request", agent=agent_id, task_type=request.task_type,
-                             args=dict(request.args), requester=request.requester)
+                             args=dict(request.args), requester=request.requester, **again)
         self._requests.clear()
         self._became.clear()  # a new request may legitimately preempt again
         self._roles_dirty = True

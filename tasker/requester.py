@@ -24,10 +24,11 @@ class Requester:
         self.harmoniser = harmoniser
         self.name = name
 
-    def request(self, task_type: str, args: Mapping[str, Any] | None = None) -> str:
-        """Ask for a task; returns its agent id (``d1``, ``d2``, ...)."""
+    def request(self, task_type: str, args: Mapping[str, Any] | None = None, *, renews: str | None = None) -> str:
+        """Ask for a task; returns its agent id (``d1``, ``d2``, ...).  ``renews``: the agent
+        whose task (ended without doing its work) this asks for again."""
         checked = self.store.validate(task_type, args or {})
-        return self.harmoniser.submit(Request(task_type, checked, self.name))
+        return self.harmoniser.submit(Request(task_type, checked, self.name, renews))
 
     def terminate(self, agent_id: str, reason: str | None = None) -> None:
         self.harmoniser.terminate(agent_id, reason or f"terminated by {self.name}")

@@ -131,3 +131,14 @@ def number(value: Any) -> float:
 
 def iter_events(events: Iterable[Mapping[str, Any]], kind: str) -> Iterator[Mapping[str, Any]]:
     return (e for e in events if e.get("event") == kind)
+
+
+def needs(events: Iterable[Mapping[str, Any]]) -> dict[str, str]:
+    """Every requested agent → the agent that first asked for its need: itself, or, for a
+    request that ``renews`` another (asked again after that task ended without doing its
+    work), the first of that chain.  Readers count needs by it, not attempts."""
+    first: dict[str, str] = {}
+    for e in iter_events(events, "request"):
+        agent, renews = str(e["agent"]), e.get("renews")
+        first[agent] = first.get(str(renews), str(renews)) if renews is not None else agent
+    return first

@@ -247,3 +247,35 @@ def test_a_person_at_any_spot_can_be_reached(name: str) -> None:
             scene.remove_person(f"p{j}")
         scene.remove_person("target")
     assert not shut, "\n".join(shut)
+
+
+def test_a_failed_fall_is_requested_again_and_served(tiny_protocol: protocol.Protocol, tmp_path: Path,
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    """The fall's first help fails (its approach finds no pose, as when people crowd round the
+    person); the fall is requested again 30 s later (``renews``), the renewal helps, the person
+    is taken away after it, and the day counts one fall, served, none dead."""
+    from robot import skills
+
+    real = skills.Navigate._approach
+
+    def first_fails(self: skills.Navigate, name: str) -> Any:  # the approach begun before t = 40 s
+        if self.sim.people[name].posture == "fallen" and self.started < 40.0:
+            return f"no reachable pose next to {name}"
+        return real(self, name)
+
+    monkeypatch.setattr(skills.Navigate, "_approach", first_fails)
+    dayreport.run_day(tiny_protocol.source, 1, "alg2", "robot", keep=str(tmp_path))
+    events = [json.loads(line) for line in (tmp_path / "trace.jsonl").read_text().splitlines()]
+    falls = [e for e in events if e["event"] == "request" and e["task_type"] == "human_fell"]
+    assert len(falls) == 2 and falls[1]["renews"] == falls[0]["agent"] and falls[1]["args"] == falls[0]["args"]
+    ends = {e["agent"]: e for e in events if e["event"] == "end"}
+    failed, renewed = ends[falls[0]["agent"]], ends[falls[1]["agent"]]
+    assert failed["cause"] == "failed" and falls[1]["t"] == pytest.approx(failed["t"] + 30.0, abs=1.0)
+    assert renewed["cause"] == "finished"
+    person = falls[0]["args"]["person"]
+    up = next(e for e in events if e["event"] == "world" and e["value"] == [person, "standing"])
+    assert up["t"] == renewed["t"] and "help done" in up["note"]  # taken away after the renewal's help
+    kinds = {v: k for k, v in days.task_names(tiny_protocol, "robot").items()}
+    m = dayreport.day_metrics(events, day_end=tiny_protocol.length_s, kinds=kinds)
+    f = m["per_type"]["fall"]
+    assert (f["requested"], f["completed"], f["failed"], f["renewals"]) == (1, 1, 0, 1) and m["dead_falls"] == 0

@@ -67,3 +67,18 @@ def test_leaving_while_driving_to_the_person_is_not_for_another_task() -> None:
     assert abandonments(other, samples(), for_another_task=True) == {"d1": 1}  # escort took the robot at 3.5
     back = sorted(EVENTS + _roles((1.0, "d2"), (4.0, "d1")), key=lambda e: e["t"])
     assert abandonments(back, samples(), for_another_task=True) == {"d1": 0}  # d1 executing from t=4 on
+
+
+def test_a_fall_requested_again_is_watched_until_its_last_task_ends() -> None:
+    # d1's help failed at t=2 and was asked again as d3 at t=5, which finished at 7.5: the robot
+    # leaving at t=4 (between them) left Ann lying, and it counts once, for the need d1
+    renewed = [EVENTS[0], EVENTS[1],
+               {"t": 2.0, "event": "end", "agent": "d1", "task_type": "help", "cause": "failed"},
+               {"t": 5.0, "event": "request", "agent": "d3", "task_type": "help", "args": EVENTS[0]["args"],
+                "renews": "d1"},
+               {"t": 7.5, "event": "end", "agent": "d3", "task_type": "help", "cause": "finished"}]
+    assert abandonments(renewed, samples()) == {"d1": 1}
+    # the renewal executing counts as the fall's own task, not another's
+    theirs = sorted(renewed + _roles((1.0, "d2"), (3.5, "d3")), key=lambda e: e["t"])
+    assert abandonments(theirs, samples(), for_another_task=True) == {"d1": 0}
+    assert path_metrics(renewed, samples())["abandoned_falls"] == 1

@@ -77,6 +77,24 @@ def test_bad_protocols_name_file_line_and_field(tmp_path: Path) -> None:
     with pytest.raises(InputError, match=r"robot_backnd: unknown key .*did you mean 'robot_backend'.*"
                                          r"\(valid keys: .*robot_backend"):  # optional, yet named
         protocol.load(write(tmp_path, text.replace("[robot_backend", "[robot_backnd")))
+    for bad, why in (("0.0", "expected a number > 0"), ('"soon"', "expected a number")):
+        with pytest.raises(InputError, match=rf"p\.toml:\d+: robot_backend\.tasks\.fall\.renew_after_s: {why}"):
+            protocol.load(write(tmp_path, text.replace("renew_after_s = 30.0", f"renew_after_s = {bad}").replace(
+                'world = "tabsa_apartment.toml"', f'world = "{TABSA.parent / "tabsa_apartment.toml"}"')))
+
+
+def test_a_failed_fall_is_requested_again_until_its_death_at(tabsa: protocol.Protocol) -> None:
+    """The fall's request carries its renewal (every 30 s after a failure, until death_at);
+    the other types' failures stand."""
+    from experiments import days
+
+    assert tabsa.robot is not None and tabsa.robot.tasks["fall"].renew_after_s == 30.0
+    assert tabsa.robot.tasks["transport"].renew_after_s is None
+    scn = days.make(tabsa, 3, backend="robot").scenario
+    requests = [a.fields for a in scn.actions if a.kind == "request"]
+    falls = [f for f in requests if f["task"] == "human_fell"]
+    assert falls and all(f["renew"] == {"after_s": 30.0, "until": f["args"]["death_at"]} for f in falls)
+    assert all("renew" not in f for f in requests if f["task"] != "human_fell")
 
 
 
@@ -210,3 +228,40 @@ def test_a_failed_tasks_own_safe_suspension_is_not_an_interruption() -> None:
     m = dayreport.day_metrics(events, day_end=100.0)
     assert m["interruptions"] == 0 and m["suspensions"] == 1 and m["suspension_time_s"] == pytest.approx(4.0)
     assert m["failed"] == 1 and m["completed"] == 0
+
+
+def _renewed(second: str) -> list[dict[str, object]]:
+    """A fall whose help fails at 100 s and is asked again (d2 renews d1), then d3 renews d2."""
+    args = {"deadline": 300.0, "death_at": 1200.0}
+    return [
+        ev(0, "request", agent="d1", task_type="fall", args=args),
+        ev(0, "command", agent="d1", flag="start"),
+        ev(100, "end", agent="d1", task_type="fall", cause="failed"),
+        ev(130, "request", agent="d2", task_type="fall", args=args, renews="d1"),
+        ev(130, "command", agent="d2", flag="start"),
+        ev(200, "end", agent="d2", task_type="fall", cause="failed"),
+        ev(230, "request", agent="d3", task_type="fall", args=args, renews="d2"),
+        ev(230, "command", agent="d3", flag="start"),
+        ev(400, "end", agent="d3", task_type="fall", cause=second),
+    ]
+
+
+def test_a_fall_requested_again_is_one_need() -> None:
+    """A renewed request is the same need: served when any of its tasks finishes, dead only
+    if none did by death_at, and counted once among the requests."""
+    served = dayreport.day_metrics(_renewed("finished"), day_end=2000.0)
+    assert (served["requested"], served["completed"], served["failed"], served["renewals"]) == (1, 1, 0, 2)
+    assert served["dead_falls"] == 0 and served["ending"] == "all done"
+    assert served["completion_minus_deadline_s"] == pytest.approx(100.0)  # served at 400, deadline 300
+    f = served["per_type"]["fall"]
+    assert (f["requested"], f["completed"], f["failed"], f["renewals"]) == (1, 1, 0, 2)
+    never = dayreport.day_metrics(_renewed("failed"), day_end=2000.0)
+    assert (never["requested"], never["completed"], never["failed"], never["renewals"]) == (1, 0, 1, 2)
+    assert never["dead_falls"] == 1 and never["first_death_t"] == 1200.0 and never["ending"] == "a fall died"
+
+
+def test_needs_follow_chains_of_renewals() -> None:
+    from tasker.trace import needs
+
+    assert needs(_renewed("finished")) == {"d1": "d1", "d2": "d1", "d3": "d1"}
+    assert needs(HAND) == {"d1": "d1", "d2": "d2", "d3": "d3"}
