@@ -164,8 +164,18 @@ def writable_file(path: str | Path, argument: str) -> Path:
 TASKS_HINT = "to add a task type, add its folder with --path DIR or TASKER_TASKS (see 'tasker new')"
 
 
+_NEGATIVE_POINT = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?,")
+"""A point argument ``x,y(,yaw)`` whose ``x`` is negative, e.g. ``-1,2``: an argument, not an option."""
+
+
 class Parser(argparse.ArgumentParser):
-    """``argparse`` with "did you mean" on a misspelt subcommand or choice."""
+    """``argparse`` with "did you mean" on a misspelt subcommand or choice, and points with a
+    negative first coordinate (``-1,2``) read as arguments rather than unknown options."""
+
+    def _parse_optional(self, arg_string: str) -> Any:
+        if _NEGATIVE_POINT.match(arg_string):
+            return None
+        return super()._parse_optional(arg_string)
 
     def error(self, message: str) -> NoReturn:
         m = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)

@@ -107,6 +107,8 @@ def test_cost_suggests_a_place_and_a_world(capsys: pytest.CaptureFixture[str]) -
     ("0.05,3", "is inside wall"),
     ("1.5,0.5", "is inside furniture 'sofa'"),
     ("1e308,2", "is outside the world's bounds"),
+    ("-1,-1", "is outside the world's bounds"),  # a negative point is an argument, not an option
+    ("-.5,2,0", "is outside the world's bounds"),
 ])
 def test_cost_refuses_a_point_where_no_robot_can_be(point: str, why: str, capsys: pytest.CaptureFixture[str]) -> None:
     """Such a point is a wrong argument (exit 2, saying why), not an 'unreachable' pair (exit 1)."""
