@@ -40,6 +40,17 @@ def test_path_rows_appear_only_with_path_metrics() -> None:
     assert "| travel distance (m) | 15.00 ± 63.53 | 15.00 ± 63.53 |" in robot
 
 
+def test_failure_rows_are_the_robots_and_a_day_stored_before_renewals_made_none() -> None:
+    synthetic = dayreport.table([{**result(n, s), "backend": "synthetic"}
+                                 for n in ("lookahead", "alg2") for s in (1, 2)])
+    assert "failed tasks" not in synthetic and "requests made again" not in synthetic
+    days = [{**result(n, s), "backend": "robot"} for n in ("lookahead", "alg2") for s in (1, 2)]
+    days[0]["renewals"], days[0]["failed"] = 2, 1  # lookahead, day 1; the other days predate renewals
+    robot = dayreport.table(days)
+    assert "| requests made again after a failed task (robot) | 1.00 ± 12.71 | 0.00 ± 0.00 |" in robot
+    assert "| failed tasks not served by their renewals (robot) | 0.50 ± 6.35 | 0.00 ± 0.00 |" in robot
+
+
 def test_a_stopped_run_resumes_from_its_database(tmp_path: Path) -> None:
     from experiments.store import ResultStore
 
