@@ -154,6 +154,7 @@ class _Made:
         self.loop, self.requester = loop, requester
         self.agents: dict[str, list[str]] = {}
         self._renewable: dict[str, tuple[str, TimedAction]] = {}  # agent -> (its scenario id, its request)
+        self._terminated: set[str] = set()  # scenario ids a requester terminated: never renewed
         loop.trace.subscribe(self._watch)
 
     def current(self, sid: str) -> str:
@@ -161,7 +162,13 @@ class _Made:
         made = self.agents.get(sid)
         return made[-1] if made else sid
 
+    def terminate(self, sid: str, reason: str) -> None:
+        self._terminated.add(sid)
+        self.requester.terminate(self.current(sid), reason)
+
     def submit(self, sid: str, a: TimedAction, renews: str | None = None) -> None:
+        if renews is not None and sid in self._terminated:
+            return
         agent = self.requester.request(a.fields["task"], a.fields["args"], renews=renews)
         self.agents.setdefault(sid, []).append(agent)
         if "renew" in a.fields:
@@ -187,7 +194,7 @@ def _action(loop: SimulationLoop, sim: Any, made: _Made, a: TimedAction, sid: st
 
         return submit
     if a.kind == "terminate":
-        return lambda: requester.terminate(made.current(f["agent"]), f["reason"])
+        return lambda: made.terminate(f["agent"], f["reason"])
     if a.kind == "change":
         return lambda: synthetic._change(loop, requester, made.current(f["agent"]), f["args"])
     if a.kind == "mode":

@@ -279,3 +279,28 @@ def test_a_failed_fall_is_requested_again_and_served(tiny_protocol: protocol.Pro
     m = dayreport.day_metrics(events, day_end=tiny_protocol.length_s, kinds=kinds)
     f = m["per_type"]["fall"]
     assert (f["requested"], f["completed"], f["failed"], f["renewals"]) == (1, 1, 0, 1) and m["dead_falls"] == 0
+
+
+def test_a_terminated_request_is_not_requested_again(tiny_protocol: protocol.Protocol, tmp_path: Path,
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    """A requester cancels the fall (its scenario id, ``dK``) after its task failed and before
+    the renewal is due: nothing is requested again."""
+    import dataclasses
+
+    from experiments.actions import TimedAction
+    from robot import skills
+
+    real = skills.Navigate._approach
+    monkeypatch.setattr(skills.Navigate, "_approach", lambda self, name: f"no reachable pose next to {name}"
+                        if self.sim.people[name].posture == "fallen" else real(self, name))
+    day = days.make(tiny_protocol, 1, backend="robot", scheduler="alg2")
+    requests = [a for a in day.scenario.actions if a.kind == "request"]
+    k = next(i for i, a in enumerate(requests, 1) if a.fields["task"] == "human_fell")
+    # its help fails at 57.65 s (the approach's block timeout) and is due again at 87.65 s
+    cancel = TimedAction(70.0, "terminate", {"agent": f"d{k}", "reason": "help came from elsewhere"})
+    scn = dataclasses.replace(day.scenario, actions=tuple(sorted((*day.scenario.actions, cancel), key=lambda a: a.t)),
+                              horizon=200.0)
+    events = days.Day(day.protocol, 1, "robot", "alg2", scn).run(out=tmp_path).events
+    falls = [e for e in events if e["event"] == "request" and e["task_type"] == "human_fell"]
+    ends = {e["agent"]: e for e in events if e["event"] == "end"}
+    assert len(falls) == 1 and ends[falls[0]["agent"]]["cause"] == "failed" and ends[falls[0]["agent"]]["t"] < 70.0
