@@ -26,7 +26,6 @@ from planners.checks import DefinitionError, load_domain, load_problem_text, rem
 from planners.pddl_task import PddlTaskType
 from planners.problem import DomainModel
 from planners.results import PlanStatus
-from planners.stages import Bindings
 from planners.taskspec import TaskSpec, meaning_of, read_task_toml
 from tasker import reader
 from tasker.meaning import Binding
@@ -170,13 +169,19 @@ def _check_example(task: PddlTaskType) -> None:
     ctx = example_context(task)
     if ctx is None:
         return
-    b = Bindings(ctx.args, ctx.world)
-    text, _, _ = task.problem_text(ctx, ctx.world, b.literals(task.spec.goal), b.literals(task.spec.facts))
+    world, goal, extra = task.update_inputs(ctx)  # what upTsk plans from: task.py's extra_facts too
+    text, init, _ = task.problem_text(ctx, world, goal, extra)
     where = f"{task.spec.folder / 'task.toml'} [example] problem"
     load_problem_text(task.domain.checked, text.problem, where)
     result = task.planner.solve(text, timeout=task.timeout)
     if result.status is PlanStatus.ERROR:  # e.g. a feature the optimal search cannot handle (axioms)
         raise DefinitionError(task.spec.domain_file, f"the planner fails on the {where}: {result.message}")
+    if result.status is PlanStatus.UNSOLVABLE:  # the example is what `tasker check` promises to solve
+        left_out = [list(f) for f in sorted(world.facts) if tuple(f) not in init]
+        raise task.spec.error("example", f"no plan reaches the goal {[list(g) for g in goal]} from the [example] "
+                                         "world" + (f"; left out of the problem (an object or predicate the "
+                                                    f"domain or [example] objects do not declare): {left_out}"
+                                                    if left_out else ""))
 
 
 def load_task(folder: str | Path, *, use_cache: bool = True) -> PddlTaskType:

@@ -262,6 +262,7 @@ def _example(r: _Reader, top: reader.Table) -> ExampleWorld | None:
     if "example" not in top:
         return None
     ex = top.table("example")
+    r.note(ex)
     poses = {}
     for name, p in ex.table("poses", {}).items():
         if not isinstance(p, list) or len(p) not in (2, 3) or not all(isinstance(v, int | float) for v in p):

@@ -1,0 +1,39 @@
+"""Task folders as a new user writes them (from ``tasker new``'s template): each mistake is
+refused at load naming the file, the line and what was expected, and each valid PDDL
+feature the docs promise works; never a traceback, never a silently wrong problem."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from planners.checks import DefinitionError
+from planners.cli import scaffold
+from planners.loader import load_task
+
+
+def _new(tmp_path: Path, name: str = "fetch") -> Path:
+    folder = tmp_path / name
+    scaffold(name, folder)
+    return folder
+
+
+def _edit(path: Path, old: str, new: str) -> None:
+    text = path.read_text()
+    assert old in text, old
+    path.write_text(text.replace(old, new, 1))
+
+
+def _line_of(path: Path, fragment: str) -> int:
+    return next(n for n, s in enumerate(path.read_text().splitlines(), 1) if fragment in s)
+
+
+def test_an_unsolvable_example_is_refused_naming_what_was_left_out(tmp_path: Path) -> None:
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, '["at", "vase", "kitchen"]', '["at", "vaze", "kitchen"]')  # a typo: the vase is nowhere
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(toml) and info.value.line == _line_of(toml, "[example]")
+    assert "example: no plan reaches the goal" in str(info.value) and "['at', 'vaze', 'kitchen']" in str(info.value)
