@@ -185,7 +185,8 @@ def render_problem(
         if all(a in objects and domain.has_type(objects[a], t) for a, t in zip(fact[1:], sig, strict=True)):
             init.add(tuple(fact))
     numeric = []
-    if travel is not None and TRAVEL_FUNCTION in domain.functions:
+    timed = TRAVEL_FUNCTION in domain.functions
+    if travel is not None and (timed or CONNECTED in domain.predicates):  # either may be declared alone
         places = [n for n, t in objects.items() if domain.has_type(t, PLACE_TYPE)]
         for a in places:
             for b in places:
@@ -198,7 +199,8 @@ def render_problem(
                     value = max(1, math.ceil(secs))
                 else:
                     value = 0 if a == b else UNREACHABLE_COST
-                numeric.append(f"(= ({TRAVEL_FUNCTION} {a} {b}) {value})")
+                if timed:
+                    numeric.append(f"(= ({TRAVEL_FUNCTION} {a} {b}) {value})")
     by_type: dict[str, list[str]] = {}
     for n, t in objects.items():
         by_type.setdefault(t, []).append(n)

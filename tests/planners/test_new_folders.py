@@ -37,3 +37,19 @@ def test_an_unsolvable_example_is_refused_naming_what_was_left_out(tmp_path: Pat
         load_task(folder, use_cache=False)
     assert info.value.file == str(toml) and info.value.line == _line_of(toml, "[example]")
     assert "example: no plan reaches the goal" in str(info.value) and "['at', 'vaze', 'kitchen']" in str(info.value)
+
+
+def test_connected_without_travel_time_still_connects_the_places(tmp_path: Path) -> None:
+    """A domain without action costs keeps ``connected``: the docs add it "when the domain declares" it."""
+    from planners.examples import example_context
+
+    folder = _new(tmp_path)
+    domain = folder / "domain.pddl"
+    _edit(domain, " :action-costs", "")
+    _edit(domain, "  (:functions\n    (travel-time ?from ?to - place) - number\n    (total-cost) - number)\n", "")
+    _edit(domain, "\n                 (increase (total-cost) (travel-time ?from ?to))", "")
+    for _ in range(2):
+        _edit(domain, "\n                 (increase (total-cost) 5)", "")
+    task = load_task(folder, use_cache=False)  # before: the example was unsolvable (no place connected)
+    plan = task.update_task(example_context(task))
+    assert [s.action for s in plan.stages] == ["navigate", "pick", "navigate", "put_down"]
