@@ -11,6 +11,7 @@ import pytest
 from planners.checks import DefinitionError
 from planners.cli import scaffold
 from planners.loader import load_task
+from tasker.stage import Purpose
 
 
 def _new(tmp_path: Path, name: str = "fetch") -> Path:
@@ -53,3 +54,18 @@ def test_connected_without_travel_time_still_connects_the_places(tmp_path: Path)
     task = load_task(folder, use_cache=False)  # before: the example was unsolvable (no place connected)
     plan = task.update_task(example_context(task))
     assert [s.action for s in plan.stages] == ["navigate", "pick", "navigate", "put_down"]
+
+
+def test_a_domain_constant_that_is_also_a_world_object(tmp_path: Path) -> None:
+    """``(:constants kitchen - place)``: the world's kitchen is that constant, declared once,
+    and facts over it are kept (before: UP's "Name kitchen already defined!")."""
+    from planners.examples import example_context
+
+    folder = _new(tmp_path)
+    _edit(folder / "domain.pddl", "  (:predicates", "  (:constants kitchen - place)\n  (:predicates")
+    task = load_task(folder, use_cache=False)
+    ctx = example_context(task)
+    text = task.planning_problem(ctx, Purpose.UP_TSK)
+    objects = text.problem.split("(:objects")[1].split(")")[0]
+    assert "kitchen" not in objects and "(at vase kitchen)" in text.problem
+    assert [s.action for s in task.update_task(ctx).stages] == ["navigate", "pick", "navigate", "put_down"]
