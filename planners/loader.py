@@ -74,13 +74,14 @@ def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
                 raise DefinitionError(toml, f"[actions.{name}] {ref} is not a parameter of {name} {sorted(params)}")
     lits = [("problem.goal", spec.goal), ("problem.facts", spec.facts),
             ("problem.suspended_facts", spec.suspended_facts)]
-    lits += [(f"suspension[{k}]", b.when + b.goal) for k, b in enumerate(spec.suspension)]
+    lits += [(f"suspension[{k}].{key}", getattr(b, key)) for k, b in enumerate(spec.suspension)
+             for key in ("when", "goal")]
     for where, group in lits:
         for lit in group:
             try:
                 dm.check_literal(lit, where)
-            except DefinitionError as exc:
-                raise DefinitionError(toml, exc.reason) from None
+            except DefinitionError as exc:  # located in task.toml, at the field's line
+                raise DefinitionError(toml, exc.reason, spec.lines.get(where)) from None
     templates = [("static.update", t) for t in spec.static_update]
     templates += [(f"suspension[{k}].stages", t) for k, b in enumerate(spec.suspension) for t in b.stages]
     for where, t in templates:

@@ -69,3 +69,17 @@ def test_a_domain_constant_that_is_also_a_world_object(tmp_path: Path) -> None:
     objects = text.problem.split("(:objects")[1].split(")")[0]
     assert "kitchen" not in objects and "(at vase kitchen)" in text.problem
     assert [s.action for s in task.update_task(ctx).stages] == ["navigate", "pick", "navigate", "put_down"]
+
+
+@pytest.mark.parametrize(("old", "new"), [
+    ('goal = [["at", "$item", "$destination"]', 'goal = [["at", "$item", "$destination", "$robot"]'),
+    ('when = [["holding", "$robot", "$item"]]', 'when = [["holds", "$robot", "$item"]]'),
+])
+def test_a_bad_literal_names_its_line(tmp_path: Path, old: str, new: str) -> None:
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, old, new)
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(toml) and info.value.line == _line_of(toml, new[:30])
+    assert f"task.toml:{info.value.line}: " in str(info.value)
