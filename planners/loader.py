@@ -84,6 +84,9 @@ def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
                 raise DefinitionError(toml, exc.reason, spec.lines.get(where)) from None
     templates = [("static.update", t) for t in spec.static_update]
     templates += [(f"suspension[{k}].stages", t) for k, b in enumerate(spec.suspension) for t in b.stages]
+    tokens = [*((w, tok) for w, group in lits for lit in group for tok in lit),
+              *((w, tok) for w, t in templates for tok in t.args)]
+    _check_request_tokens(spec, tokens)
     for where, t in templates:
         for action in filter(None, (t.action, t.suspended)):
             if action not in dm.actions:
@@ -91,6 +94,16 @@ def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
             if len(t.args) != len(dm.actions[action].params):
                 raise DefinitionError(toml, f"[{where}] {action} takes {len(dm.actions[action].params)} "
                                             f"argument(s), got {len(t.args)}")
+
+
+def _check_request_tokens(spec: TaskSpec, tokens: list[tuple[str, str]]) -> None:
+    """Every ``$name`` is a request argument or ``$robot`` (``$at:x`` may name any object): a
+    misspelt one would fail only when a request plans, or when a static strategy runs."""
+    args = [a.name for a in spec.args] + ["robot"]
+    for where, tok in tokens:
+        if tok.startswith("$") and not tok.startswith("$at:") and tok[1:] not in args:
+            raise spec.error(where, f"unknown request argument {tok!r}{reader.suggest(tok, ['$' + a for a in args])} "
+                                    f"(this task's: {', '.join('$' + a for a in args)}; $at:NAME for a place)")
 
 
 def _check_suspension(spec: TaskSpec, dm: DomainModel) -> None:

@@ -83,3 +83,19 @@ def test_a_bad_literal_names_its_line(tmp_path: Path, old: str, new: str) -> Non
         load_task(folder, use_cache=False)
     assert info.value.file == str(toml) and info.value.line == _line_of(toml, new[:30])
     assert f"task.toml:{info.value.line}: " in str(info.value)
+
+
+@pytest.mark.parametrize(("old", "new", "at"), [
+    ('goal = [["at", "$item", "$destination"]', 'goal = [["at", "$item", "$destinaton"]', "goal = "),
+    ('args = ["$robot", "$item", "$at:item"] }', 'args = ["$robot", "$itm", "$at:item"] }', "update = ["),
+])
+def test_an_unknown_request_argument_is_refused_at_load(tmp_path: Path, old: str, new: str, at: str) -> None:
+    """Before: the goal's failed with "$destinaton: no request argument" naming no file; the
+    static template's was accepted and failed only when the static strategy ran."""
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, old, new)
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(toml) and info.value.line == _line_of(toml, at)
+    assert "unknown request argument" in str(info.value) and "did you mean" in str(info.value)
