@@ -99,3 +99,18 @@ def test_an_unknown_request_argument_is_refused_at_load(tmp_path: Path, old: str
         load_task(folder, use_cache=False)
     assert info.value.file == str(toml) and info.value.line == _line_of(toml, at)
     assert "unknown request argument" in str(info.value) and "did you mean" in str(info.value)
+
+
+@pytest.mark.parametrize(("old", "new", "fragment"), [
+    ('default = "living"', "default = 3", "expected a non-empty string, got 3"),
+    ('default = "living"', 'default = "living"\nchoices = ["kitchen"]', "expected one of ['kitchen'], got 'living'"),
+])
+def test_an_argument_default_that_does_not_fit_is_refused(tmp_path: Path, old: str, new: str, fragment: str) -> None:
+    """Before: accepted, then a request without the argument failed in the planner ("Undefined object 3")."""
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, old, new)
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.line == _line_of(toml, new.split("\n")[0])
+    assert "args[1].default: " in str(info.value) and fragment in str(info.value)
