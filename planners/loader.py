@@ -17,20 +17,24 @@ by Fast Downward's parser (:mod:`planners.schema`), checked or remembered.
 from __future__ import annotations
 
 import importlib.util
+import inspect
 import sys
+import types
 from pathlib import Path
 from typing import Any
 
 from planners import cache
 from planners.checks import DefinitionError, load_domain, load_problem_text, remembered_domain
-from planners.pddl_task import PddlTaskType
+from planners.pddl_task import PddlTaskType, hook_line
 from planners.problem import DomainModel
 from planners.results import PlanStatus
 from planners.taskspec import TaskSpec, meaning_of, read_task_toml
 from tasker import reader
+from tasker.errors import BadRequest, TaskerError
 from tasker.meaning import Binding
 
 HOOK_NAMES = ("extra_facts", "check_args", "check_terminate")
+_HOOK_PARAMS = {"extra_facts": "ctx, world", "check_args": "args", "check_terminate": "ctx, world"}
 """Functions a ``task.py`` may define (see ``docs/domains.md``).  There is no hook that changes
 the suspension goal: that is declared in ``[[suspension]]``, so both strategies pursue it."""
 
@@ -55,6 +59,14 @@ def _load_hooks(spec: TaskSpec) -> dict[str, Any]:
                      and callable(vars(module)[n]) and getattr(vars(module)[n], "__module__", "") == mod_name)
     if unknown:
         raise DefinitionError(path, f"unknown hook(s) {unknown}; a task.py may define {list(HOOK_NAMES)}")
+    for name, fn in hooks.items():
+        params = _HOOK_PARAMS[name].split(", ")
+        try:
+            inspect.signature(fn).bind(*params)
+        except (TypeError, ValueError):  # ValueError: no signature to inspect (a builtin): let it be
+            if isinstance(fn, types.FunctionType):
+                raise DefinitionError(path, f"{name}{inspect.signature(fn)}: a hook {name} takes "
+                                            f"({_HOOK_PARAMS[name]})", fn.__code__.co_firstlineno) from None
     return hooks
 
 
@@ -180,10 +192,20 @@ def _check_meaning(spec: TaskSpec, dm: DomainModel) -> tuple[Binding, ...]:
 def _check_example(task: PddlTaskType) -> None:
     from planners.examples import example_context
 
-    ctx = example_context(task)
-    if ctx is None:
-        return
-    world, goal, extra = task.update_inputs(ctx)  # what upTsk plans from: task.py's extra_facts too
+    hooks = task.spec.folder / "task.py"
+    try:  # what upTsk plans from: task.py's hooks too (check_args, extra_facts, check_terminate)
+        ctx = example_context(task)
+        if ctx is None:
+            return
+        world, goal, extra = task.update_inputs(ctx)
+        task.check_terminate(ctx)
+    except BadRequest as exc:
+        raise task.spec.error("example", f"args: {exc}") from None
+    except TaskerError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - only the folder's own hooks raise anything else
+        raise DefinitionError(hooks, f"a hook fails on the [example]: {type(exc).__name__}: {exc}",
+                              hook_line(exc, hooks)) from None
     text, init, _ = task.problem_text(ctx, world, goal, extra)
     where = f"{task.spec.folder / 'task.toml'} [example] problem"
     load_problem_text(task.domain.checked, text.problem, where)

@@ -25,18 +25,21 @@ from __future__ import annotations
 
 import contextlib
 import math
+import traceback
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Any
 
+from planners.checks import DefinitionError
 from planners.estimates import estimator_for, executing
 from planners.planner import PddlText, Planner
 from planners.problem import DomainModel, PortablePddl, holds, portable, render_problem, travel_table
 from planners.results import PlanResult, PlanStatus
 from planners.stages import Bindings, StageBuilder
 from planners.taskspec import Branch, Literal, TaskSpec
-from tasker.errors import PlanningFailed, UnknownName
+from tasker.errors import BadRequest, PlanningFailed, UnknownName
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
 from tasker.stage import Purpose, Stage, StagePlan
 from tasker.task import Effects, Leaving, TaskContext, TaskType
@@ -92,6 +95,12 @@ def default_planner() -> Planner:
     return _shared_planner
 
 
+def hook_line(exc: BaseException, path: Path) -> int | None:
+    """The line of ``path`` (a folder's ``task.py``) where ``exc`` was raised, if it was there."""
+    return next((f.lineno for f in reversed(traceback.extract_tb(exc.__traceback__)) if Path(f.filename) == path),
+                None)
+
+
 class PddlTaskType(TaskType):
     """A task type defined by a folder; one instance serves every agent of the type."""
 
@@ -115,7 +124,14 @@ class PddlTaskType(TaskType):
 
     def check_args(self, args: dict[str, Any]) -> None:
         if "check_args" in self.hooks:
-            self.hooks["check_args"](args)
+            try:
+                self.hooks["check_args"](args)
+            except BadRequest:
+                raise
+            except Exception as exc:  # noqa: BLE001 - the folder's code: say whose it is, not "internal error"
+                path = self.spec.folder / "task.py"
+                raise DefinitionError(path, f"check_args raised {type(exc).__name__}: {exc} (refuse a request "
+                                            "with tasker.errors.BadRequest)", hook_line(exc, path)) from None
 
     def check_terminate(self, ctx: TaskContext) -> str | None:
         """``ic_term``: the folder's ``task.py`` may say the task is no longer needed."""

@@ -114,3 +114,38 @@ def test_an_argument_default_that_does_not_fit_is_refused(tmp_path: Path, old: s
         load_task(folder, use_cache=False)
     assert info.value.line == _line_of(toml, new.split("\n")[0])
     assert "args[1].default: " in str(info.value) and fragment in str(info.value)
+
+
+@pytest.mark.parametrize(("hook", "fragment", "line"), [
+    ("def extra_facts(ctx, world):\n    raise RuntimeError('boom')\n", "RuntimeError: boom", 2),
+    ("def extra_facts(ctx, world):\n    return None\n", "TypeError: 'NoneType' object is not iterable", None),
+    ("def check_terminate(ctx, world):\n    return {}['x']\n", "KeyError: 'x'", 2),
+    ("def check_args(args):\n    raise ValueError('no vases')\n", "ValueError: no vases", 2),
+    ("\ndef extra_facts(world):\n    return []\n", "extra_facts(world): a hook extra_facts takes (ctx, world)", 2),
+])
+def test_a_failing_task_py_hook_is_an_error_naming_task_py(tmp_path: Path, hook: str, fragment: str,
+                                                          line: int | None) -> None:
+    """Before: `tasker check` passed (the hooks never ran on the [example]) or ended in
+    "internal error"; the run then failed every request of the task."""
+    folder = _new(tmp_path)
+    (folder / "task.py").write_text(hook)
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(folder / "task.py") and fragment in str(info.value)
+    assert line is None or info.value.line == line
+
+
+def test_check_args_raising_anything_but_bad_request_names_task_py(tmp_path: Path) -> None:
+    from tasker.errors import BadRequest
+
+    folder = _new(tmp_path)
+    (folder / "task.py").write_text("def check_args(args):\n    if args['item'] == 'cup':\n"
+                                    "        raise ValueError('no cups')\n")
+    task = load_task(folder, use_cache=False)
+    with pytest.raises(DefinitionError, match="task.py:3: check_args raised ValueError: no cups"):
+        task.validate_args({"item": "cup"})
+    (folder / "task.py").write_text("from tasker.errors import BadRequest\n\ndef check_args(args):\n"
+                                    "    raise BadRequest('no cups')\n")
+    with pytest.raises(DefinitionError, match=r"task.toml:\d+: example: args: no cups"):
+        load_task(folder, use_cache=False)
+    assert issubclass(BadRequest, ValueError)
