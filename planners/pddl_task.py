@@ -198,9 +198,7 @@ class PddlTaskType(TaskType):
         world = self._world(ctx)
         b = Bindings(ctx.args, world)
         extra = b.literals(self.spec.facts) + (b.literals(self.spec.suspended_facts) if ctx.suspended else [])
-        if "extra_facts" in self.hooks:
-            extra += [tuple(f) for f in self.hooks["extra_facts"](ctx, world)]
-        return world, b.literals(self.spec.goal), extra
+        return world, b.literals(self.spec.goal), extra + self._hook_facts(ctx, world)
 
     def suspension_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], Branch]:
         """genSusp: the world at interruption, the suspension goal and the branch that chose it."""
@@ -212,10 +210,20 @@ class PddlTaskType(TaskType):
         """genSusp's extra init facts: the request's and ``task.py``'s (e.g. carry_object's
         door-free passages), as for upTsk, but not Alg. 3's ``suspended_facts``."""
         b = Bindings(ctx.args, world)
-        extra = b.literals(self.spec.facts)
-        if "extra_facts" in self.hooks:
-            extra += [tuple(f) for f in self.hooks["extra_facts"](ctx, world)]
-        return extra
+        return b.literals(self.spec.facts) + self._hook_facts(ctx, world)
+
+    def _hook_facts(self, ctx: TaskContext, world: WorldState) -> list[Literal]:
+        """``task.py``'s ``extra_facts``: ground facts as tuples of strings, checked (a string
+        would become a tuple of letters, a fact nobody declares, silently left out)."""
+        if "extra_facts" not in self.hooks:
+            return []
+        out = []
+        for f in self.hooks["extra_facts"](ctx, world):
+            if not isinstance(f, tuple | list) or not f or not all(isinstance(x, str) and x for x in f):
+                raise DefinitionError(self.spec.folder / "task.py", f"extra_facts gave {f!r}; expected facts as "
+                                                                    "tuples of strings such as ('at', 'robot', 'hall')")
+            out.append(tuple(f))
+        return out
 
     def planning_problem(self, ctx: TaskContext, purpose: Purpose) -> PddlText:
         """The PDDL problem the planned strategy solves for ``purpose`` in this context."""

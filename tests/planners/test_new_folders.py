@@ -149,3 +149,13 @@ def test_check_args_raising_anything_but_bad_request_names_task_py(tmp_path: Pat
     with pytest.raises(DefinitionError, match=r"task.toml:\d+: example: args: no cups"):
         load_task(folder, use_cache=False)
     assert issubclass(BadRequest, ValueError)
+
+
+def test_extra_facts_that_are_not_tuples_of_strings_are_refused(tmp_path: Path) -> None:
+    """Before: ``"hand_empty robot"`` became a tuple of letters, silently left out of the problem."""
+    folder = _new(tmp_path)
+    (folder / "task.py").write_text("def extra_facts(ctx, world):\n    return ['hand_empty robot']\n")
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(folder / "task.py")
+    assert "extra_facts gave 'hand_empty robot'; expected facts as tuples of strings" in str(info.value)
