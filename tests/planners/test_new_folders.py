@@ -159,3 +159,13 @@ def test_extra_facts_that_are_not_tuples_of_strings_are_refused(tmp_path: Path) 
         load_task(folder, use_cache=False)
     assert info.value.file == str(folder / "task.py")
     assert "extra_facts gave 'hand_empty robot'; expected facts as tuples of strings" in str(info.value)
+
+
+def test_a_task_toml_with_a_byte_order_mark_is_checked_like_any(tmp_path: Path,
+                                                               capsys: pytest.CaptureFixture[str]) -> None:
+    from experiments.cli import main
+
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    toml.write_bytes(b"\xef\xbb\xbf" + toml.read_bytes())
+    assert main(["check", str(folder)]) == 0, capsys.readouterr()
