@@ -32,6 +32,7 @@ from planners.taskspec import TaskSpec, meaning_of, read_task_toml
 from tasker import reader
 from tasker.errors import BadRequest, TaskerError
 from tasker.meaning import Binding
+from tasker.world import WorldState
 
 HOOK_NAMES = ("extra_facts", "check_args", "check_terminate")
 _HOOK_PARAMS = {"extra_facts": "ctx, world", "check_args": "args", "check_terminate": "ctx, world"}
@@ -189,6 +190,17 @@ def _check_meaning(spec: TaskSpec, dm: DomainModel) -> tuple[Binding, ...]:
     return tuple(out)
 
 
+def _check_example_types(task: PddlTaskType, world: WorldState, used: list[tuple[str, ...]]) -> None:
+    """An [example] object the goal or a fact names must have a type of the domain: else the
+    problem leaves it out and UP reports "unknown object" at a line of the generated problem."""
+    names = {tok for lit in used for tok in lit}
+    for name, typ in sorted(world.objects.items()):
+        if name in names and typ not in task.domain.types:
+            raise task.spec.error("example", f"objects.{name}: {typ!r} is not a type of {task.spec.domain_file.name}"
+                                             f"{reader.suggest(typ, task.domain.types)} (its types: "
+                                             f"{', '.join(sorted(task.domain.types)) or 'none'})")
+
+
 def _check_example(task: PddlTaskType) -> None:
     from planners.examples import example_context
 
@@ -206,6 +218,7 @@ def _check_example(task: PddlTaskType) -> None:
     except Exception as exc:  # noqa: BLE001 - only the folder's own hooks raise anything else
         raise DefinitionError(hooks, f"a hook fails on the [example]: {type(exc).__name__}: {exc}",
                               hook_line(exc, hooks)) from None
+    _check_example_types(task, world, [*goal, *world.facts])
     text, init, _ = task.problem_text(ctx, world, goal, extra)
     where = f"{task.spec.folder / 'task.toml'} [example] problem"
     load_problem_text(task.domain.checked, text.problem, where)

@@ -169,3 +169,15 @@ def test_a_task_toml_with_a_byte_order_mark_is_checked_like_any(tmp_path: Path,
     toml = folder / "task.toml"
     toml.write_bytes(b"\xef\xbb\xbf" + toml.read_bytes())
     assert main(["check", str(folder)]) == 0, capsys.readouterr()
+
+
+def test_an_example_object_of_an_undeclared_type_is_named(tmp_path: Path) -> None:
+    """Before: "task.toml [example] problem:27:19: unknown object or invalid expression: vase",
+    a line of the generated problem, not of task.toml."""
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, 'vase = "item"', 'vase = "itme"')
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(toml) and info.value.line == _line_of(toml, "[example]")
+    assert "objects.vase: 'itme' is not a type of domain.pddl; did you mean 'item'?" in str(info.value)
