@@ -181,3 +181,24 @@ def test_an_example_object_of_an_undeclared_type_is_named(tmp_path: Path) -> Non
         load_task(folder, use_cache=False)
     assert info.value.file == str(toml) and info.value.line == _line_of(toml, "[example]")
     assert "objects.vase: 'itme' is not a type of domain.pddl; did you mean 'item'?" in str(info.value)
+
+
+@pytest.mark.parametrize(("old", "new", "fragment"), [
+    ("(increase (total-cost) (travel-time ?from ?to))",
+     "(increase (total-cost) (travel-time ?from ?to)) (decrease (battery ?r) 1)",
+     "an effect on the numeric fluent battery"),
+    ("(and (at ?r ?from) (connected ?from ?to))", "(and (at ?r ?from) (connected ?from ?to) (> (battery ?r) 0))",
+     "a condition on the numeric fluent battery"),
+])
+def test_a_numeric_fluent_other_than_the_cost_is_refused_clearly(tmp_path: Path, old: str, new: str,
+                                                                 fragment: str) -> None:
+    """Before: "Fast Downward's parser refuses the domain: ... Undefined predicate Got: decrease"."""
+    folder = _new(tmp_path)
+    domain = folder / "domain.pddl"
+    _edit(domain, "(total-cost) - number)", "(total-cost) - number\n    (battery ?r - robot) - number)")
+    _edit(domain, old, new)
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(domain)
+    assert f"action navigate: {fragment}; numeric fluents are supported only as action costs" in str(info.value)
+    assert info.value.line == _line_of(domain, new[-25:])
