@@ -100,7 +100,7 @@ class Checker:
 
     def _toml(self, p: Path, also: list[str] | None = None) -> None:
         try:
-            raw = tomllib.loads(p.read_text(encoding="utf-8"))
+            raw = tomllib.loads(p.read_text(encoding="utf-8-sig"))  # a byte-order mark as reader.read_text
         except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
             self.problems.append((str(p), f"not valid TOML: {exc}"))
             return

@@ -182,8 +182,29 @@ def load_domain(path: str | Path) -> CheckedDomain:
     """Read and check a ``domain.pddl``; raise :class:`PddlError` naming the file and line."""
     text = _read(path)
     check_requirements(text, path)
-    parse_domain(text, path)
+    check_numeric(parse_domain(text, path), text, path)
     return CheckedDomain(Path(path), text)
+
+
+def check_numeric(domain: up.model.Problem, text: str, file: str | Path) -> None:
+    """Refuse numeric fluents in conditions and effects other than ``total-cost``'s: the classical
+    planner cannot handle them (its parser would say "Undefined predicate Got: decrease")."""
+    fve = domain.environment.free_vars_extractor
+    for a in domain.actions:
+        used = [("an effect on", e.fluent) for e in getattr(a, "effects", ())
+                if not e.fluent.type.is_bool_type() and e.fluent.fluent().name != "total-cost"]
+        used += [("a condition on", f) for c in getattr(a, "preconditions", ()) for f in fve.get(c)
+                 if not f.type.is_bool_type()]
+        if used:
+            what, fluent = used[0]
+            name = fluent.fluent().name
+            lines = text.splitlines()
+            start = next((i for i, s in enumerate(lines) if re.search(rf"\(:action\s+{re.escape(a.name)}\b", s,
+                                                                       re.IGNORECASE)), 0)
+            line = next((i + 1 for i in range(start, len(lines)) if f"({name}" in lines[i].lower()), None)
+            raise PddlError(file, f"action {a.name}: {what} the numeric fluent {name}; numeric fluents are "
+                                  "supported only as action costs: (increase (total-cost) ...) by a constant or "
+                                  "a fluent fixed in the problem such as travel-time", line)
 
 
 def remembered_domain(path: str | Path) -> CheckedDomain:

@@ -102,14 +102,19 @@ def _task_for_domain(domain_text: str, extra: list[str], beside: Path | None = N
 
 def _stages_for(domain_text: str, result: PlanResult, extra: list[str],
                 beside: Path | None = None) -> tuple[Stage, ...]:
-    """Stages of a plan: the task type's skills when the domain is a registered task's."""
+    """Stages of a plan: the task type's skills when the domain is a registered task's.
+
+    A task folder of this domain that does not load is said on stderr: its stages would
+    otherwise print as skill-less and instant, as if the domain were no task's."""
     from tasker.errors import TaskerError
     from tasker.stage import Stage
 
     assert result.plan is not None
     try:
         task = _task_for_domain(domain_text, extra, beside)
-    except TaskerError:
+    except TaskerError as exc:
+        print(f"tasker plan: warning: the stages have no skills or durations: the domain's task folder does "
+              f"not load: {exc}", file=sys.stderr)
         task = None
     if task is not None:
         return task.builder.from_steps(result.plan, {}, {})

@@ -17,21 +17,25 @@ by Fast Downward's parser (:mod:`planners.schema`), checked or remembered.
 from __future__ import annotations
 
 import importlib.util
+import inspect
 import sys
+import types
 from pathlib import Path
 from typing import Any
 
 from planners import cache
 from planners.checks import DefinitionError, load_domain, load_problem_text, remembered_domain
-from planners.pddl_task import PddlTaskType
+from planners.pddl_task import PddlTaskType, hook_line
 from planners.problem import DomainModel
 from planners.results import PlanStatus
-from planners.stages import Bindings
 from planners.taskspec import TaskSpec, meaning_of, read_task_toml
 from tasker import reader
+from tasker.errors import BadRequest, TaskerError
 from tasker.meaning import Binding
+from tasker.world import WorldState
 
 HOOK_NAMES = ("extra_facts", "check_args", "check_terminate")
+_HOOK_PARAMS = {"extra_facts": "ctx, world", "check_args": "args", "check_terminate": "ctx, world"}
 """Functions a ``task.py`` may define (see ``docs/domains.md``).  There is no hook that changes
 the suspension goal: that is declared in ``[[suspension]]``, so both strategies pursue it."""
 
@@ -56,6 +60,14 @@ def _load_hooks(spec: TaskSpec) -> dict[str, Any]:
                      and callable(vars(module)[n]) and getattr(vars(module)[n], "__module__", "") == mod_name)
     if unknown:
         raise DefinitionError(path, f"unknown hook(s) {unknown}; a task.py may define {list(HOOK_NAMES)}")
+    for name, fn in hooks.items():
+        params = _HOOK_PARAMS[name].split(", ")
+        try:
+            inspect.signature(fn).bind(*params)
+        except (TypeError, ValueError):  # ValueError: no signature to inspect (a builtin): let it be
+            if isinstance(fn, types.FunctionType):
+                raise DefinitionError(path, f"{name}{inspect.signature(fn)}: a hook {name} takes "
+                                            f"({_HOOK_PARAMS[name]})", fn.__code__.co_firstlineno) from None
     return hooks
 
 
@@ -75,15 +87,19 @@ def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
                 raise DefinitionError(toml, f"[actions.{name}] {ref} is not a parameter of {name} {sorted(params)}")
     lits = [("problem.goal", spec.goal), ("problem.facts", spec.facts),
             ("problem.suspended_facts", spec.suspended_facts)]
-    lits += [(f"suspension[{k}]", b.when + b.goal) for k, b in enumerate(spec.suspension)]
+    lits += [(f"suspension[{k}].{key}", getattr(b, key)) for k, b in enumerate(spec.suspension)
+             for key in ("when", "goal")]
     for where, group in lits:
         for lit in group:
             try:
                 dm.check_literal(lit, where)
-            except DefinitionError as exc:
-                raise DefinitionError(toml, exc.reason) from None
+            except DefinitionError as exc:  # located in task.toml, at the field's line
+                raise DefinitionError(toml, exc.reason, spec.lines.get(where)) from None
     templates = [("static.update", t) for t in spec.static_update]
     templates += [(f"suspension[{k}].stages", t) for k, b in enumerate(spec.suspension) for t in b.stages]
+    tokens = [*((w, tok) for w, group in lits for lit in group for tok in lit),
+              *((w, tok) for w, t in templates for tok in t.args)]
+    _check_request_tokens(spec, tokens)
     for where, t in templates:
         for action in filter(None, (t.action, t.suspended)):
             if action not in dm.actions:
@@ -91,6 +107,16 @@ def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
             if len(t.args) != len(dm.actions[action].params):
                 raise DefinitionError(toml, f"[{where}] {action} takes {len(dm.actions[action].params)} "
                                             f"argument(s), got {len(t.args)}")
+
+
+def _check_request_tokens(spec: TaskSpec, tokens: list[tuple[str, str]]) -> None:
+    """Every ``$name`` is a request argument or ``$robot`` (``$at:x`` may name any object): a
+    misspelt one would fail only when a request plans, or when a static strategy runs."""
+    args = [a.name for a in spec.args] + ["robot"]
+    for where, tok in tokens:
+        if tok.startswith("$") and not tok.startswith("$at:") and tok[1:] not in args:
+            raise spec.error(where, f"unknown request argument {tok!r}{reader.suggest(tok, ['$' + a for a in args])} "
+                                    f"(this task's: {', '.join('$' + a for a in args)}; $at:NAME for a place)")
 
 
 def _check_suspension(spec: TaskSpec, dm: DomainModel) -> None:
@@ -164,19 +190,47 @@ def _check_meaning(spec: TaskSpec, dm: DomainModel) -> tuple[Binding, ...]:
     return tuple(out)
 
 
+def _check_example_types(task: PddlTaskType, world: WorldState, used: list[tuple[str, ...]]) -> None:
+    """An [example] object the goal or a fact names must have a type of the domain: else the
+    problem leaves it out and UP reports "unknown object" at a line of the generated problem."""
+    names = {tok for lit in used for tok in lit}
+    for name, typ in sorted(world.objects.items()):
+        if name in names and typ not in task.domain.types:
+            raise task.spec.error("example", f"objects.{name}: {typ!r} is not a type of {task.spec.domain_file.name}"
+                                             f"{reader.suggest(typ, task.domain.types)} (its types: "
+                                             f"{', '.join(sorted(task.domain.types)) or 'none'})")
+
+
 def _check_example(task: PddlTaskType) -> None:
     from planners.examples import example_context
 
-    ctx = example_context(task)
-    if ctx is None:
-        return
-    b = Bindings(ctx.args, ctx.world)
-    text, _, _ = task.problem_text(ctx, ctx.world, b.literals(task.spec.goal), b.literals(task.spec.facts))
+    hooks = task.spec.folder / "task.py"
+    try:  # what upTsk plans from: task.py's hooks too (check_args, extra_facts, check_terminate)
+        ctx = example_context(task)
+        if ctx is None:
+            return
+        world, goal, extra = task.update_inputs(ctx)
+        task.check_terminate(ctx)
+    except BadRequest as exc:
+        raise task.spec.error("example", f"args: {exc}") from None
+    except TaskerError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - only the folder's own hooks raise anything else
+        raise DefinitionError(hooks, f"a hook fails on the [example]: {type(exc).__name__}: {exc}",
+                              hook_line(exc, hooks)) from None
+    _check_example_types(task, world, [*goal, *world.facts])
+    text, init, _ = task.problem_text(ctx, world, goal, extra)
     where = f"{task.spec.folder / 'task.toml'} [example] problem"
     load_problem_text(task.domain.checked, text.problem, where)
     result = task.planner.solve(text, timeout=task.timeout)
     if result.status is PlanStatus.ERROR:  # e.g. a feature the optimal search cannot handle (axioms)
         raise DefinitionError(task.spec.domain_file, f"the planner fails on the {where}: {result.message}")
+    if result.status is PlanStatus.UNSOLVABLE:  # the example is what `tasker check` promises to solve
+        left_out = [list(f) for f in sorted(world.facts) if tuple(f) not in init]
+        raise task.spec.error("example", f"no plan reaches the goal {[list(g) for g in goal]} from the [example] "
+                                         "world" + (f"; left out of the problem (an object or predicate the "
+                                                    f"domain or [example] objects do not declare): {left_out}"
+                                                    if left_out else ""))
 
 
 def load_task(folder: str | Path, *, use_cache: bool = True) -> PddlTaskType:

@@ -25,18 +25,21 @@ from __future__ import annotations
 
 import contextlib
 import math
+import traceback
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Any
 
+from planners.checks import DefinitionError
 from planners.estimates import estimator_for, executing
 from planners.planner import PddlText, Planner
 from planners.problem import DomainModel, PortablePddl, holds, portable, render_problem, travel_table
 from planners.results import PlanResult, PlanStatus
 from planners.stages import Bindings, StageBuilder
 from planners.taskspec import Branch, Literal, TaskSpec
-from tasker.errors import PlanningFailed, UnknownName
+from tasker.errors import BadRequest, PlanningFailed, UnknownName
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
 from tasker.stage import Purpose, Stage, StagePlan
 from tasker.task import Effects, Leaving, TaskContext, TaskType
@@ -92,6 +95,12 @@ def default_planner() -> Planner:
     return _shared_planner
 
 
+def hook_line(exc: BaseException, path: Path) -> int | None:
+    """The line of ``path`` (a folder's ``task.py``) where ``exc`` was raised, if it was there."""
+    return next((f.lineno for f in reversed(traceback.extract_tb(exc.__traceback__)) if Path(f.filename) == path),
+                None)
+
+
 class PddlTaskType(TaskType):
     """A task type defined by a folder; one instance serves every agent of the type."""
 
@@ -115,7 +124,14 @@ class PddlTaskType(TaskType):
 
     def check_args(self, args: dict[str, Any]) -> None:
         if "check_args" in self.hooks:
-            self.hooks["check_args"](args)
+            try:
+                self.hooks["check_args"](args)
+            except BadRequest:
+                raise
+            except Exception as exc:  # noqa: BLE001 - the folder's code: say whose it is, not "internal error"
+                path = self.spec.folder / "task.py"
+                raise DefinitionError(path, f"check_args raised {type(exc).__name__}: {exc} (refuse a request "
+                                            "with tasker.errors.BadRequest)", hook_line(exc, path)) from None
 
     def check_terminate(self, ctx: TaskContext) -> str | None:
         """``ic_term``: the folder's ``task.py`` may say the task is no longer needed."""
@@ -182,9 +198,7 @@ class PddlTaskType(TaskType):
         world = self._world(ctx)
         b = Bindings(ctx.args, world)
         extra = b.literals(self.spec.facts) + (b.literals(self.spec.suspended_facts) if ctx.suspended else [])
-        if "extra_facts" in self.hooks:
-            extra += [tuple(f) for f in self.hooks["extra_facts"](ctx, world)]
-        return world, b.literals(self.spec.goal), extra
+        return world, b.literals(self.spec.goal), extra + self._hook_facts(ctx, world)
 
     def suspension_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], Branch]:
         """genSusp: the world at interruption, the suspension goal and the branch that chose it."""
@@ -196,10 +210,20 @@ class PddlTaskType(TaskType):
         """genSusp's extra init facts: the request's and ``task.py``'s (e.g. carry_object's
         door-free passages), as for upTsk, but not Alg. 3's ``suspended_facts``."""
         b = Bindings(ctx.args, world)
-        extra = b.literals(self.spec.facts)
-        if "extra_facts" in self.hooks:
-            extra += [tuple(f) for f in self.hooks["extra_facts"](ctx, world)]
-        return extra
+        return b.literals(self.spec.facts) + self._hook_facts(ctx, world)
+
+    def _hook_facts(self, ctx: TaskContext, world: WorldState) -> list[Literal]:
+        """``task.py``'s ``extra_facts``: ground facts as tuples of strings, checked (a string
+        would become a tuple of letters, a fact nobody declares, silently left out)."""
+        if "extra_facts" not in self.hooks:
+            return []
+        out = []
+        for f in self.hooks["extra_facts"](ctx, world):
+            if not isinstance(f, tuple | list) or not f or not all(isinstance(x, str) and x for x in f):
+                raise DefinitionError(self.spec.folder / "task.py", f"extra_facts gave {f!r}; expected facts as "
+                                                                    "tuples of strings such as ('at', 'robot', 'hall')")
+            out.append(tuple(f))
+        return out
 
     def planning_problem(self, ctx: TaskContext, purpose: Purpose) -> PddlText:
         """The PDDL problem the planned strategy solves for ``purpose`` in this context."""

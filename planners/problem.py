@@ -43,6 +43,7 @@ class DomainModel:
         self.types: dict[str, set[str]] = {name: set(chain) for name, chain in schema.types}
         self.predicates: dict[str, tuple[str, ...]] = dict(schema.predicates)
         self.functions = set(schema.functions)
+        self.constants: dict[str, str] = dict(schema.constants)
         self.actions = {a.name: a for a in schema.actions}
 
     def has_type(self, obj_type: str, wanted: str) -> bool:
@@ -172,9 +173,11 @@ def render_problem(
 
     Objects of types the domain does not know, and facts over predicates it does not
     declare, are left out: the world holds facts for every task.  A fact with the right
-    predicate but the wrong arity is an error.
+    predicate but the wrong arity is an error.  The domain's constants are objects too
+    (declared by the domain, so a world object of the same name is not declared again).
     """
-    objects = {n: t for n, t in sorted(world.objects.items()) if t in domain.types}
+    known = {**domain.constants, **{n: t for n, t in sorted(world.objects.items()) if t in domain.types}}
+    objects = {n: t for n, t in known.items() if n not in domain.constants}
     init: set[Fact] = set()
     for fact in [*world.facts, *extra_facts]:
         sig = domain.predicates.get(fact[0]) if fact else None
@@ -182,11 +185,12 @@ def render_problem(
             continue
         if len(fact) - 1 != len(sig):
             raise PddlError(domain.checked.path, f"world fact {list(fact)}: {fact[0]!r} takes {len(sig)} argument(s)")
-        if all(a in objects and domain.has_type(objects[a], t) for a, t in zip(fact[1:], sig, strict=True)):
+        if all(a in known and domain.has_type(known[a], t) for a, t in zip(fact[1:], sig, strict=True)):
             init.add(tuple(fact))
     numeric = []
-    if travel is not None and TRAVEL_FUNCTION in domain.functions:
-        places = [n for n, t in objects.items() if domain.has_type(t, PLACE_TYPE)]
+    timed = TRAVEL_FUNCTION in domain.functions
+    if travel is not None and (timed or CONNECTED in domain.predicates):  # either may be declared alone
+        places = [n for n, t in sorted(known.items()) if domain.has_type(t, PLACE_TYPE)]
         for a in places:
             for b in places:
                 # Every pair gets a value so UP's simulator and validator accept the problem;
@@ -198,7 +202,8 @@ def render_problem(
                     value = max(1, math.ceil(secs))
                 else:
                     value = 0 if a == b else UNREACHABLE_COST
-                numeric.append(f"(= ({TRAVEL_FUNCTION} {a} {b}) {value})")
+                if timed:
+                    numeric.append(f"(= ({TRAVEL_FUNCTION} {a} {b}) {value})")
     by_type: dict[str, list[str]] = {}
     for n, t in objects.items():
         by_type.setdefault(t, []).append(n)

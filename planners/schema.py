@@ -65,6 +65,8 @@ class DomainSchema:
     predicates: tuple[tuple[str, tuple[str, ...]], ...]
     functions: frozenset[str]
     actions: tuple[ActionModel, ...]
+    constants: tuple[tuple[str, str], ...] = ()
+    """The domain's ``(:constants ...)``: ``(name, type)``, ``""`` for an untyped one."""
 
 
 class SchemaError(ValueError):
@@ -121,6 +123,7 @@ def _read(text: str) -> DomainSchema:
                          for p in predicates if p.name != "="),
         functions=frozenset(f.name for f in functions),
         actions=tuple(action(a) for a in actions),
+        constants=tuple((c.name, type_of(c.type_name)) for c in constants),
     )
 
 

@@ -20,7 +20,7 @@ from typing import Any
 
 from planners.checks import DefinitionError
 from tasker import reader
-from tasker.errors import ConfigError
+from tasker.errors import BadRequest, ConfigError
 from tasker.meaning import BINDING_KINDS, ROLES, Binding, Hazard, Meaning, People
 from tasker.stage import StageKind
 from tasker.task import POLICIES, ArgSpec
@@ -254,6 +254,11 @@ def _args(r: _Reader, top: reader.Table) -> tuple[ArgSpec, ...]:
                                choices=tuple(a.raw("choices")) if "choices" in a else None))
         except (ConfigError, TypeError) as exc:
             raise r.fail(a, None, str(exc)) from None
+        if out[-1].default is not None:  # a request without the argument gets it: it must fit the type
+            try:
+                out[-1].coerce(name, out[-1].default)
+            except BadRequest as exc:
+                raise r.fail(a, "default", str(exc).split(": ", 1)[-1]) from None
         a.done()
     return tuple(out)
 
@@ -262,6 +267,7 @@ def _example(r: _Reader, top: reader.Table) -> ExampleWorld | None:
     if "example" not in top:
         return None
     ex = top.table("example")
+    r.note(ex)
     poses = {}
     for name, p in ex.table("poses", {}).items():
         if not isinstance(p, list) or len(p) not in (2, 3) or not all(isinstance(v, int | float) for v in p):

@@ -337,7 +337,8 @@ def _show(value: Any) -> str:
 
 
 def read_text(path: str | Path, error_class: type[InputError] = InputError) -> str:
-    """A user's file as text: missing, binary and non-UTF-8 files are clean errors."""
+    """A user's file as text: missing, binary and non-UTF-8 files are clean errors.  A UTF-8
+    byte-order mark (Windows editors write one) is dropped: TOML parsers would call it a syntax error."""
     p = Path(path)
     try:
         data = p.read_bytes()
@@ -349,6 +350,7 @@ def read_text(path: str | Path, error_class: type[InputError] = InputError) -> s
         raise error_class(p, f"cannot read: {exc.strerror or exc}") from None
     if b"\x00" in data:
         raise error_class(p, "is a binary file, expected UTF-8 text")
+    data = data.removeprefix(b"\xef\xbb\xbf")
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:

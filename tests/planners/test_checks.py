@@ -38,7 +38,7 @@ CASES: dict[str, tuple[Mutation, str, bool, str]] = {
     "undefined object type": (lambda d, p: (d, p.replace("cup - item", "cup - widget")), "problem", False, "widget"),
     "numeric fluents": (lambda d, p: (d.replace("(increase (total-cost) 1)))\n  (:action drop",
                                                 "(increase (dist ?r ?r) 1)))\n  (:action drop"), p),
-                        "problem", False, "unsupported PDDL features"),
+                        "domain", True, "an effect on the numeric fluent dist"),
 }
 
 

@@ -138,3 +138,16 @@ def test_new_refuses_a_bad_name_and_a_full_folder(tmp_path: Path, capsys: pytest
     (tmp_path / "b" / "keep.txt").write_text("mine")
     assert _run(["new", "ok", str(tmp_path / "b")]) == 2
     assert "argument DIR" in capsys.readouterr().err and (tmp_path / "b" / "keep.txt").read_text() == "mine"
+
+
+def test_plan_says_when_the_domains_task_folder_does_not_load(tmp_path: Path,
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: the stages printed as "skill=-, 0 s", silently, as if the domain were no task's."""
+    folder = tmp_path / "fetch"
+    assert _run(["new", "fetch", str(folder)]) == 0
+    toml = folder / "task.toml"
+    toml.write_text(toml.read_text().replace('skill = "manipulate"', 'skill = "grasp"', 1))
+    capsys.readouterr()
+    assert _run(["plan", str(folder / "domain.pddl"), str(folder / "problem.pddl")]) == 0
+    err = capsys.readouterr().err
+    assert "warning: the stages have no skills or durations" in err and "task.toml:" in err and "'grasp'" in err

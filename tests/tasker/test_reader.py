@@ -124,3 +124,10 @@ def test_a_non_finite_number_where_no_number_belongs_says_what_was_expected(read
     with pytest.raises(InputError) as info:
         read(t)
     assert str(info.value) == expected
+
+
+def test_a_utf8_byte_order_mark_is_not_a_syntax_error(tmp_path: Path) -> None:
+    """Before: ``bad.toml:1: not valid TOML: Invalid statement`` for a file saved with a BOM."""
+    p = tmp_path / "bom.toml"
+    p.write_bytes(b'\xef\xbb\xbfname = "demo"\n')
+    assert reader.load(p).string("name") == "demo"

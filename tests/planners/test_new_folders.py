@@ -1,0 +1,204 @@
+"""Task folders as a new user writes them (from ``tasker new``'s template): each mistake is
+refused at load naming the file, the line and what was expected, and each valid PDDL
+feature the docs promise works; never a traceback, never a silently wrong problem."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from planners.checks import DefinitionError
+from planners.cli import scaffold
+from planners.loader import load_task
+from tasker.stage import Purpose
+
+
+def _new(tmp_path: Path, name: str = "fetch") -> Path:
+    folder = tmp_path / name
+    scaffold(name, folder)
+    return folder
+
+
+def _edit(path: Path, old: str, new: str) -> None:
+    text = path.read_text()
+    assert old in text, old
+    path.write_text(text.replace(old, new, 1))
+
+
+def _line_of(path: Path, fragment: str) -> int:
+    return next(n for n, s in enumerate(path.read_text().splitlines(), 1) if fragment in s)
+
+
+def test_an_unsolvable_example_is_refused_naming_what_was_left_out(tmp_path: Path) -> None:
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, '["at", "vase", "kitchen"]', '["at", "vaze", "kitchen"]')  # a typo: the vase is nowhere
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(toml) and info.value.line == _line_of(toml, "[example]")
+    assert "example: no plan reaches the goal" in str(info.value) and "['at', 'vaze', 'kitchen']" in str(info.value)
+
+
+def test_connected_without_travel_time_still_connects_the_places(tmp_path: Path) -> None:
+    """A domain without action costs keeps ``connected``: the docs add it "when the domain declares" it."""
+    from planners.examples import example_context
+
+    folder = _new(tmp_path)
+    domain = folder / "domain.pddl"
+    _edit(domain, " :action-costs", "")
+    _edit(domain, "  (:functions\n    (travel-time ?from ?to - place) - number\n    (total-cost) - number)\n", "")
+    _edit(domain, "\n                 (increase (total-cost) (travel-time ?from ?to))", "")
+    for _ in range(2):
+        _edit(domain, "\n                 (increase (total-cost) 5)", "")
+    task = load_task(folder, use_cache=False)  # before: the example was unsolvable (no place connected)
+    plan = task.update_task(example_context(task))
+    assert [s.action for s in plan.stages] == ["navigate", "pick", "navigate", "put_down"]
+
+
+def test_a_domain_constant_that_is_also_a_world_object(tmp_path: Path) -> None:
+    """``(:constants kitchen - place)``: the world's kitchen is that constant, declared once,
+    and facts over it are kept (before: UP's "Name kitchen already defined!")."""
+    from planners.examples import example_context
+
+    folder = _new(tmp_path)
+    _edit(folder / "domain.pddl", "  (:predicates", "  (:constants kitchen - place)\n  (:predicates")
+    task = load_task(folder, use_cache=False)
+    ctx = example_context(task)
+    text = task.planning_problem(ctx, Purpose.UP_TSK)
+    objects = text.problem.split("(:objects")[1].split(")")[0]
+    assert "kitchen" not in objects and "(at vase kitchen)" in text.problem
+    assert [s.action for s in task.update_task(ctx).stages] == ["navigate", "pick", "navigate", "put_down"]
+
+
+@pytest.mark.parametrize(("old", "new"), [
+    ('goal = [["at", "$item", "$destination"]', 'goal = [["at", "$item", "$destination", "$robot"]'),
+    ('when = [["holding", "$robot", "$item"]]', 'when = [["holds", "$robot", "$item"]]'),
+])
+def test_a_bad_literal_names_its_line(tmp_path: Path, old: str, new: str) -> None:
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, old, new)
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(toml) and info.value.line == _line_of(toml, new[:30])
+    assert f"task.toml:{info.value.line}: " in str(info.value)
+
+
+@pytest.mark.parametrize(("old", "new", "at"), [
+    ('goal = [["at", "$item", "$destination"]', 'goal = [["at", "$item", "$destinaton"]', "goal = "),
+    ('args = ["$robot", "$item", "$at:item"] }', 'args = ["$robot", "$itm", "$at:item"] }', "update = ["),
+])
+def test_an_unknown_request_argument_is_refused_at_load(tmp_path: Path, old: str, new: str, at: str) -> None:
+    """Before: the goal's failed with "$destinaton: no request argument" naming no file; the
+    static template's was accepted and failed only when the static strategy ran."""
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, old, new)
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(toml) and info.value.line == _line_of(toml, at)
+    assert "unknown request argument" in str(info.value) and "did you mean" in str(info.value)
+
+
+@pytest.mark.parametrize(("old", "new", "fragment"), [
+    ('default = "living"', "default = 3", "expected a non-empty string, got 3"),
+    ('default = "living"', 'default = "living"\nchoices = ["kitchen"]', "expected one of ['kitchen'], got 'living'"),
+])
+def test_an_argument_default_that_does_not_fit_is_refused(tmp_path: Path, old: str, new: str, fragment: str) -> None:
+    """Before: accepted, then a request without the argument failed in the planner ("Undefined object 3")."""
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, old, new)
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.line == _line_of(toml, new.split("\n")[0])
+    assert "args[1].default: " in str(info.value) and fragment in str(info.value)
+
+
+@pytest.mark.parametrize(("hook", "fragment", "line"), [
+    ("def extra_facts(ctx, world):\n    raise RuntimeError('boom')\n", "RuntimeError: boom", 2),
+    ("def extra_facts(ctx, world):\n    return None\n", "TypeError: 'NoneType' object is not iterable", None),
+    ("def check_terminate(ctx, world):\n    return {}['x']\n", "KeyError: 'x'", 2),
+    ("def check_args(args):\n    raise ValueError('no vases')\n", "ValueError: no vases", 2),
+    ("\ndef extra_facts(world):\n    return []\n", "extra_facts(world): a hook extra_facts takes (ctx, world)", 2),
+])
+def test_a_failing_task_py_hook_is_an_error_naming_task_py(tmp_path: Path, hook: str, fragment: str,
+                                                          line: int | None) -> None:
+    """Before: `tasker check` passed (the hooks never ran on the [example]) or ended in
+    "internal error"; the run then failed every request of the task."""
+    folder = _new(tmp_path)
+    (folder / "task.py").write_text(hook)
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(folder / "task.py") and fragment in str(info.value)
+    assert line is None or info.value.line == line
+
+
+def test_check_args_raising_anything_but_bad_request_names_task_py(tmp_path: Path) -> None:
+    from tasker.errors import BadRequest
+
+    folder = _new(tmp_path)
+    (folder / "task.py").write_text("def check_args(args):\n    if args['item'] == 'cup':\n"
+                                    "        raise ValueError('no cups')\n")
+    task = load_task(folder, use_cache=False)
+    with pytest.raises(DefinitionError, match="task.py:3: check_args raised ValueError: no cups"):
+        task.validate_args({"item": "cup"})
+    (folder / "task.py").write_text("from tasker.errors import BadRequest\n\ndef check_args(args):\n"
+                                    "    raise BadRequest('no cups')\n")
+    with pytest.raises(DefinitionError, match=r"task.toml:\d+: example: args: no cups"):
+        load_task(folder, use_cache=False)
+    assert issubclass(BadRequest, ValueError)
+
+
+def test_extra_facts_that_are_not_tuples_of_strings_are_refused(tmp_path: Path) -> None:
+    """Before: ``"hand_empty robot"`` became a tuple of letters, silently left out of the problem."""
+    folder = _new(tmp_path)
+    (folder / "task.py").write_text("def extra_facts(ctx, world):\n    return ['hand_empty robot']\n")
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(folder / "task.py")
+    assert "extra_facts gave 'hand_empty robot'; expected facts as tuples of strings" in str(info.value)
+
+
+def test_a_task_toml_with_a_byte_order_mark_is_checked_like_any(tmp_path: Path,
+                                                               capsys: pytest.CaptureFixture[str]) -> None:
+    from experiments.cli import main
+
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    toml.write_bytes(b"\xef\xbb\xbf" + toml.read_bytes())
+    assert main(["check", str(folder)]) == 0, capsys.readouterr()
+
+
+def test_an_example_object_of_an_undeclared_type_is_named(tmp_path: Path) -> None:
+    """Before: "task.toml [example] problem:27:19: unknown object or invalid expression: vase",
+    a line of the generated problem, not of task.toml."""
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, 'vase = "item"', 'vase = "itme"')
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(toml) and info.value.line == _line_of(toml, "[example]")
+    assert "objects.vase: 'itme' is not a type of domain.pddl; did you mean 'item'?" in str(info.value)
+
+
+@pytest.mark.parametrize(("old", "new", "fragment"), [
+    ("(increase (total-cost) (travel-time ?from ?to))",
+     "(increase (total-cost) (travel-time ?from ?to)) (decrease (battery ?r) 1)",
+     "an effect on the numeric fluent battery"),
+    ("(and (at ?r ?from) (connected ?from ?to))", "(and (at ?r ?from) (connected ?from ?to) (> (battery ?r) 0))",
+     "a condition on the numeric fluent battery"),
+])
+def test_a_numeric_fluent_other_than_the_cost_is_refused_clearly(tmp_path: Path, old: str, new: str,
+                                                                 fragment: str) -> None:
+    """Before: "Fast Downward's parser refuses the domain: ... Undefined predicate Got: decrease"."""
+    folder = _new(tmp_path)
+    domain = folder / "domain.pddl"
+    _edit(domain, "(total-cost) - number)", "(total-cost) - number\n    (battery ?r - robot) - number)")
+    _edit(domain, old, new)
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.file == str(domain)
+    assert f"action navigate: {fragment}; numeric fluents are supported only as action costs" in str(info.value)
+    assert info.value.line == _line_of(domain, new[-25:])
