@@ -202,3 +202,26 @@ def test_a_numeric_fluent_other_than_the_cost_is_refused_clearly(tmp_path: Path,
     assert info.value.file == str(domain)
     assert f"action navigate: {fragment}; numeric fluents are supported only as action costs" in str(info.value)
     assert info.value.line == _line_of(domain, new[-25:])
+
+
+@pytest.mark.parametrize(("old", "new", "at", "fragment"), [
+    ("(holding ?r - robot ?i - item)", "(holding ?r - robot ?i - (either item robot))", "(either",
+     "(either ...) types are not supported by tasker"),
+    ("  (:action navigate", "  (:derived (busy ?r - robot) (not (hand_empty ?r)))\n  (:action navigate", "(:derived",
+     ":derived predicates are not supported by tasker"),
+    (":action-costs)", ":action-costs :derived-predicates)", ":derived-predicates",
+     ":derived predicates are not supported by tasker"),
+])
+def test_either_types_and_derived_predicates_are_refused_plainly(tmp_path: Path, old: str, new: str, at: str,
+                                                                 fragment: str) -> None:
+    """Before: unified-planning's "syntax error: Expected ')'" at a misleading place."""
+    folder = _new(tmp_path)
+    domain = folder / "domain.pddl"
+    _edit(domain, "(hand_empty ?r - robot))", "(hand_empty ?r - robot)\n    (busy ?r - robot))")
+    _edit(domain, old, new)
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    line = _line_of(domain, at)
+    assert info.value.file == str(domain) and info.value.line == line
+    assert info.value.col == domain.read_text().splitlines()[line - 1].index(at) + 1
+    assert fragment in str(info.value) and "Expected" not in str(info.value)
