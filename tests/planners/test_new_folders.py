@@ -225,3 +225,23 @@ def test_either_types_and_derived_predicates_are_refused_plainly(tmp_path: Path,
     assert info.value.file == str(domain) and info.value.line == line
     assert info.value.col == domain.read_text().splitlines()[line - 1].index(at) + 1
     assert fragment in str(info.value) and "Expected" not in str(info.value)
+
+
+def test_pddl_names_in_task_toml_ignore_case_as_in_pddl(tmp_path: Path) -> None:
+    """Before: ``[actions.Put_Down]`` gave "no entry for domain action(s) ['put_down']" and
+    ``["HAND_EMPTY", ...]`` "unknown predicate": the domain's names are read in lower case."""
+    folder = _new(tmp_path)
+    for path in (folder / "domain.pddl", folder / "task.toml"):
+        path.write_text(path.read_text().replace("put_down", "Put_Down").replace("hand_empty", "HAND_EMPTY"))
+    toml = folder / "task.toml"
+    _edit(toml, 'fact = ["holding", "$robot", "$item"]', 'fact = ["Holding", "$robot", "$item"]')
+    _edit(toml, 'to = "?to"', 'to = "?To"')
+    _edit(toml, 'when = [["holding", "$robot", "$item"]]', 'when = [["NOT", "HOLDING", "$robot", "$item"]]')
+    task = load_task(folder, use_cache=False)
+    assert "put_down" in task.spec.actions and task.spec.actions["navigate"].to == "?to"
+    assert task.spec.goal[1] == ("hand_empty", "$robot") and task.spec.hazards[0].fact[0] == "holding"
+    assert task.spec.suspension[0].when == (("not", "holding", "$robot", "$item"),)
+    assert [t.action for t in task.spec.static_update][-1] == "put_down"
+    _edit(toml, "[actions.pick]", "[actions.PUT_DOWN]\nskill = \"manipulate\"\n\n[actions.pick]")
+    with pytest.raises(DefinitionError, match="a second entry for action 'put_down'"):
+        load_task(folder, use_cache=False)
