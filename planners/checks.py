@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from tasker import reader
 from tasker.errors import TaskerError
 
 if TYPE_CHECKING:
@@ -87,13 +88,14 @@ class PddlError(DefinitionError):
 
 
 def _read(path: str | Path) -> str:
+    """The file's text; a non-UTF-8 byte is named with its line (:func:`tasker.reader.read_text`)."""
     p = Path(path)
     if not p.is_file():
         raise PddlError(p, "no such file")
     try:
-        return p.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise PddlError(p, f"cannot read: {exc}") from None
+        return reader.read_text(p)
+    except reader.InputError as exc:
+        raise PddlError(p, exc.message, exc.line) from None
 
 
 def _located(file: str | Path, exc: BaseException) -> PddlError:

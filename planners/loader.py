@@ -51,6 +51,11 @@ def _load_hooks(spec: TaskSpec) -> dict[str, Any]:
     try:
         module_spec.loader.exec_module(module)
     except SyntaxError as exc:
+        if "can't decode" in str(exc.msg):  # Python's codec text has a byte offset, not the file's line
+            try:
+                reader.read_text(path)
+            except reader.InputError as bad:
+                raise DefinitionError(path, bad.message, bad.line) from None
         raise DefinitionError(path, f"syntax error: {exc.msg}", exc.lineno, exc.offset) from None
     except Exception as exc:  # noqa: BLE001 - any import-time failure is a definition error
         raise DefinitionError(path, f"failed to import: {type(exc).__name__}: {exc}") from None

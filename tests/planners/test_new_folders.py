@@ -245,3 +245,29 @@ def test_pddl_names_in_task_toml_ignore_case_as_in_pddl(tmp_path: Path) -> None:
     _edit(toml, "[actions.pick]", "[actions.PUT_DOWN]\nskill = \"manipulate\"\n\n[actions.pick]")
     with pytest.raises(DefinitionError, match="a second entry for action 'put_down'"):
         load_task(folder, use_cache=False)
+
+
+@pytest.mark.parametrize("name", ["domain.pddl", "task.py"])
+def test_a_file_that_is_not_utf8_is_named_with_the_line_of_the_byte(tmp_path: Path, name: str) -> None:
+    """Before: Python's "'utf-8' codec can't decode byte 0xe9 in position 183" (domain.pddl: no
+    line; task.py: a syntax error whose column is a byte offset)."""
+    folder = _new(tmp_path)
+    path = folder / name
+    if name == "task.py":
+        path.write_text("def extra_facts(ctx, world):\n    return []\n")
+    lines = path.read_bytes().split(b"\n")
+    lines[1] += b" ; caf\xe9"  # Latin-1, as an editor on Windows may write it
+    path.write_bytes(b"\n".join(lines))
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert str(info.value) == f"{path}:2: is not UTF-8 text (byte 0xe9)"
+
+
+def test_tasker_plan_names_the_line_of_a_non_utf8_byte(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from experiments.cli import main
+
+    folder = _new(tmp_path)
+    problem = folder / "problem.pddl"
+    problem.write_bytes(problem.read_bytes().replace(b"\n", b" ; caf\xe9\n", 1))
+    assert main(["plan", str(folder / "domain.pddl"), str(problem)]) == 2
+    assert f"argument PROBLEM: {problem}:1: is not UTF-8 text (byte 0xe9)" in capsys.readouterr().err
