@@ -242,6 +242,7 @@ def _action(r: _Reader, a: reader.Table, name: str) -> ActionSpec:
     to = to.lower() if to and to.startswith("?") else to
     text = a.string("text", None)
     r.note(a)
+    r.lines[f"actions.{name}.text"] = a.line("text")  # by the PDDL name: the loader checks the placeholders
     a.done()
     if skill == "navigate" and to is None:
         raise r.fail(a, None, "a navigate action needs 'to' (the parameter naming its target)")

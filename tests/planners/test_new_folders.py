@@ -271,3 +271,23 @@ def test_tasker_plan_names_the_line_of_a_non_utf8_byte(tmp_path: Path, capsys: p
     problem.write_bytes(problem.read_bytes().replace(b"\n", b" ; caf\xe9\n", 1))
     assert main(["plan", str(folder / "domain.pddl"), str(problem)]) == 2
     assert f"argument PROBLEM: {problem}:1: is not UTF-8 text (byte 0xe9)" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("text", "fragment"), [
+    ("Here is {itme}", "unknown placeholder {itme}; did you mean '{item}'? (placeholders name a parameter of "
+                       "put_down (r, i, p) or a request argument (item, destination)"),
+    ("{nowhere}", "unknown placeholder {nowhere}"),
+    ("a { brace", "expected '}' before end of string"),
+    ("{i:d}", "{i:d}: Unknown format code 'd'"),
+])
+def test_a_say_text_placeholder_is_checked_at_load(tmp_path: Path, text: str, fragment: str) -> None:
+    """Before: an unknown placeholder was said as written ("{nowhere}"), a malformed one failed at run time."""
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, '# text = "..."', f'text = "{text}"')
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.line == _line_of(toml, f'text = "{text}"')
+    assert "actions.put_down.text: " in str(info.value) and fragment in str(info.value)
+    _edit(toml, f'text = "{text}"', 'text = "{{Put}} {i!r} at {destination:>8}"')
+    load_task(folder, use_cache=False)
