@@ -291,3 +291,21 @@ def test_a_say_text_placeholder_is_checked_at_load(tmp_path: Path, text: str, fr
     assert "actions.put_down.text: " in str(info.value) and fragment in str(info.value)
     _edit(toml, f'text = "{text}"', 'text = "{{Put}} {i!r} at {destination:>8}"')
     load_task(folder, use_cache=False)
+
+
+def test_a_folder_reached_twice_is_one_task_type_and_a_real_clash_names_both(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Before: $TASKER_TASKS and --path naming the same folder (or a folder and its parent) gave
+    "task type name(s) defined twice: ['fetch']", and a real clash named neither file."""
+    from domains import BUNDLED
+    from planners.bundled import ENV_VAR, task_types
+    from tasker.errors import ConfigError
+
+    folder = _new(tmp_path)
+    monkeypatch.setenv(ENV_VAR, str(folder))
+    assert [t.name for t in task_types([tmp_path, f"{folder}/"])].count("fetch") == 1
+    other = _new(tmp_path / "more", "guide_human")
+    with pytest.raises(ConfigError) as info:
+        task_types([other])
+    bundled = (BUNDLED / "guide_human" / "task.toml").resolve()
+    assert f"'guide_human' by {bundled} and {(other / 'task.toml').resolve()}" in str(info.value)
