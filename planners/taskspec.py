@@ -197,7 +197,8 @@ class _Reader:
             out = [Branch()]
         else:
             out = []
-            for b in t.tables(key):
+            tables = t.tables(key)
+            for b in tables:
                 policy = b.string("policy", "strict", choices=POLICIES)
                 limit = b.number("max_interruption_s", None, min=0)
                 if (policy == "conditional") != (limit is not None):
@@ -211,6 +212,11 @@ class _Reader:
                 b.done()
             if not out:
                 raise self.fail(t, key, "needs at least one branch (the default case, with no 'when')")
+            for k, branch in enumerate(out[:-1]):  # the first branch that holds is chosen: this one always does
+                if not branch.when and branch.policy == "strict":
+                    later = ", ".join(repr(x.label or f"suspension[{j}]") for j, x in enumerate(out[k + 1:], k + 1))
+                    raise self.fail(tables[k], None, f"no 'when': it always holds, so the branches after it ({later}) "
+                                                     "are never chosen; give it a 'when' or make it the last")
         last = out[-1]
         if last.when or last.policy != "strict":
             raise self.fail(t, key, "the last branch must have no 'when' and the strict policy (the default case)")

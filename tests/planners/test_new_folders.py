@@ -309,3 +309,18 @@ def test_a_folder_reached_twice_is_one_task_type_and_a_real_clash_names_both(
         task_types([other])
     bundled = (BUNDLED / "guide_human" / "task.toml").resolve()
     assert f"'guide_human' by {bundled} and {(other / 'task.toml').resolve()}" in str(info.value)
+
+
+def test_a_suspension_branch_without_when_before_the_last_is_refused(tmp_path: Path) -> None:
+    """Before: accepted, and the branches after it were silently never chosen (the held item was never put down)."""
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, '[[suspension]]\nlabel = "item held: put it down"',
+          '[[suspension]]\nlabel = "first"\ngoal = []\n\n[[suspension]]\nlabel = "item held: put it down"')
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.line == _line_of(toml, "[[suspension]]")
+    assert "suspension[0]: no 'when': it always holds, so the branches after it ('item held: put it down', " \
+           "'nothing to make safe') are never chosen" in str(info.value)
+    _edit(toml, 'label = "first"', 'label = "first"\npolicy = "conditional"\nmax_interruption_s = 5')
+    load_task(folder, use_cache=False)  # a conditional branch is not always eligible: the others are reachable
