@@ -324,3 +324,16 @@ def test_a_suspension_branch_without_when_before_the_last_is_refused(tmp_path: P
            "'nothing to make safe') are never chosen" in str(info.value)
     _edit(toml, 'label = "first"', 'label = "first"\npolicy = "conditional"\nmax_interruption_s = 5')
     load_task(folder, use_cache=False)  # a conditional branch is not always eligible: the others are reachable
+
+
+def test_an_upper_case_scenario_object_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: [objects.Cup] ran, but the plan moved "cup": the robot never held Cup and its hazard never fired."""
+    from experiments.cli import main
+
+    folder = _new(tmp_path)
+    scenario = folder / "scenario.toml"
+    _edit(scenario, 'item = "vase"', 'item = "Cup"')
+    scenario.write_text(scenario.read_text() + '\n[objects.Cup]\ntype = "item"\nplace = "kitchen"\n')
+    assert main(["check", str(scenario), "--path", str(folder)]) == 1
+    assert f"{scenario}:{_line_of(scenario, '[objects.Cup]')}: objects.Cup: PDDL names ignore case and plans give " \
+           "them in lower case: write 'cup'" in capsys.readouterr().out
