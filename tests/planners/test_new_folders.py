@@ -337,3 +337,19 @@ def test_an_upper_case_scenario_object_is_refused(tmp_path: Path, capsys: pytest
     assert main(["check", str(scenario), "--path", str(folder)]) == 1
     assert f"{scenario}:{_line_of(scenario, '[objects.Cup]')}: objects.Cup: PDDL names ignore case and plans give " \
            "them in lower case: write 'cup'" in capsys.readouterr().out
+
+
+def test_a_binding_of_the_wrong_kind_for_the_world_is_a_warning(tmp_path: Path) -> None:
+    """Before: kind = "device" for the held item ran silently: the robot "held" the vase only symbolically."""
+    from experiments import scenario as scenarios
+    from tasker.reader import InputWarning
+
+    folder = _new(tmp_path)
+    _edit(folder / "task.toml", 'kind = "held"', 'kind = "device"')
+    with pytest.warns(InputWarning) as caught:
+        scn = scenarios.load(folder / "scenario.toml", task_paths=[str(folder)])
+    message = "task type 'fetch': its device binding of ['holding', '?r', '?i'] covers vase here, and none is a " \
+              "device thing of world 'flat', so the fact stays symbolic (kind = 'held'?)"
+    assert any(message in str(w.message) for w in caught) and any(message in w for w in scn.warnings)
+    _edit(folder / "task.toml", 'kind = "device"', 'kind = "held"')
+    assert scenarios.load(folder / "scenario.toml", task_paths=[str(folder)]).warnings == ()
