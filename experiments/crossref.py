@@ -16,7 +16,8 @@ not in the world, is refused at load, not deep in the PDDL translator.
 What is valid but doubtful is an :class:`~tasker.reader.InputWarning` (also kept on
 ``RobotScenario.warnings``): an action after the horizon, two requests of the same
 task type with identical arguments that may overlap in time, a task type's default
-argument that names nothing in this world.
+argument that names nothing in this world, a requested task type's ``[[bindings]]`` entry
+that no thing of its kind in this world can satisfy.
 """
 
 from __future__ import annotations
@@ -199,6 +200,9 @@ class _Checker:
             if name in self.objects:
                 raise ot.error(name, f"the name {name!r} is already a {self.objects[name]} of world "
                                      f"{self.world.name!r}; expected a new name")
+            if name != name.lower():  # the plan would name another object than the world's
+                raise ot.error(name, f"PDDL names ignore case and plans give them in lower case: write "
+                                     f"{name.lower()!r}")
             if self.types:
                 check_name(t, "type", entry["type"], self.types, "object type")
             check_name(t, "place", entry["place"], self.world.places, f"place of world {self.world.name!r}")
@@ -294,6 +298,26 @@ class _Checker:
                     for fact in value:
                         self.fact(f, what, fact)
         self.overlaps(requests)
+        for a in {a.fields["task"]: a for a, _ in reversed(requests)}.values():  # the first request of each type
+            self.bindings(located(self.top, a), self.tasks[a.fields["task"]])
+
+    def bindings(self, f: Table, task: TaskType) -> None:
+        """A ``[[bindings]]`` entry whose objects in this world are none of its kind (an item bound as a
+        ``device``) never applies: the robot would, say, "hold" the item only symbolically."""
+        meaning = getattr(task, "meaning", None)
+        things = {"device": set(self.world.devices), "door": set(self.world.doors),
+                  "held": set(self.world.objects) | set(self.scn.objects),
+                  "follower": set(self.world.people), "waiting": set(self.world.people)}
+        for b in getattr(meaning, "bindings", ()):
+            if not b.types:
+                continue
+            covered = sorted(n for n, ty in self.objects.items() if ty in b.types)
+            if covered and not any(n in things[b.kind] for n in covered):
+                fits = sorted({k for k, names in things.items() if any(n in names for n in covered)})
+                self.warn(f, "task", f"task type {task.name!r}: its {b.kind} binding of {list(b.fact)} covers "
+                                     f"{', '.join(covered)} here, and none is a {b.kind} thing of world "
+                                     f"{self.world.name!r}, so the fact stays symbolic"
+                                     + (f" (kind = {' or '.join(map(repr, fits))}?)" if fits else ""))
 
     def _request(self, k: int) -> tuple[TimedAction, dict[str, Any]]:
         req = [a for a in self.scn.actions if a.kind == "request"][k - 1]

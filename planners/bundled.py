@@ -14,6 +14,7 @@ from pathlib import Path
 
 from domains import BUNDLED
 from planners.loader import load_task, load_task_folder
+from planners.pddl_task import PddlTaskType
 from tasker.errors import ConfigError
 from tasker.task import TaskType
 
@@ -31,8 +32,18 @@ def task_types(extra: Iterable[str | Path] = ()) -> list[TaskType]:
     paths = [p for p in os.environ.get(ENV_VAR, "").split(os.pathsep) if p] + [str(p) for p in extra]
     for p in paths:
         out.extend(load_task_folder(p))
-    names = [t.name for t in out]
+    # a folder reached twice (in $TASKER_TASKS and --path, or as itself and in its parent) is one definition
+    files: dict[str, list[Path]] = {}
+    unique = []
+    for t in out:
+        toml = (t.spec.folder / "task.toml").resolve() if isinstance(t, PddlTaskType) else None
+        if toml is not None and toml in files.get(t.name, []):
+            continue
+        files.setdefault(t.name, []).extend([toml] if toml is not None else [])
+        unique.append(t)
+    names = [t.name for t in unique]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
-        raise ConfigError(f"task type name(s) defined twice: {dup}")
-    return out
+        where = "; ".join(f"{n!r} by {' and '.join(map(str, files[n])) or 'two task types'}" for n in dup)
+        raise ConfigError(f"task type name(s) defined twice: {where} (a [task] name must be unique)")
+    return unique

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from tasker import reader
 from tasker.errors import TaskerError
 
 if TYPE_CHECKING:
@@ -87,13 +88,14 @@ class PddlError(DefinitionError):
 
 
 def _read(path: str | Path) -> str:
+    """The file's text; a non-UTF-8 byte is named with its line (:func:`tasker.reader.read_text`)."""
     p = Path(path)
     if not p.is_file():
         raise PddlError(p, "no such file")
     try:
-        return p.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise PddlError(p, f"cannot read: {exc}") from None
+        return reader.read_text(p)
+    except reader.InputError as exc:
+        raise PddlError(p, exc.message, exc.line) from None
 
 
 def _located(file: str | Path, exc: BaseException) -> PddlError:
@@ -129,17 +131,26 @@ def declared_requirements(domain_text: str, file: str | Path = "<domain>") -> tu
     return tuple(str(f) for f in res.get("features", []) if str(f) != ":requirements")
 
 
+def _nested(domain_text: str) -> list[object] | None:
+    """The domain as Fast Downward's s-expression reader sees it (lower case, no comments),
+    or ``None`` when it cannot read it (unbalanced parentheses, no token at all)."""
+    from fast_downward.translate.pddl_parser import lisp_parser
+    from fast_downward.translate.pddl_parser.parse_error import ParseError
+
+    try:
+        nested: list[object] = lisp_parser.parse_nested_list(io.StringIO(domain_text))
+    except (ParseError, StopIteration):  # StopIteration: no token at all
+        return None
+    return nested
+
+
 def _supported_at_a_glance(domain_text: str) -> bool:
     """Whether Fast Downward's s-expression reader (a few ms, no grammar) finds the domain's
     ``:requirements`` all supported.  When it does, unified-planning's grammar would read them
     the same way, and any syntax error elsewhere is reported by :func:`parse_domain`, which
     reads the whole text with that grammar next; otherwise the grammar decides (and words it)."""
-    from fast_downward.translate.pddl_parser import lisp_parser
-    from fast_downward.translate.pddl_parser.parse_error import ParseError
-
-    try:
-        nested = lisp_parser.parse_nested_list(io.StringIO(domain_text))
-    except (ParseError, StopIteration):  # StopIteration: no token at all
+    nested = _nested(domain_text)
+    if nested is None:
         return False
     blocks = [b for b in nested if isinstance(b, list) and b and b[0] == ":requirements"]
     return len(blocks) <= 1 and all(len(b) > 1 for b in blocks) and all(
@@ -155,6 +166,45 @@ def check_requirements(domain_text: str, file: str | Path) -> None:
         line = next((i for i, s in enumerate(domain_text.splitlines(), 1) if bad[0] in s.lower()), None)
         raise PddlError(file, f"unsupported requirement(s) {' '.join(bad)}; supported: "
                               f"{' '.join(sorted(SUPPORTED_REQUIREMENTS))}", line)
+
+
+_INSTEAD = {
+    "either": "(either ...) types are not supported by tasker (unified-planning's PDDL reader cannot read "
+              "them): declare a common supertype instead, e.g. (:types item robot - carriable), and use it",
+    "derived": ":derived predicates are not supported by tasker (unified-planning's PDDL reader cannot read "
+               "them): compute the predicate in task.py's extra_facts (as domains/doors.py does for "
+               "free_passage), or write its condition into the actions' preconditions",
+}
+_CONSTRUCT_RE = {"either": re.compile(r"-\s*(\(\s*either\b)", re.IGNORECASE),
+                 "derived": re.compile(r"(\(\s*:derived\b|:derived-predicates\b)", re.IGNORECASE)}
+
+
+def _uses_either(node: object) -> bool:
+    """Whether ``- (either ...)`` is a type anywhere in Fast Downward's nested list."""
+    if not isinstance(node, list):
+        return False
+    pairs = zip(node, node[1:], strict=False)
+    if any(prev == "-" and isinstance(x, list) and x[:1] == ["either"] for prev, x in pairs):
+        return True
+    return any(_uses_either(x) for x in node)
+
+
+def check_constructs(domain_text: str, file: str | Path) -> None:
+    """Refuse ``(either ...)`` types and ``:derived`` predicates plainly, with their line:
+    unified-planning's reader would call them "syntax error: Expected ')'" somewhere else.
+    Fast Downward's s-expression reader finds them; the line is that of the first occurrence
+    outside comments."""
+    nested = _nested(domain_text)
+    if nested is None:
+        return  # unbalanced: unified-planning's grammar words the syntax error
+    derived = any(isinstance(b, list) and b[:1] == [":derived"] for b in nested) or any(
+        isinstance(b, list) and b[:1] == [":requirements"] and ":derived-predicates" in b for b in nested)
+    for what in [w for w, found in (("either", _uses_either(nested)), ("derived", derived)) if found]:
+        code = "\n".join(s.split(";", 1)[0] for s in domain_text.splitlines())
+        m = _CONSTRUCT_RE[what].search(code)
+        at = m.start(1) if m else 0
+        line, col = (code.count("\n", 0, at) + 1, at - code.rfind("\n", 0, at)) if m else (None, None)
+        raise PddlError(file, _INSTEAD[what], line, col)
 
 
 def check_kind(problem: up.model.Problem, file: str | Path) -> None:
@@ -181,6 +231,7 @@ class CheckedDomain:
 def load_domain(path: str | Path) -> CheckedDomain:
     """Read and check a ``domain.pddl``; raise :class:`PddlError` naming the file and line."""
     text = _read(path)
+    check_constructs(text, path)
     check_requirements(text, path)
     check_numeric(parse_domain(text, path), text, path)
     return CheckedDomain(Path(path), text)

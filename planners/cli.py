@@ -22,6 +22,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from tasker import reader
 from tasker.cliargs import EXIT_FAILED, EXIT_OK, UsageError, non_negative_int, note, positive_seconds
 
 if TYPE_CHECKING:
@@ -126,9 +127,9 @@ def _read_arg(path: str, argument: str) -> str:
     if not p.is_file():
         raise UsageError(argument, f"{path}: no such file")
     try:
-        return p.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UsageError(argument, f"{path}: cannot read: {exc}") from None
+        return reader.read_text(p)
+    except reader.InputError as exc:
+        raise UsageError(argument, str(exc)) from None
 
 
 def plan_command(args: argparse.Namespace) -> int:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import importlib.util
 import inspect
+import string
 import sys
 import types
 from pathlib import Path
@@ -51,6 +52,11 @@ def _load_hooks(spec: TaskSpec) -> dict[str, Any]:
     try:
         module_spec.loader.exec_module(module)
     except SyntaxError as exc:
+        if "can't decode" in str(exc.msg):  # Python's codec text has a byte offset, not the file's line
+            try:
+                reader.read_text(path)
+            except reader.InputError as bad:
+                raise DefinitionError(path, bad.message, bad.line) from None
         raise DefinitionError(path, f"syntax error: {exc.msg}", exc.lineno, exc.offset) from None
     except Exception as exc:  # noqa: BLE001 - any import-time failure is a definition error
         raise DefinitionError(path, f"failed to import: {type(exc).__name__}: {exc}") from None
@@ -85,6 +91,7 @@ def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
         for ref in [*(a.travel or ()), *([a.to] if a.to and a.to.startswith("?") else [])]:
             if ref not in params:
                 raise DefinitionError(toml, f"[actions.{name}] {ref} is not a parameter of {name} {sorted(params)}")
+    _check_texts(spec, dm)
     lits = [("problem.goal", spec.goal), ("problem.facts", spec.facts),
             ("problem.suspended_facts", spec.suspended_facts)]
     lits += [(f"suspension[{k}].{key}", getattr(b, key)) for k, b in enumerate(spec.suspension)
@@ -107,6 +114,33 @@ def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
             if len(t.args) != len(dm.actions[action].params):
                 raise DefinitionError(toml, f"[{where}] {action} takes {len(dm.actions[action].params)} "
                                             f"argument(s), got {len(t.args)}")
+
+
+def _check_texts(spec: TaskSpec, dm: DomainModel) -> None:
+    """A say action's ``text`` is a format string whose ``{placeholders}`` name a parameter of the
+    action or a request argument: an unknown one was said as written ("{nowhere}"), a malformed one
+    (a lone brace, ``{h.x}``, ``{h:d}``) failed the stage at run time."""
+    for name, a in spec.actions.items():
+        if a.text is None:
+            continue
+        where = f"actions.{name}.text"
+        params = list(dm.actions[name].params)
+        known = [*params, *(arg.name for arg in spec.args)]
+        hint = (f"(placeholders name a parameter of {name} ({', '.join(params) or 'none'}) or a request "
+                f"argument ({', '.join(arg.name for arg in spec.args) or 'none'}); write {{{{ and }}}} for braces)")
+        try:
+            fields = [(f, s) for _, f, s, _ in string.Formatter().parse(a.text) if f is not None]
+        except ValueError as exc:
+            raise spec.error(where, f"{exc} in {a.text!r} {hint}") from None
+        for field, fmt in fields:
+            if field not in known:
+                shown = "{" + field + "}"
+                raise spec.error(where, f"unknown placeholder {shown}"
+                                        f"{reader.suggest(shown, ['{' + k + '}' for k in known])} {hint}")
+            try:
+                format("x", fmt or "")  # every value is a string
+            except ValueError as exc:
+                raise spec.error(where, f"{{{field}:{fmt}}}: {exc} (the values are strings)") from None
 
 
 def _check_request_tokens(spec: TaskSpec, tokens: list[tuple[str, str]]) -> None:

@@ -166,9 +166,11 @@ class _Reader:
     def literal(self, t: reader.Table, key: str, lit: Any) -> Literal:
         if not isinstance(lit, list) or not lit or not all(isinstance(s, str) and s for s in lit):
             raise self.fail(t, key, f"a literal is a non-empty list of strings, got {lit!r}")
-        if lit[0] == "not" and len(lit) < 2:
+        if lit[0].lower() == "not" and len(lit) < 2:
             raise self.fail(t, key, f"'not' needs a predicate: {lit!r}")
-        return tuple(lit)
+        # PDDL names are case-insensitive and the domain is read in lower case: so is a predicate here
+        head = 2 if lit[0].lower() == "not" else 1
+        return (*(s.lower() for s in lit[:head]), *lit[head:])
 
     def templates(self, t: reader.Table, key: str) -> tuple[StageTemplate, ...]:
         value = t.raw(key, [])
@@ -180,11 +182,12 @@ class _Reader:
             if not isinstance(raw, dict):
                 raise self.fail(t, key, f"a stage is a table {{action = ..., args = [...]}}, got {raw!r}")
             st = reader.Table(self.file, raw, (*t.path, key, i), t._index)
-            action = st.string("action")
+            action = st.string("action").lower()  # PDDL names are case-insensitive
             args = st.raw("args", [])
             if not isinstance(args, list) or not all(isinstance(a, str) for a in args):
                 raise self.fail(st, "args", f"stage {action!r}: expected a list of strings")
             sus = st.string("suspended", None)
+            sus = None if sus is None else sus.lower()
             st.done()
             out.append(StageTemplate(action, tuple(args), sus))
         return tuple(out)
@@ -194,7 +197,8 @@ class _Reader:
             out = [Branch()]
         else:
             out = []
-            for b in t.tables(key):
+            tables = t.tables(key)
+            for b in tables:
                 policy = b.string("policy", "strict", choices=POLICIES)
                 limit = b.number("max_interruption_s", None, min=0)
                 if (policy == "conditional") != (limit is not None):
@@ -208,6 +212,11 @@ class _Reader:
                 b.done()
             if not out:
                 raise self.fail(t, key, "needs at least one branch (the default case, with no 'when')")
+            for k, branch in enumerate(out[:-1]):  # the first branch that holds is chosen: this one always does
+                if not branch.when and branch.policy == "strict":
+                    later = ", ".join(repr(x.label or f"suspension[{j}]") for j, x in enumerate(out[k + 1:], k + 1))
+                    raise self.fail(tables[k], None, f"no 'when': it always holds, so the branches after it ({later}) "
+                                                     "are never chosen; give it a 'when' or make it the last")
         last = out[-1]
         if last.when or last.policy != "strict":
             raise self.fail(t, key, "the last branch must have no 'when' and the strict policy (the default case)")
@@ -233,10 +242,13 @@ def _action(r: _Reader, a: reader.Table, name: str) -> ActionSpec:
     if travel is not None and (not isinstance(travel, list) or len(travel) != 2
                                or not all(isinstance(t, str) and t.startswith("?") for t in travel)):
         raise r.fail(a, "travel", f"expected two parameters [\"?from\", \"?to\"], got {travel!r}")
+    travel = travel and [t.lower() for t in travel]  # PDDL parameters are case-insensitive
     duration = a.number("duration", None, min=0)
     to = a.string("to", None)
+    to = to.lower() if to and to.startswith("?") else to
     text = a.string("text", None)
     r.note(a)
+    r.lines[f"actions.{name}.text"] = a.line("text")  # by the PDDL name: the loader checks the placeholders
     a.done()
     if skill == "navigate" and to is None:
         raise r.fail(a, None, "a navigate action needs 'to' (the parameter naming its target)")
@@ -358,7 +370,11 @@ def read_task_toml(path: Path) -> TaskSpec:
         suspended_facts = r.literals(problem, "suspended_facts")
         problem.done()
         actions_t = top.table("actions")
-        actions = {n: _action(r, actions_t.table(n), n) for n in actions_t.keys()}
+        actions = {}
+        for n in actions_t.keys():  # PDDL names are case-insensitive: the domain's are read in lower case
+            if n.lower() in actions:
+                raise r.fail(actions_t, n, f"a second entry for action {n.lower()!r} (PDDL names ignore case)")
+            actions[n.lower()] = _action(r, actions_t.table(n), n.lower())
         actions_t.done()
         static = top.table("static")
         static_update = r.templates(static, "update")

@@ -202,6 +202,9 @@ def read_world(top: Table, source: str) -> WorldSpec:
             if n in seen:
                 raise top.at(what, {}).error(n, f"the name {n!r} is used twice ({seen[n]} and {what}); "
                                                 "places, people, devices, doors, objects and 'robot' share names")
+            if n != n.lower():  # the plan would name another object than the world's
+                raise top.at(what, {}).error(n, f"PDDL names ignore case and plans give them in lower case: "
+                                                f"write {n.lower()!r}")
             seen[n] = what
     facts = []
     facts_t = top.at("facts", {})

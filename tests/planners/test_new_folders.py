@@ -202,3 +202,154 @@ def test_a_numeric_fluent_other_than_the_cost_is_refused_clearly(tmp_path: Path,
     assert info.value.file == str(domain)
     assert f"action navigate: {fragment}; numeric fluents are supported only as action costs" in str(info.value)
     assert info.value.line == _line_of(domain, new[-25:])
+
+
+@pytest.mark.parametrize(("old", "new", "at", "fragment"), [
+    ("(holding ?r - robot ?i - item)", "(holding ?r - robot ?i - (either item robot))", "(either",
+     "(either ...) types are not supported by tasker"),
+    ("  (:action navigate", "  (:derived (busy ?r - robot) (not (hand_empty ?r)))\n  (:action navigate", "(:derived",
+     ":derived predicates are not supported by tasker"),
+    (":action-costs)", ":action-costs :derived-predicates)", ":derived-predicates",
+     ":derived predicates are not supported by tasker"),
+])
+def test_either_types_and_derived_predicates_are_refused_plainly(tmp_path: Path, old: str, new: str, at: str,
+                                                                 fragment: str) -> None:
+    """Before: unified-planning's "syntax error: Expected ')'" at a misleading place."""
+    folder = _new(tmp_path)
+    domain = folder / "domain.pddl"
+    _edit(domain, "(hand_empty ?r - robot))", "(hand_empty ?r - robot)\n    (busy ?r - robot))")
+    _edit(domain, old, new)
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    line = _line_of(domain, at)
+    assert info.value.file == str(domain) and info.value.line == line
+    assert info.value.col == domain.read_text().splitlines()[line - 1].index(at) + 1
+    assert fragment in str(info.value) and "Expected" not in str(info.value)
+
+
+def test_pddl_names_in_task_toml_ignore_case_as_in_pddl(tmp_path: Path) -> None:
+    """Before: ``[actions.Put_Down]`` gave "no entry for domain action(s) ['put_down']" and
+    ``["HAND_EMPTY", ...]`` "unknown predicate": the domain's names are read in lower case."""
+    folder = _new(tmp_path)
+    for path in (folder / "domain.pddl", folder / "task.toml"):
+        path.write_text(path.read_text().replace("put_down", "Put_Down").replace("hand_empty", "HAND_EMPTY"))
+    toml = folder / "task.toml"
+    _edit(toml, 'fact = ["holding", "$robot", "$item"]', 'fact = ["Holding", "$robot", "$item"]')
+    _edit(toml, 'to = "?to"', 'to = "?To"')
+    _edit(toml, 'when = [["holding", "$robot", "$item"]]', 'when = [["NOT", "HOLDING", "$robot", "$item"]]')
+    task = load_task(folder, use_cache=False)
+    assert "put_down" in task.spec.actions and task.spec.actions["navigate"].to == "?to"
+    assert task.spec.goal[1] == ("hand_empty", "$robot") and task.spec.hazards[0].fact[0] == "holding"
+    assert task.spec.suspension[0].when == (("not", "holding", "$robot", "$item"),)
+    assert [t.action for t in task.spec.static_update][-1] == "put_down"
+    _edit(toml, "[actions.pick]", "[actions.PUT_DOWN]\nskill = \"manipulate\"\n\n[actions.pick]")
+    with pytest.raises(DefinitionError, match="a second entry for action 'put_down'"):
+        load_task(folder, use_cache=False)
+
+
+@pytest.mark.parametrize("name", ["domain.pddl", "task.py"])
+def test_a_file_that_is_not_utf8_is_named_with_the_line_of_the_byte(tmp_path: Path, name: str) -> None:
+    """Before: Python's "'utf-8' codec can't decode byte 0xe9 in position 183" (domain.pddl: no
+    line; task.py: a syntax error whose column is a byte offset)."""
+    folder = _new(tmp_path)
+    path = folder / name
+    if name == "task.py":
+        path.write_text("def extra_facts(ctx, world):\n    return []\n")
+    lines = path.read_bytes().split(b"\n")
+    lines[1] += b" ; caf\xe9"  # Latin-1, as an editor on Windows may write it
+    path.write_bytes(b"\n".join(lines))
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert str(info.value) == f"{path}:2: is not UTF-8 text (byte 0xe9)"
+
+
+def test_tasker_plan_names_the_line_of_a_non_utf8_byte(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from experiments.cli import main
+
+    folder = _new(tmp_path)
+    problem = folder / "problem.pddl"
+    problem.write_bytes(problem.read_bytes().replace(b"\n", b" ; caf\xe9\n", 1))
+    assert main(["plan", str(folder / "domain.pddl"), str(problem)]) == 2
+    assert f"argument PROBLEM: {problem}:1: is not UTF-8 text (byte 0xe9)" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("text", "fragment"), [
+    ("Here is {itme}", "unknown placeholder {itme}; did you mean '{item}'? (placeholders name a parameter of "
+                       "put_down (r, i, p) or a request argument (item, destination)"),
+    ("{nowhere}", "unknown placeholder {nowhere}"),
+    ("a { brace", "expected '}' before end of string"),
+    ("{i:d}", "{i:d}: Unknown format code 'd'"),
+])
+def test_a_say_text_placeholder_is_checked_at_load(tmp_path: Path, text: str, fragment: str) -> None:
+    """Before: an unknown placeholder was said as written ("{nowhere}"), a malformed one failed at run time."""
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, '# text = "..."', f'text = "{text}"')
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.line == _line_of(toml, f'text = "{text}"')
+    assert "actions.put_down.text: " in str(info.value) and fragment in str(info.value)
+    _edit(toml, f'text = "{text}"', 'text = "{{Put}} {i!r} at {destination:>8}"')
+    load_task(folder, use_cache=False)
+
+
+def test_a_folder_reached_twice_is_one_task_type_and_a_real_clash_names_both(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Before: $TASKER_TASKS and --path naming the same folder (or a folder and its parent) gave
+    "task type name(s) defined twice: ['fetch']", and a real clash named neither file."""
+    from domains import BUNDLED
+    from planners.bundled import ENV_VAR, task_types
+    from tasker.errors import ConfigError
+
+    folder = _new(tmp_path)
+    monkeypatch.setenv(ENV_VAR, str(folder))
+    assert [t.name for t in task_types([tmp_path, f"{folder}/"])].count("fetch") == 1
+    other = _new(tmp_path / "more", "guide_human")
+    with pytest.raises(ConfigError) as info:
+        task_types([other])
+    bundled = (BUNDLED / "guide_human" / "task.toml").resolve()
+    assert f"'guide_human' by {bundled} and {(other / 'task.toml').resolve()}" in str(info.value)
+
+
+def test_a_suspension_branch_without_when_before_the_last_is_refused(tmp_path: Path) -> None:
+    """Before: accepted, and the branches after it were silently never chosen (the held item was never put down)."""
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, '[[suspension]]\nlabel = "item held: put it down"',
+          '[[suspension]]\nlabel = "first"\ngoal = []\n\n[[suspension]]\nlabel = "item held: put it down"')
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.line == _line_of(toml, "[[suspension]]")
+    assert "suspension[0]: no 'when': it always holds, so the branches after it ('item held: put it down', " \
+           "'nothing to make safe') are never chosen" in str(info.value)
+    _edit(toml, 'label = "first"', 'label = "first"\npolicy = "conditional"\nmax_interruption_s = 5')
+    load_task(folder, use_cache=False)  # a conditional branch is not always eligible: the others are reachable
+
+
+def test_an_upper_case_scenario_object_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: [objects.Cup] ran, but the plan moved "cup": the robot never held Cup and its hazard never fired."""
+    from experiments.cli import main
+
+    folder = _new(tmp_path)
+    scenario = folder / "scenario.toml"
+    _edit(scenario, 'item = "vase"', 'item = "Cup"')
+    scenario.write_text(scenario.read_text() + '\n[objects.Cup]\ntype = "item"\nplace = "kitchen"\n')
+    assert main(["check", str(scenario), "--path", str(folder)]) == 1
+    assert f"{scenario}:{_line_of(scenario, '[objects.Cup]')}: objects.Cup: PDDL names ignore case and plans give " \
+           "them in lower case: write 'cup'" in capsys.readouterr().out
+
+
+def test_a_binding_of_the_wrong_kind_for_the_world_is_a_warning(tmp_path: Path) -> None:
+    """Before: kind = "device" for the held item ran silently: the robot "held" the vase only symbolically."""
+    from experiments import scenario as scenarios
+    from tasker.reader import InputWarning
+
+    folder = _new(tmp_path)
+    _edit(folder / "task.toml", 'kind = "held"', 'kind = "device"')
+    with pytest.warns(InputWarning) as caught:
+        scn = scenarios.load(folder / "scenario.toml", task_paths=[str(folder)])
+    message = "task type 'fetch': its device binding of ['holding', '?r', '?i'] covers vase here, and none is a " \
+              "device thing of world 'flat', so the fact stays symbolic (kind = 'held'?)"
+    assert any(message in str(w.message) for w in caught) and any(message in w for w in scn.warnings)
+    _edit(folder / "task.toml", 'kind = "device"', 'kind = "held"')
+    assert scenarios.load(folder / "scenario.toml", task_paths=[str(folder)]).warnings == ()

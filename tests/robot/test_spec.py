@@ -68,3 +68,12 @@ def test_names_must_be_unique() -> None:
             "people": {"john": {"pose": [2, 2, 0]}}}
     with pytest.raises(WorldFileError, match="used twice"):
         parse_world(data, "dup.toml")
+
+
+def test_names_must_be_lower_case() -> None:
+    """Plans name objects in lower case (PDDL ignores case): before, a person "John" was never the
+    "john" a plan guided, silently."""
+    data = {"bounds": [[0, 0], [5, 5]], "robot": {"pose": [1, 1, 0]}, "places": {"hall": [1, 1, 0]},
+            "people": {"John": {"pose": [2, 2, 0]}}}
+    with pytest.raises(WorldFileError, match="people.John: PDDL names ignore case .* write 'john'"):
+        parse_world(data, "upper.toml")
