@@ -27,6 +27,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from unified_planning.shortcuts import OneshotPlanner  # noqa: E402
 
 from planners.bundled import task_types  # noqa: E402
+from planners.engine import register_engine  # noqa: E402
 from planners.checks import load_problem_text  # noqa: E402
 from planners.examples import StraightLineMotion, example_context  # noqa: E402
 from planners.pddl_task import PddlTaskType  # noqa: E402
@@ -70,6 +71,7 @@ def timed(fn: Callable[[], float | None], repeat: int) -> tuple[float, float | N
 
 
 def up_solver(name: str, problem: object) -> Callable[[], float | None]:
+    register_engine()  # "tasker-fd" is known to UP's factory once registered (idempotent)
     def run() -> float | None:
         with warnings.catch_warnings(), OneshotPlanner(name=name) as engine:
             warnings.simplefilter("ignore")
