@@ -27,8 +27,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from unified_planning.shortcuts import OneshotPlanner  # noqa: E402
 
 from planners.bundled import task_types  # noqa: E402
-from planners.engine import register_engine  # noqa: E402
 from planners.checks import load_problem_text  # noqa: E402
+from planners.engine import register_engine  # noqa: E402
 from planners.examples import StraightLineMotion, example_context  # noqa: E402
 from planners.pddl_task import PddlTaskType  # noqa: E402
 from planners.planner import PddlText, Planner, plan_cost  # noqa: E402
