@@ -53,7 +53,6 @@ def main(argv: list[str]) -> int:
 
     from planners.bundled import task_types
     from planners.examples import example_context
-    from planners.stages import Bindings
     from tests.planners.conftest import DOMAIN, problem_text
 
     with tempfile.TemporaryDirectory(prefix="tasker-bench-startup-") as tmp:
@@ -63,8 +62,9 @@ def main(argv: list[str]) -> int:
         cook = next(t for t in task_types() if t.name == "cook")
         ctx = example_context(cook)  # type: ignore[arg-type]
         assert ctx is not None
-        b = Bindings(ctx.args, ctx.world)
-        text, _, _ = cook.problem_text(ctx, ctx.world, b.literals(cook.spec.goal), b.literals(cook.spec.facts))  # type: ignore[attr-defined]
+        # upTsk's own inputs: the request's facts and task.py's extra_facts (without them it has no plan)
+        world, goal, extra = cook.update_inputs(ctx)  # type: ignore[attr-defined]
+        text, _, _ = cook.problem_text(ctx, world, goal, extra)  # type: ignore[attr-defined]
         cook_problem = Path(tmp) / "cook_problem.pddl"
         cook_problem.write_text(text.problem)
         cook_domain = str(ROOT / "domains" / "cook" / "domain.pddl")
