@@ -137,6 +137,14 @@ def meaning_of(spec: TaskSpec, bindings: tuple[Binding, ...]) -> Meaning:
     return Meaning(spec.hazards, spec.people, bindings)
 
 
+def _object_token(token: str) -> str:
+    """A literal's argument as the domain reads it: an object name in lower case (``$at:NAME``'s
+    name too); a request argument ``$name`` as written."""
+    if token.startswith("$at:"):
+        return "$at:" + token[4:].lower()
+    return token if token.startswith("$") else token.lower()
+
+
 class _Reader:
     """Reads ``task.toml`` through :class:`tasker.reader.Table`; remembers field lines."""
 
@@ -168,9 +176,10 @@ class _Reader:
             raise self.fail(t, key, f"a literal is a non-empty list of strings, got {lit!r}")
         if lit[0].lower() == "not" and len(lit) < 2:
             raise self.fail(t, key, f"'not' needs a predicate: {lit!r}")
-        # PDDL names are case-insensitive and the domain is read in lower case: so is a predicate here
+        # PDDL names are case-insensitive and the domain is read in lower case: so are a predicate
+        # and an object named here (a world's names are lower case); $arguments keep theirs
         head = 2 if lit[0].lower() == "not" else 1
-        return (*(s.lower() for s in lit[:head]), *lit[head:])
+        return (*(s.lower() for s in lit[:head]), *(_object_token(s) for s in lit[head:]))
 
     def templates(self, t: reader.Table, key: str) -> tuple[StageTemplate, ...]:
         value = t.raw(key, [])
@@ -189,7 +198,7 @@ class _Reader:
             sus = st.string("suspended", None)
             sus = None if sus is None else sus.lower()
             st.done()
-            out.append(StageTemplate(action, tuple(args), sus))
+            out.append(StageTemplate(action, tuple(_object_token(a) for a in args), sus))
         return tuple(out)
 
     def branches(self, t: reader.Table, key: str) -> tuple[Branch, ...]:

@@ -242,6 +242,14 @@ def test_pddl_names_in_task_toml_ignore_case_as_in_pddl(tmp_path: Path) -> None:
     assert task.spec.goal[1] == ("hand_empty", "$robot") and task.spec.hazards[0].fact[0] == "holding"
     assert task.spec.suspension[0].when == (("not", "holding", "$robot", "$item"),)
     assert [t.action for t in task.spec.static_update][-1] == "put_down"
+    # object names too (a world's are lower case); a request's $argument keeps its case
+    _edit(toml, 'goal = [["HAND_EMPTY", "$robot"]]', 'goal = [["HAND_EMPTY", "$robot"], ["at", "$item", "Kitchen"]]')
+    _edit(toml, 'args = ["$robot", "$item", "$at:robot"]', 'args = ["$robot", "$item", "$at:Robot"]')
+    from planners.taskspec import read_task_toml
+
+    spec = read_task_toml(toml)
+    assert spec.suspension[0].goal == (("hand_empty", "$robot"), ("at", "$item", "kitchen"))
+    assert spec.suspension[0].stages[0].args == ("$robot", "$item", "$at:robot")
     _edit(toml, "[actions.pick]", "[actions.PUT_DOWN]\nskill = \"manipulate\"\n\n[actions.pick]")
     with pytest.raises(DefinitionError, match="a second entry for action 'put_down'"):
         load_task(folder, use_cache=False)
