@@ -60,3 +60,12 @@ def test_a_misspelt_field_is_located_and_named(tmp_path: Path) -> None:
     msg = str(err.value)
     assert f"{path}:10" in msg and "dedline" in msg and "did you mean 'deadline'" in msg
     assert "any request may also give deadline, priority, death_at" in msg
+
+
+def test_tasker_check_takes_the_fields_the_run_takes(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``tasker check`` refused ``deadline`` in a request's args ("unknown argument(s)") that load and run take."""
+    from experiments.cli import main
+
+    path = write(tmp_path, TWO_GUIDES.format(john=", deadline = 100.0, priority = 2", alice=", death_at = 50.0"))
+    assert main(["check", str(path)]) == 0, capsys.readouterr().out
+    assert "0 problems" in capsys.readouterr().out
