@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from experiments.fields import MODES, ScenarioError
+from experiments.request_fields import FIELD_NAMES
 from tasker.reader import Table, check_name, suggest
 
 __all__ = ["TABLES", "WORLD_EVENT_KINDS", "ScenarioError", "TimedAction", "located", "read_actions"]
@@ -77,6 +78,10 @@ def _read(f: Table, kind: str, task_names: Collection[str] | None) -> dict[str, 
         task = f.string("task")
         if task_names is not None:
             check_name(f, "task", task, task_names, "task type")
+        misplaced = next((k for k in FIELD_NAMES if k in f), None)
+        if misplaced is not None:  # docs/scenarios.md: "any request may also give deadline = …" (in its args)
+            raise f.error(misplaced, f"{misplaced!r} is one of the request's args: write it as "
+                                     f"args = {{ …, {misplaced} = {f.data[misplaced]!r} }}")
         return {"task": task, "args": _args(f, "args", False)}
     if kind == "terminate":
         return {"agent": f.string("agent"), "reason": f.string("reason", "terminated by the requester")}

@@ -125,11 +125,15 @@ class Checker:
 
     # -- scenarios and sweeps -----------------------------------------------------------------
 
-    def _tasks(self, also: list[str]) -> Any:
+    def _tasks(self, also: list[str], request_fields: bool = False) -> Any:
+        from experiments.request_fields import with_request_fields
         from planners.bundled import task_types
         from tasker.store import TaskStore
 
-        return TaskStore(task_types([*self.paths, *also]))
+        loaded = task_types([*self.paths, *also])
+        if request_fields:  # as the scenario's load and run take them (experiments.request_fields)
+            loaded = [with_request_fields(t) for t in loaded]
+        return TaskStore(loaded)
 
     def _scenario(self, p: Path, also: list[str]) -> None:
         from experiments import scenario as scenarios
@@ -154,8 +158,11 @@ class Checker:
                     self.problems.append((f"{p}: people.{name}", f"no such person in world {scn.world!r}"
                                                                  f"{did_you_mean(name, world[0].people)}; "
                                                                  f"known: {sorted(world[0].people)}"))
+        from experiments.request_fields import asked_for
+
         stores: list[Any] = []
-        if not self.attempt(p, "its task types loaded", lambda: stores.append(self._tasks(also))):
+        wrap = asked_for(scn.actions)
+        if not self.attempt(p, "its task types loaded", lambda: stores.append(self._tasks(also, wrap))):
             return
         for k, a in enumerate(scn.actions):
             if a.kind == "request":

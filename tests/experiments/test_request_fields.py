@@ -60,3 +60,21 @@ def test_a_misspelt_field_is_located_and_named(tmp_path: Path) -> None:
     msg = str(err.value)
     assert f"{path}:10" in msg and "dedline" in msg and "did you mean 'deadline'" in msg
     assert "any request may also give deadline, priority, death_at" in msg
+
+
+def test_tasker_check_takes_the_fields_the_run_takes(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``tasker check`` refused ``deadline`` in a request's args ("unknown argument(s)") that load and run take."""
+    from experiments.cli import main
+
+    path = write(tmp_path, TWO_GUIDES.format(john=", deadline = 100.0, priority = 2", alice=", death_at = 50.0"))
+    assert main(["check", str(path)]) == 0, capsys.readouterr().out
+    assert "0 problems" in capsys.readouterr().out
+
+
+def test_a_field_beside_args_says_to_write_it_in_args(tmp_path: Path) -> None:
+    """``deadline = 100.0`` beside ``args`` got "unknown key 'deadline' (valid keys: args, t, task)"."""
+    path = write(tmp_path, TWO_GUIDES.format(john="", alice="").replace('"bedroom" }', '"bedroom" }\ndeadline = 100.0'))
+    with pytest.raises(scenarios.ScenarioError) as err:
+        scenarios.load(path)
+    msg = str(err.value)
+    assert f"{path}:11" in msg and "requests[0].deadline" in msg and "args = { …, deadline = 100.0 }" in msg
