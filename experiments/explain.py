@@ -1,4 +1,4 @@
-"""``tasker explain RUN_DIR [--agent dN [--at T]]``: what an agent planned from, and what moved it.
+"""``tasker explain RUN_DIR --agent dN [--at T]``: what an agent planned from, and what moved it.
 
 A run's ``problems/`` folder (written by :func:`write_problems` from the journal of
 :func:`planners.pddl_task.planning_journal`) holds, for every planned upTsk and
@@ -244,25 +244,6 @@ def explain(run_dir: str | Path, agent: str, at: float | None = None) -> Explana
     return Explanation(agent, at, entry, domain, problem, plan, tuple(moved(load_trace(run), agent, at)))
 
 
-def agents_summary(run_dir: str | Path) -> str:
-    """What ``tasker explain RUN_DIR`` without ``--agent`` prints: every agent that planned,
-    its task type, its problems (purpose and time) and how it ended (from the trace)."""
-    run = Path(run_dir)
-    index = load_index(run)
-    ends = {str(e["agent"]): e for e in load_trace(run) if e["event"] == "end"}
-    by: dict[str, list[dict[str, Any]]] = {}
-    for e in index:
-        by.setdefault(str(e["agent"]), []).append(e)
-    lines = [f"; {run}: {len(by)} agent(s) planned; explain one with: tasker explain {run} --agent AGENT"]
-    for agent in sorted(by, key=lambda a: (len(a), a)):
-        entries = by[agent]
-        end = ends.get(agent)
-        how = f"ended at t={number(end['t']):g} s ({end.get('cause', '?')})" if end else "did not end"
-        plans = ", ".join(f"{e['purpose']} t={float(e['t']):g}" for e in entries)
-        lines.append(f"{agent:>5}  {entries[0].get('task_type', '?')}: {how}; {len(entries)} problem(s): {plans}")
-    return "\n".join(lines) + "\n"
-
-
 def write(ex: Explanation, out: Path) -> list[Path]:
     """``domain.pddl``, ``problem.pddl``, ``plan`` (if any) and ``explain.txt`` in ``out``."""
     out.mkdir(parents=True, exist_ok=True)
@@ -282,7 +263,6 @@ def write(ex: Explanation, out: Path) -> list[Path]:
 
 EXAMPLES = """\
 examples:
-  tasker explain out/paper                            # the agents that planned, and how each ended
   tasker explain out/paper --agent d3                 # d3's last problem, plan and what moved it
   tasker explain out/paper --agent d1 --at 60         # the problem d1 planned from at t = 60 s
   tasker explain out/run --agent d2 --out /tmp/d2     # domain.pddl, problem.pddl, plan, explain.txt"""
@@ -301,19 +281,13 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("run_dir", metavar="RUN_DIR", help="the output folder of `tasker run`")
-    p.add_argument("--agent", default=None,
-                   help="agent id: d1, d2, ... (without it: the agents that planned, and how each ended)")
+    p.add_argument("--agent", required=True, help="agent id: d1, d2, ...")
     p.add_argument("--at", type=non_negative_seconds, default=None,
                    help="simulated time in s (default: the agent's last plan)")
     p.add_argument("--out", default=None, help="write domain.pddl, problem.pddl, plan and explain.txt here")
 
 
 def _command(args: argparse.Namespace) -> int:
-    if args.agent is None:
-        if args.at is not None or args.out:
-            raise ExplainError("--at and --out explain one agent: give --agent too")
-        sys.stdout.write(agents_summary(args.run_dir))
-        return 0
     ex = explain(args.run_dir, args.agent, args.at)
     if args.out:
         files = write(ex, Path(args.out))

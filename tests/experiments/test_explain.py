@@ -121,16 +121,6 @@ def test_explain_picks_the_problem_in_force(tmp_path: Path) -> None:
         explain.explain(run, "d11")
 
 
-def test_without_an_agent_the_run_is_summarised(unsolvable_run: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """``tasker explain RUN`` lists the agents that planned, their problems and how each ended."""
-    assert explain.main([str(unsolvable_run)]) == 0
-    out = capsys.readouterr().out
-    assert "1 agent(s) planned" in out and f"tasker explain {unsolvable_run} --agent AGENT" in out
-    assert "d1  guide_human: ended at t=" in out and "upTsk t=1" in out
-    assert explain.main([str(unsolvable_run), "--at", "5"]) == 2
-    assert "--at and --out explain one agent: give --agent too" in capsys.readouterr().err
-
-
 def test_explain_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert explain.main([str(tmp_path / "nope"), "--agent", "d1"]) == 2
     assert "no such run folder" in capsys.readouterr().err
