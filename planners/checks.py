@@ -253,9 +253,9 @@ def check_numeric(domain: up.model.Problem, text: str, file: str | Path) -> None
             start = next((i for i, s in enumerate(lines) if re.search(rf"\(:action\s+{re.escape(a.name)}\b", s,
                                                                        re.IGNORECASE)), 0)
             line = next((i + 1 for i in range(start, len(lines)) if f"({name}" in lines[i].lower()), None)
-            raise PddlError(file, f"action {a.name}: {what} the numeric fluent {name}; numeric fluents are "
-                                  "supported only as action costs: (increase (total-cost) ...) by a constant or "
-                                  "a fluent fixed in the problem such as travel-time", line)
+            raise PddlError(file, f"action {a.name}: {what} the numeric fluent {name}: unsupported PDDL features "
+                                  "(numeric fluents are supported only as action costs: (increase (total-cost) "
+                                  "...) by a constant or a fluent fixed in the problem such as travel-time)", line)
 
 
 def remembered_domain(path: str | Path) -> CheckedDomain:
