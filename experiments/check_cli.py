@@ -15,12 +15,14 @@ from __future__ import annotations
 import argparse
 import functools
 import tomllib
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from experiments.run_cli import add_path_option, task_paths
 from tasker.cliargs import EXIT_FAILED, EXIT_OK, error_text
+from tasker.reader import InputWarning
 
 EXAMPLES = """\
 examples:
@@ -86,8 +88,14 @@ class Checker:
     def _task_folder(self, p: Path) -> None:
         from planners.loader import load_task
 
-        self.attempt(p, "task folder: PDDL, task.toml and the [example] solved",
-                     lambda: load_task(p, use_cache=False))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", InputWarning)
+            ok = self.attempt(p, "task folder: PDDL, task.toml and the [example] solved",
+                              lambda: load_task(p, use_cache=False))
+        for w in caught:  # shown as any other warning; they only change what "ok" claims
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        if ok and any(issubclass(w.category, InputWarning) for w in caught):
+            self.passed[-1] = (str(p), "task folder: PDDL and task.toml (its [example]: see the warning)")
 
     def _pddl(self, p: Path) -> None:
         from planners.checks import load_domain

@@ -21,6 +21,7 @@ import inspect
 import string
 import sys
 import types
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -31,8 +32,9 @@ from planners.problem import DomainModel
 from planners.results import PlanStatus
 from planners.taskspec import TaskSpec, meaning_of, read_task_toml
 from tasker import reader
-from tasker.errors import BadRequest, TaskerError
+from tasker.errors import BadRequest
 from tasker.meaning import Binding
+from tasker.reader import InputWarning
 from tasker.world import WorldState
 
 HOOK_NAMES = ("extra_facts", "check_args", "check_terminate")
@@ -247,11 +249,15 @@ def _check_example(task: PddlTaskType) -> None:
         task.check_terminate(ctx)
     except BadRequest as exc:
         raise task.spec.error("example", f"args: {exc}") from None
-    except TaskerError:
-        raise
-    except Exception as exc:  # noqa: BLE001 - only the folder's own hooks raise anything else
-        raise DefinitionError(hooks, f"a hook fails on the [example]: {type(exc).__name__}: {exc}",
-                              hook_line(exc, hooks)) from None
+    except Exception as exc:  # noqa: BLE001 - the folder's own hooks (DefinitionError: extra_facts' shape)
+        # a warning, not a refusal: a task whose hook fails at run time ends alone, with its reason
+        # in the trace, and the run goes on; the user hears of it before any run
+        line = exc.line if isinstance(exc, DefinitionError) else hook_line(exc, hooks)
+        why = exc.reason if isinstance(exc, DefinitionError) else f"{type(exc).__name__}: {exc}"
+        warnings.warn_explicit(InputWarning(f"{hooks}{f':{line}' if line else ''}: a hook fails on the [example]: "
+                                            f"{why}; every request of this type will end with cause error"),
+                               InputWarning, str(hooks), line or 0, module="planners.loader")
+        return
     _check_example_types(task, world, [*goal, *world.facts])
     text, init, _ = task.problem_text(ctx, world, goal, extra)
     where = f"{task.spec.folder / 'task.toml'} [example] problem"
@@ -259,12 +265,12 @@ def _check_example(task: PddlTaskType) -> None:
     result = task.planner.solve(text, timeout=task.timeout)
     if result.status is PlanStatus.ERROR:  # e.g. a feature the optimal search cannot handle (axioms)
         raise DefinitionError(task.spec.domain_file, f"the planner fails on the {where}: {result.message}")
-    if result.status is PlanStatus.UNSOLVABLE:  # the example is what `tasker check` promises to solve
+    if result.status is PlanStatus.UNSOLVABLE:  # tasker check promises a solvable example: say it is not
         left_out = [list(f) for f in sorted(world.facts) if tuple(f) not in init]
-        raise task.spec.error("example", f"no plan reaches the goal {[list(g) for g in goal]} from the [example] "
-                                         "world" + (f"; left out of the problem (an object or predicate the "
-                                                    f"domain or [example] objects do not declare): {left_out}"
-                                                    if left_out else ""))
+        task.spec.warn("example", f"no plan reaches the goal {[list(g) for g in goal]} from the [example] world"
+                                  + (f"; left out of the problem (an object or predicate the domain or [example] "
+                                     f"objects do not declare): {left_out}" if left_out else "")
+                                  + "; a request like it will end 'upTsk unsolvable'")
 
 
 def load_task(folder: str | Path, *, use_cache: bool = True) -> PddlTaskType:

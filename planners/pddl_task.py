@@ -97,8 +97,9 @@ def default_planner() -> Planner:
 
 def hook_line(exc: BaseException, path: Path) -> int | None:
     """The line of ``path`` (a folder's ``task.py``) where ``exc`` was raised, if it was there."""
-    return next((f.lineno for f in reversed(traceback.extract_tb(exc.__traceback__)) if Path(f.filename) == path),
-                None)
+    where = path.resolve()
+    return next((f.lineno for f in reversed(traceback.extract_tb(exc.__traceback__))
+                 if Path(f.filename).resolve() == where), None)
 
 
 class PddlTaskType(TaskType):

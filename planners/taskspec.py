@@ -12,6 +12,7 @@ negated as ``["not", "following", "$person"]``; ``$name`` is a request argument,
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -116,6 +117,14 @@ class TaskSpec:
     def error(self, fieldname: str, message: str) -> DefinitionError:
         """A fault found after reading (against the domain), located like the reader's own."""
         return DefinitionError(self.toml, f"{fieldname}: {message}", self.lines.get(fieldname))
+
+    def warn(self, fieldname: str, message: str) -> None:
+        """Valid but doubtful, found after reading: an :class:`~tasker.reader.InputWarning`
+        located like :meth:`error`."""
+        line = self.lines.get(fieldname)
+        text = f"{self.toml}{f':{line}' if line else ''}: {fieldname}: {message}"
+        warnings.warn_explicit(reader.InputWarning(text), reader.InputWarning, str(self.toml), line or 0,
+                               module="planners.taskspec")
 
 
 @dataclass(frozen=True, slots=True)
