@@ -210,16 +210,23 @@ def test_an_example_object_of_an_undeclared_type_is_named(tmp_path: Path) -> Non
 def test_a_numeric_fluent_other_than_the_cost_is_refused_clearly(tmp_path: Path, old: str, new: str,
                                                                  fragment: str) -> None:
     """Before: "Fast Downward's parser refuses the domain: ... Undefined predicate Got: decrease"."""
+    domain, err = _refused_domain(tmp_path, ("(total-cost) - number)",
+                                             "(total-cost) - number\n    (battery ?r - robot) - number)"), old, new)
+    assert err.file == str(domain)
+    assert (f"action navigate: {fragment}: unsupported PDDL features (numeric fluents are supported only as "
+            "action costs") in str(err)
+    assert err.line == _line_of(domain, new[-25:])
+
+
+def _refused_domain(tmp_path: Path, prepare: tuple[str, str], old: str, new: str) -> tuple[Path, DefinitionError]:
+    """The template's domain edited by ``prepare`` then ``old -> new``, and the error its loading raises."""
     folder = _new(tmp_path)
     domain = folder / "domain.pddl"
-    _edit(domain, "(total-cost) - number)", "(total-cost) - number\n    (battery ?r - robot) - number)")
+    _edit(domain, *prepare)
     _edit(domain, old, new)
     with pytest.raises(DefinitionError) as info:
         load_task(folder, use_cache=False)
-    assert info.value.file == str(domain)
-    assert (f"action navigate: {fragment}: unsupported PDDL features (numeric fluents are supported only as "
-            "action costs") in str(info.value)
-    assert info.value.line == _line_of(domain, new[-25:])
+    return domain, info.value
 
 
 @pytest.mark.parametrize(("old", "new", "at", "fragment"), [
@@ -233,16 +240,12 @@ def test_a_numeric_fluent_other_than_the_cost_is_refused_clearly(tmp_path: Path,
 def test_either_types_and_derived_predicates_are_refused_plainly(tmp_path: Path, old: str, new: str, at: str,
                                                                  fragment: str) -> None:
     """Before: unified-planning's "syntax error: Expected ')'" at a misleading place."""
-    folder = _new(tmp_path)
-    domain = folder / "domain.pddl"
-    _edit(domain, "(hand_empty ?r - robot))", "(hand_empty ?r - robot)\n    (busy ?r - robot))")
-    _edit(domain, old, new)
-    with pytest.raises(DefinitionError) as info:
-        load_task(folder, use_cache=False)
+    busy = ("(hand_empty ?r - robot))", "(hand_empty ?r - robot)\n    (busy ?r - robot))")
+    domain, err = _refused_domain(tmp_path, busy, old, new)
     line = _line_of(domain, at)
-    assert info.value.file == str(domain) and info.value.line == line
-    assert info.value.col == domain.read_text().splitlines()[line - 1].index(at) + 1
-    assert fragment in str(info.value) and "Expected" not in str(info.value)
+    assert err.file == str(domain) and err.line == line
+    assert err.col == domain.read_text().splitlines()[line - 1].index(at) + 1
+    assert fragment in str(err) and "Expected" not in str(err)
 
 
 def test_pddl_names_in_task_toml_ignore_case_as_in_pddl(tmp_path: Path) -> None:
