@@ -109,7 +109,7 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
             longest_order = max(longest_order, len(e["order"]))
             anytime += e.get("rule") == "anytime"
     first = needs(events)  # a renewed request (a failed fall asked again) is the same need
-    need_args = {a for a in kind if first[a] == a}
+    firsts = {a for a in kind if first[a] == a}
     served: dict[str, float] = {}
     for a, when in finished.items():
         served[first[a]] = min(when, served.get(first[a], math.inf))
@@ -119,7 +119,7 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
     dead: list[float] = []
     for t in types:
         agents = [a for a in kind if kind[a] == t]
-        asked = [a for a in agents if a in need_args]
+        asked = [a for a in agents if a in firsts]
         done = [a for a in asked if a in served]
         gaps = [served[a] - number(args[a]["deadline"]) for a in done if args[a].get("deadline") is not None]
         n_int = sum(interruptions.get(a, 0) for a in agents)
@@ -139,11 +139,11 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
     if stops_at:
         ending = min(stops_at)[1]
     else:
-        ending = "all done" if len(served) == len(need_args) else "time ran out"
+        ending = "all done" if len(served) == len(firsts) else "time ran out"
     all_gaps = [served[a] - number(args[a]["deadline"]) for a in served if args[a].get("deadline") is not None]
     return {
-        "requested": len(need_args), "completed": len(served), "failed": len(unserved_failed),
-        "renewals": len(kind) - len(need_args),
+        "requested": len(firsts), "completed": len(served), "failed": len(unserved_failed),
+        "renewals": len(kind) - len(firsts),
         "completion_minus_deadline_s": _mean(all_gaps), "lateness_s": sum(max(0.0, g) for g in all_gaps),
         "dead_falls": len(dead), "first_death_t": first_death,
         "interruptions": sum(interruptions.values()), "suspensions": suspensions,

@@ -21,7 +21,6 @@ import inspect
 import string
 import sys
 import types
-import warnings
 from pathlib import Path
 from typing import Any
 
@@ -34,7 +33,6 @@ from planners.taskspec import TaskSpec, meaning_of, read_task_toml
 from tasker import reader
 from tasker.errors import BadRequest
 from tasker.meaning import Binding
-from tasker.reader import InputWarning
 from tasker.world import WorldState
 
 HOOK_NAMES = ("extra_facts", "check_args", "check_terminate")
@@ -254,9 +252,8 @@ def _check_example(task: PddlTaskType) -> None:
         # in the trace, and the run goes on; the user hears of it before any run
         line = exc.line if isinstance(exc, DefinitionError) else hook_line(exc, hooks)
         why = exc.reason if isinstance(exc, DefinitionError) else f"{type(exc).__name__}: {exc}"
-        warnings.warn_explicit(InputWarning(f"{hooks}{f':{line}' if line else ''}: a hook fails on the [example]: "
-                                            f"{why}; every request of this type will end with cause error"),
-                               InputWarning, str(hooks), line or 0, module="planners.loader")
+        reader.warn_at(hooks, line, "", f"a hook fails on the [example]: {why}; every request of this type "
+                                        "will end with cause error")
         return
     _check_example_types(task, world, [*goal, *world.facts])
     text, init, _ = task.problem_text(ctx, world, goal, extra)

@@ -12,7 +12,6 @@ negated as ``["not", "following", "$person"]``; ``$name`` is a request argument,
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -121,10 +120,7 @@ class TaskSpec:
     def warn(self, fieldname: str, message: str) -> None:
         """Valid but doubtful, found after reading: an :class:`~tasker.reader.InputWarning`
         located like :meth:`error`."""
-        line = self.lines.get(fieldname)
-        text = f"{self.toml}{f':{line}' if line else ''}: {fieldname}: {message}"
-        warnings.warn_explicit(reader.InputWarning(text), reader.InputWarning, str(self.toml), line or 0,
-                               module="planners.taskspec")
+        reader.warn_at(self.toml, self.lines.get(fieldname), fieldname, message)
 
 
 @dataclass(frozen=True, slots=True)

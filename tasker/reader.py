@@ -77,6 +77,15 @@ def _where(file: str, line: int | None, field: str, message: str) -> str:
     return f"{where}: {field}: {message}" if field else f"{where}: {message}"
 
 
+def warn_at(file: str | Path, line: int | None, field: str, message: str) -> str:
+    """Emit an :class:`InputWarning` about ``file`` (at ``line``, ``field`` when known); returns
+    its text.  Located at the user's file and line, not at the code that found it, so Python
+    shows that line."""
+    text = _where(str(file), line, field, message)
+    warnings.warn_explicit(InputWarning(text), InputWarning, str(file), line or 0, module="tasker.reader")
+    return text
+
+
 def suggest(name: str, known: Iterable[str]) -> str:
     """``"; did you mean 'x'?"`` for the closest known name, or ``""``."""
     close = difflib.get_close_matches(str(name), [str(k) for k in known], n=1, cutoff=0.6)
@@ -162,11 +171,7 @@ class Table:
 
     def warn(self, key: str | int | None, message: str) -> str:
         """Emit an :class:`InputWarning` located like :meth:`error`; returns its text."""
-        line = self.line(key)
-        text = _where(self.file, line, self.field(key), message)
-        # located at the user's file and line (not at the reader's code), so Python shows that line
-        warnings.warn_explicit(InputWarning(text), InputWarning, self.file, line or 0, module="tasker.reader")
-        return text
+        return warn_at(self.file, self.line(key), self.field(key), message)
 
     def at(self, key: str | int, data: Any) -> Table:
         """A table at ``key`` below this one whose value is ``data`` (e.g. an element of an array)."""
