@@ -111,11 +111,12 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
     loop.observers.append(monitor.observe)
     loop.harmoniser.hazards = monitor.active  # hazard-aware waiting learns of hazards from the monitor
     made = _Made(loop, Requester(store, loop.harmoniser, "scenario"))
-    sids = iter(range(1, len(scn.actions) + 1))
+    requests = 0  # the K-th request is the scenario's dK
     for a in scn.actions:
-        loop.at(a.t, _action(loop, sim, made, a, f"d{next(sids)}" if a.kind == "request" else None))
         if a.kind == "request":
+            requests += 1
             store.validate(a.fields["task"], a.fields["args"])  # bad requests fail before the run
+        loop.at(a.t, _action(loop, sim, made, a, f"d{requests}"))
     return loop, sim
 
 
@@ -183,16 +184,12 @@ class _Made:
             self.loop.at(when, lambda: self.submit(sid, a, renews=e["agent"]))
 
 
-def _action(loop: SimulationLoop, sim: Any, made: _Made, a: TimedAction, sid: str | None) -> Callable[[], None]:
+def _action(loop: SimulationLoop, sim: Any, made: _Made, a: TimedAction, sid: str) -> Callable[[], None]:
+    """What happens at ``a.t``; ``sid``: the scenario's id of the latest request (``a``'s own if it is one)."""
     f = a.fields
     requester = made.requester
     if a.kind == "request":
-        assert sid is not None
-
-        def submit() -> None:  # through the public requester, as any user's requests
-            made.submit(sid, a)
-
-        return submit
+        return lambda: made.submit(sid, a)  # through the public requester, as any user's requests
     if a.kind == "terminate":
         return lambda: made.terminate(f["agent"], f["reason"])
     if a.kind == "change":
