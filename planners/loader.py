@@ -167,6 +167,10 @@ def _check_suspension(spec: TaskSpec, dm: DomainModel) -> None:
                 raise spec.error(where, f"{free[0]} is not bound by a positive `when` literal of this branch")
         true = {lit for lit in b.when if lit[0] != "not"}
         false = {lit[1:] for lit in b.when if lit[0] == "not"}
+        both = sorted(true & false)
+        if both:  # no state has a fact and its negation: the branch could never be chosen
+            raise spec.error(where, f"`when` asks for {list(both[0])} and for its negation, so no state satisfies it "
+                                    f"and this branch is never chosen")
         for t in b.stages:
             add, delete = dm.ground(t.action, t.args)
             true -= set(delete)
@@ -268,6 +272,10 @@ def _check_example(task: PddlTaskType) -> None:
                                   + (f"; left out of the problem (an object or predicate the domain or [example] "
                                      f"objects do not declare): {left_out}" if left_out else "")
                                   + "; a request like it will end 'upTsk unsolvable'")
+    if result.status is PlanStatus.TIMEOUT:  # not solved, not proven unsolvable: say so, not "solved"
+        task.spec.warn("task.timeout_s", f"the planner did not finish the [example] within timeout_s = "
+                                         f"{task.timeout:g} s (raise it, or simplify the domain); a request like it "
+                                         f"falls back to the [static] template for upTsk")
 
 
 def load_task(folder: str | Path, *, use_cache: bool = True) -> PddlTaskType:

@@ -355,6 +355,18 @@ def test_a_suspension_branch_without_when_before_the_last_is_refused(tmp_path: P
     load_task(folder, use_cache=False)  # a conditional branch is not always eligible: the others are reachable
 
 
+def test_a_suspension_when_that_contradicts_itself_is_refused(tmp_path: Path) -> None:
+    """Before: accepted, and the branch was silently never chosen (no state has a fact and its negation)."""
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, 'when = [["holding", "$robot", "$item"]]',
+          'when = [["holding", "$robot", "$item"], ["not", "holding", "$robot", "$item"]]')
+    with pytest.raises(DefinitionError) as info:
+        load_task(folder, use_cache=False)
+    assert info.value.line == _line_of(toml, "[[suspension]]")
+    assert "suspension[0]: `when` asks for ['holding', '$robot', '$item'] and for its negation" in str(info.value)
+
+
 def test_an_upper_case_scenario_object_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Before: [objects.Cup] ran, but the plan moved "cup": the robot never held Cup and its hazard never fired."""
     from experiments.cli import main
@@ -396,3 +408,17 @@ def test_check_says_when_the_example_was_not_solved(tmp_path: Path, capsys: pyte
     assert "task folder: PDDL and task.toml (its [example]: see the warning)" in out.out
     assert "[example] solved" not in out.out
     assert f"{folder / 'task.py'}:2: a hook fails on the [example]: ValueError: boom" in out.err
+
+
+def test_an_example_the_planner_does_not_finish_in_time_is_a_warning(tmp_path: Path) -> None:
+    """Before: a timeout on the [example] passed silently and `tasker check` said "solved"."""
+    folder = _new(tmp_path)
+    toml = folder / "task.toml"
+    _edit(toml, "timeout_s = 10.0", "timeout_s = 0.000001")
+    load_task(folder, use_cache=False).planner.clear_cache()  # the scaffold solved it: forget that plan
+    with pytest.warns(InputWarning) as caught:
+        load_task(folder, use_cache=False)
+    text = next(str(w.message) for w in caught if issubclass(w.category, InputWarning))
+    assert text.startswith(f"{toml}:{_line_of(toml, 'timeout_s =')}: task.timeout_s: the planner did not finish "
+                           "the [example] within timeout_s = 1e-06 s")
+    assert "falls back to the [static] template" in text
