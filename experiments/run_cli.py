@@ -11,7 +11,18 @@ import argparse
 import sys
 from pathlib import Path
 
-from tasker.cliargs import EXIT_FAILED, EXIT_OK, UsageError, did_you_mean, note, seed, show_progress, writable_dir
+from tasker.cliargs import (
+    EXIT_FAILED,
+    EXIT_INTERRUPTED,
+    EXIT_OK,
+    UsageError,
+    did_you_mean,
+    note,
+    seed,
+    show_progress,
+    writable_dir,
+)
+from tasker.errors import RunInterrupted
 from tasker.trace import FAILED
 
 EXAMPLES = """\
@@ -95,6 +106,10 @@ def _run(args: argparse.Namespace) -> int:
                               progress=show_progress(args), pictures=not args.no_pictures,
                               task_paths=tuple(paths), policy=args.policy,
                               hazard_waiting=args.hazard_waiting)
+    except RunInterrupted as exc:  # stopped while running: what ran is written (experiments.runner)
+        print(f"tasker run: {exc.reason}; the trace so far, run.json and metrics.json are in {out}/",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
     except Exception:  # bad input refused before the run: no empty output folder left behind
         if made and out.is_dir() and not any(out.iterdir()):
             out.rmdir()

@@ -32,7 +32,7 @@ from experiments.actions import TimedAction
 from experiments.request_fields import asked_for
 from tasker import schedulers
 from tasker.agent import Rates
-from tasker.errors import RunAborted
+from tasker.errors import RunAborted, RunInterrupted
 from tasker.harmoniser import Mode
 from tasker.loop import SimulationLoop
 from tasker.meaning import Monitor
@@ -279,12 +279,15 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         spec_json = {"kind": "robot", **scn.to_json()}
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")
-    error: Exception | None = None
+    error: BaseException | None = None
     with _journal(kind) as journal:  # the PDDL of every planning call, for problems/
         try:
             _run(loop, progress)
         except Exception as exc:  # the trace so far, run.json and metrics.json are still written, then it propagates
             error = exc
+        except KeyboardInterrupt as exc:  # the user stopped it: keep what ran, closed like a run cut by its horizon
+            error = exc
+            loop.trace.emit(loop.now, "run", status="interrupted", active=sorted(loop.harmoniser.agents))
     wall = time.perf_counter() - t0
     trace = loop.trace
     world_spec = None
@@ -311,8 +314,12 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
     if error is None:
         metrics = _metrics(trace, calls, wall)
     else:
-        reason = error.reason if isinstance(error, RunAborted) else f"{type(error).__name__}: {error}"
-        record["status"], record["error"] = "aborted", reason
+        if isinstance(error, KeyboardInterrupt):
+            reason, record["status"] = f"interrupted by the user at t={loop.now:g} s", "interrupted"
+        else:
+            reason = error.reason if isinstance(error, RunAborted) else f"{type(error).__name__}: {error}"
+            record["status"] = "aborted"
+        record["error"] = reason
         try:
             metrics = _metrics(trace, calls, wall)
         except Exception as exc:  # metrics of a cut trace may not compute: say so, keep the rest
@@ -320,6 +327,8 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
     if out is not None:
         _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures and error is None, sim, journal)
     result = RunResult(record, metrics, trace, trajectory)
+    if isinstance(error, KeyboardInterrupt):
+        raise RunInterrupted(reason, result, out) from error
     if error is not None:
         raise RunAborted(reason, result) from error
     return result

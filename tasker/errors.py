@@ -81,6 +81,18 @@ class RunAborted(TaskerError):
         super().__init__(f"run aborted: {reason}")
 
 
+class RunInterrupted(KeyboardInterrupt):
+    """The user stopped a run (Ctrl-C).  Still a :class:`KeyboardInterrupt`, so whatever
+    catches those goes on doing so; ``result`` carries what the run produced so far (the
+    runner writes the trace, ``run.json`` and ``metrics.json`` first), ``out`` where."""
+
+    def __init__(self, reason: str, result: object = None, out: object = None) -> None:
+        self.reason = reason
+        self.result = result
+        self.out = out
+        super().__init__(reason)
+
+
 class AgentEnded(TaskerError):
     """An agent ended (a hook raised) while the harmoniser was asking it something (``reqSP``).
 

@@ -204,6 +204,31 @@ def test_verbose_shows_the_traceback_of_an_internal_error(monkeypatch: pytest.Mo
     assert "Traceback" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("scenario", [SYNTHETIC, "paper"])
+def test_a_run_stopped_by_ctrl_c_keeps_what_ran(scenario: str, monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
+                                                capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: Ctrl-C during a run wrote nothing, so a long run's first hours were lost."""
+    import experiments.runner
+
+    def stopped(loop: Any, progress: bool) -> None:
+        loop.run(until=10.0)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(experiments.runner, "_run", stopped)
+    out = tmp_path / "o"
+    assert main(["run", scenario, "--out", str(out), "--no-pictures"]) == 130
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert f"tasker run: interrupted by the user at t=10 s; the trace so far, run.json and metrics.json are in {out}/" \
+        in err
+    events = [json.loads(line) for line in (out / "trace.jsonl").read_text().splitlines()]
+    assert events[0]["event"] == "run" and events[-1]["event"] == "run"
+    assert events[-1]["status"] == "interrupted" and events[-1]["t"] == 10.0 and events[-1]["active"]
+    record = json.loads((out / "run.json").read_text())
+    assert record["status"] == "interrupted" and record["error"] == "interrupted by the user at t=10 s"
+    assert "tasks" in json.loads((out / "metrics.json").read_text())  # computed from the trace so far
+
+
 def test_quiet_run_prints_the_summary_only(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["run", SYNTHETIC, "--out", str(tmp_path), "--no-pictures", "--quiet"]) == 0
     out, err = capsys.readouterr()
