@@ -127,6 +127,23 @@ class Scheduler:
         """
         return self.queue_key(c)
 
+    def preempt_when_better(self, view: ScheduleView, field: str, value: Callable[[Candidate], Any],
+                            higher: bool = False) -> Decision:
+        """The rule of the single-key preemptive baselines: the best candidate (lowest
+        :meth:`select_key`) starts when nothing executes, and preempts the executing agent
+        when its ``value`` is strictly better — lower, or with ``higher`` higher.  The
+        decision records both values as ``{field}_dac`` and ``{field}_exeDA``."""
+        best = view.best(self.select_key)
+        if best is None:
+            return NO_CHANGE
+        if view.exe is None:
+            return Decision(best.id)
+        v_dac, v_exe = value(best), value(view.exe)
+        switch = v_dac > v_exe if higher else v_dac < v_exe
+        record = {"algorithm": self.name, "dac": best.id, "exeDA": view.exe.id,
+                  f"{field}_dac": v_dac, f"{field}_exeDA": v_exe, "switch": switch}
+        return Decision(best.id if switch else None, record)
+
     @staticmethod
     def cost_params(c: Candidate, algorithm: str) -> CostParams:
         if not isinstance(c.params, CostParams):

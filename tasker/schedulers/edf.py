@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 
-from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, ScheduleView
+from tasker.schedulers.base import Candidate, Decision, Scheduler, ScheduleView
 
 
 class EarliestDeadlineFirst(Scheduler):
@@ -23,13 +23,4 @@ class EarliestDeadlineFirst(Scheduler):
         return (self.deadline(c), c.order)
 
     def schedule(self, view: ScheduleView) -> Decision:
-        best = view.best(self.select_key)
-        if best is None:
-            return NO_CHANGE
-        if view.exe is None:
-            return Decision(best.id)
-        d_dac, d_exe = self.deadline(best), self.deadline(view.exe)
-        switch = d_dac < d_exe
-        record = {"algorithm": self.name, "dac": best.id, "exeDA": view.exe.id,
-                  "deadline_dac": d_dac, "deadline_exeDA": d_exe, "switch": switch}
-        return Decision(best.id if switch else None, record)
+        return self.preempt_when_better(view, "deadline", self.deadline)

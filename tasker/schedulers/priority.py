@@ -11,7 +11,7 @@ import math
 from collections.abc import Mapping
 
 from tasker.errors import ConfigError
-from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, ScheduleView
+from tasker.schedulers.base import Candidate, Decision, Scheduler, ScheduleView
 
 
 class FixedPriority(Scheduler):
@@ -37,13 +37,4 @@ class FixedPriority(Scheduler):
         return (-self.priority(c), c.order)
 
     def schedule(self, view: ScheduleView) -> Decision:
-        best = view.best(self.select_key)
-        if best is None:
-            return NO_CHANGE
-        if view.exe is None:
-            return Decision(best.id)
-        p_dac, p_exe = self.priority(best), self.priority(view.exe)
-        switch = p_dac > p_exe
-        record = {"algorithm": self.name, "dac": best.id, "exeDA": view.exe.id,
-                  "priority_dac": p_dac, "priority_exeDA": p_exe, "switch": switch}
-        return Decision(best.id if switch else None, record)
+        return self.preempt_when_better(view, "priority", self.priority, higher=True)
