@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from tasker.cliargs import non_negative_seconds
+from tasker.cliargs import UsageError, non_negative_seconds
 from tasker.errors import TaskerError
 from tasker.trace import number, read
 
@@ -244,6 +244,16 @@ def explain(run_dir: str | Path, agent: str, at: float | None = None) -> Explana
     return Explanation(agent, at, entry, domain, problem, plan, tuple(moved(load_trace(run), agent, at)))
 
 
+def _planned_in(run_dir: str) -> str:
+    """``"; agents that planned in RUN: d1, d2"`` when ``run_dir`` is a run that planned, else ``""``."""
+    try:
+        index = load_index(Path(run_dir))
+    except TaskerError:
+        return ""
+    agents = sorted({str(e["agent"]) for e in index}, key=lambda a: (len(a), a))
+    return f"; agents that planned in {run_dir}: {', '.join(agents)}" if agents else ""
+
+
 def write(ex: Explanation, out: Path) -> list[Path]:
     """``domain.pddl``, ``problem.pddl``, ``plan`` (if any) and ``explain.txt`` in ``out``."""
     out.mkdir(parents=True, exist_ok=True)
@@ -281,13 +291,16 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("run_dir", metavar="RUN_DIR", help="the output folder of `tasker run`")
-    p.add_argument("--agent", required=True, help="agent id: d1, d2, ...")
+    p.add_argument("--agent", default=None, help="agent id: d1, d2, ... (required; without it the error lists the "
+                                                 "run's agents that planned)")
     p.add_argument("--at", type=non_negative_seconds, default=None,
                    help="simulated time in s (default: the agent's last plan)")
     p.add_argument("--out", default=None, help="write domain.pddl, problem.pddl, plan and explain.txt here")
 
 
 def _command(args: argparse.Namespace) -> int:
+    if args.agent is None:
+        raise UsageError("--agent", f"which agent? an id such as d1{_planned_in(args.run_dir)}")
     ex = explain(args.run_dir, args.agent, args.at)
     if args.out:
         files = write(ex, Path(args.out))

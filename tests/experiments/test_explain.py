@@ -121,6 +121,15 @@ def test_explain_picks_the_problem_in_force(tmp_path: Path) -> None:
         explain.explain(run, "d11")
 
 
+def test_explain_without_an_agent_names_the_agents_of_the_run(unsolvable_run: Path,
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: argparse's bare "the following arguments are required: --agent", whatever the folder held."""
+    assert explain.main([str(unsolvable_run)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("tasker explain: error: argument --agent: which agent? an id such as d1; agents that "
+                          f"planned in {unsolvable_run}: d1") and "Traceback" not in err
+
+
 def test_explain_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert explain.main([str(tmp_path / "nope"), "--agent", "d1"]) == 2
     assert "no such run folder" in capsys.readouterr().err
