@@ -194,15 +194,17 @@ class _Checker:
             check_name(st, task, task, names, "task type", TASKS_HINT)
 
     def scenario_objects(self) -> None:
+        from robot.spec import name_problem
+
         ot = self.top.table("objects", {})
         for name, entry in self.scn.objects.items():
             t = ot.at(name, ot.data[name])
             if name in self.objects:
                 raise ot.error(name, f"the name {name!r} is already a {self.objects[name]} of world "
                                      f"{self.world.name!r}; expected a new name")
-            if name != name.lower():  # the plan would name another object than the world's
-                raise ot.error(name, f"PDDL names ignore case and plans give them in lower case: write "
-                                     f"{name.lower()!r}")
+            bad = name_problem(name)
+            if bad:
+                raise ot.error(name, bad)
             if self.types:
                 check_name(t, "type", entry["type"], self.types, "object type")
             check_name(t, "place", entry["place"], self.world.places, f"place of world {self.world.name!r}")

@@ -13,6 +13,7 @@ Boxes are axis-aligned rectangles ``[xmin, ymin, xmax, ymax]`` in metres; poses 
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -109,6 +110,9 @@ class WorldSpec:
 
 POSE = "[x, y, yaw]"
 BOX = "[xmin, ymin, xmax, ymax]"
+PDDL_NAME = re.compile(r"[a-z][a-z0-9_-]*")
+"""A name of the world as a PDDL object: a letter, then letters, digits, ``-`` and ``_`` (PDDL's
+``<name>``, in the lower case plans give it)."""
 TOP_KEYS = ("name", "description", "bounds", "rooms", "walls", "furniture", "doors", "places", "devices",
             "people", "robot", "facts", "objects")
 
@@ -202,9 +206,9 @@ def read_world(top: Table, source: str) -> WorldSpec:
             if n in seen:
                 raise top.at(what, {}).error(n, f"the name {n!r} is used twice ({seen[n]} and {what}); "
                                                 "places, people, devices, doors, objects and 'robot' share names")
-            if n != n.lower():  # the plan would name another object than the world's
-                raise top.at(what, {}).error(n, f"PDDL names ignore case and plans give them in lower case: "
-                                                f"write {n.lower()!r}")
+            bad = name_problem(n)
+            if bad:
+                raise top.at(what, {}).error(n, bad)
             seen[n] = what
     facts = []
     facts_t = top.at("facts", {})
@@ -223,6 +227,21 @@ def read_world(top: Table, source: str) -> WorldSpec:
     top.done(TOP_KEYS)
     _check_geometry(spec, top)
     return spec
+
+
+def name_problem(name: str) -> str | None:
+    """Why ``name`` cannot name an object of the world in a PDDL problem, or ``None``.
+
+    Every place, person, device, door and object is written into the problems the planner
+    reads: a space, a ``?``, a dot or a non-ASCII letter would make every planning call of
+    the run fail, and a name in upper case would never be the lower-case name a plan gives.
+    """
+    if name != name.lower():  # the plan would name another object than the world's
+        return f"PDDL names ignore case and plans give them in lower case: write {name.lower()!r}"
+    if not PDDL_NAME.fullmatch(name):
+        return (f"{name!r} is not a PDDL name: expected a letter, then letters, digits, '-' or '_' "
+                "(the name is an object of every planning problem)")
+    return None
 
 
 def room_of(spec: WorldSpec, x: float, y: float) -> str | None:

@@ -174,6 +174,7 @@ TAILS = [
     ('[objects.cup]\ntype = "item"\n', "objects.cup.place", "missing"),
     ('[objects.cup]\ntype = "item"\nplace = "kitchen"\ncolour = "red"\n', "objects.cup.colour", "unknown key"),
     ('[objects.john]\ntype = "item"\nplace = "kitchen"\n', "objects.john", "already a person"),
+    ('[objects."my cup"]\ntype = "item"\nplace = "kitchen"\n', "objects.my cup", "is not a PDDL name"),
     ('[objects.cup]\ntype = "item"\nplace = "kitchen"\nfacts = [["at", "cup", "gardn"]]\n', "objects.cup.facts[0]",
      "'gardn'"),
     ('[objects.cup]\ntype = "item"\nplace = "kitchen"\nfacts = ["at"]\n', "objects.cup.facts[0]",
