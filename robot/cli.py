@@ -78,12 +78,22 @@ def travel_matrix(model: MotionModel, poses: Sequence[Pose], progress: bool = Fa
     return out
 
 
+def _picture_file(text: str) -> Path:
+    """``--out``: a ``.png`` file name that can be written (the picture is a PNG; matplotlib would
+    refuse another suffix after the work, or add ``.png`` to a name without one)."""
+    p = Path(text)
+    if p.suffix.lower() != ".png":
+        raise UsageError("--out", f"{text}: expected a file name ending in .png (the picture is a PNG)")
+    return writable_file(p, "--out")
+
+
 def _world(args: argparse.Namespace) -> int:
+    out = _picture_file(args.out) if args.out else None  # before the work, like every argument
     spec = _load(args.world)
-    if args.out:
+    if out is not None:
         from robot.picture import draw_world
 
-        draw_world(spec, writable_file(args.out, "--out"))
+        draw_world(spec, out)
     if args.json:
         from robot.describe import describe_world
 
@@ -138,7 +148,7 @@ def register(subparsers: Any) -> None:
         epilog="examples:\n  tasker world paper\n  tasker world flat --json\n  tasker world paper --json --no-roadmap\n"
                "  tasker world my_flat.toml --out flat.png")
     p.add_argument("world", metavar="WORLD", help="a shipped world name (paper, flat) or a .toml path")
-    p.add_argument("--out", metavar="PNG", help="write a top-down picture")
+    p.add_argument("--out", metavar="PNG", help="write a top-down picture (a .png file)")
     p.add_argument("--json", action="store_true",
                    help="print the whole world as JSON (format tasker.world/1, see docs/robot.md): places, rooms, "
                         "doors, devices, people, objects and the roadmap's statistics")
