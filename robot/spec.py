@@ -108,6 +108,10 @@ class WorldSpec:
     objects: Mapping[str, str] = field(default_factory=dict)
 
 
+MAX_AREA = 10_000.0
+"""The largest area of a world's bounds, in m²: the roadmap (:mod:`robot.roadmap`) is grown over the
+bounds at 13 milestones a m², about 10 s and 1 GB for this many; four times as many take a minute and
+3 GB, and a typo such as ``1e6`` never ends."""
 POSE = "[x, y, yaw]"
 BOX = "[xmin, ymin, xmax, ymax]"
 PDDL_NAME = re.compile(r"[a-z][a-z0-9_-]*")
@@ -175,6 +179,11 @@ def read_world(top: Table, source: str) -> WorldSpec:
     hi = check_numbers(top, "bounds", b[1], 2, "[[xmin, ymin], [xmax, ymax]]")
     if hi[0] <= lo[0] or hi[1] <= lo[1]:
         raise top.error("bounds", f"expected xmin < xmax and ymin < ymax, got {b!r}")
+    area = (hi[0] - lo[0]) * (hi[1] - lo[1])
+    if area > MAX_AREA:
+        raise top.error("bounds", f"the world covers {area:.4g} m², more than {MAX_AREA:g} m² (e.g. 100 m x 100 m): "
+                                  "the robot's roadmap grows milestones over the whole of the bounds (13 a m²), "
+                                  "which would take minutes and gigabytes; expected bounds around the rooms")
     rooms_t = top.table("rooms", {})
     rooms = {n: _box(rooms_t, n, v) for n, v in rooms_t.items()}
     obstacles = []

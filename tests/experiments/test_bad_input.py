@@ -331,6 +331,8 @@ WORLD = 'bounds = [[0, 0], [6, 6]]\nwalls = [[0, 2.9, 2, 3.1]]\n[robot]\npose = 
     (WORLD + '[people.ann]\npose = [1, 1, 0]\nspeed = nan\n', "people.ann.speed", "finite"),
     (WORLD.replace("[[0, 0], [6, 6]]", "[[0, 0], [6, nan]]"), "bounds", "finite"),
     (WORLD.replace("[[0, 0], [6, 6]]", "[[6, 0], [0, 6]]"), "bounds", "xmin < xmax"),
+    # before: accepted, and growing the roadmap over 1e12 m² never ended (gigabytes and counting)
+    (WORLD.replace("[[0, 0], [6, 6]]", "[[0, 0], [1e6, 1e6]]"), "bounds", "covers 1e+12 m², more than 10000 m²"),
     (WORLD + '[devices.cooker]\nplace = "hal"\n', "devices.cooker.place", "did you mean 'hall'"),
     (WORLD + '[doors.hall]\nbox = [1, 1, 2, 2]\n', "doors.hall", "used twice"),
     ('facts = [["at", "robot", "kitchen"]]\n' + WORLD, "facts[0]", "'kitchen'"),
