@@ -40,11 +40,15 @@ def _pose(spec: WorldSpec, text: str, argument: str = "PLACE") -> Pose:
     if len(values) not in (2, 3) or not all(math.isfinite(v) for v in values):
         raise BadInput(argument, f"{text!r} is neither a place of {spec.name}{did_you_mean(text, spec.places)} "
                                  f"({', '.join(sorted(spec.places))}) nor x,y[,yaw]")
-    from robot.spec import point_problem
+    from robot.spec import point_problem, robot_problem
 
-    why = point_problem(spec, values[0], values[1])  # where no robot can be: not "unreachable", a wrong point
+    # where no robot can be: not "unreachable" (as a goal; a start would be moved), a wrong point
+    why = point_problem(spec, values[0], values[1])
     if why:
         raise BadInput(argument, f"{text!r} is {why} of world {spec.name}; expected a point in free space")
+    why = robot_problem(spec, values[0], values[1])
+    if why:
+        raise BadInput(argument, f"{text!r}: {why} of world {spec.name}; expected a point with room for the robot")
     return (values[0], values[1], values[2] if len(values) == 3 else 0.0)
 
 

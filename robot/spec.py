@@ -282,9 +282,8 @@ def check_point(spec: WorldSpec, t: Table, key: str | int, x: float, y: float) -
 
 
 def _check_geometry(spec: WorldSpec, top: Table) -> None:
-    """Places, people, walks inside the bounds and not inside a wall or furniture; the robot in free space."""
-    from robot.scene import Scene
-
+    """Places, people, walks inside the bounds and not inside a wall or furniture; the robot, at its pose
+    and at every place, in free space."""
     def check(t: Table, key: str | int, x: float, y: float) -> None:
         check_point(spec, t, key, x, y)
 
@@ -312,12 +311,25 @@ def _check_geometry(spec: WorldSpec, top: Table) -> None:
     robot_t = top.table("robot")
     x, y, _ = spec.robot.pose
     check(robot_t, "pose", x, y)
+    bad = robot_problem(spec, x, y)
+    if bad:
+        raise robot_t.error("pose", f"{bad}; expected free space")
+    for n, (x, y, _) in spec.places.items():  # the robot drives to every place: a goal it never reaches
+        bad = robot_problem(spec, x, y)
+        if bad:
+            raise places_t.error(n, f"{bad}, and a place is where the robot stands (it could never get there); "
+                                    "expected a point with room for the robot")
+
+
+def robot_problem(spec: WorldSpec, x: float, y: float) -> str | None:
+    """Why the robot cannot stand at ``(x, y)`` (its disc overlaps a wall, furniture or the bounds), or ``None``."""
+    from robot.scene import Scene
     from robot.tiago import robot_dimensions
 
     radius = robot_dimensions()[2]
-    if not Scene(spec, radius).static_free(x, y):
-        raise robot_t.error("pose", f"the robot (radius {radius:g} m) at ({x:g}, {y:g}) overlaps a wall, "
-                                    "furniture or the world's bounds; expected free space")
+    if Scene(spec, radius).static_free(x, y):
+        return None
+    return f"the robot (radius {radius:g} m) at ({x:g}, {y:g}) overlaps a wall, furniture or the world's bounds"
 
 
 def parse_world(data: Mapping[str, Any], source: str) -> WorldSpec:

@@ -323,6 +323,8 @@ WORLD = 'bounds = [[0, 0], [6, 6]]\nwalls = [[0, 2.9, 2, 3.1]]\n[robot]\npose = 
     (WORLD.replace("pose = [4, 4, 0]", "pose = [1, 3, 0]"), "robot.pose", "inside wall"),
     (WORLD.replace("pose = [4, 4, 0]", "pose = [0.1, 4, 0]"), "robot.pose", "overlaps a wall"),
     (WORLD.replace("hall = [1, 1, 0]", "hall = [9, 1, 0]"), "places.hall", "outside the world's bounds"),
+    # before: accepted, and every task sent there failed with "no plan reaches the goal"
+    (WORLD.replace("hall = [1, 1, 0]", "hall = [1, 2.7, 0]"), "places.hall", "a place is where the robot stands"),
     (WORLD + '[people.ann]\npose = [1, 3, 0]\n', "people.ann.pose", "inside wall"),
     (WORLD + '[people.ann]\npose = [1, 1, 0]\nwalk = [[1, 1, 1], [2, 7, 1]]\n', "people.ann.walk[1]", "outside"),
     (WORLD + '[people.ann]\npose = [1, 1, 0]\nwalk = [[3, 1, 1], [3, 1, 2]]\n', "people.ann.walk[1]", "increase"),
