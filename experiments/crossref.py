@@ -27,7 +27,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from experiments import fields
-from experiments.actions import TimedAction, located
+from experiments.actions import NO_REQUESTS, TimedAction, located
 from experiments.request_fields import FIELD_NAMES, asked_for, with_request_fields
 from tasker.cliargs import TASKS_HINT
 from tasker.errors import TaskerError
@@ -299,6 +299,8 @@ class _Checker:
                 else:
                     for fact in value:
                         self.fact(f, what, fact)
+        if not requests:
+            self.warn(self.top, "requests", NO_REQUESTS)
         self.overlaps(requests)
         for a in {a.fields["task"]: a for a, _ in reversed(requests)}.values():  # the first request of each type
             self.bindings(located(self.top, a), self.tasks[a.fields["task"]])

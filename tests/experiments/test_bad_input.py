@@ -268,6 +268,22 @@ def test_identical_requests_after_a_termination_do_not_warn(tmp_path: Path) -> N
         assert scenarios.load(_write(tmp_path, text)).warnings == ()
 
 
+@pytest.mark.parametrize("text", [
+    'kind = "robot"\nworld = "paper"\n[[world_events]]\nt = 3.0\nposture = ["peter", "fallen"]\n',
+    'kind = "synthetic"\n[tasks.a]\nstages = [{ action = "x", duration = 2.0 }]\n',
+])
+def test_a_scenario_without_requests_warns_and_runs(tmp_path: Path, text: str,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    """A world and its events to watch, nothing requested: valid.  Before, refused ("a scenario
+    needs at least one request")."""
+    path = _write(tmp_path, text)
+    assert main(["run", str(path), "--out", str(tmp_path / "o"), "--no-pictures"]) == 0
+    captured = capsys.readouterr()
+    assert "0 tasks, 0 ended" in captured.out
+    assert f"warning: {path}: requests: no [[requests]]: no task runs" in captured.err
+    assert (tmp_path / "o" / "trace.jsonl").read_text().startswith('{"t":0.0,"event":"run"')
+
+
 def test_cli_reports_a_bad_cross_reference_without_a_traceback(tmp_path: Path,
                                                                capsys: pytest.CaptureFixture[str]) -> None:
     path = _write(tmp_path, ROBOT.replace('person = "peter"', 'person = "bob"'))
