@@ -63,6 +63,21 @@ def test_unsolvable_task_raises(task: PddlTaskType) -> None:
     assert info.value.status == "unsolvable"
 
 
+def test_unsolvable_task_names_the_places_the_robot_cannot_reach(tasks: dict[str, PddlTaskType]) -> None:
+    """Before: a guide to a walled-off place ended with only "no plan reaches the goal …", which
+    did not say that the robot could not get there."""
+    task = tasks["guide_human"]
+    ctx = make_ctx(task)
+    here = next(f[2] for f in ctx.world.facts if f[:2] == ("at", "robot"))
+    there = ctx.args["destination"]
+    blocked = StraightLineMotion(blocked=frozenset({ctx.world.poses[there]}))
+    with pytest.raises(PlanningFailed) as info:
+        task.update_task(make_ctx(task, motion=blocked))
+    assert info.value.status == "unsolvable"
+    assert str(info.value).endswith(f"; the robot cannot drive from {here!r} to {there!r} "
+                                    "(walled off, or behind a closed door)")
+
+
 def test_no_world_is_an_error(task: PddlTaskType) -> None:
     ctx = make_ctx(task)
     ctx.world = None
