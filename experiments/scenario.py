@@ -104,6 +104,9 @@ def name_of(path: Path) -> str:
 def kind_of(path: Path) -> str:
     """``robot`` or ``synthetic`` (the default), read strictly."""
     top = reader.load(path, ScenarioError)
+    if "kind" not in top and "world" in top and "tasks" not in top:  # read as synthetic: "tasks: missing"
+        raise top.error("kind", 'missing: a scenario with a world is a robot scenario, so write kind = "robot" '
+                                "(without kind a scenario is synthetic, with [tasks.NAME] and no world)")
     return str(top.string("kind", "synthetic", choices=("robot", "synthetic")))
 
 

@@ -268,6 +268,16 @@ def test_identical_requests_after_a_termination_do_not_warn(tmp_path: Path) -> N
         assert scenarios.load(_write(tmp_path, text)).warnings == ()
 
 
+def test_a_robot_scenario_without_kind_says_to_add_it(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: read as a synthetic scenario (the default kind), it failed with "tasks: missing
+    (required)", a key robot scenarios do not have."""
+    path = _write(tmp_path, ROBOT.replace('kind = "robot"\n', ""))
+    assert main(["run", str(path), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"tasker run: error: {path}: kind: missing: a scenario with a world is a robot scenario, "
+                          'so write kind = "robot"'), err
+
+
 @pytest.mark.parametrize("text", [
     'kind = "robot"\nworld = "paper"\n[[world_events]]\nt = 3.0\nposture = ["peter", "fallen"]\n',
     'kind = "synthetic"\n[tasks.a]\nstages = [{ action = "x", duration = 2.0 }]\n',
