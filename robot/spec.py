@@ -169,6 +169,9 @@ def _robot(t: Table) -> RobotSpec:
 
 def read_world(top: Table, source: str) -> WorldSpec:
     """Check a world file read by :mod:`tasker.reader` and build a :class:`WorldSpec`."""
+    if "kind" in top and "bounds" not in top:  # a scenario given where a world is expected
+        raise top.error("kind", "this is a scenario file, not a world file (a world has bounds, rooms, walls, "
+                                "places, ...; a robot scenario names its world with world = ...)")
     for key in top.keys():
         if key not in TOP_KEYS:
             raise top.error(key, f"unknown key {key!r}{suggest(key, TOP_KEYS)} (valid keys: {', '.join(TOP_KEYS)})")

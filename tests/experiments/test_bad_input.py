@@ -278,6 +278,26 @@ def test_a_robot_scenario_without_kind_says_to_add_it(tmp_path: Path, capsys: py
                           'so write kind = "robot"'), err
 
 
+ROOT = Path(__file__).parents[2]
+
+
+@pytest.mark.parametrize(("argv", "expected"), [
+    (["run", "robot/worlds/flat.toml"], "robot/worlds/flat.toml: is a world file"),
+    (["run", "experiments/sweeps/suspension.toml"], "experiments/sweeps/suspension.toml: is a sweep spec"),
+    (["run", "experiments/protocols/tabsa.toml"], "experiments/protocols/tabsa.toml: is a day protocol"),
+    (["world", "experiments/scenarios/paper.toml"], "paper.toml:6: kind: this is a scenario file, not a world file"),
+])
+def test_another_kind_of_file_is_named_for_what_it_is(argv: list[str], expected: str, tmp_path: Path,
+                                                      monkeypatch: pytest.MonkeyPatch,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: a world file or a sweep spec given to ``run`` failed with "tasks: missing (required)",
+    a scenario given to ``world`` with "unknown key 'kind'"."""
+    monkeypatch.chdir(ROOT)
+    assert main([*argv, *(["--out", str(tmp_path / "o")] if argv[0] == "run" else [])]) == 2
+    err = capsys.readouterr().err
+    assert expected in err and "tasks: missing" not in err, err
+
+
 @pytest.mark.parametrize("text", [
     'kind = "robot"\nworld = "paper"\n[[world_events]]\nt = 3.0\nposture = ["peter", "fallen"]\n',
     'kind = "synthetic"\n[tasks.a]\nstages = [{ action = "x", duration = 2.0 }]\n',
