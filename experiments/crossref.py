@@ -276,6 +276,7 @@ class _Checker:
                 task = self.tasks[a.fields["task"]]
                 checked = self.validate(f, task, a.fields["args"])
                 self.args(f, task, a.fields["args"], checked)
+                self.times(f, a, checked)
                 requests.append((a, checked))
             elif a.kind == "change":
                 k = int(a.fields["agent"][1:])
@@ -304,6 +305,15 @@ class _Checker:
         self.overlaps(requests)
         for a in {a.fields["task"]: a for a, _ in reversed(requests)}.values():  # the first request of each type
             self.bindings(located(self.top, a), self.tasks[a.fields["task"]])
+
+    def times(self, f: Table, a: TimedAction, checked: Mapping[str, Any]) -> None:
+        """A deadline or death time no later than the request itself has passed before the task exists."""
+        for name in ("deadline", "death_at"):
+            value = checked.get(name)
+            if name in a.fields["args"] and isinstance(value, int | float) and value <= a.t:
+                self.warn(f.table("args", {}), name, f"{name}={value:g} is not after the request (t={a.t:g}): "
+                                                     "it has passed before the task is requested (an absolute "
+                                                     "simulated time, not one relative to the request)")
 
     def bindings(self, f: Table, task: TaskType) -> None:
         """A ``[[bindings]]`` entry whose objects in this world are none of its kind (an item bound as a

@@ -249,6 +249,18 @@ def test_a_request_after_the_horizon_warns(tmp_path: Path) -> None:
     assert any("after the horizon" in w for w in scn.warnings)
 
 
+@pytest.mark.parametrize("field", ["deadline = -5.0", "deadline = 20.0", "death_at = 10.0"])
+def test_a_deadline_not_after_its_request_warns(tmp_path: Path, field: str) -> None:
+    """Before: ``deadline = -5`` or a deadline before the request (read as relative to it, say)
+    loaded silently, and every scheduler saw a task late before it existed."""
+    name = field.split(" ")[0]
+    text = ROBOT.replace('args = { person = "peter" }', f'args = {{ person = "peter", {field} }}')
+    with pytest.warns(InputWarning, match=rf"requests\[1\]\.args\.{name}: {name}=.* is not after the request "
+                                          r"\(t=20\)"):
+        scn = scenarios.load(_write(tmp_path, text))
+    assert len(scn.warnings) == 1
+
+
 @pytest.mark.parametrize("task, args", [
     ("guide_human", '{ person = "john", destination = "bedroom" }'),
     ("human_fell", '{ person = "peter" }'),
