@@ -261,14 +261,18 @@ class PddlTaskType(TaskType):
     # -- helpers ----------------------------------------------------------------------
 
     def _unreachable(self, ctx: TaskContext, world: WorldState, goal: list[Literal]) -> str:
-        """Why a goal may be unsolvable, for the failure's reason: the places it names that the robot
-        cannot drive to from where it is (walled off, behind a closed door), or ``""``."""
-        here = place_of(world, robot_name(world))
+        """Why a goal may be unsolvable, for the failure's reason: the places it names, and the places of
+        the things it names, that the robot cannot drive to from where it is (walled off, behind a
+        closed door), or ``""``."""
+        robot = robot_name(world)
+        here = place_of(world, robot)
         if here is None:
             return ""
         travel = travel_table(world, ctx.motion, self.spec.travel_s)
-        places = sorted({a for lit in goal for a in lit[1:] if world.objects.get(a) == PLACE_TYPE})
-        cut = [p for p in places if p != here and not math.isfinite(travel.get((here, p), math.inf))]
+        named = {a for lit in goal for a in lit[1:]}
+        places = {a for a in named if world.objects.get(a) == PLACE_TYPE}
+        places |= {p for a in named - places - {robot} if (p := place_of(world, a)) is not None}
+        cut = [p for p in sorted(places) if p != here and not math.isfinite(travel.get((here, p), math.inf))]
         if not cut:
             return ""
         return (f"; the robot cannot drive from {here!r} to {', '.join(map(repr, cut))} "
