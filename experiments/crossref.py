@@ -317,7 +317,8 @@ class _Checker:
 
     def bindings(self, f: Table, task: TaskType) -> None:
         """A ``[[bindings]]`` entry whose objects in this world are none of its kind (an item bound as a
-        ``device``) never applies: the robot would, say, "hold" the item only symbolically."""
+        ``device``) never applies: the robot would, say, "hold" the item only symbolically.  A device
+        in a state its binding does not name (``"On"`` for ``"on"``) reads as the fact not holding."""
         meaning = getattr(task, "meaning", None)
         things = {"device": set(self.world.devices), "door": set(self.world.doors),
                   "held": set(self.world.objects) | set(self.scn.objects),
@@ -332,6 +333,13 @@ class _Checker:
                                      f"{', '.join(covered)} here, and none is a {b.kind} thing of world "
                                      f"{self.world.name!r}, so the fact stays symbolic"
                                      + (f" (kind = {' or '.join(map(repr, fits))}?)" if fits else ""))
+            if b.kind == "device":
+                for n, d in sorted(self.world.devices.items()):
+                    if d.type in b.types and d.state not in (b.state, b.otherwise):
+                        self.warn(f, "task", f"device {n!r} of world {self.world.name!r} starts in state "
+                                             f"{d.state!r}, and task type {task.name!r} reads {list(b.fact)} from "
+                                             f"state {b.state!r} (else {b.otherwise!r}): it starts as not holding; "
+                                             f"expected state = {b.state!r} or {b.otherwise!r}")
 
     def _request(self, k: int) -> tuple[TimedAction, dict[str, Any]]:
         req = [a for a in self.scn.actions if a.kind == "request"][k - 1]

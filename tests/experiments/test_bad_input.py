@@ -249,6 +249,20 @@ def test_a_request_after_the_horizon_warns(tmp_path: Path) -> None:
     assert any("after the horizon" in w for w in scn.warnings)
 
 
+def test_a_device_in_a_state_its_binding_does_not_name_warns(tmp_path: Path) -> None:
+    """Before: a cooker written ``state = "On"`` loaded silently, and cook read it as off."""
+    world = (ROOT / "robot" / "worlds" / "flat.toml").read_text().replace('state = "on"', 'state = "On"')
+    _write(tmp_path, world, "w.toml")
+    text = ('kind = "robot"\nworld = "w.toml"\n[objects.pan]\ntype = "pan"\nplace = "kitchen"\n'
+            '[[requests]]\nt = 0.0\ntask = "cook"\nargs = { pan = "pan" }\n')
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        scn = scenarios.load(_write(tmp_path, text))
+    hits = [w for w in scn.warnings if "device 'cooker'" in w]
+    assert len(hits) == 1 and "starts in state 'On'" in hits[0] and "expected state = 'on' or 'off'" in hits[0]
+    assert any(issubclass(w.category, InputWarning) for w in caught)
+
+
 @pytest.mark.parametrize("field", ["deadline = -5.0", "deadline = 20.0", "death_at = 10.0"])
 def test_a_deadline_not_after_its_request_warns(tmp_path: Path, field: str) -> None:
     """Before: ``deadline = -5`` or a deadline before the request (read as relative to it, say)
