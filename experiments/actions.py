@@ -18,7 +18,7 @@ from experiments.fields import MODES, ScenarioError
 from experiments.request_fields import FIELD_NAMES
 from tasker.reader import Table, check_name, suggest
 
-__all__ = ["TABLES", "WORLD_EVENT_KINDS", "ScenarioError", "TimedAction", "located", "read_actions"]
+__all__ = ["NO_REQUESTS", "TABLES", "WORLD_EVENT_KINDS", "ScenarioError", "TimedAction", "located", "read_actions"]
 
 WORLD_EVENT_KINDS = ("posture", "door", "walk", "add", "delete")
 
@@ -56,10 +56,12 @@ def read_actions(top: Table, *, task_names: Collection[str] | None = None,
             out.append(TimedAction(t, kind, _read(f, kind, task_names), (key, i)))
             f.done()
     actions = tuple(sorted(out, key=lambda a: a.t))
-    if not any(a.kind == "request" for a in actions):
-        raise top.error("requests", "a scenario needs at least one request ([[requests]] with t and task)")
     _check_agents(top, actions)
     return actions
+
+
+NO_REQUESTS = "no [[requests]]: no task runs, and the run ends after the scenario's last other event"
+"""The warning for a scenario without requests (valid: a world, its people and its events to watch)."""
 
 
 def located(top: Table, a: TimedAction) -> Table:

@@ -27,7 +27,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from experiments import fields
-from experiments.actions import TimedAction, located
+from experiments.actions import NO_REQUESTS, TimedAction, located
 from experiments.request_fields import FIELD_NAMES, asked_for, with_request_fields
 from tasker.cliargs import TASKS_HINT
 from tasker.errors import TaskerError
@@ -194,15 +194,17 @@ class _Checker:
             check_name(st, task, task, names, "task type", TASKS_HINT)
 
     def scenario_objects(self) -> None:
+        from robot.spec import name_problem
+
         ot = self.top.table("objects", {})
         for name, entry in self.scn.objects.items():
             t = ot.at(name, ot.data[name])
             if name in self.objects:
                 raise ot.error(name, f"the name {name!r} is already a {self.objects[name]} of world "
                                      f"{self.world.name!r}; expected a new name")
-            if name != name.lower():  # the plan would name another object than the world's
-                raise ot.error(name, f"PDDL names ignore case and plans give them in lower case: write "
-                                     f"{name.lower()!r}")
+            bad = name_problem(name)
+            if bad:
+                raise ot.error(name, bad)
             if self.types:
                 check_name(t, "type", entry["type"], self.types, "object type")
             check_name(t, "place", entry["place"], self.world.places, f"place of world {self.world.name!r}")
@@ -274,6 +276,7 @@ class _Checker:
                 task = self.tasks[a.fields["task"]]
                 checked = self.validate(f, task, a.fields["args"])
                 self.args(f, task, a.fields["args"], checked)
+                self.times(f, a, checked)
                 requests.append((a, checked))
             elif a.kind == "change":
                 k = int(a.fields["agent"][1:])
@@ -297,13 +300,25 @@ class _Checker:
                 else:
                     for fact in value:
                         self.fact(f, what, fact)
+        if not requests:
+            self.warn(self.top, "requests", NO_REQUESTS)
         self.overlaps(requests)
         for a in {a.fields["task"]: a for a, _ in reversed(requests)}.values():  # the first request of each type
             self.bindings(located(self.top, a), self.tasks[a.fields["task"]])
 
+    def times(self, f: Table, a: TimedAction, checked: Mapping[str, Any]) -> None:
+        """A deadline or death time no later than the request itself has passed before the task exists."""
+        for name in ("deadline", "death_at"):
+            value = checked.get(name)
+            if name in a.fields["args"] and isinstance(value, int | float) and value <= a.t:
+                self.warn(f.table("args", {}), name, f"{name}={value:g} is not after the request (t={a.t:g}): "
+                                                     "it has passed before the task is requested (an absolute "
+                                                     "simulated time, not one relative to the request)")
+
     def bindings(self, f: Table, task: TaskType) -> None:
         """A ``[[bindings]]`` entry whose objects in this world are none of its kind (an item bound as a
-        ``device``) never applies: the robot would, say, "hold" the item only symbolically."""
+        ``device``) never applies: the robot would, say, "hold" the item only symbolically.  A device
+        in a state its binding does not name (``"On"`` for ``"on"``) reads as the fact not holding."""
         meaning = getattr(task, "meaning", None)
         things = {"device": set(self.world.devices), "door": set(self.world.doors),
                   "held": set(self.world.objects) | set(self.scn.objects),
@@ -318,6 +333,13 @@ class _Checker:
                                      f"{', '.join(covered)} here, and none is a {b.kind} thing of world "
                                      f"{self.world.name!r}, so the fact stays symbolic"
                                      + (f" (kind = {' or '.join(map(repr, fits))}?)" if fits else ""))
+            if b.kind == "device":
+                for n, d in sorted(self.world.devices.items()):
+                    if d.type in b.types and d.state not in (b.state, b.otherwise):
+                        self.warn(f, "task", f"device {n!r} of world {self.world.name!r} starts in state "
+                                             f"{d.state!r}, and task type {task.name!r} reads {list(b.fact)} from "
+                                             f"state {b.state!r} (else {b.otherwise!r}): it starts as not holding; "
+                                             f"expected state = {b.state!r} or {b.otherwise!r}")
 
     def _request(self, k: int) -> tuple[TimedAction, dict[str, Any]]:
         req = [a for a in self.scn.actions if a.kind == "request"][k - 1]

@@ -387,12 +387,35 @@ def _metrics(trace: Trace, calls: list[dict[str, Any]], wall: float) -> dict[str
     return m
 
 
+OUTPUTS = ("trace.jsonl", "trajectory.jsonl", "run.json", "metrics.json", "timeline.png", "gantt.png",
+           "world.png", "report.html")
+"""The files a run writes into its folder (and ``problems/``), each only when it has one."""
+
+
+def _clear_outputs(out: Path) -> None:
+    """Remove what an earlier run wrote into ``out`` (:data:`OUTPUTS`, ``problems/``'s PDDL, plans and
+    index) and nothing else: a run writes only some of them (no pictures with ``--no-pictures``, no
+    trajectory for a synthetic scenario, fewer planning calls), so the rest would read as this run's."""
+    from experiments.explain import INDEX
+
+    for name in OUTPUTS:
+        (out / name).unlink(missing_ok=True)
+    problems = out / "problems"
+    if problems.is_dir():
+        for f in problems.iterdir():
+            if f.is_file() and (f.name == INDEX or f.suffix in (".pddl", ".plan")):
+                f.unlink()
+        if not any(problems.iterdir()):
+            problems.rmdir()
+
+
 def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Trace,
           trajectory: tuple[tuple[float, float, float, float], ...], world: Any, pictures: bool,
           sim: Any = None, journal: Any = ()) -> None:
     from experiments.explain import write_problems
 
     out.mkdir(parents=True, exist_ok=True)
+    _clear_outputs(out)
     trace.write(out / "trace.jsonl")
     if sim is not None:  # poses and postures at a fixed rate (robot.recording)
         sim.write_trajectory(out / "trajectory.jsonl")

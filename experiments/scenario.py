@@ -104,7 +104,22 @@ def name_of(path: Path) -> str:
 def kind_of(path: Path) -> str:
     """``robot`` or ``synthetic`` (the default), read strictly."""
     top = reader.load(path, ScenarioError)
+    if "kind" not in top:  # read as synthetic, another file would fail with "tasks: missing" or an unknown key
+        if "world" in top and "tasks" not in top:
+            raise top.error("kind", 'missing: a scenario with a world is a robot scenario, so write kind = "robot" '
+                                    "(without kind a scenario is synthetic, with [tasks.NAME] and no world)")
+        other = next((what for keys, what in _OTHER_FILES if all(k in top for k in keys)), None)
+        if other is not None:
+            raise ScenarioError(str(path), f"is {other}, not a scenario (a scenario has kind = \"robot\" or "
+                                           "\"synthetic\")")
     return str(top.string("kind", "synthetic", choices=("robot", "synthetic")))
+
+
+_OTHER_FILES = ((("bounds",), "a world file (name it in a robot scenario: world = \"FILE\"; tasker world FILE "
+                             "shows it)"),
+                (("scenarios", "seeds"), "a sweep spec (tasker sweep SPEC --db DB)"),
+                (("day", "tasks"), "a day protocol (tasker day --protocol FILE)"))
+"""Keys that tell another kind of file given where a scenario is expected, and what to do with it."""
 
 
 def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()) -> RobotScenario:

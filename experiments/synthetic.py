@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from experiments import fields
-from experiments.actions import TABLES, TimedAction, located, read_actions
+from experiments.actions import NO_REQUESTS, TABLES, TimedAction, located, read_actions
 from experiments.crossref import validate_request
 from experiments.fields import MODES, ScenarioError
 from tasker import reader, schedulers
@@ -124,6 +124,8 @@ def load(path: str | Path) -> SyntheticScenario:
     )
     settings.done()
     top.done(SYNTHETIC_KEYS)
+    if not any(a.kind == "request" for a in actions):
+        top.warn("requests", NO_REQUESTS)
     for a in actions:
         if a.t > scenario.horizon:
             located(top, a).warn("t", f"t={a.t:g} is after the horizon ({scenario.horizon:g} s): it never happens")

@@ -35,9 +35,9 @@ from typing import Any
 from planners.checks import DefinitionError
 from planners.estimates import estimator_for, executing
 from planners.planner import PddlText, Planner
-from planners.problem import DomainModel, PortablePddl, holds, portable, render_problem, travel_table
+from planners.problem import PLACE_TYPE, DomainModel, PortablePddl, holds, portable, render_problem, travel_table
 from planners.results import PlanResult, PlanStatus
-from planners.stages import Bindings, StageBuilder
+from planners.stages import Bindings, StageBuilder, place_of, robot_name
 from planners.taskspec import Branch, Literal, TaskSpec
 from tasker.errors import BadRequest, PlanningFailed, UnknownName
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
@@ -150,7 +150,8 @@ class PddlTaskType(TaskType):
         if isinstance(outcome, StagePlan):
             return outcome
         if outcome.status is PlanStatus.UNSOLVABLE:
-            raise PlanningFailed("unsolvable", f"{self.name}: no plan reaches the goal {goal} from the world now")
+            raise PlanningFailed("unsolvable", f"{self.name}: no plan reaches the goal {goal} from the world now"
+                                               + self._unreachable(ctx, world, goal))
         if outcome.status is PlanStatus.TIMEOUT:
             return self._fallback(self.static_update(ctx), "planner timed out for upTsk")
         raise PlanningFailed("error", f"{self.name}: planner error: {outcome.message}")
@@ -258,6 +259,24 @@ class PddlTaskType(TaskType):
                          note=f"decision tree: {branch.label or ('save' if not stages else 'branch')}")
 
     # -- helpers ----------------------------------------------------------------------
+
+    def _unreachable(self, ctx: TaskContext, world: WorldState, goal: list[Literal]) -> str:
+        """Why a goal may be unsolvable, for the failure's reason: the places it names, and the places of
+        the things it names, that the robot cannot drive to from where it is (walled off, behind a
+        closed door), or ``""``."""
+        robot = robot_name(world)
+        here = place_of(world, robot)
+        if here is None:
+            return ""
+        travel = travel_table(world, ctx.motion, self.spec.travel_s)
+        named = {a for lit in goal for a in lit[1:]}
+        places = {a for a in named if world.objects.get(a) == PLACE_TYPE}
+        places |= {p for a in named - places - {robot} if (p := place_of(world, a)) is not None}
+        cut = [p for p in sorted(places) if p != here and not math.isfinite(travel.get((here, p), math.inf))]
+        if not cut:
+            return ""
+        return (f"; the robot cannot drive from {here!r} to {', '.join(map(repr, cut))} "
+                "(walled off, or behind a closed door)")
 
     def _world(self, ctx: TaskContext) -> WorldState:
         if not isinstance(ctx.world, WorldState):

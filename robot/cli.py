@@ -40,11 +40,15 @@ def _pose(spec: WorldSpec, text: str, argument: str = "PLACE") -> Pose:
     if len(values) not in (2, 3) or not all(math.isfinite(v) for v in values):
         raise BadInput(argument, f"{text!r} is neither a place of {spec.name}{did_you_mean(text, spec.places)} "
                                  f"({', '.join(sorted(spec.places))}) nor x,y[,yaw]")
-    from robot.spec import point_problem
+    from robot.spec import point_problem, robot_problem
 
-    why = point_problem(spec, values[0], values[1])  # where no robot can be: not "unreachable", a wrong point
+    # where no robot can be: not "unreachable" (as a goal; a start would be moved), a wrong point
+    why = point_problem(spec, values[0], values[1])
     if why:
         raise BadInput(argument, f"{text!r} is {why} of world {spec.name}; expected a point in free space")
+    why = robot_problem(spec, values[0], values[1])
+    if why:
+        raise BadInput(argument, f"{text!r}: {why} of world {spec.name}; expected a point with room for the robot")
     return (values[0], values[1], values[2] if len(values) == 3 else 0.0)
 
 
@@ -78,12 +82,22 @@ def travel_matrix(model: MotionModel, poses: Sequence[Pose], progress: bool = Fa
     return out
 
 
+def _picture_file(text: str) -> Path:
+    """``--out``: a ``.png`` file name that can be written (the picture is a PNG; matplotlib would
+    refuse another suffix after the work, or add ``.png`` to a name without one)."""
+    p = Path(text)
+    if p.suffix.lower() != ".png":
+        raise UsageError("--out", f"{text}: expected a file name ending in .png (the picture is a PNG)")
+    return writable_file(p, "--out")
+
+
 def _world(args: argparse.Namespace) -> int:
+    out = _picture_file(args.out) if args.out else None  # before the work, like every argument
     spec = _load(args.world)
-    if args.out:
+    if out is not None:
         from robot.picture import draw_world
 
-        draw_world(spec, writable_file(args.out, "--out"))
+        draw_world(spec, out)
     if args.json:
         from robot.describe import describe_world
 
@@ -138,7 +152,7 @@ def register(subparsers: Any) -> None:
         epilog="examples:\n  tasker world paper\n  tasker world flat --json\n  tasker world paper --json --no-roadmap\n"
                "  tasker world my_flat.toml --out flat.png")
     p.add_argument("world", metavar="WORLD", help="a shipped world name (paper, flat) or a .toml path")
-    p.add_argument("--out", metavar="PNG", help="write a top-down picture")
+    p.add_argument("--out", metavar="PNG", help="write a top-down picture (a .png file)")
     p.add_argument("--json", action="store_true",
                    help="print the whole world as JSON (format tasker.world/1, see docs/robot.md): places, rooms, "
                         "doors, devices, people, objects and the roadmap's statistics")

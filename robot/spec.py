@@ -13,6 +13,7 @@ Boxes are axis-aligned rectangles ``[xmin, ymin, xmax, ymax]`` in metres; poses 
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -107,8 +108,15 @@ class WorldSpec:
     objects: Mapping[str, str] = field(default_factory=dict)
 
 
+MAX_AREA = 10_000.0
+"""The largest area of a world's bounds, in m²: the roadmap (:mod:`robot.roadmap`) is grown over the
+bounds at 13 milestones a m², about 10 s and 1 GB for this many; four times as many take a minute and
+3 GB, and a typo such as ``1e6`` never ends."""
 POSE = "[x, y, yaw]"
 BOX = "[xmin, ymin, xmax, ymax]"
+PDDL_NAME = re.compile(r"[a-z][a-z0-9_-]*")
+"""A name of the world as a PDDL object: a letter, then letters, digits, ``-`` and ``_`` (PDDL's
+``<name>``, in the lower case plans give it)."""
 TOP_KEYS = ("name", "description", "bounds", "rooms", "walls", "furniture", "doors", "places", "devices",
             "people", "robot", "facts", "objects")
 
@@ -161,6 +169,9 @@ def _robot(t: Table) -> RobotSpec:
 
 def read_world(top: Table, source: str) -> WorldSpec:
     """Check a world file read by :mod:`tasker.reader` and build a :class:`WorldSpec`."""
+    if "kind" in top and "bounds" not in top:  # a scenario given where a world is expected
+        raise top.error("kind", "this is a scenario file, not a world file (a world has bounds, rooms, walls, "
+                                "places, ...; a robot scenario names its world with world = ...)")
     for key in top.keys():
         if key not in TOP_KEYS:
             raise top.error(key, f"unknown key {key!r}{suggest(key, TOP_KEYS)} (valid keys: {', '.join(TOP_KEYS)})")
@@ -171,6 +182,11 @@ def read_world(top: Table, source: str) -> WorldSpec:
     hi = check_numbers(top, "bounds", b[1], 2, "[[xmin, ymin], [xmax, ymax]]")
     if hi[0] <= lo[0] or hi[1] <= lo[1]:
         raise top.error("bounds", f"expected xmin < xmax and ymin < ymax, got {b!r}")
+    area = (hi[0] - lo[0]) * (hi[1] - lo[1])
+    if area > MAX_AREA:
+        raise top.error("bounds", f"the world covers {area:.4g} m², more than {MAX_AREA:g} m² (e.g. 100 m x 100 m): "
+                                  "the robot's roadmap grows milestones over the whole of the bounds (13 a m²), "
+                                  "which would take minutes and gigabytes; expected bounds around the rooms")
     rooms_t = top.table("rooms", {})
     rooms = {n: _box(rooms_t, n, v) for n, v in rooms_t.items()}
     obstacles = []
@@ -202,9 +218,9 @@ def read_world(top: Table, source: str) -> WorldSpec:
             if n in seen:
                 raise top.at(what, {}).error(n, f"the name {n!r} is used twice ({seen[n]} and {what}); "
                                                 "places, people, devices, doors, objects and 'robot' share names")
-            if n != n.lower():  # the plan would name another object than the world's
-                raise top.at(what, {}).error(n, f"PDDL names ignore case and plans give them in lower case: "
-                                                f"write {n.lower()!r}")
+            bad = name_problem(n)
+            if bad:
+                raise top.at(what, {}).error(n, bad)
             seen[n] = what
     facts = []
     facts_t = top.at("facts", {})
@@ -223,6 +239,21 @@ def read_world(top: Table, source: str) -> WorldSpec:
     top.done(TOP_KEYS)
     _check_geometry(spec, top)
     return spec
+
+
+def name_problem(name: str) -> str | None:
+    """Why ``name`` cannot name an object of the world in a PDDL problem, or ``None``.
+
+    Every place, person, device, door and object is written into the problems the planner
+    reads: a space, a ``?``, a dot or a non-ASCII letter would make every planning call of
+    the run fail, and a name in upper case would never be the lower-case name a plan gives.
+    """
+    if name != name.lower():  # the plan would name another object than the world's
+        return f"PDDL names ignore case and plans give them in lower case: write {name.lower()!r}"
+    if not PDDL_NAME.fullmatch(name):
+        return (f"{name!r} is not a PDDL name: expected a letter, then letters, digits, '-' or '_' "
+                "(the name is an object of every planning problem)")
+    return None
 
 
 def room_of(spec: WorldSpec, x: float, y: float) -> str | None:
@@ -254,9 +285,8 @@ def check_point(spec: WorldSpec, t: Table, key: str | int, x: float, y: float) -
 
 
 def _check_geometry(spec: WorldSpec, top: Table) -> None:
-    """Places, people, walks inside the bounds and not inside a wall or furniture; the robot in free space."""
-    from robot.scene import Scene
-
+    """Places, people, walks inside the bounds and not inside a wall or furniture; the robot, at its pose
+    and at every place, in free space."""
     def check(t: Table, key: str | int, x: float, y: float) -> None:
         check_point(spec, t, key, x, y)
 
@@ -284,12 +314,25 @@ def _check_geometry(spec: WorldSpec, top: Table) -> None:
     robot_t = top.table("robot")
     x, y, _ = spec.robot.pose
     check(robot_t, "pose", x, y)
+    bad = robot_problem(spec, x, y)
+    if bad:
+        raise robot_t.error("pose", f"{bad}; expected free space")
+    for n, (x, y, _) in spec.places.items():  # the robot drives to every place: a goal it never reaches
+        bad = robot_problem(spec, x, y)
+        if bad:
+            raise places_t.error(n, f"{bad}, and a place is where the robot stands (it could never get there); "
+                                    "expected a point with room for the robot")
+
+
+def robot_problem(spec: WorldSpec, x: float, y: float) -> str | None:
+    """Why the robot cannot stand at ``(x, y)`` (its disc overlaps a wall, furniture or the bounds), or ``None``."""
+    from robot.scene import Scene
     from robot.tiago import robot_dimensions
 
     radius = robot_dimensions()[2]
-    if not Scene(spec, radius).static_free(x, y):
-        raise robot_t.error("pose", f"the robot (radius {radius:g} m) at ({x:g}, {y:g}) overlaps a wall, "
-                                    "furniture or the world's bounds; expected free space")
+    if Scene(spec, radius).static_free(x, y):
+        return None
+    return f"the robot (radius {radius:g} m) at ({x:g}, {y:g}) overlaps a wall, furniture or the world's bounds"
 
 
 def parse_world(data: Mapping[str, Any], source: str) -> WorldSpec:

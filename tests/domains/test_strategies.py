@@ -9,6 +9,7 @@ import pytest
 from planners.examples import StraightLineMotion
 from planners.pddl_task import INTERRUPTION_KEY, PddlTaskType
 from planners.planner import Planner
+from planners.stages import place_of
 from planners.taskspec import Branch
 from tasker.errors import PlanningFailed
 from tasker.stage import Purpose
@@ -61,6 +62,35 @@ def test_unsolvable_task_raises(task: PddlTaskType) -> None:
     with pytest.raises(PlanningFailed) as info:
         task.update_task(make_ctx(task, motion=blocked))
     assert info.value.status == "unsolvable"
+
+
+def test_unsolvable_task_names_the_places_the_robot_cannot_reach(tasks: dict[str, PddlTaskType]) -> None:
+    """Before: a guide to a walled-off place ended with only "no plan reaches the goal …", which
+    did not say that the robot could not get there."""
+    task = tasks["guide_human"]
+    ctx = make_ctx(task)
+    here = next(f[2] for f in ctx.world.facts if f[:2] == ("at", "robot"))
+    there = ctx.args["destination"]
+    blocked = StraightLineMotion(blocked=frozenset({ctx.world.poses[there]}))
+    with pytest.raises(PlanningFailed) as info:
+        task.update_task(make_ctx(task, motion=blocked))
+    assert info.value.status == "unsolvable"
+    assert str(info.value).endswith(f"; the robot cannot drive from {here!r} to {there!r} "
+                                    "(walled off, or behind a closed door)")
+
+
+def test_unsolvable_task_names_where_the_thing_it_moves_is(tasks: dict[str, PddlTaskType]) -> None:
+    """The item to carry lies where the robot cannot go: its place is named, not only the goal's."""
+    task = tasks["carry_object"]
+    ctx = make_ctx(task)
+    here = next(f[2] for f in ctx.world.facts if f[:2] == ("at", "robot"))
+    there = place_of(ctx.world, ctx.args["item"])
+    assert there is not None and there not in (here, ctx.args["destination"])
+    blocked = StraightLineMotion(blocked=frozenset({ctx.world.poses[there]}))
+    with pytest.raises(PlanningFailed) as info:
+        task.update_task(make_ctx(task, motion=blocked))
+    assert str(info.value).endswith(f"; the robot cannot drive from {here!r} to {there!r} "
+                                    "(walled off, or behind a closed door)")
 
 
 def test_no_world_is_an_error(task: PddlTaskType) -> None:

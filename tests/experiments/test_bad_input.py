@@ -174,6 +174,7 @@ TAILS = [
     ('[objects.cup]\ntype = "item"\n', "objects.cup.place", "missing"),
     ('[objects.cup]\ntype = "item"\nplace = "kitchen"\ncolour = "red"\n', "objects.cup.colour", "unknown key"),
     ('[objects.john]\ntype = "item"\nplace = "kitchen"\n', "objects.john", "already a person"),
+    ('[objects."my cup"]\ntype = "item"\nplace = "kitchen"\n', "objects.my cup", "is not a PDDL name"),
     ('[objects.cup]\ntype = "item"\nplace = "kitchen"\nfacts = [["at", "cup", "gardn"]]\n', "objects.cup.facts[0]",
      "'gardn'"),
     ('[objects.cup]\ntype = "item"\nplace = "kitchen"\nfacts = ["at"]\n', "objects.cup.facts[0]",
@@ -248,6 +249,32 @@ def test_a_request_after_the_horizon_warns(tmp_path: Path) -> None:
     assert any("after the horizon" in w for w in scn.warnings)
 
 
+def test_a_device_in_a_state_its_binding_does_not_name_warns(tmp_path: Path) -> None:
+    """Before: a cooker written ``state = "On"`` loaded silently, and cook read it as off."""
+    world = (ROOT / "robot" / "worlds" / "flat.toml").read_text().replace('state = "on"', 'state = "On"')
+    _write(tmp_path, world, "w.toml")
+    text = ('kind = "robot"\nworld = "w.toml"\n[objects.pan]\ntype = "pan"\nplace = "kitchen"\n'
+            '[[requests]]\nt = 0.0\ntask = "cook"\nargs = { pan = "pan" }\n')
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        scn = scenarios.load(_write(tmp_path, text))
+    hits = [w for w in scn.warnings if "device 'cooker'" in w]
+    assert len(hits) == 1 and "starts in state 'On'" in hits[0] and "expected state = 'on' or 'off'" in hits[0]
+    assert any(issubclass(w.category, InputWarning) for w in caught)
+
+
+@pytest.mark.parametrize("field", ["deadline = -5.0", "deadline = 20.0", "death_at = 10.0"])
+def test_a_deadline_not_after_its_request_warns(tmp_path: Path, field: str) -> None:
+    """Before: ``deadline = -5`` or a deadline before the request (read as relative to it, say)
+    loaded silently, and every scheduler saw a task late before it existed."""
+    name = field.split(" ")[0]
+    text = ROBOT.replace('args = { person = "peter" }', f'args = {{ person = "peter", {field} }}')
+    with pytest.warns(InputWarning, match=rf"requests\[1\]\.args\.{name}: {name}=.* is not after the request "
+                                          r"\(t=20\)"):
+        scn = scenarios.load(_write(tmp_path, text))
+    assert len(scn.warnings) == 1
+
+
 @pytest.mark.parametrize("task, args", [
     ("guide_human", '{ person = "john", destination = "bedroom" }'),
     ("human_fell", '{ person = "peter" }'),
@@ -265,6 +292,52 @@ def test_identical_requests_after_a_termination_do_not_warn(tmp_path: Path) -> N
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert scenarios.load(_write(tmp_path, text)).warnings == ()
+
+
+def test_a_robot_scenario_without_kind_says_to_add_it(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: read as a synthetic scenario (the default kind), it failed with "tasks: missing
+    (required)", a key robot scenarios do not have."""
+    path = _write(tmp_path, ROBOT.replace('kind = "robot"\n', ""))
+    assert main(["run", str(path), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"tasker run: error: {path}: kind: missing: a scenario with a world is a robot scenario, "
+                          'so write kind = "robot"'), err
+
+
+ROOT = Path(__file__).parents[2]
+
+
+@pytest.mark.parametrize(("argv", "expected"), [
+    (["run", "robot/worlds/flat.toml"], "robot/worlds/flat.toml: is a world file"),
+    (["run", "experiments/sweeps/suspension.toml"], "experiments/sweeps/suspension.toml: is a sweep spec"),
+    (["run", "experiments/protocols/tabsa.toml"], "experiments/protocols/tabsa.toml: is a day protocol"),
+    (["world", "experiments/scenarios/paper.toml"], "paper.toml:6: kind: this is a scenario file, not a world file"),
+])
+def test_another_kind_of_file_is_named_for_what_it_is(argv: list[str], expected: str, tmp_path: Path,
+                                                      monkeypatch: pytest.MonkeyPatch,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: a world file or a sweep spec given to ``run`` failed with "tasks: missing (required)",
+    a scenario given to ``world`` with "unknown key 'kind'"."""
+    monkeypatch.chdir(ROOT)
+    assert main([*argv, *(["--out", str(tmp_path / "o")] if argv[0] == "run" else [])]) == 2
+    err = capsys.readouterr().err
+    assert expected in err and "tasks: missing" not in err, err
+
+
+@pytest.mark.parametrize("text", [
+    'kind = "robot"\nworld = "paper"\n[[world_events]]\nt = 3.0\nposture = ["peter", "fallen"]\n',
+    'kind = "synthetic"\n[tasks.a]\nstages = [{ action = "x", duration = 2.0 }]\n',
+])
+def test_a_scenario_without_requests_warns_and_runs(tmp_path: Path, text: str,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    """A world and its events to watch, nothing requested: valid.  Before, refused ("a scenario
+    needs at least one request")."""
+    path = _write(tmp_path, text)
+    assert main(["run", str(path), "--out", str(tmp_path / "o"), "--no-pictures"]) == 0
+    captured = capsys.readouterr()
+    assert "0 tasks, 0 ended" in captured.out
+    assert f"warning: {path}: requests: no [[requests]]: no task runs" in captured.err
+    assert (tmp_path / "o" / "trace.jsonl").read_text().startswith('{"t":0.0,"event":"run"')
 
 
 def test_cli_reports_a_bad_cross_reference_without_a_traceback(tmp_path: Path,
@@ -322,6 +395,8 @@ WORLD = 'bounds = [[0, 0], [6, 6]]\nwalls = [[0, 2.9, 2, 3.1]]\n[robot]\npose = 
     (WORLD.replace("pose = [4, 4, 0]", "pose = [1, 3, 0]"), "robot.pose", "inside wall"),
     (WORLD.replace("pose = [4, 4, 0]", "pose = [0.1, 4, 0]"), "robot.pose", "overlaps a wall"),
     (WORLD.replace("hall = [1, 1, 0]", "hall = [9, 1, 0]"), "places.hall", "outside the world's bounds"),
+    # before: accepted, and every task sent there failed with "no plan reaches the goal"
+    (WORLD.replace("hall = [1, 1, 0]", "hall = [1, 2.7, 0]"), "places.hall", "a place is where the robot stands"),
     (WORLD + '[people.ann]\npose = [1, 3, 0]\n', "people.ann.pose", "inside wall"),
     (WORLD + '[people.ann]\npose = [1, 1, 0]\nwalk = [[1, 1, 1], [2, 7, 1]]\n', "people.ann.walk[1]", "outside"),
     (WORLD + '[people.ann]\npose = [1, 1, 0]\nwalk = [[3, 1, 1], [3, 1, 2]]\n', "people.ann.walk[1]", "increase"),
@@ -330,6 +405,8 @@ WORLD = 'bounds = [[0, 0], [6, 6]]\nwalls = [[0, 2.9, 2, 3.1]]\n[robot]\npose = 
     (WORLD + '[people.ann]\npose = [1, 1, 0]\nspeed = nan\n', "people.ann.speed", "finite"),
     (WORLD.replace("[[0, 0], [6, 6]]", "[[0, 0], [6, nan]]"), "bounds", "finite"),
     (WORLD.replace("[[0, 0], [6, 6]]", "[[6, 0], [0, 6]]"), "bounds", "xmin < xmax"),
+    # before: accepted, and growing the roadmap over 1e12 m² never ended (gigabytes and counting)
+    (WORLD.replace("[[0, 0], [6, 6]]", "[[0, 0], [1e6, 1e6]]"), "bounds", "covers 1e+12 m², more than 10000 m²"),
     (WORLD + '[devices.cooker]\nplace = "hal"\n', "devices.cooker.place", "did you mean 'hall'"),
     (WORLD + '[doors.hall]\nbox = [1, 1, 2, 2]\n', "doors.hall", "used twice"),
     ('facts = [["at", "robot", "kitchen"]]\n' + WORLD, "facts[0]", "'kitchen'"),

@@ -32,3 +32,21 @@ def test_a_run_that_raises_still_writes_trace_record_and_metrics(tmp_path: Path,
     assert lines[0]["event"] == "run" and lines[-1]["event"] == "run" and lines[-1]["status"] == "aborted"
     assert lines[-1]["t"] == pytest.approx(5.0)
     assert not (out / "timeline.png").exists()  # pictures of a cut run are not drawn
+
+
+def test_a_run_into_a_used_folder_leaves_no_file_of_the_earlier_run(tmp_path: Path) -> None:
+    """Before: a run into the folder of an earlier one rewrote only what it writes, so after
+    ``--no-pictures`` (or a synthetic run, or fewer planning calls) the old report.html, pictures,
+    trajectory and problems/ sat beside the new trace as if they were its own."""
+    out = tmp_path / "o"
+    (out / "problems").mkdir(parents=True)
+    stale = [*(out / n for n in ("trace.jsonl", "trajectory.jsonl", "run.json", "metrics.json", "timeline.png",
+                                 "gantt.png", "world.png", "report.html")),
+             *(out / "problems" / n for n in ("index.json", "001_d1_upTsk.pddl", "001_d1_upTsk.plan"))]
+    for f in stale:
+        f.write_text("from an earlier run")
+    (out / "notes.txt").write_text("the user's")
+    runner.run_scenario("synthetic_demo", out=out, seed=3, pictures=False)
+    left = sorted(p.relative_to(out).as_posix() for p in out.rglob("*"))
+    assert left == ["metrics.json", "notes.txt", "run.json", "trace.jsonl"]
+    assert all(f.read_text() != "from an earlier run" for f in out.iterdir() if f.is_file() and f.suffix != ".txt")

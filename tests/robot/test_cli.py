@@ -116,3 +116,21 @@ def test_cost_refuses_a_point_where_no_robot_can_be(point: str, why: str, capsys
     captured = capsys.readouterr()
     assert captured.out == ""
     assert captured.err.startswith(f"tasker cost: error: argument PLACE: {point!r} {why}"), captured.err
+
+
+@pytest.mark.parametrize("name", ["flat.txt", "flat.svg", "flat"])
+def test_world_out_must_be_a_png_file_name(tmp_path: Path, name: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: ``--out flat.txt`` drew the world and then failed in matplotlib (exit 3, "a bug in
+    tasker"), ``flat.svg`` likewise, and ``flat`` exited 0 with the picture in ``flat.png``."""
+    assert cli(["world", "flat", "--out", str(tmp_path / name)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("tasker world: error: argument --out: ") and "ending in .png" in err
+    assert not list(tmp_path.iterdir())
+
+
+def test_cost_point_without_room_for_the_robot_is_bad_input(capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: 0.15,2.0 (clear of flat's wall, but not by the robot's radius) exited 1 after printing
+    a reachable path from it: as a goal it was unreachable, as a start it was moved."""
+    assert cli(["cost", "flat", "0.15,2.0", "5.0,2.0"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("tasker cost: error: argument PLACE: '0.15,2.0': the robot (radius ") and "room" in err

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -77,3 +78,21 @@ def test_names_must_be_lower_case() -> None:
             "people": {"John": {"pose": [2, 2, 0]}}}
     with pytest.raises(WorldFileError, match="people.John: PDDL names ignore case .* write 'john'"):
         parse_world(data, "upper.toml")
+
+
+@pytest.mark.parametrize("name", ["kit chen", "küche", "kitchen?", "1st_floor", "_hall", "hall.1"])
+@pytest.mark.parametrize("what", ["places", "people", "doors", "objects"])
+def test_names_must_be_pddl_names(name: str, what: str) -> None:
+    """Every name is an object of the planning problems: before, a place "kit chen" or "küche"
+    loaded, and every planning call of the run failed in Fast Downward's parser."""
+    entry = {"places": [1, 1, 0], "people": {"pose": [2, 2, 0]}, "doors": {"box": [3, 3, 4, 4]},
+             "objects": "item"}[what]
+    data = {"bounds": [[0, 0], [5, 5]], "robot": {"pose": [1, 1, 0]}, what: {name: entry}}
+    with pytest.raises(WorldFileError, match=f"{what}.{re.escape(name)}: .* is not a PDDL name: expected a letter"):
+        parse_world(data, "names.toml")
+
+
+@pytest.mark.parametrize("name", ["hall", "john_destination", "door-2", "r2d2"])
+def test_pddl_names_load(name: str) -> None:
+    data = {"bounds": [[0, 0], [5, 5]], "robot": {"pose": [1, 1, 0]}, "places": {name: [1, 1, 0]}}
+    assert name in parse_world(data, "names.toml").places
