@@ -398,6 +398,8 @@ def _clear_outputs(out: Path) -> None:
     trajectory for a synthetic scenario, fewer planning calls), so the rest would read as this run's."""
     from experiments.explain import INDEX
 
+    if not ((out / "trace.jsonl").is_file() and (out / "run.json").is_file()):
+        return  # not a run's folder (e.g. --out . in a project): nothing of a run to remove
     for name in OUTPUTS:
         (out / name).unlink(missing_ok=True)
     problems = out / "problems"

@@ -50,3 +50,12 @@ def test_a_run_into_a_used_folder_leaves_no_file_of_the_earlier_run(tmp_path: Pa
     left = sorted(p.relative_to(out).as_posix() for p in out.rglob("*"))
     assert left == ["metrics.json", "notes.txt", "run.json", "trace.jsonl"]
     assert all(f.read_text() != "from an earlier run" for f in out.iterdir() if f.is_file() and f.suffix != ".txt")
+
+
+def test_a_folder_that_holds_no_run_keeps_its_files(tmp_path: Path) -> None:
+    """Only an earlier run's outputs are removed: ``--out .`` in a project keeps its own report.html."""
+    out = tmp_path / "project"
+    out.mkdir()
+    (out / "report.html").write_text("the user's")
+    runner.run_scenario("synthetic_demo", out=out, seed=3, pictures=False)
+    assert (out / "report.html").read_text() == "the user's"
