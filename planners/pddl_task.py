@@ -150,8 +150,12 @@ class PddlTaskType(TaskType):
         if isinstance(outcome, StagePlan):
             return outcome
         if outcome.status is PlanStatus.UNSOLVABLE:
+            try:  # a hint only: whatever it meets, the task ends 'unsolvable' as the planner said
+                hint = self._unreachable(ctx, world, goal)
+            except Exception:  # noqa: BLE001
+                hint = ""
             raise PlanningFailed("unsolvable", f"{self.name}: no plan reaches the goal {goal} from the world now"
-                                               + self._unreachable(ctx, world, goal))
+                                               + hint)
         if outcome.status is PlanStatus.TIMEOUT:
             return self._fallback(self.static_update(ctx), "planner timed out for upTsk")
         raise PlanningFailed("error", f"{self.name}: planner error: {outcome.message}")
