@@ -79,7 +79,10 @@ def resolve(name_or_path: str | Path) -> Path:
     p = Path(name_or_path)
     if p.suffix in (".toml", ".json") or p.exists():
         if not p.is_file():
-            raise ScenarioError(str(p), "no such scenario file" if not p.exists() else "is not a file")
+            hint = ""
+            if not p.exists() and (SCENARIOS / f"{p.stem}.toml").is_file() and len(p.parts) == 1:
+                hint = f" (the shipped scenario is named without a suffix: {p.stem})"
+            raise ScenarioError(str(p), ("no such scenario file" if not p.exists() else "is not a file") + hint)
         return p.resolve()
     shipped = SCENARIOS / f"{name_or_path}.toml"
     if shipped.is_file():

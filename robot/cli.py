@@ -60,7 +60,9 @@ def _load(world: str) -> WorldSpec:
         raise UsageError("WORLD", f"unknown world {world!r}{did_you_mean(world, shipped_worlds())}; shipped: "
                                   f"{', '.join(shipped_worlds())}, or give a world file (.toml)")
     if p.suffix == ".toml" and not p.is_file():
-        raise UsageError("WORLD", f"{world}: no such world file")
+        hint = (f" (the shipped world is named without a suffix: {p.stem})"
+                if p.stem in shipped_worlds() and len(p.parts) == 1 else "")
+        raise UsageError("WORLD", f"{world}: no such world file{hint}")
     return load_world(world)
 
 

@@ -79,6 +79,8 @@ BAD: list[tuple[list[str], str]] = [
     (["new", "Not-A-Name", "{tmp}/n"], "TASK"),
     (["new", "fine", "{tmp}"], "DIR"),
     (["world", "papr"], "did you mean 'paper'"),
+    (["world", "paper.toml"], "named without a suffix: paper"),
+    (["run", "paper.toml"], "named without a suffix: paper"),
     (["world", "flat", "--out", "{under_file}"], "--out"),
     (["cost", "flat", "living"], "PLACE"),
     (["cost", "flat", "living", "kitchn"], "did you mean 'kitchen'"),
