@@ -49,7 +49,7 @@ from experiments import protocol as protocols
 from experiments.metrics import HazardCollector
 from experiments.stats import estimate, holm
 from experiments.strategy import Strategy
-from experiments.sweepspec import Job
+from experiments.sweepspec import MAX_JOBS, Job
 from tasker.errors import ConfigError
 from tasker.trace import FAILED, needs, number
 
@@ -460,6 +460,10 @@ def run(a: argparse.Namespace) -> int:
         strategies.append(st)
     if len({st.label for st in strategies}) != len(strategies):
         raise UsageError("--strategies", "a strategy is given twice")
+    n_jobs = a.days * len(a.schedulers) * len(strategies)
+    if n_jobs > MAX_JOBS:  # as a sweep refuses: a typo such as --days 1000000 would fill memory before any day
+        raise UsageError("--days", f"{a.days} days x {len(a.schedulers)} schedulers x {len(strategies)} strategies "
+                                   f"= {n_jobs} days to run, more than the {MAX_JOBS} a run may have")
     for st in strategies:
         try:
             day_pipeline.check_settings(a.backend, dict(st.items()))

@@ -218,3 +218,17 @@ def test_a_scheduler_given_twice_or_an_out_that_is_a_file_names_the_argument(
     (tmp_path / "file").write_text("")
     assert dayreport.main([*base, "--schedulers", "fifo", "--out", str(tmp_path / "file")]) == 2
     assert f"argument --out: {tmp_path / 'file'} exists and is not a folder" in capsys.readouterr().err
+
+
+def test_more_days_than_a_sweep_may_have_are_refused_before_any_job(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--days 3000000 built millions of jobs (gigabytes) before the first day; a sweep refuses
+    more than MAX_JOBS, and so does a day run."""
+    from experiments.sweepspec import MAX_JOBS
+
+    days = MAX_JOBS // 2 + 1
+    assert dayreport.main(["--protocol", "tabsa-short", "--days", str(days), "--schedulers", "fifo", "alg2",
+                           "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f"argument --days: {days} days x 2 schedulers x 1 strategies" in err and str(MAX_JOBS) in err
+    assert "Traceback" not in err and not (tmp_path / "out").exists()
