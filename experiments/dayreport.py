@@ -433,7 +433,7 @@ def run(a: argparse.Namespace) -> int:
     :class:`tasker.reader.InputError`) before the first day runs.  Returns 1 if a day failed
     to run (it is listed under the table), else 0."""
     from tasker import schedulers
-    from tasker.cliargs import SEED_LIMIT, UsageError, show_progress, writable_dir
+    from tasker.cliargs import SEED_LIMIT, UsageError, show_progress, writable_dir, writable_file
     from tasker.reader import suggest
 
     unknown = [n for n in a.schedulers if n not in schedulers.names()]
@@ -482,6 +482,8 @@ def run(a: argparse.Namespace) -> int:
     workers = a.workers if a.workers is not None else (2 if a.backend == "synthetic" else 1)
     writable_dir(a.out, "--out")
     db, log = a.out / "days.db", a.out / "days.jsonl"
+    for written in (db, log, a.out / "table.md"):  # now, not after hours of days: their table would be lost
+        writable_file(written, "--out")
     if not a.resume:
         for old in (db, log):
             old.unlink(missing_ok=True)

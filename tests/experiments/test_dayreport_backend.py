@@ -232,3 +232,17 @@ def test_more_days_than_a_sweep_may_have_are_refused_before_any_job(
     err = capsys.readouterr().err
     assert f"argument --days: {days} days x 2 schedulers x 1 strategies" in err and str(MAX_JOBS) in err
     assert "Traceback" not in err and not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("name", ["table.md", "days.jsonl", "days.db"])
+def test_an_output_that_cannot_be_written_is_refused_before_any_day(
+        name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A folder where table.md goes was found only after every day had run: the table was lost."""
+    out = tmp_path / "out"
+    (out / name).mkdir(parents=True)
+    for resume in ([], ["--resume"]):
+        assert dayreport.main(["--protocol", "tabsa-short", "--days", "1", "--schedulers", "fifo", "--workers", "1",
+                               "--out", str(out), *resume]) == 2
+        err = capsys.readouterr().err
+        assert f"argument --out: {out / name} is a folder; expected a file name" in err and "Traceback" not in err
+        assert sorted(p.name for p in out.iterdir()) == [name]  # no day ran, nothing written
