@@ -210,10 +210,11 @@ def run_day(protocol: str, seed: int, scheduler: str, backend: str = "synthetic"
     return out
 
 
-def day_job(job: Job, *, backend: str, keep: str | None = None) -> tuple[dict[str, Any], dict[str, Any]]:
+def day_job(job: Job, *, backend: str, keep: str | None = None,
+            digest: str | None = None) -> tuple[dict[str, Any], dict[str, Any]]:
     """A sweep's ``run_fn`` for days: the job's scenario is ``PROTOCOL@BACKEND``, its source the
     protocol, its strategy's scheduler the day's.  Returns ``(record, metrics)``; the metrics are
-    :func:`run_day`'s."""
+    :func:`run_day`'s, the record holds the protocol's ``digest`` (:meth:`Protocol.digest`)."""
     st = job.strategy
     if st.scheduler is None:
         raise ConfigError(f"day job {job.key}: its strategy names no scheduler")
@@ -221,8 +222,24 @@ def day_job(job: Job, *, backend: str, keep: str | None = None) -> tuple[dict[st
     where = None if keep is None else str(Path(keep) / _folder(rest) / st.scheduler / str(job.seed))
     metrics = run_day(job.source, job.seed, st.scheduler, backend, where, strategy=rest)
     record = {"protocol": job.source, "backend": backend, "seed": job.seed, "scheduler": st.scheduler,
-              "strategy": rest.label, "wall_time_s": metrics.get("wall_time_s")}
+              "strategy": rest.label, "wall_time_s": metrics.get("wall_time_s"), "protocol_digest": digest}
     return record, metrics
+
+
+def check_resumable(db: Path, scenario: str, proto: protocols.Protocol) -> None:
+    """A :class:`ConfigError` when ``db`` holds days of ``scenario`` (``PROTOCOL@BACKEND``) drawn from
+    another version of ``proto``: resumed, they would be compared with days of this one as if alike.
+    Days stored without a digest (by an older tasker, or imported from a ``days.jsonl``) are kept."""
+    from experiments.store import ResultStore
+
+    if not db.is_file():
+        return
+    with ResultStore(db, readonly=True) as store:
+        stored = {r.record.get("protocol_digest") for r in store.rows() if r.scenario == scenario}
+    if stored - {None, proto.digest()}:
+        raise ConfigError(f"{db} holds days of {proto.source} as it was when they ran, and it has changed since "
+                          f"(a value of the protocol{', or its world file' if proto.robot else ''}): new days would "
+                          "not be comparable with them")
 
 
 def _folder(strategy: Strategy) -> str:
@@ -253,12 +270,15 @@ def run_days(protocol: str | Path, days: int, names: Sequence[str], *, first_see
     from experiments.store import ResultStore, Status
     from experiments.sweep import run_sweep
 
-    day_pipeline.load(protocol)  # a bad protocol fails here, once, with its file and line
+    proto = day_pipeline.load(protocol)  # a bad protocol fails here, once, with its file and line
     scenario = scenario_key(protocol, backend)
+    if db is not None:
+        check_resumable(db, scenario, proto)
     jobs = [Job(scenario, str(protocol), seed, dataclasses.replace(st, scheduler=name))
             for seed in range(first_seed, first_seed + days) for st in strategies for name in names]
     # seed-major: a run stopped early leaves every scheduler with (nearly) as many days
-    run_fn = functools.partial(day_job, backend=backend, keep=None if keep is None else str(keep))
+    run_fn = functools.partial(day_job, backend=backend, keep=None if keep is None else str(keep),
+                               digest=proto.digest())
     with tempfile.TemporaryDirectory(prefix="tasker-days-") as tmp:
         path = db if db is not None else Path(tmp) / "days.db"
         run_sweep(jobs, path, workers=workers, scheduler_address=address, run_fn=run_fn, progress=progress,
@@ -489,6 +509,12 @@ def run(a: argparse.Namespace) -> int:
             old.unlink(missing_ok=True)
     elif not db.exists() and log.is_file():
         _import_log(log, db, a.protocol, a.backend)
+    else:
+        try:
+            check_resumable(db, scenario_key(a.protocol, a.backend), proto)
+        except ConfigError as exc:
+            raise UsageError("--resume", f"{exc}; run without --resume to start afresh, or give another --out") \
+                from None
     from experiments.sweep_cli import dask_scheduler
 
     with dask_scheduler(a.scheduler_address):

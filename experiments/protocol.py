@@ -17,6 +17,9 @@ request records its ``deadline`` and, for a fall, ``death_at`` (deadline +
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
+import json
 import math
 import random
 from dataclasses import dataclass
@@ -121,6 +124,17 @@ class Protocol:
     @property
     def death_after_s(self) -> float | None:
         return self.tasks["fall"].death_after_s if "fall" in self.tasks else None
+
+    def digest(self) -> str:
+        """A SHA-256 of what its days are drawn and run from: every checked value (not the file's
+        comments, layout or place) and, with a robot backend, the bytes of its world file.  Stored
+        with each day, so that a resumed run does not mix days of two versions of a protocol."""
+        values = dataclasses.asdict(self)
+        values.pop("source")
+        h = hashlib.sha256(json.dumps(values, sort_keys=True, default=str).encode())
+        if self.robot is not None:
+            h.update(Path(self.robot.world).read_bytes())
+        return h.hexdigest()
 
 
 # -- reading ---------------------------------------------------------------------------------------

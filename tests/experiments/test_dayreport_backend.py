@@ -246,3 +246,28 @@ def test_an_output_that_cannot_be_written_is_refused_before_any_day(
         err = capsys.readouterr().err
         assert f"argument --out: {out / name} is a folder; expected a file name" in err and "Traceback" not in err
         assert sorted(p.name for p in out.iterdir()) == [name]  # no day ran, nothing written
+
+
+def test_resuming_with_a_changed_protocol_is_refused_and_keeps_the_stored_days(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--resume kept the days of the protocol as it was and ran the others from the edited file:
+    one table mixed days of 3 and of 15 requests.  A comment changes nothing and resumes."""
+    from experiments.store import ResultStore
+
+    shipped = Path(dayreport.__file__).parent / "protocols" / "tabsa_short.toml"
+    text = shipped.read_text(encoding="utf-8").split("\n[robot_backend]")[0]
+    proto, out = tmp_path / "mine.toml", tmp_path / "out"
+    proto.write_text(text, encoding="utf-8")
+    args = ["--protocol", str(proto), "--schedulers", "fifo", "--workers", "1", "--out", str(out), "--resume"]
+    assert dayreport.main([*args, "--days", "1"]) == 0
+    proto.write_text("# my edit\n" + text, encoding="utf-8")
+    assert dayreport.main([*args, "--days", "2"]) == 0  # the same values: day 1 is kept, day 2 added
+    proto.write_text(text.replace("count = 3", "count = 5", 1), encoding="utf-8")
+    capsys.readouterr()
+    assert dayreport.main([*args, "--days", "3"]) == 2
+    err = capsys.readouterr().err
+    assert f"argument --resume: {out / 'days.db'} holds days of {proto} as it was when they ran" in err
+    assert "run without --resume to start afresh" in err and "Traceback" not in err
+    with ResultStore(out / "days.db", readonly=True) as store:
+        assert sorted(r.seed for r in store.rows()) == [1, 2]
+    assert dayreport.main([a for a in args if a != "--resume"] + ["--days", "1"]) == 0  # afresh
