@@ -209,6 +209,9 @@ def load(path: str | Path) -> Protocol:
     if not tasks:
         raise tasks_t.error(None, f"expected at least one of {', '.join(KINDS)}")
     total = sum(spec.count for spec in tasks.values())
+    if total == 0:  # every day would be empty: a table of zeros, "all done", for every scheduler
+        raise tasks_t.error(None, f"the day's counts add up to 0 requests: expected a count > 0 for at least one "
+                                  f"of {', '.join(tasks)}")
     if total > MAX_REQUESTS:
         kind = max(tasks, key=lambda k: tasks[k].count)
         raise tasks_t.at(kind, tasks_t.data[kind]).error(

@@ -83,6 +83,17 @@ def test_bad_protocols_name_file_line_and_field(tmp_path: Path) -> None:
                 'world = "tabsa_apartment.toml"', f'world = "{TABSA.parent / "tabsa_apartment.toml"}"')))
 
 
+def test_a_day_of_no_requests_is_refused_and_a_day_of_one_type_runs(tmp_path: Path) -> None:
+    """Counts that were all 0 gave every scheduler an empty day: 'completed 0', 'all done', exit 0."""
+    text = TABSA.read_text(encoding="utf-8").split("\n[robot_backend]")[0]
+    with pytest.raises(InputError, match=r"p\.toml: tasks: the day's counts add up to 0 requests: expected a "
+                                         r"count > 0 for at least one of transport, fall, pick_place"):
+        protocol.load(write(tmp_path, text.replace("count = 12", "count = 0")))
+    falls = protocol.load(write(tmp_path, text.replace("count = 12", "count = 0").replace(
+        "count = 0\npriority = 3", "count = 1\npriority = 3")))
+    assert [r.kind for r in protocol.draw(falls, 1)] == ["fall"]
+
+
 def test_a_failed_fall_is_requested_again_until_its_death_at(tabsa: protocol.Protocol) -> None:
     """The fall's request carries its renewal (every 30 s after a failure, until death_at);
     the other types' failures stand."""
