@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from experiments.actions import TimedAction
+from experiments.filekinds import expect
 from experiments.synthetic import SyntheticScenario
 from tasker.agent import Rates
 from tasker.loop import SimulationLoop
@@ -180,6 +181,7 @@ def _task(t: Table, kind: str) -> TaskSpec:
 def load(path: str | Path) -> Protocol:
     """Read and check a protocol file; every fault names the file, line and field."""
     top = read_table(path)
+    expect(top, "day protocol")
     top.string("name")
     day, robot, apartment = top.table("day"), top.table("robot"), top.table("apartment")
     arrivals, tasks_t = top.table("arrivals"), top.table("tasks")

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from experiments.filekinds import expect
 from experiments.scenario import InterruptionGrid
 from experiments.store import JobKey
 from experiments.strategy import FACTOR_LEVELS, FACTORS, Strategy, expand
@@ -110,6 +111,7 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
     limit = MAX_JOBS if max_jobs is None else max_jobs
     p = Path(path).resolve()
     top = reader.load(p, SpecError)
+    expect(top, "sweep spec")
     name = str(top.string("name", p.stem))
     scenario_list = top.array("scenarios", nonempty=True)
     at = top.at("scenarios", {})

@@ -440,3 +440,36 @@ def test_typed_cases_cover_every_bundled_task_type() -> None:
     from planners.bundled import task_types
 
     assert {c[1] for c in _typed_cases()} == {t.name for t in task_types()}
+
+
+SHIPPED = Path(__file__).resolve().parents[2] / "experiments"
+_KIND_CASES = [  # (command, file of another kind, what the message must say)
+    (["day", "--days", "1", "--protocol"], "scenarios/paper.toml", "this is a scenario (it has 'requests'), not a "
+                                                                   "day protocol: run it with 'tasker run FILE'"),
+    (["day", "--days", "1", "--protocol"], "sweeps/suspension.toml", "this is a sweep spec (it has 'scenarios'), "
+                                                                     "not a day protocol"),
+    (["day", "--days", "1", "--protocol"], "protocols/tabsa_apartment.toml", "this is a world file (it has 'rooms')"),
+    (["run"], "protocols/tabsa.toml", "this is a day protocol (it has 'arrivals'), not a scenario: run it with "
+                                      "'tasker day --protocol FILE'"),
+    (["run"], "sweeps/suspension.toml", "this is a sweep spec (it has 'scenarios'), not a scenario"),
+    (["sweep", "--db", "{tmp}/r.db"], "protocols/tabsa.toml", "this is a day protocol (it has 'arrivals'), not a "
+                                                              "sweep spec"),
+    (["sweep", "--db", "{tmp}/r.db"], "scenarios/synthetic_demo.toml", "this is a scenario (it has 'requests'), "
+                                                                       "not a sweep spec"),
+]
+
+
+@pytest.mark.parametrize(("command", "file", "message"), _KIND_CASES, ids=[f"{c[0][0]} {c[1]}" for c in _KIND_CASES])
+def test_a_file_of_another_kind_is_named_for_what_it_is(command: list[str], file: str, message: str, tmp_path: Path,
+                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    """A protocol given to 'tasker run' was refused with 'tasks.transport.stages: missing (required)',
+    a scenario given to 'tasker day' with 'day: missing (required)': each sent the user to fix a
+    file that was fine."""
+    argv = [a.format(tmp=tmp_path) for a in command] + [str(SHIPPED / file)]
+    if command[0] == "sweep":  # the spec is positional
+        argv = [argv[0], str(SHIPPED / file), *argv[1:-1]]
+    if command[0] != "sweep":
+        argv += ["--out", str(tmp_path / "out")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert f"{SHIPPED / file}: {message}" in err and "Traceback" not in err
