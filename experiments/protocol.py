@@ -45,6 +45,8 @@ MAX_REQUESTS = 10_000
 """A protocol whose counts add up to more requests a day than this is refused (a typo such as
 ``count = 1200000`` would otherwise run for hours; 9 000 take a minute on the synthetic backend)."""
 _RESUME_STAGES = ("go_back", "apologise", "pick_again")
+TOP_KEYS = ("name", "day", "robot", "apartment", "arrivals", "tasks", "robot_backend")
+"""The top-level keys and tables of a protocol file."""
 
 
 @dataclass(frozen=True)
@@ -182,9 +184,13 @@ def load(path: str | Path) -> Protocol:
     """Read and check a protocol file; every fault names the file, line and field."""
     top = read_table(path)
     expect(top, "day protocol")
+    top.declare(TOP_KEYS)  # a misspelt [arivals] is named where "arrivals: missing" is said
     top.string("name")
     day, robot, apartment = top.table("day"), top.table("robot"), top.table("apartment")
     arrivals, tasks_t = top.table("arrivals"), top.table("tasks")
+    for t, keys in ((day, ("length_s", "step_s", "start")), (robot, ("speed", "start_site", "planning_time_s")),
+                    (arrivals, ("process", "last_call_s"))):
+        t.declare(keys)
     length = day.number("length_s", positive=True)
     step = day.number("step_s", positive=True)
     if step > length:
@@ -220,7 +226,7 @@ def load(path: str | Path) -> Protocol:
             "count", f"the day's counts add up to {total} requests, more than the {MAX_REQUESTS} a day may have")
     tasks_t.done()
     backend = _robot_backend(top.table("robot_backend"), Path(path), sites, tasks) if "robot_backend" in top else None
-    top.done(also=("robot_backend",))  # optional: listed among the valid keys even when absent
+    top.done(also=TOP_KEYS)  # robot_backend is optional: listed among the valid keys even when absent
     return Protocol(name=top.data["name"], source=str(path), start=start, length_s=length, step_s=step,
                     robot_speed=speed, start_site=start_site, planning_time_s=planning, sites=sites,
                     last_call_s=last_call, tasks=tasks, robot=backend)

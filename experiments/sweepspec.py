@@ -112,6 +112,7 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
     p = Path(path).resolve()
     top = reader.load(p, SpecError)
     expect(top, "sweep spec")
+    top.declare(SPEC_KEYS)  # a misspelt 'scenario = [...]' is named where "scenarios: missing" is said
     name = str(top.string("name", p.stem))
     scenario_list = top.array("scenarios", nonempty=True)
     at = top.at("scenarios", {})

@@ -372,6 +372,8 @@ def test_a_scenario_on_a_bad_world_names_the_world_file(tmp_path: Path) -> None:
      "did you mean 'alg2'"),
     ('scenarios = ["paper", "paper"]\nseeds = 2\nstrategies = ["default"]', "scenarios[1]", "listed twice"),
     ('scenarios = ["paper"]\nseds = 2\nstrategies = ["default"]', "seeds", "missing"),
+    ('scenario = ["paper"]\nseeds = 2\nstrategies = ["default"]', "scenarios",
+     "missing (required); the file has 'scenario' (line 1), not a valid key: did you mean 'scenarios'?"),
     ('scenarios = "paper"\nseeds = 2\nstrategies = ["default"]', "scenarios", "expected an array"),
     ('scenarios = ["paper"]\nseeds = 2\nstrategies = ["default"]\n[variants.paper]\ninterrupt = "requests[9]"\n'
      'times = { start = 0.0, stop = 60.0, step = 20.0 }', "variants.paper.interrupt",

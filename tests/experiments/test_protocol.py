@@ -276,3 +276,14 @@ def test_needs_follow_chains_of_renewals() -> None:
 
     assert needs(_renewed("finished")) == {"d1": "d1", "d2": "d1", "d3": "d1"}
     assert needs(HAND) == {"d1": "d1", "d2": "d2", "d3": "d3"}
+
+
+def test_a_misspelt_table_or_key_is_named_with_the_one_it_should_be(tmp_path: Path) -> None:
+    """A misspelt [arivals] or lenght_s was reported only as the missing one it should have been."""
+    text = TABSA.read_text(encoding="utf-8")
+    for old, new, message in (("[arrivals]", "[arivals]", r"arrivals: missing \(required\); the file has 'arivals' "
+                                                          r"\(line \d+\), not a valid key: did you mean 'arrivals'\?"),
+                              ("length_s =", "lenght_s =", r"day\.length_s: missing \(required\); the file has "
+                                                           r"'lenght_s' \(line \d+\)")):
+        with pytest.raises(InputError, match=r"p\.toml(:\d+)?: " + message):
+            protocol.load(write(tmp_path, text.replace(old, new)))
