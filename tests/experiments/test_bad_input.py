@@ -386,6 +386,23 @@ def test_bad_sweep_spec_field_is_named(tmp_path: Path, body: str, field: str, fr
     _fails(_write(tmp_path, body, "spec.toml"), load_spec, field, fragment, SpecError)
 
 
+def test_strategies_a_synthetic_scenario_ignores_warn(tmp_path: Path) -> None:
+    """A synthetic scenario swept over suspension=static/planned ran static twice, silently: the
+    report then compared two identical strategies.  The scheduler alone, or a robot scenario, is quiet."""
+    demo = standin.DEMO.as_posix()
+    body = f'scenarios = ["{demo}", "paper"]\nseeds = 2\n[factors]\nsuspension = ["static", "planned"]\n'
+    with pytest.warns(InputWarning, match=rf"spec\.toml:3: factors: '{demo}' is a synthetic scenario, whose timed "
+                                          r"stages ignore suspension: its runs of strategies that differ only there "
+                                          r"are alike") as caught:
+        load_spec(_write(tmp_path, body, "spec.toml"))
+    assert len(caught) == 1  # paper is a robot scenario
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        load_spec(_write(tmp_path, f'scenarios = ["{demo}"]\nseeds = 2\nstrategies = ["scheduler=fifo", '
+                                   '"scheduler=alg2"]\n', "spec.toml"))
+        load_spec(_write(tmp_path, body.replace(f'"{demo}", ', ""), "spec.toml"))
+
+
 def test_a_non_utf8_spec_is_a_clean_error(tmp_path: Path) -> None:
     with pytest.raises(SpecError, match="not UTF-8"):
         load_spec(_write(tmp_path, b'name = "\xff"\n', "spec.toml"))
