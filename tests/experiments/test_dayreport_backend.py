@@ -271,3 +271,12 @@ def test_resuming_with_a_changed_protocol_is_refused_and_keeps_the_stored_days(
     with ResultStore(out / "days.db", readonly=True) as store:
         assert sorted(r.seed for r in store.rows()) == [1, 2]
     assert dayreport.main([a for a in args if a != "--resume"] + ["--days", "1"]) == 0  # afresh
+
+
+def test_a_folder_given_as_the_protocol_is_named_a_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--protocol my_protocols (a folder) was 'no protocol ...; or give a .toml file', as if it did not exist."""
+    (tmp_path / "my_protocols").mkdir()
+    assert dayreport.main(["--protocol", str(tmp_path / "my_protocols"), "--days", "1", "--schedulers", "fifo",
+                           "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f"{tmp_path / 'my_protocols'}: is a directory, expected a file" in err and "Traceback" not in err
