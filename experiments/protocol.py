@@ -22,6 +22,7 @@ import hashlib
 import json
 import math
 import random
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -196,6 +197,8 @@ def load(path: str | Path) -> Protocol:
     if step > length:
         raise day.error("step_s", f"expected at most the day's length_s ({length:g} s), got {step:g}")
     start = day.string("start", "00:00")
+    if not re.fullmatch(r"([01]\d|2[0-3]):[0-5]\d", start):
+        raise day.error("start", f"expected a wall-clock time HH:MM (00:00 to 23:59), got {start!r}")
     day.done()
     sites_t = apartment.table("sites")
     sites = {name: _pose(sites_t, name, v) for name, v in sites_t.items()}

@@ -287,3 +287,14 @@ def test_a_misspelt_table_or_key_is_named_with_the_one_it_should_be(tmp_path: Pa
                                                            r"'lenght_s' \(line \d+\)")):
         with pytest.raises(InputError, match=r"p\.toml(:\d+)?: " + message):
             protocol.load(write(tmp_path, text.replace(old, new)))
+
+
+def test_the_days_start_is_a_wall_clock_time(tmp_path: Path) -> None:
+    """day.start took any string ('banana', '8 o'clock') and kept it as the day's label."""
+    text = TABSA.read_text(encoding="utf-8").split("\n[robot_backend]")[0]
+    assert 'start = "08:00"' in text
+    for bad in ("banana", "8:00", "24:00", "08:60"):
+        with pytest.raises(InputError, match=rf"p\.toml:\d+: day\.start: expected a wall-clock time HH:MM "
+                                             rf"\(00:00 to 23:59\), got '{bad}'"):
+            protocol.load(write(tmp_path, text.replace('start = "08:00"', f'start = "{bad}"')))
+    assert protocol.load(write(tmp_path, text.replace('start = "08:00"', 'start = "23:59"'))).start == "23:59"
