@@ -487,8 +487,11 @@ def run(a: argparse.Namespace) -> int:
     for written in (db, log, a.out / "table.md"):  # now, not after hours of days: their table would be lost
         writable_file(written, "--out")
     if not a.resume:
-        for old in (db, log):
-            old.unlink(missing_ok=True)
+        from experiments.sweep import lease
+
+        with lease(db):  # a run still writing into OUT keeps its days: this one stops instead
+            for old in (db, log):
+                old.unlink(missing_ok=True)
     elif not db.exists() and log.is_file():
         import_log(log, db, a.protocol, a.backend)
     else:

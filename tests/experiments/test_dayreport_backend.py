@@ -280,3 +280,25 @@ def test_a_folder_given_as_the_protocol_is_named_a_folder(tmp_path: Path, capsys
                            "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert f"{tmp_path / 'my_protocols'}: is a directory, expected a file" in err and "Traceback" not in err
+
+
+def test_a_second_run_into_the_same_out_leaves_the_running_ones_days(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Without --resume, a second 'tasker day' into the OUT of a running one deleted its days.db
+    before finding the sweep lease taken: the running one then wrote into a deleted file and ended
+    'no such results database', every day it had run lost."""
+    from experiments.store import ResultStore
+    from experiments.sweep import lease
+
+    out = tmp_path / "out"
+    assert dayreport.main(["--protocol", "tabsa-short", "--days", "1", "--schedulers", "fifo", "--workers", "1",
+                           "--out", str(out)]) == 0
+    capsys.readouterr()
+    with lease(out / "days.db"):  # the running one holds it
+        assert dayreport.main(["--protocol", "tabsa-short", "--days", "1", "--schedulers", "alg2", "--workers", "1",
+                               "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "another sweep is running on this database" in err and "Traceback" not in err
+    with ResultStore(out / "days.db", readonly=True) as store:
+        assert [r.strategy for r in store.rows()] == ["scheduler=fifo"]
+    assert (out / "days.jsonl").is_file()
