@@ -45,6 +45,10 @@ SUSP, BLOCK = StageKind.SUSPENDABLE, StageKind.BLOCKING
 MAX_REQUESTS = 10_000
 """A protocol whose counts add up to more requests a day than this is refused (a typo such as
 ``count = 1200000`` would otherwise run for hours; 9 000 take a minute on the synthetic backend)."""
+MAX_STEPS = 1_000_000
+"""A protocol whose day has more steps than this (``length_s / step_s``) is refused: the loop steps
+through the whole day (about 2 million steps take 5 s of one synthetic day, and a robot day far
+more), so ``length_s = 1e9`` never ended; the shipped days have 720 to 2 880 steps."""
 _RESUME_STAGES = ("go_back", "apologise", "pick_again")
 TOP_KEYS = ("name", "day", "robot", "apartment", "arrivals", "tasks", "robot_backend")
 """The top-level keys and tables of a protocol file."""
@@ -196,6 +200,9 @@ def load(path: str | Path) -> Protocol:
     step = day.number("step_s", positive=True)
     if step > length:
         raise day.error("step_s", f"expected at most the day's length_s ({length:g} s), got {step:g}")
+    if length / step > MAX_STEPS:
+        raise day.error("length_s", f"{length:g} s in steps of step_s = {step:g} s is {length / step:.3g} steps, "
+                                    f"more than the {MAX_STEPS} a day may have")
     start = day.string("start", "00:00")
     if not re.fullmatch(r"([01]\d|2[0-3]):[0-5]\d", start):
         raise day.error("start", f"expected a wall-clock time HH:MM (00:00 to 23:59), got {start!r}")

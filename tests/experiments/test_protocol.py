@@ -298,3 +298,14 @@ def test_the_days_start_is_a_wall_clock_time(tmp_path: Path) -> None:
                                              rf"\(00:00 to 23:59\), got '{bad}'"):
             protocol.load(write(tmp_path, text.replace('start = "08:00"', f'start = "{bad}"')))
     assert protocol.load(write(tmp_path, text.replace('start = "08:00"', 'start = "23:59"'))).start == "23:59"
+
+
+def test_a_day_of_too_many_steps_is_refused(tmp_path: Path) -> None:
+    """length_s = 1e9 (or a step_s of a millisecond) was accepted, and the day never ended."""
+    text = TABSA.read_text(encoding="utf-8").split("\n[robot_backend]")[0]
+    for old, new in (("length_s = 14400.0", "length_s = 1e9"), ("step_s = 5.0", "step_s = 0.001")):
+        assert old in text
+        with pytest.raises(InputError, match=rf"p\.toml:\d+: day\.length_s: .* steps, more than the "
+                                             rf"{protocol.MAX_STEPS} a day may have"):
+            protocol.load(write(tmp_path, text.replace(old, new)))
+    protocol.load(write(tmp_path, text.replace("step_s = 5.0", "step_s = 0.0144")))  # exactly MAX_STEPS
