@@ -24,8 +24,9 @@ confidence intervals and paired comparisons of ``lookahead`` against each baseli
 
 ``tasker day`` is the same command.  The days are jobs of the sweep runner
 (:func:`run_days`): local processes or Dask, each day stored in ``OUT/days.db`` as it
-ends (so ``--resume`` goes on where a stopped run stopped), a failed day stored and
-listed while the others go on; ``--strategies`` compares strategies on the robot backend.
+ends (so ``--resume`` goes on where a stopped run stopped; :mod:`experiments.dayresume`
+checks what it resumes), a failed day stored and listed while the others go on;
+``--strategies`` compares strategies on the robot backend.
 """
 
 from __future__ import annotations
@@ -46,10 +47,11 @@ from scipy import stats
 
 from experiments import days as day_pipeline
 from experiments import protocol as protocols
+from experiments.dayresume import check_resumable, import_log, scenario_key
 from experiments.metrics import HazardCollector
 from experiments.stats import estimate, holm
 from experiments.strategy import Strategy
-from experiments.sweepspec import Job
+from experiments.sweepspec import MAX_JOBS, Job
 from tasker.errors import ConfigError
 from tasker.trace import FAILED, needs, number
 
@@ -210,10 +212,11 @@ def run_day(protocol: str, seed: int, scheduler: str, backend: str = "synthetic"
     return out
 
 
-def day_job(job: Job, *, backend: str, keep: str | None = None) -> tuple[dict[str, Any], dict[str, Any]]:
+def day_job(job: Job, *, backend: str, keep: str | None = None,
+            digest: str | None = None) -> tuple[dict[str, Any], dict[str, Any]]:
     """A sweep's ``run_fn`` for days: the job's scenario is ``PROTOCOL@BACKEND``, its source the
     protocol, its strategy's scheduler the day's.  Returns ``(record, metrics)``; the metrics are
-    :func:`run_day`'s."""
+    :func:`run_day`'s, the record holds the protocol's ``digest`` (:meth:`Protocol.digest`)."""
     st = job.strategy
     if st.scheduler is None:
         raise ConfigError(f"day job {job.key}: its strategy names no scheduler")
@@ -221,7 +224,7 @@ def day_job(job: Job, *, backend: str, keep: str | None = None) -> tuple[dict[st
     where = None if keep is None else str(Path(keep) / _folder(rest) / st.scheduler / str(job.seed))
     metrics = run_day(job.source, job.seed, st.scheduler, backend, where, strategy=rest)
     record = {"protocol": job.source, "backend": backend, "seed": job.seed, "scheduler": st.scheduler,
-              "strategy": rest.label, "wall_time_s": metrics.get("wall_time_s")}
+              "strategy": rest.label, "wall_time_s": metrics.get("wall_time_s"), "protocol_digest": digest}
     return record, metrics
 
 
@@ -229,10 +232,6 @@ def _folder(strategy: Strategy) -> str:
     """Where ``--keep-runs`` puts a strategy's days: nowhere extra for the day's own settings."""
     return "" if strategy.label == "default" else strategy.label.replace(",", "_").replace("=", "-")
 
-
-def scenario_key(protocol: str | Path, backend: str) -> str:
-    """The scenario column of a day in the results database: ``PROTOCOL@BACKEND``."""
-    return f"{protocol}@{backend}"
 
 
 def run_days(protocol: str | Path, days: int, names: Sequence[str], *, first_seed: int = 1,
@@ -253,12 +252,15 @@ def run_days(protocol: str | Path, days: int, names: Sequence[str], *, first_see
     from experiments.store import ResultStore, Status
     from experiments.sweep import run_sweep
 
-    day_pipeline.load(protocol)  # a bad protocol fails here, once, with its file and line
+    proto = day_pipeline.load(protocol)  # a bad protocol fails here, once, with its file and line
     scenario = scenario_key(protocol, backend)
+    if db is not None:
+        check_resumable(db, scenario, proto)
     jobs = [Job(scenario, str(protocol), seed, dataclasses.replace(st, scheduler=name))
             for seed in range(first_seed, first_seed + days) for st in strategies for name in names]
     # seed-major: a run stopped early leaves every scheduler with (nearly) as many days
-    run_fn = functools.partial(day_job, backend=backend, keep=None if keep is None else str(keep))
+    run_fn = functools.partial(day_job, backend=backend, keep=None if keep is None else str(keep),
+                               digest=proto.digest())
     with tempfile.TemporaryDirectory(prefix="tasker-days-") as tmp:
         path = db if db is not None else Path(tmp) / "days.db"
         run_sweep(jobs, path, workers=workers, scheduler_address=address, run_fn=run_fn, progress=progress,
@@ -433,7 +435,7 @@ def run(a: argparse.Namespace) -> int:
     :class:`tasker.reader.InputError`) before the first day runs.  Returns 1 if a day failed
     to run (it is listed under the table), else 0."""
     from tasker import schedulers
-    from tasker.cliargs import SEED_LIMIT, UsageError, show_progress, writable_dir
+    from tasker.cliargs import SEED_LIMIT, UsageError, show_progress, writable_dir, writable_file
     from tasker.reader import suggest
 
     unknown = [n for n in a.schedulers if n not in schedulers.names()]
@@ -460,6 +462,10 @@ def run(a: argparse.Namespace) -> int:
         strategies.append(st)
     if len({st.label for st in strategies}) != len(strategies):
         raise UsageError("--strategies", "a strategy is given twice")
+    n_jobs = a.days * len(a.schedulers) * len(strategies)
+    if n_jobs > MAX_JOBS:  # as a sweep refuses: a typo such as --days 1000000 would fill memory before any day
+        raise UsageError("--days", f"{a.days} days x {len(a.schedulers)} schedulers x {len(strategies)} strategies "
+                                   f"= {n_jobs} days to run, more than the {MAX_JOBS} a run may have")
     for st in strategies:
         try:
             day_pipeline.check_settings(a.backend, dict(st.items()))
@@ -478,11 +484,22 @@ def run(a: argparse.Namespace) -> int:
     workers = a.workers if a.workers is not None else (2 if a.backend == "synthetic" else 1)
     writable_dir(a.out, "--out")
     db, log = a.out / "days.db", a.out / "days.jsonl"
+    for written in (db, log, a.out / "table.md"):  # now, not after hours of days: their table would be lost
+        writable_file(written, "--out")
     if not a.resume:
-        for old in (db, log):
-            old.unlink(missing_ok=True)
+        from experiments.sweep import lease
+
+        with lease(db):  # a run still writing into OUT keeps its days: this one stops instead
+            for old in (db, log):
+                old.unlink(missing_ok=True)
     elif not db.exists() and log.is_file():
-        _import_log(log, db, a.protocol, a.backend)
+        import_log(log, db, a.protocol, a.backend)
+    else:
+        try:
+            check_resumable(db, scenario_key(a.protocol, a.backend), proto)
+        except ConfigError as exc:
+            raise UsageError("--resume", f"{exc}; run without --resume to start afresh, or give another --out") \
+                from None
     from experiments.sweep_cli import dask_scheduler
 
     with dask_scheduler(a.scheduler_address):
@@ -500,70 +517,6 @@ def run(a: argparse.Namespace) -> int:
     (a.out / "table.md").write_text(text + f"\nGenerated by `{cmd}`.\n", encoding="utf-8")
     print(text)
     return 1 if any("error" in r for r in results) else 0
-
-
-_DAY_NUMBERS = ("completed", "lateness_s", "dead_falls", "interruptions", "suspensions", "suspension_time_s",
-                "switches", "longest_order", "anytime_decisions")
-"""Numbers every day of a ``days.jsonl`` carries (the table reads them); ``completion_minus_deadline_s``
-may also be null."""
-
-
-def _day_problem(r: Any) -> tuple[str, str] | None:
-    """``(field, why)`` when ``r`` (a line of ``days.jsonl``) is not a day the table can read."""
-    if not isinstance(r, dict):
-        return "", f"expected a day (a JSON object), got {json.dumps(r)[:40]}"
-    if "error" in r:  # a day that failed to run: skipped, so only where it belongs is read
-        return None
-    if not isinstance(r.get("scheduler"), str):
-        return "scheduler", "expected a scheduler name"
-    seed = r.get("seed")
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        return "seed", f"expected an integer >= 0, got {json.dumps(seed)}"
-    try:
-        Strategy.parse(r.get("strategy", "default"))
-    except (ValueError, TypeError) as exc:
-        return "strategy", str(exc)
-    for key in (*_DAY_NUMBERS, "completion_minus_deadline_s"):
-        v = r.get(key)
-        if (isinstance(v, bool) or not isinstance(v, int | float)) and not (
-                v is None and key == "completion_minus_deadline_s" and key in r):
-            return key, f"expected a number, got {json.dumps(v) if key in r else 'nothing'}"
-    if not isinstance(r.get("per_type"), dict) or not all(isinstance(v, dict) for v in r["per_type"].values()):
-        return "per_type", "expected an object of task type -> its metrics"
-    if not isinstance(r.get("ending"), str):
-        return "ending", "expected a string"
-    return None
-
-
-def _import_log(log: Path, db: Path, protocol: str, backend: str) -> None:
-    """Days of an older ``days.jsonl`` (before the database) into ``db``, so ``--resume`` keeps them.
-
-    The whole file is checked first: a damaged line is an :class:`~tasker.reader.InputError`
-    naming it (and nothing is imported)."""
-    from experiments.store import ResultStore, RunRow, Status
-    from tasker.reader import InputError, read_text
-
-    days = []
-    for n, line in enumerate(read_text(log).splitlines(), start=1):
-        if not line.strip():
-            continue
-        try:
-            r = json.loads(line)
-        except json.JSONDecodeError as exc:
-            raise InputError(log, f"not a JSON object: {exc.msg} (a days.jsonl that tasker day wrote, or "
-                                  "resume without it)", line=n) from None
-        why = _day_problem(r)
-        if why:
-            raise InputError(log, f"{why[1]} (a days.jsonl that tasker day wrote, or resume without it)", line=n,
-                             field=why[0])
-        if r.get("backend", "synthetic") == backend and "error" not in r:
-            days.append(r)
-    with ResultStore(db) as store:
-        for r in days:
-            st = Strategy.parse(r.get("strategy", "default"))
-            label = dataclasses.replace(st, scheduler=r["scheduler"]).label
-            store.add(RunRow(scenario_key(protocol, backend), int(r["seed"]), label, Status.OK,
-                             {"imported_from": str(log)}, r, None, 0.0, ""))
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -81,7 +81,7 @@ def resolve(name_or_path: str | Path) -> Path:
     if str(name_or_path) in _registry:
         return _registry[str(name_or_path)]
     p = Path(name_or_path)
-    if p.suffix == ".toml" or p.is_file():
+    if p.suffix == ".toml" or p.exists():  # a folder too: the reader says it is one, not "no protocol"
         return p
     raise ConfigError(f"no protocol {str(name_or_path)!r}{suggest(str(name_or_path), _registry)} "
                       f"(registered: {', '.join(names())}; or give a .toml file)")

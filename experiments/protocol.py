@@ -17,13 +17,18 @@ request records its ``deadline`` and, for a fall, ``death_at`` (deadline +
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
+import json
 import math
 import random
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from experiments.actions import TimedAction
+from experiments.filekinds import expect
 from experiments.synthetic import SyntheticScenario
 from tasker.agent import Rates
 from tasker.loop import SimulationLoop
@@ -40,7 +45,13 @@ SUSP, BLOCK = StageKind.SUSPENDABLE, StageKind.BLOCKING
 MAX_REQUESTS = 10_000
 """A protocol whose counts add up to more requests a day than this is refused (a typo such as
 ``count = 1200000`` would otherwise run for hours; 9 000 take a minute on the synthetic backend)."""
+MAX_STEPS = 1_000_000
+"""A protocol whose day has more steps than this (``length_s / step_s``) is refused: the loop steps
+through the whole day (about 2 million steps take 5 s of one synthetic day, and a robot day far
+more), so ``length_s = 1e9`` never ended; the shipped days have 720 to 2 880 steps."""
 _RESUME_STAGES = ("go_back", "apologise", "pick_again")
+TOP_KEYS = ("name", "day", "robot", "apartment", "arrivals", "tasks", "robot_backend")
+"""The top-level keys and tables of a protocol file."""
 
 
 @dataclass(frozen=True)
@@ -122,6 +133,17 @@ class Protocol:
     def death_after_s(self) -> float | None:
         return self.tasks["fall"].death_after_s if "fall" in self.tasks else None
 
+    def digest(self) -> str:
+        """A SHA-256 of what its days are drawn and run from: every checked value (not the file's
+        comments, layout or place) and, with a robot backend, the bytes of its world file.  Stored
+        with each day, so that a resumed run does not mix days of two versions of a protocol."""
+        values = dataclasses.asdict(self)
+        values.pop("source")
+        h = hashlib.sha256(json.dumps(values, sort_keys=True, default=str).encode())
+        if self.robot is not None:
+            h.update(Path(self.robot.world).read_bytes())
+        return h.hexdigest()
+
 
 # -- reading ---------------------------------------------------------------------------------------
 
@@ -166,14 +188,24 @@ def _task(t: Table, kind: str) -> TaskSpec:
 def load(path: str | Path) -> Protocol:
     """Read and check a protocol file; every fault names the file, line and field."""
     top = read_table(path)
+    expect(top, "day protocol")
+    top.declare(TOP_KEYS)  # a misspelt [arivals] is named where "arrivals: missing" is said
     top.string("name")
     day, robot, apartment = top.table("day"), top.table("robot"), top.table("apartment")
     arrivals, tasks_t = top.table("arrivals"), top.table("tasks")
+    for t, keys in ((day, ("length_s", "step_s", "start")), (robot, ("speed", "start_site", "planning_time_s")),
+                    (arrivals, ("process", "last_call_s"))):
+        t.declare(keys)
     length = day.number("length_s", positive=True)
     step = day.number("step_s", positive=True)
     if step > length:
         raise day.error("step_s", f"expected at most the day's length_s ({length:g} s), got {step:g}")
+    if length / step > MAX_STEPS:
+        raise day.error("length_s", f"{length:g} s in steps of step_s = {step:g} s is {length / step:.3g} steps, "
+                                    f"more than the {MAX_STEPS} a day may have")
     start = day.string("start", "00:00")
+    if not re.fullmatch(r"([01]\d|2[0-3]):[0-5]\d", start):
+        raise day.error("start", f"expected a wall-clock time HH:MM (00:00 to 23:59), got {start!r}")
     day.done()
     sites_t = apartment.table("sites")
     sites = {name: _pose(sites_t, name, v) for name, v in sites_t.items()}
@@ -195,13 +227,16 @@ def load(path: str | Path) -> Protocol:
     if not tasks:
         raise tasks_t.error(None, f"expected at least one of {', '.join(KINDS)}")
     total = sum(spec.count for spec in tasks.values())
+    if total == 0:  # every day would be empty: a table of zeros, "all done", for every scheduler
+        raise tasks_t.error(None, f"the day's counts add up to 0 requests: expected a count > 0 for at least one "
+                                  f"of {', '.join(tasks)}")
     if total > MAX_REQUESTS:
         kind = max(tasks, key=lambda k: tasks[k].count)
         raise tasks_t.at(kind, tasks_t.data[kind]).error(
             "count", f"the day's counts add up to {total} requests, more than the {MAX_REQUESTS} a day may have")
     tasks_t.done()
     backend = _robot_backend(top.table("robot_backend"), Path(path), sites, tasks) if "robot_backend" in top else None
-    top.done(also=("robot_backend",))  # optional: listed among the valid keys even when absent
+    top.done(also=TOP_KEYS)  # robot_backend is optional: listed among the valid keys even when absent
     return Protocol(name=top.data["name"], source=str(path), start=start, length_s=length, step_s=step,
                     robot_speed=speed, start_site=start_site, planning_time_s=planning, sites=sites,
                     last_call_s=last_call, tasks=tasks, robot=backend)

@@ -27,6 +27,7 @@ import numpy as np
 from experiments import fields
 from experiments.actions import TABLES, TimedAction, read_actions
 from experiments.fields import MODES, POLICIES, STRATEGIES, ScenarioError
+from experiments.filekinds import expect
 from tasker import reader
 
 __all__ = ["InterruptionGrid", "RobotScenario", "ScenarioError", "load", "randomize", "resolve", "kind_of", "SCENARIOS"]
@@ -135,6 +136,7 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
     p = resolve(path)
     source = str(p)
     top = reader.load(p, ScenarioError)
+    expect(top, "scenario")
     top.string("kind", choices=("robot",))
     world = top.string("world")
     world_file = p.parent / world

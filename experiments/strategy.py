@@ -68,6 +68,10 @@ class Strategy:
         for part in text.split(","):
             key, sep, value = part.partition("=")
             key, value = key.strip(), value.strip()
+            if sep and key in FACTORS and not value:  # the factor is right: "did you mean" it would mislead
+                levels = FACTOR_LEVELS[key]
+                one_of = "a scheduler name" if levels is None else " or ".join(_show(v) for v in levels)
+                raise ValueError(f"{key}: expected {one_of} after '{key}=', got nothing in {text!r}")
             if not sep or key not in FACTORS or not value:
                 raise ValueError(f"expected 'update=…,suspension=…[,policy=…][,hazard_waiting=on|off]"
                                  f"[,scheduler=…]', got {text!r}{reader.suggest(key, list(FACTORS))}")

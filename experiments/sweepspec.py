@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from experiments.filekinds import expect
 from experiments.scenario import InterruptionGrid
 from experiments.store import JobKey
 from experiments.strategy import FACTOR_LEVELS, FACTORS, Strategy, expand
@@ -110,6 +111,8 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
     limit = MAX_JOBS if max_jobs is None else max_jobs
     p = Path(path).resolve()
     top = reader.load(p, SpecError)
+    expect(top, "sweep spec")
+    top.declare(SPEC_KEYS)  # a misspelt 'scenario = [...]' is named where "scenarios: missing" is said
     name = str(top.string("name", p.stem))
     scenario_list = top.array("scenarios", nonempty=True)
     at = top.at("scenarios", {})
@@ -188,7 +191,30 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
         raise top.error("seeds", f"the spec expands to {len(scenario_list)} scenarios x {len(seeds)} seeds x "
                                  f"{len(strategies)} strategies = {n} jobs, more than the {limit} a sweep may have")
     variants = _variants(top.table("variants", {}), scenario_list, sources)
+    _warn_ignored_factors(top, scenario_list, sources, strategies)
     return SweepSpec(tuple(scenario_list), seeds, tuple(strategies), name=name, sources=sources, variants=variants)
+
+
+def _warn_ignored_factors(top: reader.Table, scenario_list: Sequence[str], sources: Mapping[str, str],
+                          strategies: Sequence[Strategy]) -> None:
+    """An :class:`~tasker.reader.InputWarning` for each synthetic scenario that strategies set
+    factors for: its timed stages have no suspension or update plans, no policy and no hazards
+    (the run records them as static), so strategies that differ only there run alike."""
+    from experiments import scenario as scenarios
+
+    ignored = [k for k in FACTORS if k != "scheduler" and any(getattr(st, k) is not None for st in strategies)]
+    if not ignored:
+        return
+    for sc in scenario_list:
+        try:
+            kind = scenarios.kind_of(scenarios.resolve(sources.get(sc, sc)))
+        except reader.InputError:
+            continue  # the scenario's own fault: its loader names it (sweep.precheck, before any job runs)
+        if kind == "synthetic":
+            top.warn("strategies" if "strategies" in top else "factors",
+                     f"{sc!r} is a synthetic scenario, whose timed stages ignore {', '.join(ignored)}: its runs of "
+                     "strategies that differ only there are alike (compare them on robot scenarios; a synthetic "
+                     "one varies with scheduler only)")
 
 
 def _check_scheduler(t: reader.Table, key: str | int, strategy: Strategy) -> None:

@@ -17,6 +17,7 @@ from experiments import fields
 from experiments.actions import NO_REQUESTS, TABLES, TimedAction, located, read_actions
 from experiments.crossref import validate_request
 from experiments.fields import MODES, ScenarioError
+from experiments.filekinds import expect
 from tasker import reader, schedulers
 from tasker.agent import Rates
 from tasker.errors import TaskerError
@@ -84,6 +85,7 @@ def load(path: str | Path) -> SyntheticScenario:
     """Read and check a synthetic scenario file (``.toml`` or ``.json``)."""
     p = Path(path)
     top = reader.load(p, ScenarioError)
+    expect(top, "scenario")
     top.string("kind", "synthetic", choices=("synthetic",))
     settings = top.table("settings", {})
     tasks_f = top.table("tasks")

@@ -152,6 +152,7 @@ class Table:
                              field=self.field() or "top level")
         self.data: dict[str, Any] = data
         self.used: set[str] = set()
+        self.declared: frozenset[str] | None = None
 
     # -- where ----------------------------------------------------------------------
     def field(self, key: str | int | None = None) -> str:
@@ -190,7 +191,7 @@ class Table:
         self.used.add(key)
         if key not in self.data:
             if default is _MISSING:
-                raise self.error(key, "missing (required)")
+                raise self.error(key, "missing (required)" + self._misspelt(key))
             return default
         value = self.data[key]
         if finite:
@@ -276,6 +277,21 @@ class Table:
         if key in self.data:
             check_name(self, key, value, known, what)
         return value
+
+    def declare(self, keys: Iterable[str]) -> None:
+        """Say, before reading, every key this table may hold.  Then a required key that is
+        missing names a key of the table that is none of these and close to it: ``[arivals]``
+        is reported with "arrivals: missing (required)", not left for :meth:`done`, never reached."""
+        self.declared = frozenset(keys)
+
+    def _misspelt(self, key: str) -> str:
+        if self.declared is None:
+            return ""
+        close = difflib.get_close_matches(key, [k for k in self.data if k not in self.declared], n=1, cutoff=0.6)
+        if not close:
+            return ""
+        line = self.line(close[0])
+        return f"; the file has {close[0]!r}{f' (line {line})' if line else ''}, not a valid key: did you mean {key!r}?"
 
     def done(self, also: Iterable[str] = ()) -> None:
         """Refuse keys nobody read, naming the valid ones (and the closest); ``also`` are valid too."""

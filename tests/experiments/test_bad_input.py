@@ -449,6 +449,8 @@ def test_a_scenario_on_a_bad_world_names_the_world_file(tmp_path: Path) -> None:
      "did you mean 'alg2'"),
     ('scenarios = ["paper", "paper"]\nseeds = 2\nstrategies = ["default"]', "scenarios[1]", "listed twice"),
     ('scenarios = ["paper"]\nseds = 2\nstrategies = ["default"]', "seeds", "missing"),
+    ('scenario = ["paper"]\nseeds = 2\nstrategies = ["default"]', "scenarios",
+     "missing (required); the file has 'scenario' (line 1), not a valid key: did you mean 'scenarios'?"),
     ('scenarios = "paper"\nseeds = 2\nstrategies = ["default"]', "scenarios", "expected an array"),
     ('scenarios = ["paper"]\nseeds = 2\nstrategies = ["default"]\n[variants.paper]\ninterrupt = "requests[9]"\n'
      'times = { start = 0.0, stop = 60.0, step = 20.0 }', "variants.paper.interrupt",
@@ -459,6 +461,23 @@ def test_a_scenario_on_a_bad_world_names_the_world_file(tmp_path: Path) -> None:
 ])
 def test_bad_sweep_spec_field_is_named(tmp_path: Path, body: str, field: str, fragment: str) -> None:
     _fails(_write(tmp_path, body, "spec.toml"), load_spec, field, fragment, SpecError)
+
+
+def test_strategies_a_synthetic_scenario_ignores_warn(tmp_path: Path) -> None:
+    """A synthetic scenario swept over suspension=static/planned ran static twice, silently: the
+    report then compared two identical strategies.  The scheduler alone, or a robot scenario, is quiet."""
+    demo = standin.DEMO.as_posix()
+    body = f'scenarios = ["{demo}", "paper"]\nseeds = 2\n[factors]\nsuspension = ["static", "planned"]\n'
+    with pytest.warns(InputWarning, match=rf"spec\.toml:3: factors: '{demo}' is a synthetic scenario, whose timed "
+                                          r"stages ignore suspension: its runs of strategies that differ only there "
+                                          r"are alike") as caught:
+        load_spec(_write(tmp_path, body, "spec.toml"))
+    assert len(caught) == 1  # paper is a robot scenario
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        load_spec(_write(tmp_path, f'scenarios = ["{demo}"]\nseeds = 2\nstrategies = ["scheduler=fifo", '
+                                   '"scheduler=alg2"]\n', "spec.toml"))
+        load_spec(_write(tmp_path, body.replace(f'"{demo}", ', ""), "spec.toml"))
 
 
 def test_a_non_utf8_spec_is_a_clean_error(tmp_path: Path) -> None:
@@ -517,3 +536,36 @@ def test_typed_cases_cover_every_bundled_task_type() -> None:
     from planners.bundled import task_types
 
     assert {c[1] for c in _typed_cases()} == {t.name for t in task_types()}
+
+
+SHIPPED = Path(__file__).resolve().parents[2] / "experiments"
+_KIND_CASES = [  # (command, file of another kind, what the message must say)
+    (["day", "--days", "1", "--protocol"], "scenarios/paper.toml", "this is a scenario (it has 'requests'), not a "
+                                                                   "day protocol: run it with 'tasker run FILE'"),
+    (["day", "--days", "1", "--protocol"], "sweeps/suspension.toml", "this is a sweep spec (it has 'scenarios'), "
+                                                                     "not a day protocol"),
+    (["day", "--days", "1", "--protocol"], "protocols/tabsa_apartment.toml", "this is a world file (it has 'rooms')"),
+    (["run"], "protocols/tabsa.toml", "this is a day protocol (it has 'arrivals'), not a scenario: run it with "
+                                      "'tasker day --protocol FILE'"),
+    (["run"], "sweeps/suspension.toml", "this is a sweep spec (it has 'scenarios'), not a scenario"),
+    (["sweep", "--db", "{tmp}/r.db"], "protocols/tabsa.toml", "this is a day protocol (it has 'arrivals'), not a "
+                                                              "sweep spec"),
+    (["sweep", "--db", "{tmp}/r.db"], "scenarios/synthetic_demo.toml", "this is a scenario (it has 'requests'), "
+                                                                       "not a sweep spec"),
+]
+
+
+@pytest.mark.parametrize(("command", "file", "message"), _KIND_CASES, ids=[f"{c[0][0]} {c[1]}" for c in _KIND_CASES])
+def test_a_file_of_another_kind_is_named_for_what_it_is(command: list[str], file: str, message: str, tmp_path: Path,
+                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    """A protocol given to 'tasker run' was refused with 'tasks.transport.stages: missing (required)',
+    a scenario given to 'tasker day' with 'day: missing (required)': each sent the user to fix a
+    file that was fine."""
+    argv = [a.format(tmp=tmp_path) for a in command] + [str(SHIPPED / file)]
+    if command[0] == "sweep":  # the spec is positional
+        argv = [argv[0], str(SHIPPED / file), *argv[1:-1]]
+    if command[0] != "sweep":
+        argv += ["--out", str(tmp_path / "out")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert f"{SHIPPED / file}: {message}" in err and "Traceback" not in err

@@ -218,3 +218,87 @@ def test_a_scheduler_given_twice_or_an_out_that_is_a_file_names_the_argument(
     (tmp_path / "file").write_text("")
     assert dayreport.main([*base, "--schedulers", "fifo", "--out", str(tmp_path / "file")]) == 2
     assert f"argument --out: {tmp_path / 'file'} exists and is not a folder" in capsys.readouterr().err
+
+
+def test_more_days_than_a_sweep_may_have_are_refused_before_any_job(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--days 3000000 built millions of jobs (gigabytes) before the first day; a sweep refuses
+    more than MAX_JOBS, and so does a day run."""
+    from experiments.sweepspec import MAX_JOBS
+
+    days = MAX_JOBS // 2 + 1
+    assert dayreport.main(["--protocol", "tabsa-short", "--days", str(days), "--schedulers", "fifo", "alg2",
+                           "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f"argument --days: {days} days x 2 schedulers x 1 strategies" in err and str(MAX_JOBS) in err
+    assert "Traceback" not in err and not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("name", ["table.md", "days.jsonl", "days.db"])
+def test_an_output_that_cannot_be_written_is_refused_before_any_day(
+        name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A folder where table.md goes was found only after every day had run: the table was lost."""
+    out = tmp_path / "out"
+    (out / name).mkdir(parents=True)
+    for resume in ([], ["--resume"]):
+        assert dayreport.main(["--protocol", "tabsa-short", "--days", "1", "--schedulers", "fifo", "--workers", "1",
+                               "--out", str(out), *resume]) == 2
+        err = capsys.readouterr().err
+        assert f"argument --out: {out / name} is a folder; expected a file name" in err and "Traceback" not in err
+        assert sorted(p.name for p in out.iterdir()) == [name]  # no day ran, nothing written
+
+
+def test_resuming_with_a_changed_protocol_is_refused_and_keeps_the_stored_days(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--resume kept the days of the protocol as it was and ran the others from the edited file:
+    one table mixed days of 3 and of 15 requests.  A comment changes nothing and resumes."""
+    from experiments.store import ResultStore
+
+    shipped = Path(dayreport.__file__).parent / "protocols" / "tabsa_short.toml"
+    text = shipped.read_text(encoding="utf-8").split("\n[robot_backend]")[0]
+    proto, out = tmp_path / "mine.toml", tmp_path / "out"
+    proto.write_text(text, encoding="utf-8")
+    args = ["--protocol", str(proto), "--schedulers", "fifo", "--workers", "1", "--out", str(out), "--resume"]
+    assert dayreport.main([*args, "--days", "1"]) == 0
+    proto.write_text("# my edit\n" + text, encoding="utf-8")
+    assert dayreport.main([*args, "--days", "2"]) == 0  # the same values: day 1 is kept, day 2 added
+    proto.write_text(text.replace("count = 3", "count = 5", 1), encoding="utf-8")
+    capsys.readouterr()
+    assert dayreport.main([*args, "--days", "3"]) == 2
+    err = capsys.readouterr().err
+    assert f"argument --resume: {out / 'days.db'} holds days of {proto} as it was when they ran" in err
+    assert "run without --resume to start afresh" in err and "Traceback" not in err
+    with ResultStore(out / "days.db", readonly=True) as store:
+        assert sorted(r.seed for r in store.rows()) == [1, 2]
+    assert dayreport.main([a for a in args if a != "--resume"] + ["--days", "1"]) == 0  # afresh
+
+
+def test_a_folder_given_as_the_protocol_is_named_a_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--protocol my_protocols (a folder) was 'no protocol ...; or give a .toml file', as if it did not exist."""
+    (tmp_path / "my_protocols").mkdir()
+    assert dayreport.main(["--protocol", str(tmp_path / "my_protocols"), "--days", "1", "--schedulers", "fifo",
+                           "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f"{tmp_path / 'my_protocols'}: is a directory, expected a file" in err and "Traceback" not in err
+
+
+def test_a_second_run_into_the_same_out_leaves_the_running_ones_days(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Without --resume, a second 'tasker day' into the OUT of a running one deleted its days.db
+    before finding the sweep lease taken: the running one then wrote into a deleted file and ended
+    'no such results database', every day it had run lost."""
+    from experiments.store import ResultStore
+    from experiments.sweep import lease
+
+    out = tmp_path / "out"
+    assert dayreport.main(["--protocol", "tabsa-short", "--days", "1", "--schedulers", "fifo", "--workers", "1",
+                           "--out", str(out)]) == 0
+    capsys.readouterr()
+    with lease(out / "days.db"):  # the running one holds it
+        assert dayreport.main(["--protocol", "tabsa-short", "--days", "1", "--schedulers", "alg2", "--workers", "1",
+                               "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "another sweep is running on this database" in err and "Traceback" not in err
+    with ResultStore(out / "days.db", readonly=True) as store:
+        assert [r.strategy for r in store.rows()] == ["scheduler=fifo"]
+    assert (out / "days.jsonl").is_file()

@@ -38,6 +38,13 @@ def test_strategy_label_with_policy_and_hazard_waiting_round_trips() -> None:
         Strategy.parse("hazard_waiting=maybe")
     with pytest.raises(ValueError, match="did you mean 'policy'"):
         Strategy.parse("polcy=strict")
+    # a factor with no value was answered "did you mean 'suspension'?" for 'suspension='
+    for text, expected in (("suspension=", "suspension: expected static or planned after 'suspension='"),
+                           ("update=static, hazard_waiting = ", "hazard_waiting: expected off or on after"),
+                           ("scheduler=", "scheduler: expected a scheduler name after 'scheduler='")):
+        with pytest.raises(ValueError, match=expected) as info:
+            Strategy.parse(text)
+        assert "did you mean" not in str(info.value)
     with pytest.raises(ValueError, match="hazard_waiting: expected true or false"):
         Strategy(hazard_waiting="yes")  # type: ignore[arg-type]
 

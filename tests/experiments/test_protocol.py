@@ -83,6 +83,17 @@ def test_bad_protocols_name_file_line_and_field(tmp_path: Path) -> None:
                 'world = "tabsa_apartment.toml"', f'world = "{TABSA.parent / "tabsa_apartment.toml"}"')))
 
 
+def test_a_day_of_no_requests_is_refused_and_a_day_of_one_type_runs(tmp_path: Path) -> None:
+    """Counts that were all 0 gave every scheduler an empty day: 'completed 0', 'all done', exit 0."""
+    text = TABSA.read_text(encoding="utf-8").split("\n[robot_backend]")[0]
+    with pytest.raises(InputError, match=r"p\.toml: tasks: the day's counts add up to 0 requests: expected a "
+                                         r"count > 0 for at least one of transport, fall, pick_place"):
+        protocol.load(write(tmp_path, text.replace("count = 12", "count = 0")))
+    falls = protocol.load(write(tmp_path, text.replace("count = 12", "count = 0").replace(
+        "count = 0\npriority = 3", "count = 1\npriority = 3")))
+    assert [r.kind for r in protocol.draw(falls, 1)] == ["fall"]
+
+
 def test_a_failed_fall_is_requested_again_until_its_death_at(tabsa: protocol.Protocol) -> None:
     """The fall's request carries its renewal (every 30 s after a failure, until death_at);
     the other types' failures stand."""
@@ -265,3 +276,36 @@ def test_needs_follow_chains_of_renewals() -> None:
 
     assert needs(_renewed("finished")) == {"d1": "d1", "d2": "d1", "d3": "d1"}
     assert needs(HAND) == {"d1": "d1", "d2": "d2", "d3": "d3"}
+
+
+def test_a_misspelt_table_or_key_is_named_with_the_one_it_should_be(tmp_path: Path) -> None:
+    """A misspelt [arivals] or lenght_s was reported only as the missing one it should have been."""
+    text = TABSA.read_text(encoding="utf-8")
+    for old, new, message in (("[arrivals]", "[arivals]", r"arrivals: missing \(required\); the file has 'arivals' "
+                                                          r"\(line \d+\), not a valid key: did you mean 'arrivals'\?"),
+                              ("length_s =", "lenght_s =", r"day\.length_s: missing \(required\); the file has "
+                                                           r"'lenght_s' \(line \d+\)")):
+        with pytest.raises(InputError, match=r"p\.toml(:\d+)?: " + message):
+            protocol.load(write(tmp_path, text.replace(old, new)))
+
+
+def test_the_days_start_is_a_wall_clock_time(tmp_path: Path) -> None:
+    """day.start took any string ('banana', '8 o'clock') and kept it as the day's label."""
+    text = TABSA.read_text(encoding="utf-8").split("\n[robot_backend]")[0]
+    assert 'start = "08:00"' in text
+    for bad in ("banana", "8:00", "24:00", "08:60"):
+        with pytest.raises(InputError, match=rf"p\.toml:\d+: day\.start: expected a wall-clock time HH:MM "
+                                             rf"\(00:00 to 23:59\), got '{bad}'"):
+            protocol.load(write(tmp_path, text.replace('start = "08:00"', f'start = "{bad}"')))
+    assert protocol.load(write(tmp_path, text.replace('start = "08:00"', 'start = "23:59"'))).start == "23:59"
+
+
+def test_a_day_of_too_many_steps_is_refused(tmp_path: Path) -> None:
+    """length_s = 1e9 (or a step_s of a millisecond) was accepted, and the day never ended."""
+    text = TABSA.read_text(encoding="utf-8").split("\n[robot_backend]")[0]
+    for old, new in (("length_s = 14400.0", "length_s = 1e9"), ("step_s = 5.0", "step_s = 0.001")):
+        assert old in text
+        with pytest.raises(InputError, match=rf"p\.toml:\d+: day\.length_s: .* steps, more than the "
+                                             rf"{protocol.MAX_STEPS} a day may have"):
+            protocol.load(write(tmp_path, text.replace(old, new)))
+    protocol.load(write(tmp_path, text.replace("step_s = 5.0", "step_s = 0.0144")))  # exactly MAX_STEPS
