@@ -112,18 +112,9 @@ def kind_of(path: Path) -> str:
         if "world" in top and "tasks" not in top:
             raise top.error("kind", 'missing: a scenario with a world is a robot scenario, so write kind = "robot" '
                                     "(without kind a scenario is synthetic, with [tasks.NAME] and no world)")
-        other = next((what for keys, what in _OTHER_FILES if all(k in top for k in keys)), None)
-        if other is not None:
-            raise ScenarioError(str(path), f"is {other}, not a scenario (a scenario has kind = \"robot\" or "
-                                           "\"synthetic\")")
+        expect(top, "scenario")  # a world file, sweep spec or protocol: named for what it is
     return str(top.string("kind", "synthetic", choices=("robot", "synthetic")))
 
-
-_OTHER_FILES = ((("bounds",), "a world file (name it in a robot scenario: world = \"FILE\"; tasker world FILE "
-                             "shows it)"),
-                (("scenarios", "seeds"), "a sweep spec (tasker sweep SPEC --db DB)"),
-                (("day", "tasks"), "a day protocol (tasker day --protocol FILE)"))
-"""Keys that tell another kind of file given where a scenario is expected, and what to do with it."""
 
 
 def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()) -> RobotScenario:

@@ -308,9 +308,9 @@ ROOT = Path(__file__).parents[2]
 
 
 @pytest.mark.parametrize(("argv", "expected"), [
-    (["run", "robot/worlds/flat.toml"], "robot/worlds/flat.toml: is a world file"),
-    (["run", "experiments/sweeps/suspension.toml"], "experiments/sweeps/suspension.toml: is a sweep spec"),
-    (["run", "experiments/protocols/tabsa.toml"], "experiments/protocols/tabsa.toml: is a day protocol"),
+    (["run", "robot/worlds/flat.toml"], "this is a world file (it has 'rooms'), not a scenario"),
+    (["run", "experiments/sweeps/suspension.toml"], "this is a sweep spec (it has 'scenarios'), not a scenario"),
+    (["run", "experiments/protocols/tabsa.toml"], "this is a day protocol (it has 'arrivals'), not a scenario"),
     (["world", "experiments/scenarios/paper.toml"], "paper.toml:6: kind: this is a scenario file, not a world file"),
 ])
 def test_another_kind_of_file_is_named_for_what_it_is(argv: list[str], expected: str, tmp_path: Path,
