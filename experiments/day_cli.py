@@ -8,10 +8,11 @@ The same as ``python -m experiments.dayreport``; this module holds only the opti
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from experiments import days
-from tasker.cliargs import seed
+from tasker.cliargs import EXIT_INTERRUPTED, seed
 
 EXAMPLES = """\
 examples:
@@ -53,7 +54,15 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
 def _run(args: argparse.Namespace) -> int:
     from experiments import dayreport
 
-    return dayreport.run(args)
+    try:
+        return dayreport.run(args)
+    except KeyboardInterrupt:  # every day that ended is already in days.db
+        db = Path(args.out) / "days.db"
+        if db.is_file():
+            print(f"tasker day: interrupted; the days that ended are in {db}: run the same command with --resume "
+                  "to go on", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        raise
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:

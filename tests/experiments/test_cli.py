@@ -346,3 +346,20 @@ def test_a_task_ended_by_an_exception_counts_as_failed(tmp_path: Path, monkeypat
     totals = json.loads((tmp_path / "out" / "fetch_demo" / "metrics.json").read_text())["totals"]
     assert totals["failed"] == 1 and totals["by_cause"] == {"error": 1}
     assert totals["failure_reasons"][0].startswith("d1: check_terminate() raised ValueError: boom")
+
+
+def test_day_stopped_by_ctrl_c_says_how_to_go_on(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
+                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: a bare "interrupted", though the days that ended were kept and --resume goes on."""
+    import experiments.dayreport
+
+    def stopped(args: Any) -> int:
+        (Path(args.out) / "days.db").write_bytes(b"")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(experiments.dayreport, "run", stopped)
+    out = tmp_path / "day"
+    out.mkdir()
+    assert main(["day", "--protocol", "tabsa", "--days", "1", "--out", str(out)]) == 130
+    err = capsys.readouterr().err
+    assert f"the days that ended are in {out / 'days.db'}: run the same command with --resume" in err
