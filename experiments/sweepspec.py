@@ -202,7 +202,8 @@ def _warn_ignored_factors(top: reader.Table, scenario_list: Sequence[str], sourc
     (the run records them as static), so strategies that differ only there run alike."""
     from experiments import scenario as scenarios
 
-    ignored = [k for k in FACTORS if k != "scheduler" and any(getattr(st, k) is not None for st in strategies)]
+    # only factors the strategies vary: one setting alone compares nothing (and runs as recorded)
+    ignored = [k for k in FACTORS if k != "scheduler" and len({getattr(st, k) for st in strategies}) > 1]
     if not ignored:
         return
     for sc in scenario_list:
