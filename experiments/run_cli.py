@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from pathlib import Path
 
 from tasker.cliargs import (
@@ -23,6 +24,7 @@ from tasker.cliargs import (
     writable_dir,
 )
 from tasker.errors import RunInterrupted
+from tasker.reader import InputWarning
 from tasker.trace import FAILED
 
 EXAMPLES = """\
@@ -93,6 +95,12 @@ def _run(args: argparse.Namespace) -> int:
     paths = task_paths(args)
     path = scenarios.resolve(args.scenario)
     label = scenarios.name_of(path)
+    ignored = [f"--{name.replace('_', '-')}" for name in ("update", "suspension", "policy", "hazard_waiting")
+               if getattr(args, name)]
+    if ignored and scenarios.kind_of(path) == "synthetic":  # its timed stages have no plans, policy or hazards
+        warnings.warn(InputWarning(f"{path}: a synthetic scenario's timed stages ignore {', '.join(ignored)}: "
+                                   "the run is the static one (run.json records it); compare strategies on a "
+                                   "robot scenario"), stacklevel=1)
     want = Path(args.out) if args.out else Path("out") / label
     made = not want.exists()
     out = writable_dir(want, "--out")

@@ -363,3 +363,12 @@ def test_day_stopped_by_ctrl_c_says_how_to_go_on(monkeypatch: pytest.MonkeyPatch
     assert main(["day", "--protocol", "tabsa", "--days", "1", "--out", str(out)]) == 130
     err = capsys.readouterr().err
     assert f"the days that ended are in {out / 'days.db'}: run the same command with --resume" in err
+
+
+def test_strategy_options_on_a_synthetic_scenario_warn(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: ``--suspension planned`` on a synthetic scenario ran static without a word."""
+    assert main(["run", SYNTHETIC, "--out", str(tmp_path / "a"), "--no-pictures", "--suspension", "planned"]) == 0
+    assert "a synthetic scenario's timed stages ignore --suspension: the run is the static one" in \
+        capsys.readouterr().err
+    assert main(["run", SYNTHETIC, "--out", str(tmp_path / "b"), "--no-pictures", "--scheduler", "fifo"]) == 0
+    assert "warning" not in capsys.readouterr().err
