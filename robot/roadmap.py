@@ -46,10 +46,9 @@ from scipy.sparse import csr_matrix
 
 from robot import scene as scene_module
 from robot.scene import Scene
-from robot.spec import WorldSpec
+from robot.spec import DEFAULT_DENSITY, WorldSpec
 from tasker.diskcache import content_key, installed_version, remembered
 
-DEFAULT_DENSITY = 13.0  # milestones per square metre of the bounding box
 DISK_KIND = "roadmap"  # the on-disk cache's kind (tasker.diskcache)
 _CACHE: dict[tuple[object, ...], Roadmap] = {}
 log = logging.getLogger(__name__)

@@ -17,11 +17,14 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from tasker import reader
 from tasker.reader import InputError, Table, check_name, check_number, check_numbers, suggest
 from tasker.world import Pose
+
+if TYPE_CHECKING:
+    from robot.scene import Scene
 
 WORLDS_DIR = Path(__file__).with_name("worlds")
 POSTURES = ("standing", "sitting", "fallen")
@@ -108,10 +111,12 @@ class WorldSpec:
     objects: Mapping[str, str] = field(default_factory=dict)
 
 
+DEFAULT_DENSITY = 13.0
+"""The roadmap's milestones per square metre of the bounds (:mod:`robot.roadmap` grows them)."""
 MAX_AREA = 10_000.0
-"""The largest area of a world's bounds, in m²: the roadmap (:mod:`robot.roadmap`) is grown over the
-bounds at 13 milestones a m², about 10 s and 1 GB for this many; four times as many take a minute and
-3 GB, and a typo such as ``1e6`` never ends."""
+"""The largest area of a world's bounds, in m²: the roadmap is grown over all of the bounds at
+:data:`DEFAULT_DENSITY`, so its time and memory grow with the area, and a typo such as ``1e6``
+never ends."""
 POSE = "[x, y, yaw]"
 BOX = "[xmin, ymin, xmax, ymax]"
 PDDL_NAME = re.compile(r"[a-z][a-z0-9_-]*")
@@ -185,7 +190,8 @@ def read_world(top: Table, source: str) -> WorldSpec:
     area = (hi[0] - lo[0]) * (hi[1] - lo[1])
     if area > MAX_AREA:
         raise top.error("bounds", f"the world covers {area:.4g} m², more than {MAX_AREA:g} m² (e.g. 100 m x 100 m): "
-                                  "the robot's roadmap grows milestones over the whole of the bounds (13 a m²), "
+                                  "the robot's roadmap grows milestones over the whole of the bounds "
+                                  f"({DEFAULT_DENSITY:g} a m²), "
                                   "which would take minutes and gigabytes; expected bounds around the rooms")
     rooms_t = top.table("rooms", {})
     rooms = {n: _box(rooms_t, n, v) for n, v in rooms_t.items()}
@@ -314,25 +320,32 @@ def _check_geometry(spec: WorldSpec, top: Table) -> None:
     robot_t = top.table("robot")
     x, y, _ = spec.robot.pose
     check(robot_t, "pose", x, y)
-    bad = robot_problem(spec, x, y)
+    from robot.scene import Scene
+    from robot.tiago import robot_dimensions
+
+    scene = Scene(spec, robot_dimensions()[2])  # one for the robot's pose and every place
+    bad = robot_problem(spec, x, y, scene)
     if bad:
         raise robot_t.error("pose", f"{bad}; expected free space")
     for n, (x, y, _) in spec.places.items():  # the robot drives to every place: a goal it never reaches
-        bad = robot_problem(spec, x, y)
+        bad = robot_problem(spec, x, y, scene)
         if bad:
             raise places_t.error(n, f"{bad}, and a place is where the robot stands (it could never get there); "
                                     "expected a point with room for the robot")
 
 
-def robot_problem(spec: WorldSpec, x: float, y: float) -> str | None:
-    """Why the robot cannot stand at ``(x, y)`` (its disc overlaps a wall, furniture or the bounds), or ``None``."""
-    from robot.scene import Scene
-    from robot.tiago import robot_dimensions
+def robot_problem(spec: WorldSpec, x: float, y: float, scene: Scene | None = None) -> str | None:
+    """Why the robot cannot stand at ``(x, y)`` (its disc overlaps a wall, furniture or the bounds), or
+    ``None``; ``scene``: the world's, at the robot's radius, when the caller asks of many points."""
+    if scene is None:
+        from robot.scene import Scene
+        from robot.tiago import robot_dimensions
 
-    radius = robot_dimensions()[2]
-    if Scene(spec, radius).static_free(x, y):
+        scene = Scene(spec, robot_dimensions()[2])
+    if scene.static_free(x, y):
         return None
-    return f"the robot (radius {radius:g} m) at ({x:g}, {y:g}) overlaps a wall, furniture or the world's bounds"
+    return (f"the robot (radius {scene.radius:g} m) at ({x:g}, {y:g}) overlaps a wall, furniture or the "
+            "world's bounds")
 
 
 def parse_world(data: Mapping[str, Any], source: str) -> WorldSpec:
