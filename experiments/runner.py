@@ -328,7 +328,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures and error is None, sim, journal)
     result = RunResult(record, metrics, trace, trajectory)
     if isinstance(error, KeyboardInterrupt):
-        raise RunInterrupted(reason, result, out) from error
+        raise RunInterrupted(reason, result) from error
     if error is not None:
         raise RunAborted(reason, result) from error
     return result

@@ -84,12 +84,11 @@ class RunAborted(TaskerError):
 class RunInterrupted(KeyboardInterrupt):
     """The user stopped a run (Ctrl-C).  Still a :class:`KeyboardInterrupt`, so whatever
     catches those goes on doing so; ``result`` carries what the run produced so far (the
-    runner writes the trace, ``run.json`` and ``metrics.json`` first), ``out`` where."""
+    runner writes the trace, ``run.json`` and ``metrics.json`` first)."""
 
-    def __init__(self, reason: str, result: object = None, out: object = None) -> None:
+    def __init__(self, reason: str, result: object = None) -> None:
         self.reason = reason
         self.result = result
-        self.out = out
         super().__init__(reason)
 
 
