@@ -6,7 +6,7 @@ Prints real-time factors (simulated seconds / wall seconds of ``run_scenario``),
 cold figure the median of three fresh processes:
 
 * the paper scenario **cold**: a fresh process, so the task folders and every plan are
-  paid (target >= 60x).  Its on-disk cache (:mod:`tasker.diskcache`, ``$TASKER_CACHE``)
+  paid (target >= 60x).  Its on-disk cache (:mod:`tasker.support.diskcache`, ``$TASKER_CACHE``)
   is a fresh folder of this run, never the user's: first **empty** (a first run:
   unified-planning checks every task folder and solves its example, Pinocchio builds TIAGo
   for its dimensions, the DAE meshes are converted for MuJoCo, OMPL grows the roadmap),

@@ -2,7 +2,7 @@
 
     python benchmarks/profile_cold.py [SCENARIO] [--first]     # default: paper, disk cache primed
 
-Runs the scenario once in a fresh process (its on-disk cache, :mod:`tasker.diskcache`, a
+Runs the scenario once in a fresh process (its on-disk cache, :mod:`tasker.support.diskcache`, a
 fresh folder: ``--first`` leaves it empty, as on a first run — no task folder's checks, no
 robot dimensions, MuJoCo source or roadmap remembered; otherwise a first run primes it) and
 prints the wall seconds of ``run_scenario`` split by what ran: loading the scenario (of

@@ -2,7 +2,7 @@
 changes, mode switches and world events, each at a time.
 
 Shared by the synthetic and the robot scenario loaders, so both check the same
-fields the same way, with :mod:`tasker.reader`: errors name the file, the line and
+fields the same way, with :mod:`tasker.support.reader`: errors name the file, the line and
 the field.  Cross-references to the world and the task store (who is a person, what
 a task type takes) are checked by :mod:`experiments.crossref`.
 """
@@ -16,7 +16,7 @@ from typing import Any
 
 from experiments.fields import MODES, ScenarioError
 from experiments.request_fields import FIELD_NAMES
-from tasker.reader import Table, check_name, suggest
+from tasker.support.reader import Table, check_name, suggest
 
 __all__ = ["NO_REQUESTS", "TABLES", "WORLD_EVENT_KINDS", "ScenarioError", "TimedAction", "located", "read_actions"]
 

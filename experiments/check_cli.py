@@ -21,8 +21,8 @@ from pathlib import Path
 from typing import Any
 
 from experiments.run_cli import add_path_option, task_paths
-from tasker.cliargs import EXIT_FAILED, EXIT_OK, error_text
-from tasker.reader import InputWarning
+from tasker.support.cliargs import EXIT_FAILED, EXIT_OK, error_text
+from tasker.support.reader import InputWarning
 
 EXAMPLES = """\
 examples:
@@ -159,7 +159,7 @@ class Checker:
         from robot.spec import load_world
 
         if self.attempt(p, f"world {scn.world}", lambda: world.append(load_world(scn.world))):
-            from tasker.cliargs import did_you_mean
+            from tasker.support.cliargs import did_you_mean
 
             for name in scn.people:
                 if name not in world[0].people:

@@ -20,7 +20,7 @@ import sys
 from collections.abc import Sequence
 
 from tasker import __version__
-from tasker.cliargs import EXIT_EPILOG, EXIT_USAGE, Parser, run_handler
+from tasker.support.cliargs import EXIT_EPILOG, EXIT_USAGE, Parser, run_handler
 
 SUBCOMMAND_MODULES = (
     "experiments.run_cli",    # run

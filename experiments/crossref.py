@@ -13,7 +13,7 @@ world object whose type is ``T`` or a subtype of ``T`` in that task's domain.  S
 ``guide_human`` whose destination is a person, or a ``human_fell`` of someone who is
 not in the world, is refused at load, not deep in the PDDL translator.
 
-What is valid but doubtful is an :class:`~tasker.reader.InputWarning` (also kept on
+What is valid but doubtful is an :class:`~tasker.support.reader.InputWarning` (also kept on
 ``RobotScenario.warnings``): an action after the horizon, two requests of the same
 task type with identical arguments that may overlap in time, a task type's default
 argument that names nothing in this world, a requested task type's ``[[bindings]]`` entry
@@ -29,9 +29,9 @@ from typing import TYPE_CHECKING, Any
 from experiments import fields
 from experiments.actions import NO_REQUESTS, TimedAction, located
 from experiments.request_fields import FIELD_NAMES, asked_for, with_request_fields
-from tasker.cliargs import TASKS_HINT
 from tasker.errors import TaskerError
-from tasker.reader import Table, check_name, suggest
+from tasker.support.cliargs import TASKS_HINT
+from tasker.support.reader import Table, check_name, suggest
 
 if TYPE_CHECKING:
     from experiments.scenario import RobotScenario

@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 from experiments import days
-from tasker.cliargs import EXIT_INTERRUPTED, seed
+from tasker.support.cliargs import EXIT_INTERRUPTED, seed
 
 EXAMPLES = """\
 examples:

@@ -431,12 +431,12 @@ def report(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead"
 def run(a: argparse.Namespace) -> int:
     """Run the days into ``OUT/days.db``; write ``days.jsonl`` and ``table.md``; print the table.
 
-    Bad input raises :class:`tasker.cliargs.UsageError` (or the protocol's
-    :class:`tasker.reader.InputError`) before the first day runs.  Returns 1 if a day failed
+    Bad input raises :class:`tasker.support.cliargs.UsageError` (or the protocol's
+    :class:`tasker.support.reader.InputError`) before the first day runs.  Returns 1 if a day failed
     to run (it is listed under the table), else 0."""
     from tasker import schedulers
-    from tasker.cliargs import SEED_LIMIT, UsageError, show_progress, writable_dir, writable_file
-    from tasker.reader import suggest
+    from tasker.support.cliargs import SEED_LIMIT, UsageError, show_progress, writable_dir, writable_file
+    from tasker.support.reader import suggest
 
     unknown = [n for n in a.schedulers if n not in schedulers.names()]
     if unknown:

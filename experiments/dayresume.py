@@ -75,10 +75,10 @@ def _day_problem(r: Any) -> tuple[str, str] | None:
 def import_log(log: Path, db: Path, protocol: str, backend: str) -> None:
     """Days of an older ``days.jsonl`` (before the database) into ``db``, so ``--resume`` keeps them.
 
-    The whole file is checked first: a damaged line is an :class:`~tasker.reader.InputError`
+    The whole file is checked first: a damaged line is an :class:`~tasker.support.reader.InputError`
     naming it (and nothing is imported)."""
     from experiments.store import ResultStore, RunRow, Status
-    from tasker.reader import InputError, read_text
+    from tasker.support.reader import InputError, read_text
 
     days = []
     for n, line in enumerate(read_text(log).splitlines(), start=1):

@@ -39,7 +39,7 @@ from experiments.protocol import DayRequest, Protocol
 from experiments.strategy import FACTORS
 from experiments.synthetic import SyntheticScenario
 from tasker.errors import ConfigError
-from tasker.reader import suggest
+from tasker.support.reader import suggest
 
 PROTOCOLS_DIR = Path(__file__).resolve().parent / "protocols"
 BACKENDS = ("synthetic", "robot")

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from tasker.cliargs import UsageError, non_negative_seconds
 from tasker.errors import TaskerError
+from tasker.support.cliargs import UsageError, non_negative_seconds
 from tasker.trace import number, read
 
 PROBLEMS = "problems"

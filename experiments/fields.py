@@ -1,6 +1,6 @@
 """What every scenario reader shares: the error class and the ``[settings]`` fields.
 
-Files are read with the strict reader :mod:`tasker.reader` (every fault names the file,
+Files are read with the strict reader :mod:`tasker.support.reader` (every fault names the file,
 the line, the field, what was expected and "did you mean"); this module holds only
 what the robot and the synthetic scenario readers have in common.
 """
@@ -10,8 +10,8 @@ from __future__ import annotations
 from typing import Any
 
 from tasker import schedulers
-from tasker.cliargs import TASKS_HINT
-from tasker.reader import InputError, Table
+from tasker.support.cliargs import TASKS_HINT
+from tasker.support.reader import InputError, Table
 
 MODES = ("IT", "CT")
 STRATEGIES = ("planned", "static")
@@ -59,6 +59,6 @@ def rate(s: Table, key: str, default: float) -> float:
 
 
 def _suggest(name: str, known: list[str]) -> str:
-    from tasker.reader import suggest
+    from tasker.support.reader import suggest
 
     return suggest(name, known)

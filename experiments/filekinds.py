@@ -9,7 +9,7 @@ and the command that runs it.
 
 from __future__ import annotations
 
-from tasker.reader import Table
+from tasker.support.reader import Table
 
 KINDS: dict[str, tuple[tuple[str, ...], str]] = {
     "day protocol": (("arrivals",), "run it with 'tasker day --protocol FILE'"),

@@ -33,9 +33,9 @@ from experiments.synthetic import SyntheticScenario
 from tasker.agent import Rates
 from tasker.loop import SimulationLoop
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
-from tasker.reader import Table, check_name, suggest
-from tasker.reader import load as read_table
 from tasker.stage import Purpose, Stage, StageKind, StagePlan
+from tasker.support.reader import Table, check_name, suggest
+from tasker.support.reader import load as read_table
 from tasker.synthetic import SyntheticTask
 from tasker.task import ArgSpec, TaskContext
 

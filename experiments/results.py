@@ -532,7 +532,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                          "(e.g. planned/strict/off)")
     ap.add_argument("--no-run", action="store_true", help="do not run missing jobs; report what the database holds")
     args = ap.parse_args(argv)
-    from tasker.reader import InputError
+    from tasker.support.reader import InputError
 
     try:
         spec = load_spec(args.spec)

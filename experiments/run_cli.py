@@ -12,7 +12,8 @@ import sys
 import warnings
 from pathlib import Path
 
-from tasker.cliargs import (
+from tasker.errors import RunInterrupted
+from tasker.support.cliargs import (
     EXIT_FAILED,
     EXIT_INTERRUPTED,
     EXIT_OK,
@@ -23,8 +24,7 @@ from tasker.cliargs import (
     show_progress,
     writable_dir,
 )
-from tasker.errors import RunInterrupted
-from tasker.reader import InputWarning
+from tasker.support.reader import InputWarning
 from tasker.trace import FAILED
 
 EXAMPLES = """\

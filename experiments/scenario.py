@@ -1,7 +1,7 @@
 """Robot scenarios: a world, task requests over time, changes during the run, settings.
 
 A scenario file (TOML) says everything a run needs.  It is read with the strict reader
-:mod:`tasker.reader` and every field is checked when the file is loaded, with its
+:mod:`tasker.support.reader` and every field is checked when the file is loaded, with its
 cross-references against the world and the task store (:mod:`experiments.crossref`):
 an error names the file, the line, the field, what was expected and "did you mean".  ``kind = "synthetic"``
 files are read by :mod:`experiments.synthetic` instead.  The format is documented in
@@ -28,7 +28,7 @@ from experiments import fields
 from experiments.actions import TABLES, TimedAction, read_actions
 from experiments.fields import MODES, POLICIES, STRATEGIES, ScenarioError
 from experiments.filekinds import expect
-from tasker import reader
+from tasker.support import reader
 
 __all__ = ["InterruptionGrid", "RobotScenario", "ScenarioError", "load", "randomize", "resolve", "kind_of", "SCENARIOS"]
 
@@ -122,7 +122,7 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
 
     With ``check`` (the default) every cross-reference is checked against the world and
     the task store too (:mod:`experiments.crossref`); doubtful but valid inputs are
-    :class:`~tasker.reader.InputWarning` warnings, kept on ``RobotScenario.warnings``.
+    :class:`~tasker.support.reader.InputWarning` warnings, kept on ``RobotScenario.warnings``.
     """
     p = resolve(path)
     source = str(p)

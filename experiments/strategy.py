@@ -14,7 +14,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from tasker import reader
+from tasker.support import reader
 
 STRATEGY_VALUES = ("static", "planned")
 

@@ -18,7 +18,7 @@ from pathlib import Path
 from urllib.parse import urlsplit
 
 from experiments.run_cli import add_path_option, task_paths
-from tasker.cliargs import (
+from tasker.support.cliargs import (
     EXIT_FAILED,
     EXIT_OK,
     UsageError,

@@ -1,6 +1,6 @@
 """The sweep spec: scenarios × seeds × strategies, read from a TOML file and checked.
 
-:func:`load_spec` reads a spec file with :mod:`tasker.reader` (every error names the file,
+:func:`load_spec` reads a spec file with :mod:`tasker.support.reader` (every error names the file,
 the line and the field: :class:`SpecError`) into a frozen :class:`SweepSpec`, which expands
 to the list of :class:`Job` a sweep runs (:func:`experiments.sweep.run_sweep`).  The
 strategies themselves are :mod:`experiments.strategy`.  See ``docs/sweeps.md``.
@@ -18,8 +18,8 @@ from experiments.filekinds import expect
 from experiments.scenario import InterruptionGrid
 from experiments.store import JobKey
 from experiments.strategy import FACTOR_LEVELS, FACTORS, Strategy, expand
-from tasker import reader
-from tasker.reader import InputError
+from tasker.support import reader
+from tasker.support.reader import InputError
 
 MAX_JOBS = 100_000
 """A spec that expands to more jobs than this is refused (a typo such as ``seeds = 10000000``)."""
@@ -97,7 +97,7 @@ SPEC_KEYS = ("name", "scenarios", "seeds", "seed_start", "strategies", "factors"
 
 
 def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
-    """Read and check a sweep spec (TOML) with :mod:`tasker.reader`.
+    """Read and check a sweep spec (TOML) with :mod:`tasker.support.reader`.
 
     Fields: ``name`` (optional), ``scenarios`` (list of files or shipped names), ``seeds``
     (a count, seeds ``seed_start`` … ``seed_start + count - 1``, or a list), ``seed_start``
@@ -197,7 +197,7 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
 
 def _warn_ignored_factors(top: reader.Table, scenario_list: Sequence[str], sources: Mapping[str, str],
                           strategies: Sequence[Strategy]) -> None:
-    """An :class:`~tasker.reader.InputWarning` for each synthetic scenario that strategies set
+    """An :class:`~tasker.support.reader.InputWarning` for each synthetic scenario that strategies set
     factors for: its timed stages have no suspension or update plans, no policy and no hazards
     (the run records them as static), so strategies that differ only there run alike."""
     from experiments import scenario as scenarios

@@ -2,7 +2,7 @@
 
 A synthetic scenario file (TOML or JSON) defines task types as stage templates,
 the requests with their times, changes during the run, and the harmonisation
-settings.  Every field is checked when the file is loaded, with :mod:`tasker.reader`;
+settings.  Every field is checked when the file is loaded, with :mod:`tasker.support.reader`;
 an error names the file, the line and the field.  See ``docs/scenarios.md`` for the format.
 """
 
@@ -18,14 +18,15 @@ from experiments.actions import NO_REQUESTS, TABLES, TimedAction, located, read_
 from experiments.crossref import validate_request
 from experiments.fields import MODES, ScenarioError
 from experiments.filekinds import expect
-from tasker import reader, schedulers
+from tasker import schedulers
 from tasker.agent import Rates
 from tasker.errors import TaskerError
 from tasker.harmoniser import Mode
 from tasker.loop import SimulationLoop
-from tasker.reader import Table, check_name
 from tasker.stage import Stage, StageKind
 from tasker.store import TaskStore
+from tasker.support import reader
+from tasker.support.reader import Table, check_name
 from tasker.synthetic import SyntheticTask, TimedExecutor
 from tasker.trace import Trace
 

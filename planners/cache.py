@@ -9,7 +9,7 @@ process skips it: a changed file, or another tasker version, is a different key.
 Only successes are recorded; a failing input is checked again (and fails again with
 its message) every time.
 
-The folder, the key and the atomic write are :mod:`tasker.diskcache`'s, shared with the
+The folder, the key and the atomic write are :mod:`tasker.support.diskcache`'s, shared with the
 robot's caches: ``$TASKER_CACHE``, else ``$XDG_CACHE_HOME/tasker``, else
 ``~/.cache/tasker``; markers are written to a temporary file and renamed into place
 (atomic on POSIX), so concurrent processes — sweep workers — never see half a marker.
@@ -24,7 +24,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from tasker import __version__
-from tasker.diskcache import ENV_VAR, cache_dir, content_key, entry_path, write_atomic
+from tasker.support.diskcache import ENV_VAR, cache_dir, content_key, entry_path, write_atomic
 
 __all__ = ["ENV_VAR", "cache_dir", "content_key", "file_parts", "passed", "record"]
 

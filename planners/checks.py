@@ -25,8 +25,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from tasker import reader
 from tasker.errors import TaskerError
+from tasker.support import reader
 
 if TYPE_CHECKING:
     import unified_planning as up
@@ -88,7 +88,7 @@ class PddlError(DefinitionError):
 
 
 def _read(path: str | Path) -> str:
-    """The file's text; a non-UTF-8 byte is named with its line (:func:`tasker.reader.read_text`)."""
+    """The file's text; a non-UTF-8 byte is named with its line (:func:`tasker.support.reader.read_text`)."""
     p = Path(path)
     if not p.is_file():
         raise PddlError(p, "no such file")

@@ -2,8 +2,8 @@
 
 :func:`register` adds the subcommands to an ``argparse`` sub-parser set; each sets
 ``func`` to a handler ``(args) -> int`` returning the exit status (0 success, 1 no
-plan, 2 bad input; :mod:`tasker.cliargs`).  Handlers raise on bad input and the caller
-(:func:`tasker.cliargs.run_handler`) prints one line, never a traceback.
+plan, 2 bad input; :mod:`tasker.support.cliargs`).  Handlers raise on bad input and the caller
+(:func:`tasker.support.cliargs.run_handler`) prints one line, never a traceback.
 
 Heavy modules are imported inside the handlers.  ``tasker plan`` with the default
 engine goes to Fast Downward without unified-planning's engine framework, and skips
@@ -22,8 +22,8 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from tasker import reader
-from tasker.cliargs import EXIT_FAILED, EXIT_OK, UsageError, non_negative_int, note, positive_seconds
+from tasker.support import reader
+from tasker.support.cliargs import EXIT_FAILED, EXIT_OK, UsageError, non_negative_int, note, positive_seconds
 
 if TYPE_CHECKING:
     from planners.pddl_task import PddlTaskType
@@ -348,7 +348,7 @@ def register(subparsers: Any) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Stand-alone entry: these subcommands without the rest of ``tasker``."""
-    from tasker.cliargs import standalone
+    from tasker.support.cliargs import standalone
 
     return standalone(register, argv)
 

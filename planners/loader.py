@@ -30,9 +30,9 @@ from planners.pddl_task import PddlTaskType, hook_line
 from planners.problem import DomainModel
 from planners.results import PlanStatus
 from planners.taskspec import TaskSpec, meaning_of, read_task_toml
-from tasker import reader
 from tasker.errors import BadRequest
 from tasker.meaning import Binding
+from tasker.support import reader
 from tasker.world import WorldState
 
 HOOK_NAMES = ("extra_facts", "check_args", "check_terminate")

@@ -1,6 +1,6 @@
 """``task.toml``: the declarative part of a task folder, read into frozen dataclasses.
 
-It is read strictly with :mod:`tasker.reader`: every fault (an unknown key or table
+It is read strictly with :mod:`tasker.support.reader`: every fault (an unknown key or table
 such as ``kindd`` or ``[shedule]`` included) is a :class:`~planners.checks.DefinitionError`
 naming ``task.toml``, the line, the field and what was expected, with a "did you mean".
 The format is documented, with an example, in ``docs/domains.md``.
@@ -19,10 +19,10 @@ from pathlib import Path
 from typing import Any
 
 from planners.checks import DefinitionError
-from tasker import reader
 from tasker.errors import BadRequest, ConfigError
 from tasker.meaning import BINDING_KINDS, ROLES, Binding, Hazard, Meaning, People
 from tasker.stage import StageKind
+from tasker.support import reader
 from tasker.task import POLICIES, ArgSpec
 
 SKILLS = ("navigate", "say", "manipulate", "wait")
@@ -118,7 +118,7 @@ class TaskSpec:
         return DefinitionError(self.toml, f"{fieldname}: {message}", self.lines.get(fieldname))
 
     def warn(self, fieldname: str, message: str) -> None:
-        """Valid but doubtful, found after reading: an :class:`~tasker.reader.InputWarning`
+        """Valid but doubtful, found after reading: an :class:`~tasker.support.reader.InputWarning`
         located like :meth:`error`."""
         reader.warn_at(self.toml, self.lines.get(fieldname), fieldname, message)
 
@@ -151,7 +151,7 @@ def _object_token(token: str) -> str:
 
 
 class _Reader:
-    """Reads ``task.toml`` through :class:`tasker.reader.Table`; remembers field lines."""
+    """Reads ``task.toml`` through :class:`tasker.support.reader.Table`; remembers field lines."""
 
     def __init__(self, file: Path) -> None:
         self.file = file

@@ -5,7 +5,7 @@
 ``register(subparsers)`` adds them to an :mod:`argparse` parser; each handler returns
 the exit status.  ``cost`` answers the travel-time matrix of every given place or
 point in one process; it exits 0 when every pair is reachable, 1 when one is not and
-2 on bad input (:mod:`tasker.cliargs`; one line on stderr, never a traceback).
+2 on bad input (:mod:`tasker.support.cliargs`; one line on stderr, never a traceback).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from tasker.cliargs import EXIT_FAILED, EXIT_OK, UsageError, did_you_mean, seed, show_progress, writable_file
+from tasker.support.cliargs import EXIT_FAILED, EXIT_OK, UsageError, did_you_mean, seed, show_progress, writable_file
 from tasker.world import MotionEstimate, MotionModel, Pose
 
 if TYPE_CHECKING:
@@ -178,7 +178,7 @@ def register(subparsers: Any) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the subcommands on their own (the ``tasker`` command wires them in normally)."""
-    from tasker.cliargs import standalone
+    from tasker.support.cliargs import standalone
 
     return standalone(register, argv)
 

@@ -23,7 +23,7 @@ the build (no nanobind leaks at exit), and completed:
 
 Shortest paths are searched per source and scene state by :mod:`robot.motion`
 (Dijkstra, scipy).  Roadmaps are cached in-process by (world, radius, seed, size), and
-on disk (:mod:`tasker.diskcache`, kind ``roadmap``, an ``.npz`` of the nodes, edges,
+on disk (:mod:`tasker.support.diskcache`, kind ``roadmap``, an ``.npz`` of the nodes, edges,
 lengths, corner nodes and stats) under the SHA-256 of the world's ``repr``, the robot's
 radius, the seed, the size, the OMPL and numpy versions and the source of this module and
 of :mod:`robot.scene` (whose exact tests complete the roadmap): a process that finds it
@@ -47,9 +47,9 @@ from scipy.sparse import csr_matrix
 from robot import scene as scene_module
 from robot.scene import Scene
 from robot.spec import DEFAULT_DENSITY, WorldSpec
-from tasker.diskcache import content_key, installed_version, remembered
+from tasker.support.diskcache import content_key, installed_version, remembered
 
-DISK_KIND = "roadmap"  # the on-disk cache's kind (tasker.diskcache)
+DISK_KIND = "roadmap"  # the on-disk cache's kind (tasker.support.diskcache)
 _CACHE: dict[tuple[object, ...], Roadmap] = {}
 log = logging.getLogger(__name__)
 

@@ -1,6 +1,6 @@
 """World files: an apartment described as data, read and checked into frozen dataclasses.
 
-A world file is TOML, read with the strict reader :mod:`tasker.reader`.  Every field
+A world file is TOML, read with the strict reader :mod:`tasker.support.reader`.  Every field
 is checked here, and a bad one raises :class:`WorldFileError` naming the file, the line
 and the field, e.g. ``paper.toml:61: people.john.pose: expected [x, y, yaw]``; unknown
 keys, NaN, binary files, decreasing walk times, names used twice, facts naming nothing,
@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from tasker import reader
-from tasker.reader import InputError, Table, check_name, check_number, check_numbers, suggest
+from tasker.support import reader
+from tasker.support.reader import InputError, Table, check_name, check_number, check_numbers, suggest
 from tasker.world import Pose
 
 if TYPE_CHECKING:
@@ -173,7 +173,7 @@ def _robot(t: Table) -> RobotSpec:
 
 
 def read_world(top: Table, source: str) -> WorldSpec:
-    """Check a world file read by :mod:`tasker.reader` and build a :class:`WorldSpec`."""
+    """Check a world file read by :mod:`tasker.support.reader` and build a :class:`WorldSpec`."""
     if "kind" in top and "bounds" not in top:  # a scenario given where a world is expected
         raise top.error("kind", "this is a scenario file, not a world file (a world has bounds, rooms, walls, "
                                 "places, ...; a robot scenario names its world with world = ...)")

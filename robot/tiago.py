@@ -5,7 +5,7 @@
   2-D planner uses and the wheels' radius and separation (:func:`robot_dimensions`), and
   checks planned paths against the real geometry (:class:`RobotCollision`).  Building it
   from the URDF takes about 0.4 s, so the dimensions are kept on disk
-  (:mod:`tasker.diskcache`, kind ``robot-dimensions``) under the SHA-256 of the URDF, this
+  (:mod:`tasker.support.diskcache`, kind ``robot-dimensions``) under the SHA-256 of the URDF, this
   module's source and the versions of Pinocchio, coal and example-robot-data: a process
   that finds them there imports no Pinocchio at all.
 * **MuJoCo** compiles the same URDF at load time: ``package://`` paths are resolved,
@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from tasker.diskcache import content_key, installed_version, remembered
+from tasker.support.diskcache import content_key, installed_version, remembered
 
 if TYPE_CHECKING:  # imported lazily at run time; neither library ships type stubs, so these are Any to mypy
     import mujoco
@@ -50,7 +50,7 @@ TUCK = {"torso_lift_joint": 0.15, "arm_1_joint": 0.20, "arm_2_joint": -1.34, "ar
 
 WHEELS = ("wheel_left_joint", "wheel_right_joint")
 PLANNING_MARGIN = 0.03  # metres added to the footprint for the 2-D planner
-DIMENSIONS_KIND = "robot-dimensions"  # the on-disk caches' kinds (tasker.diskcache)
+DIMENSIONS_KIND = "robot-dimensions"  # the on-disk caches' kinds (tasker.support.diskcache)
 SOURCE_KIND = "tiago-mujoco"
 _DIMENSIONS = ("wheel_radius", "wheel_separation", "planning_radius")
 log = logging.getLogger(__name__)

@@ -18,8 +18,8 @@ from collections.abc import Callable
 from typing import Any
 
 from tasker.errors import ConfigError, UnknownName
-from tasker.reader import suggest
 from tasker.schedulers.base import Candidate, Decision, Scheduler, ScheduleView
+from tasker.support.reader import suggest
 
 __all__ = ["Candidate", "Decision", "Scheduler", "ScheduleView", "create", "names", "options", "register",
            "unknown_option"]

@@ -1,5 +1,5 @@
 """Every input is checked before anything runs: each class of bad input is a clean error
-(an :class:`~tasker.reader.InputError`) naming the file, the line, the field and what was
+(an :class:`~tasker.support.reader.InputError`) naming the file, the line, the field and what was
 expected — never a traceback, never silently accepted.  Doubtful but valid inputs warn."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from experiments.cli import main
 from experiments.fields import ScenarioError
 from experiments.sweepspec import SpecError, load_spec
 from robot.spec import WorldFileError, load_world
-from tasker.reader import InputError, InputWarning
+from tasker.support.reader import InputError, InputWarning
 from tests.experiments import standin
 
 ROBOT = """\

@@ -8,7 +8,7 @@ import pytest
 
 from experiments import dayreport, protocol
 from tasker import schedulers
-from tasker.reader import InputError
+from tasker.support.reader import InputError
 
 TABSA = Path(__file__).resolve().parents[2] / "experiments" / "protocols" / "tabsa.toml"
 

@@ -11,8 +11,8 @@ import pytest
 from planners.checks import DefinitionError
 from planners.cli import scaffold
 from planners.loader import load_task
-from tasker.reader import InputWarning
 from tasker.stage import Purpose
+from tasker.support.reader import InputWarning
 
 
 def _new(tmp_path: Path, name: str = "fetch") -> Path:
@@ -383,7 +383,7 @@ def test_an_upper_case_scenario_object_is_refused(tmp_path: Path, capsys: pytest
 def test_a_binding_of_the_wrong_kind_for_the_world_is_a_warning(tmp_path: Path) -> None:
     """Before: kind = "device" for the held item ran silently: the robot "held" the vase only symbolically."""
     from experiments import scenario as scenarios
-    from tasker.reader import InputWarning
+    from tasker.support.reader import InputWarning
 
     folder = _new(tmp_path)
     _edit(folder / "task.toml", 'kind = "held"', 'kind = "device"')

@@ -10,7 +10,7 @@ import pytest
 from unified_planning.shortcuts import OneshotPlanner
 
 import planners.cache as cache
-import tasker.diskcache
+import tasker.support.diskcache
 from planners.checks import load_problem
 from planners.engine import register_engine
 from planners.fd import FDExit, FDOutcome
@@ -87,7 +87,7 @@ def test_cache_is_keyed_by_content_kind_and_version(cache_dir: Path, monkeypatch
     assert cache.passed("k", key) and not cache.passed("other", key)
     assert cache.content_key("k", ["a", b"c"]) != key
     assert cache.content_key("k", ["ab", b""]) != cache.content_key("k", ["a", b"b"])  # length-prefixed
-    monkeypatch.setattr(tasker.diskcache, "__version__", "9.9.9")
+    monkeypatch.setattr(tasker.support.diskcache, "__version__", "9.9.9")
     assert cache.content_key("k", ["a", b"b"]) != key
 
 

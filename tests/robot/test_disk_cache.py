@@ -22,7 +22,7 @@ import pytest
 
 import robot.roadmap as roadmap_module
 import robot.tiago as tiago
-import tasker.diskcache
+import tasker.support.diskcache
 from robot.roadmap import Roadmap, disk_key
 from robot.scene import Scene
 from robot.spec import WorldSpec, load_world
@@ -140,7 +140,7 @@ def test_roadmap_key_has_every_input(paper: WorldSpec, scene: Scene, monkeypatch
         m.setattr(metadata, "version", lambda dist: "0.0.0" if dist == "ompl" else real(dist))
         others.append(disk_key(paper, scene, 1, SMALL))
     with monkeypatch.context() as m:
-        m.setattr(tasker.diskcache, "__version__", "9.9.9")
+        m.setattr(tasker.support.diskcache, "__version__", "9.9.9")
         others.append(disk_key(paper, scene, 1, SMALL))
     with monkeypatch.context() as m:  # the roadmap module's source
         m.setattr(roadmap_module, "__file__", str(ROOT / "robot" / "spec.py"))
@@ -229,7 +229,7 @@ def _keys_under_other_versions(key: Callable[[], str], dists: tuple[str, ...],
             m.setattr(metadata, "version", lambda d, dist=dist: "0.0.0" if d == dist else real(d))
             keys.append(key())
     with monkeypatch.context() as m:
-        m.setattr(tasker.diskcache, "__version__", "9.9.9")
+        m.setattr(tasker.support.diskcache, "__version__", "9.9.9")
         keys.append(key())
     return keys
 

@@ -1,4 +1,4 @@
-"""The on-disk cache's folder, entries and writes (:mod:`tasker.diskcache`), shared by every cache."""
+"""The on-disk cache's folder, entries and writes (:mod:`tasker.support.diskcache`), shared by every cache."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from tasker import diskcache
+from tasker.support import diskcache
 
 
 def test_entries_live_under_their_kind_and_key(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -21,7 +21,7 @@ def test_import_tasker_with_heavy_dependencies_blocked() -> None:
         "'coal','matplotlib','dask','planners','robot','domains','experiments'}:\n"
         "            raise ImportError('blocked: ' + name)\n"
         "sys.meta_path.insert(0, Block())\n"
-        "import tasker, tasker.synthetic, tasker.schedulers, tasker.diskcache\n"
+        "import tasker, tasker.synthetic, tasker.schedulers, tasker.support.diskcache\n"
         "names = tasker.schedulers.names()\n"  # lists entry points (lookahead-cpsat) without importing them
         "for n in tasker.schedulers._BUILTIN: tasker.schedulers.create(n)\n"
         "print('ok')\n"

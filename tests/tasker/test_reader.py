@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from tasker import reader
-from tasker.reader import InputError
+from tasker.support import reader
+from tasker.support.reader import InputError
 
 TEXT = """\
 name = "demo"

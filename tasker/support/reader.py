@@ -82,7 +82,7 @@ def warn_at(file: str | Path, line: int | None, field: str, message: str) -> str
     its text.  Located at the user's file and line, not at the code that found it, so Python
     shows that line."""
     text = _where(str(file), line, field, message)
-    warnings.warn_explicit(InputWarning(text), InputWarning, str(file), line or 0, module="tasker.reader")
+    warnings.warn_explicit(InputWarning(text), InputWarning, str(file), line or 0, module="tasker.support.reader")
     return text
 
 

@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 from tasker.errors import TaskerError, UnknownName
-from tasker.reader import InputWarning
+from tasker.support.reader import InputWarning
 
 EXIT_OK = 0
 """The command did what it was asked."""
