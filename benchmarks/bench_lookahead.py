@@ -10,7 +10,7 @@
    the optimum (the same search with an unlimited budget).  1.000 means optimal.
 3. Long queues (12, 16 and 24 jobs, 5 queues each), where neither search can prove its
    order optimal: the objective of ``lookahead`` at its default node budget and of
-   ``lookahead-cpsat`` (:mod:`experiments.cpsat`, OR-Tools CP-SAT) at its default time
+   ``lookahead-cpsat`` (:mod:`planners.cpsat`, OR-Tools CP-SAT) at its default time
    limit, over the best order known (the better of CP-SAT with 10x its limit and the
    branch and bound with 100x its budget), and the wall time of one search of each.
 """
@@ -22,7 +22,7 @@ import random
 import statistics
 import time
 
-from experiments.cpsat import LookAheadCpSat, solve_cpsat
+from planners.cpsat import LookAheadCpSat, solve_cpsat
 from tasker import schedulers
 from tasker.messages import CompletionCost, CostParams, SPRequest
 from tasker.schedulers.base import Candidate, Scheduler, ScheduleView

@@ -37,7 +37,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from experiments.runner import run_scenario  # noqa: E402
+from experiments.run.runner import run_scenario  # noqa: E402
 
 
 def day_scenario(path: Path, falls: int = 36) -> Path:
@@ -64,7 +64,7 @@ if {slow}:
 if {legacy}:  # the previous path: remembered task folders still read by unified-planning
     import planners.checks, planners.loader
     planners.loader.remembered_domain = planners.checks.load_domain
-from experiments.runner import run_scenario
+from experiments.run.runner import run_scenario
 t = time.perf_counter()
 r = run_scenario({scenario!r}, pictures=False)
 print(json.dumps([r.trace.events[-1]["t"], time.perf_counter() - t]))

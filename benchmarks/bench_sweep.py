@@ -24,13 +24,13 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from experiments import synthetic  # noqa: E402
-from experiments.store import ResultStore  # noqa: E402
-from experiments.strategy import Strategy  # noqa: E402
-from experiments.sweep import run_sweep  # noqa: E402
-from experiments.sweepspec import Job, SweepSpec  # noqa: E402
+from experiments.inputs import synthetic  # noqa: E402
+from experiments.inputs.strategy import Strategy  # noqa: E402
+from experiments.metrics.store import ResultStore  # noqa: E402
+from experiments.sweep.driver import run_sweep  # noqa: E402
+from experiments.sweep.spec import Job, SweepSpec  # noqa: E402
 
-DEMO = ROOT / "experiments" / "scenarios" / "synthetic_demo.toml"
+DEMO = ROOT / "experiments" / "inputs" / "scenarios" / "synthetic_demo.toml"
 
 
 def cpu_job(job: Job) -> tuple[dict[str, Any], dict[str, Any]]:

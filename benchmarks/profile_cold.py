@@ -29,10 +29,10 @@ _CHILD = r"""
 import functools, importlib, json, sys, time
 sys.path.insert(0, {root!r})
 t0 = time.perf_counter()
-from experiments.runner import run_scenario
+from experiments.run.runner import run_scenario
 imported = time.perf_counter() - t0
 PHASES = [  # (label, module, attribute path); outermost first
-    ("scenario load", "experiments.scenario", "load"),
+    ("scenario load", "experiments.inputs.scenario", "load"),
     ("  task folders", "planners.bundled", "_bundled"),
     ("Fast Downward translate", "planners.fd", "_translate"),
     ("Fast Downward search", "planners.fd", "_search"),

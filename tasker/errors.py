@@ -70,7 +70,7 @@ class RunAborted(TaskerError):
     """A run stopped before its end because something outside the tasks failed.
 
     ``reason`` says what; ``result`` carries what the run produced so far (the runner
-    puts its partial :class:`~experiments.runner.RunResult` here after writing the trace,
+    puts its partial :class:`~experiments.run.runner.RunResult` here after writing the trace,
     ``run.json`` and ``metrics.json``), or ``None`` when raised by the loop itself.
     The original exception is the ``__cause__``.
     """

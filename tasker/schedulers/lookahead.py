@@ -253,7 +253,7 @@ class LookAhead(Scheduler):
     def solve(self, prob: Problem, budget: int, *, fixed_first: int | None = None,
               exclude_first: int | None = None) -> tuple[list[int], float, int, bool]:
         """The search one decision runs (:func:`solve`); a subclass may put another solver
-        behind the same problem, budget split and record (``experiments.cpsat``)."""
+        behind the same problem, budget split and record (``planners.cpsat``)."""
         return solve(prob, node_budget=budget, fixed_first=fixed_first, exclude_first=exclude_first)
 
     def schedule(self, view: ScheduleView) -> Decision:

@@ -51,7 +51,7 @@ class InputError(TaskerError, ValueError):
     """A user's file is malformed.  ``str()`` is ``file:line: field: message``.
 
     ``InputError(text)`` with a single argument is a whole message (the older subclasses
-    :class:`~experiments.scenario.ScenarioError` and :class:`~robot.spec.WorldFileError`
+    :class:`~experiments.inputs.scenario.ScenarioError` and :class:`~robot.spec.WorldFileError`
     were raised that way, and still may be).
     """
 

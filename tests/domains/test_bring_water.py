@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from experiments.runner import run_scenario
+from experiments.run.runner import run_scenario
 from planners.bundled import ENV_VAR
 
 FOLDER = Path(__file__).parent / "fixtures" / "bring_water"

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 import domains
-from experiments.runner import run_scenario
+from experiments.run.runner import run_scenario
 from planners.examples import example_world
 from planners.pddl_task import PddlTaskType
 from planners.validate import validate_plan
@@ -23,7 +23,7 @@ from tasker.world import WorldState
 from tests.domains.conftest import BUNDLED, apply, make_ctx, steps, up_problem
 
 ROOT = Path(__file__).parents[2]
-COMPOUND = ROOT / "experiments" / "sweeps" / "scenarios" / "compound.toml"
+COMPOUND = ROOT / "experiments" / "sweep" / "specs" / "scenarios" / "compound.toml"
 DOOR = "shut_door"
 
 

@@ -1,6 +1,6 @@
 """A stand-in ``run_fn`` for sweep tests: a synthetic scenario run, metrics read from its trace.
 
-It returns the same shape as :func:`experiments.workers.run_job` (a record with the
+It returns the same shape as :func:`experiments.sweep.workers.run_job` (a record with the
 scenario, seed, settings, planner, host, date and version; flat numeric metrics)
 without the robot or the planner, so sweep tests stay fast.
 """
@@ -15,15 +15,15 @@ from pathlib import Path
 from typing import Any
 
 import tasker
-from experiments import synthetic
-from experiments.sweepspec import Job
+from experiments.inputs import synthetic
+from experiments.sweep.spec import Job
 from tasker.trace import Trace
 
-DEMO = Path(__file__).parents[2] / "experiments" / "scenarios" / "synthetic_demo.toml"
+DEMO = Path(__file__).parents[2] / "experiments" / "inputs" / "scenarios" / "synthetic_demo.toml"
 
 
 def trace_metrics(trace: Trace) -> dict[str, Any]:
-    """A few metrics computed from the trace alone (a stand-in for ``experiments.metrics``)."""
+    """A few metrics computed from the trace alone (a stand-in for ``experiments.metrics.run``)."""
     requested = {e["agent"]: e["t"] for e in trace.of("request")}
     ends = trace.of("end")
     durations = [e["t"] - requested[e["agent"]] for e in ends if e["agent"] in requested]

@@ -9,11 +9,11 @@ from pathlib import Path
 
 import pytest
 
-from experiments import scenario as scenarios
-from experiments import synthetic
 from experiments.cli import main
-from experiments.fields import ScenarioError
-from experiments.sweepspec import SpecError, load_spec
+from experiments.inputs import scenario as scenarios
+from experiments.inputs import synthetic
+from experiments.inputs.fields import ScenarioError
+from experiments.sweep.spec import SpecError, load_spec
 from robot.spec import WorldFileError, load_world
 from tasker.support.reader import InputError, InputWarning
 from tests.experiments import standin
@@ -309,9 +309,10 @@ ROOT = Path(__file__).parents[2]
 
 @pytest.mark.parametrize(("argv", "expected"), [
     (["run", "robot/worlds/flat.toml"], "this is a world file (it has 'rooms'), not a scenario"),
-    (["run", "experiments/sweeps/suspension.toml"], "this is a sweep spec (it has 'scenarios'), not a scenario"),
-    (["run", "experiments/protocols/tabsa.toml"], "this is a day protocol (it has 'arrivals'), not a scenario"),
-    (["world", "experiments/scenarios/paper.toml"], "paper.toml:6: kind: this is a scenario file, not a world file"),
+    (["run", "experiments/sweep/specs/suspension.toml"], "this is a sweep spec (it has 'scenarios'), not a scenario"),
+    (["run", "experiments/days/protocols/tabsa.toml"], "this is a day protocol (it has 'arrivals'), not a scenario"),
+    (["world", "experiments/inputs/scenarios/paper.toml"],
+     "paper.toml:6: kind: this is a scenario file, not a world file"),
 ])
 def test_another_kind_of_file_is_named_for_what_it_is(argv: list[str], expected: str, tmp_path: Path,
                                                       monkeypatch: pytest.MonkeyPatch,
@@ -493,7 +494,7 @@ def test_a_non_utf8_spec_is_a_clean_error(tmp_path: Path) -> None:
 def _typed_cases() -> list[tuple[str, str, str, str]]:
     """(world, task, argument, PDDL type) for each typed argument of each bundled task type, in
     each shipped world that has objects of every type the task's arguments need."""
-    from experiments.crossref import _most_specific, arg_types, world_objects
+    from experiments.inputs.crossref import _most_specific, arg_types, world_objects
     from planners.bundled import task_types
 
     out = []
@@ -512,7 +513,7 @@ def _typed_cases() -> list[tuple[str, str, str, str]]:
 def test_every_typed_argument_must_name_a_world_object_of_its_type(tmp_path: Path, world: str, task: str, arg: str,
                                                                    pddl_type: str) -> None:
     """The general rule: an argument used as a PDDL object of type T names a world object of type T."""
-    from experiments.crossref import arg_types, world_objects
+    from experiments.inputs.crossref import arg_types, world_objects
     from planners.bundled import task_types
 
     tt = next(t for t in task_types() if t.name == task)
@@ -543,18 +544,19 @@ def test_typed_cases_cover_every_bundled_task_type() -> None:
 
 SHIPPED = Path(__file__).resolve().parents[2] / "experiments"
 _KIND_CASES = [  # (command, file of another kind, what the message must say)
-    (["day", "--days", "1", "--protocol"], "scenarios/paper.toml", "this is a scenario (it has 'requests'), not a "
-                                                                   "day protocol: run it with 'tasker run FILE'"),
-    (["day", "--days", "1", "--protocol"], "sweeps/suspension.toml", "this is a sweep spec (it has 'scenarios'), "
-                                                                     "not a day protocol"),
-    (["day", "--days", "1", "--protocol"], "protocols/tabsa_apartment.toml", "this is a world file (it has 'rooms')"),
-    (["run"], "protocols/tabsa.toml", "this is a day protocol (it has 'arrivals'), not a scenario: run it with "
-                                      "'tasker day --protocol FILE'"),
-    (["run"], "sweeps/suspension.toml", "this is a sweep spec (it has 'scenarios'), not a scenario"),
-    (["sweep", "--db", "{tmp}/r.db"], "protocols/tabsa.toml", "this is a day protocol (it has 'arrivals'), not a "
-                                                              "sweep spec"),
-    (["sweep", "--db", "{tmp}/r.db"], "scenarios/synthetic_demo.toml", "this is a scenario (it has 'requests'), "
-                                                                       "not a sweep spec"),
+    (["day", "--days", "1", "--protocol"], "inputs/scenarios/paper.toml",
+     "this is a scenario (it has 'requests'), not a day protocol: run it with 'tasker run FILE'"),
+    (["day", "--days", "1", "--protocol"], "sweep/specs/suspension.toml",
+     "this is a sweep spec (it has 'scenarios'), not a day protocol"),
+    (["day", "--days", "1", "--protocol"], "days/protocols/tabsa_apartment.toml",
+     "this is a world file (it has 'rooms')"),
+    (["run"], "days/protocols/tabsa.toml",
+     "this is a day protocol (it has 'arrivals'), not a scenario: run it with 'tasker day --protocol FILE'"),
+    (["run"], "sweep/specs/suspension.toml", "this is a sweep spec (it has 'scenarios'), not a scenario"),
+    (["sweep", "--db", "{tmp}/r.db"], "days/protocols/tabsa.toml",
+     "this is a day protocol (it has 'arrivals'), not a sweep spec"),
+    (["sweep", "--db", "{tmp}/r.db"], "inputs/scenarios/synthetic_demo.toml",
+     "this is a scenario (it has 'requests'), not a sweep spec"),
 ]
 
 

@@ -1,4 +1,4 @@
-"""Calibration metrics (experiments.calibration) on hand-made traces, values worked out by hand."""
+"""Calibration metrics (experiments.metrics.calibration) on hand-made traces, values worked out by hand."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from typing import Any
 
 import pytest
 
-from experiments import metrics
+from experiments.metrics import run as metrics
 
 
 def ev(t: float, event: str, **fields: Any) -> dict[str, Any]:

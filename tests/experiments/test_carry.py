@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from experiments.runner import run_scenario
+from experiments.run.runner import run_scenario
 
 
 def test_carry_opens_the_door_and_both_suspensions_close_it() -> None:

@@ -21,7 +21,7 @@ from experiments.cli import build_parser, main
 from tasker.errors import TaskerError
 
 ROOT = Path(__file__).resolve().parents[2]
-SYNTHETIC = str(ROOT / "experiments" / "scenarios" / "synthetic_demo.toml")
+SYNTHETIC = str(ROOT / "experiments" / "inputs" / "scenarios" / "synthetic_demo.toml")
 
 
 @pytest.fixture
@@ -151,9 +151,9 @@ def _fake_result(causes: list[str]) -> Any:
 ])
 def test_run_strict(strict: bool, causes: list[str], status: int, tmp_path: Path,
                     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
-    import experiments.runner
+    import experiments.run.runner
 
-    monkeypatch.setattr(experiments.runner, "run_scenario", lambda *a, **k: _fake_result(causes))
+    monkeypatch.setattr(experiments.run.runner, "run_scenario", lambda *a, **k: _fake_result(causes))
     argv = ["run", SYNTHETIC, "--out", str(tmp_path / "o"), *(["--strict"] if strict else [])]
     assert main(argv) == status
     err = capsys.readouterr().err
@@ -161,12 +161,12 @@ def test_run_strict(strict: bool, causes: list[str], status: int, tmp_path: Path
 
 
 def test_out_is_checked_before_the_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    import experiments.runner
+    import experiments.run.runner
 
     def never(*_: object, **__: object) -> None:
         raise AssertionError("the run started although --out cannot be written")
 
-    monkeypatch.setattr(experiments.runner, "run_scenario", never)
+    monkeypatch.setattr(experiments.run.runner, "run_scenario", never)
     (tmp_path / "f").write_text("")
     assert main(["run", SYNTHETIC, "--out", str(tmp_path / "f")]) == 2
 
@@ -183,12 +183,12 @@ class RunAborted(TaskerError):
 ])
 def test_exit_statuses(exc: BaseException, status: int, text: str, monkeypatch: pytest.MonkeyPatch,
                        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    import experiments.runner
+    import experiments.run.runner
 
     def boom(*_: object, **__: object) -> None:
         raise exc
 
-    monkeypatch.setattr(experiments.runner, "run_scenario", boom)
+    monkeypatch.setattr(experiments.run.runner, "run_scenario", boom)
     assert main(["run", SYNTHETIC, "--out", str(tmp_path)]) == status
     err = capsys.readouterr().err
     assert err.startswith("tasker run: ") and text in err and "Traceback" not in err
@@ -196,12 +196,12 @@ def test_exit_statuses(exc: BaseException, status: int, text: str, monkeypatch: 
 
 def test_verbose_shows_the_traceback_of_an_internal_error(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
                                                           capsys: pytest.CaptureFixture[str]) -> None:
-    import experiments.runner
+    import experiments.run.runner
 
     def boom(*_: object, **__: object) -> None:
         raise RuntimeError("oops")
 
-    monkeypatch.setattr(experiments.runner, "run_scenario", boom)
+    monkeypatch.setattr(experiments.run.runner, "run_scenario", boom)
     assert main(["run", SYNTHETIC, "--out", str(tmp_path), "--verbose"]) == 3
     assert "Traceback" in capsys.readouterr().err
 
@@ -210,13 +210,13 @@ def test_verbose_shows_the_traceback_of_an_internal_error(monkeypatch: pytest.Mo
 def test_a_run_stopped_by_ctrl_c_keeps_what_ran(scenario: str, monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
                                                 capsys: pytest.CaptureFixture[str]) -> None:
     """Before: Ctrl-C during a run wrote nothing, so a long run's first hours were lost."""
-    import experiments.runner
+    import experiments.run.runner
 
     def stopped(loop: Any, progress: bool) -> None:
         loop.run(until=10.0)
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(experiments.runner, "_run", stopped)
+    monkeypatch.setattr(experiments.run.runner, "_run", stopped)
     out = tmp_path / "o"
     assert main(["run", scenario, "--out", str(out), "--no-pictures"]) == 130
     err = capsys.readouterr().err
@@ -250,7 +250,7 @@ def test_check_lists_every_problem(tmp_path: Path, capsys: pytest.CaptureFixture
                     'args = { person = "anna" }\n[people.bob]\npose = [1, 1, 0]\n')
     capsys.readouterr()
     assert main(["check", str(tmp_path / "tasks"), str(scn), str(scn2), str(ROOT / "robot" / "worlds"),
-                 str(ROOT / "experiments" / "sweeps"), str(tmp_path / "nothing")]) == 1
+                 str(ROOT / "experiments" / "sweep" / "specs"), str(tmp_path / "nothing")]) == 1
     out = capsys.readouterr().out
     problems = [line for line in out.splitlines() if line.startswith("error")]
     assert any("one/domain.pddl" in p for p in problems)
@@ -263,9 +263,9 @@ def test_check_lists_every_problem(tmp_path: Path, capsys: pytest.CaptureFixture
 
 
 def test_check_passes_the_shipped_files(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["check", str(ROOT / "domains"), str(ROOT / "experiments" / "scenarios"),
-                 str(ROOT / "robot" / "worlds"), str(ROOT / "experiments" / "sweeps"),
-                 str(ROOT / "experiments" / "protocols"), "-q"]) == 0
+    assert main(["check", str(ROOT / "domains"), str(ROOT / "experiments" / "inputs" / "scenarios"),
+                 str(ROOT / "robot" / "worlds"), str(ROOT / "experiments" / "sweep" / "specs"),
+                 str(ROOT / "experiments" / "days" / "protocols"), "-q"]) == 0
     assert "0 problems" in capsys.readouterr().out
 
 
@@ -294,7 +294,7 @@ def test_help_and_a_warm_plan_stay_clear_of_heavy_imports(tmp_path: Path) -> Non
 
 def test_sweep_jobs_carry_absolute_task_paths(tmp_path: Path, files: dict[str, str],
                                               monkeypatch: pytest.MonkeyPatch) -> None:
-    import experiments.sweep
+    import experiments.sweep.driver
 
     assert main(["new", "mine", str(tmp_path / "tasks" / "mine")]) == 0
     seen: list[Any] = []
@@ -303,7 +303,7 @@ def test_sweep_jobs_carry_absolute_task_paths(tmp_path: Path, files: dict[str, s
         seen.append(spec)
         return SimpleNamespace(total=0, skipped=0, ran=0, ok=0, errors=0, wall=0.0, backend="local")
 
-    monkeypatch.setattr(experiments.sweep, "run_sweep", fake)
+    monkeypatch.setattr(experiments.sweep.driver, "run_sweep", fake)
     monkeypatch.chdir(tmp_path)
     assert main(["sweep", files["spec"], "--db", files["db"], "--path", "tasks"]) == 0
     jobs = seen[0].jobs()
@@ -351,13 +351,13 @@ def test_a_task_ended_by_an_exception_counts_as_failed(tmp_path: Path, monkeypat
 def test_day_stopped_by_ctrl_c_says_how_to_go_on(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
                                                  capsys: pytest.CaptureFixture[str]) -> None:
     """Before: a bare "interrupted", though the days that ended were kept and --resume goes on."""
-    import experiments.dayreport
+    import experiments.days.report
 
     def stopped(args: Any) -> int:
         (Path(args.out) / "days.db").write_bytes(b"")
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(experiments.dayreport, "run", stopped)
+    monkeypatch.setattr(experiments.days.report, "run", stopped)
     out = tmp_path / "day"
     out.mkdir()
     assert main(["day", "--protocol", "tabsa", "--days", "1", "--out", str(out)]) == 130

@@ -1,4 +1,4 @@
-"""``lookahead-cpsat``: the look-ahead's problem solved by OR-Tools CP-SAT (experiments.cpsat)."""
+"""``lookahead-cpsat``: the look-ahead's problem solved by OR-Tools CP-SAT (planners.cpsat)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import random
 
 import pytest
 
-from experiments.cpsat import LookAheadCpSat, solve_cpsat
+from planners.cpsat import LookAheadCpSat, solve_cpsat
 from tasker import schedulers
 from tasker.errors import ConfigError
 from tasker.schedulers.lookahead import Problem, solve
@@ -72,7 +72,7 @@ def test_registered_with_the_look_ahead_s_options() -> None:
 
 
 def test_a_synthetic_day_runs_and_repeats() -> None:
-    from experiments import days
+    from experiments.days import pipeline as days
 
     def trace() -> str:
         run = days.make("tabsa-short", 2, scheduler="lookahead-cpsat").run()

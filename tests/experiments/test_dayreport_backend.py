@@ -11,8 +11,8 @@ from typing import Any
 
 import pytest
 
-from experiments import dayreport
-from experiments.sweepspec import Job
+from experiments.days import report as dayreport
+from experiments.sweep.spec import Job
 from tasker.errors import ConfigError
 
 EVENTS = [
@@ -52,7 +52,7 @@ def test_failure_rows_are_the_robots_and_a_day_stored_before_renewals_made_none(
 
 
 def test_a_stopped_run_resumes_from_its_database(tmp_path: Path) -> None:
-    from experiments.store import ResultStore
+    from experiments.metrics.store import ResultStore
 
     db = tmp_path / "days.db"
     first = dayreport.run_days("tabsa-short", 1, ["fifo"], workers=1, db=db)
@@ -224,7 +224,7 @@ def test_more_days_than_a_sweep_may_have_are_refused_before_any_job(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """--days 3000000 built millions of jobs (gigabytes) before the first day; a sweep refuses
     more than MAX_JOBS, and so does a day run."""
-    from experiments.sweepspec import MAX_JOBS
+    from experiments.sweep.spec import MAX_JOBS
 
     days = MAX_JOBS // 2 + 1
     assert dayreport.main(["--protocol", "tabsa-short", "--days", str(days), "--schedulers", "fifo", "alg2",
@@ -252,7 +252,7 @@ def test_resuming_with_a_changed_protocol_is_refused_and_keeps_the_stored_days(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """--resume kept the days of the protocol as it was and ran the others from the edited file:
     one table mixed days of 3 and of 15 requests.  A comment changes nothing and resumes."""
-    from experiments.store import ResultStore
+    from experiments.metrics.store import ResultStore
 
     shipped = Path(dayreport.__file__).parent / "protocols" / "tabsa_short.toml"
     text = shipped.read_text(encoding="utf-8").split("\n[robot_backend]")[0]
@@ -287,8 +287,8 @@ def test_a_second_run_into_the_same_out_leaves_the_running_ones_days(
     """Without --resume, a second 'tasker day' into the OUT of a running one deleted its days.db
     before finding the sweep lease taken: the running one then wrote into a deleted file and ended
     'no such results database', every day it had run lost."""
-    from experiments.store import ResultStore
-    from experiments.sweep import lease
+    from experiments.metrics.store import ResultStore
+    from experiments.sweep.driver import lease
 
     out = tmp_path / "out"
     assert dayreport.main(["--protocol", "tabsa-short", "--days", "1", "--schedulers", "fifo", "--workers", "1",

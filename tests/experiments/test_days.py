@@ -1,7 +1,7 @@
 """The one scenario pipeline: (protocol, seed, backend) → a scenario, on both backends.
 
 Robot days here are tiny (one request of each type in a few minutes) so the suite stays
-fast; the shipped protocols' days are run by ``python -m experiments.dayreport``.
+fast; the shipped protocols' days are run by ``python -m experiments.days.report``.
 """
 
 from __future__ import annotations
@@ -13,13 +13,15 @@ from typing import Any
 
 import pytest
 
-from experiments import dayreport, days, protocol
+from experiments.days import pipeline as days
+from experiments.days import protocol
+from experiments.days import report as dayreport
 from robot.estimator import motion_model
 from robot.spec import load_world
 from tasker import schedulers
 from tasker.errors import ConfigError
 
-PROTOCOLS = Path(__file__).resolve().parents[2] / "experiments" / "protocols"
+PROTOCOLS = Path(__file__).resolve().parents[2] / "experiments" / "days" / "protocols"
 
 
 def tiny(tmp_path: Path) -> Path:
@@ -124,7 +126,7 @@ def test_every_scheduler_runs_every_task_type_robot(tiny_protocol: protocol.Prot
 
 
 def test_a_robot_day_runs_under_the_strategy_it_is_given(tiny_protocol: protocol.Protocol, tmp_path: Path) -> None:
-    from experiments.strategy import Strategy
+    from experiments.inputs.strategy import Strategy
 
     m = dayreport.run_day(tiny_protocol.source, 1, "alg2", "robot", keep=str(tmp_path),
                           strategy=Strategy(update="static", suspension="static"))
@@ -132,7 +134,7 @@ def test_a_robot_day_runs_under_the_strategy_it_is_given(tiny_protocol: protocol
     run = json.loads((tmp_path / "trace.jsonl").read_text().splitlines()[0])
     assert (run["event"], run["update"], run["suspension"]) == ("run", "static", "static")
     # the day's hazard rows are the run metrics' safety section, one definition
-    from experiments.metrics import compute_file
+    from experiments.metrics.run import compute_file
 
     safety = compute_file(tmp_path / "trace.jsonl")["safety"]
     assert m["hazard_unattended_s"] == pytest.approx(safety["unattended_s"], abs=1e-6)
@@ -287,7 +289,7 @@ def test_a_terminated_request_is_not_requested_again(tiny_protocol: protocol.Pro
     the renewal is due: nothing is requested again."""
     import dataclasses
 
-    from experiments.actions import TimedAction
+    from experiments.inputs.actions import TimedAction
     from robot import skills
 
     real = skills.Navigate._approach

@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 from unified_planning.io import PDDLReader
 
-from experiments import explain
 from experiments.cli import main as cli_main
-from experiments.runner import run_scenario
+from experiments.report import explain
+from experiments.run.runner import run_scenario
 from planners.bundled import task_types
 from planners.examples import StraightLineMotion, example_context
 from planners.pddl_task import PddlTaskType, planning_journal

@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from experiments import scenario as scenarios
-from experiments.scenario import InterruptionGrid
-from experiments.strategy import Strategy, expand
-from experiments.sweepspec import SpecError, load_spec
+from experiments.inputs import scenario as scenarios
+from experiments.inputs.scenario import InterruptionGrid
+from experiments.inputs.strategy import Strategy, expand
+from experiments.sweep.spec import SpecError, load_spec
 from robot.scene import PERSON_RADIUS, Scene
 from robot.spec import load_world
 

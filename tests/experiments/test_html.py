@@ -10,11 +10,14 @@ from typing import Any
 import pytest
 from plotly.offline import get_plotlyjs
 
-from experiments import html_timeline, html_world, report_html, synthetic
-from experiments.runner import run_scenario
+from experiments.inputs import synthetic
+from experiments.report import run_page as report_html
+from experiments.report import timeline_figures as html_timeline
+from experiments.report import world_figure as html_world
+from experiments.run.runner import run_scenario
 from robot.spec import load_world
 
-DEMO = Path(__file__).resolve().parents[2] / "experiments" / "scenarios" / "synthetic_demo.toml"
+DEMO = Path(__file__).resolve().parents[2] / "experiments" / "inputs" / "scenarios" / "synthetic_demo.toml"
 HAZARD = {"event": "hazard", "agent": "d1", "hazard": "device_on", "args": ["cooker"], "budget_s": 30.0}
 
 

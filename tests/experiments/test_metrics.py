@@ -9,10 +9,11 @@ from typing import Any
 
 import pytest
 
-from experiments import metrics, synthetic
+from experiments.inputs import synthetic
+from experiments.metrics import run as metrics
 from tasker.trace import Trace
 
-DEMO = Path(__file__).resolve().parents[2] / "experiments" / "scenarios" / "synthetic_demo.toml"
+DEMO = Path(__file__).resolve().parents[2] / "experiments" / "inputs" / "scenarios" / "synthetic_demo.toml"
 
 
 @pytest.fixture(scope="module")

@@ -1,7 +1,7 @@
 """End to end: ``tasker run paper`` writes its outputs, is reproducible, and reproduces the
 steps of Appendix B that follow from the costs — with the paper's rule (hysteresis 1.0) and
 the ROS code's 0.9 — plus the counterfactuals that show the causes (John stands still;
-Peter stays down).  The 50-variant reproduction rate is ``python -m experiments.paper_report``
+Peter stays down).  The 50-variant reproduction rate is ``python -m experiments.paper.report``
 (``docs/paper.md``), not a test."""
 
 from __future__ import annotations
@@ -14,11 +14,11 @@ from typing import Any
 
 import pytest
 
-from experiments import appendix_b
-from experiments import scenario as scenarios
 from experiments.cli import main
-from experiments.paper_report import run_one
-from experiments.runner import run_scenario
+from experiments.inputs import scenario as scenarios
+from experiments.paper import appendix_b
+from experiments.paper.report import run_one
+from experiments.run.runner import run_scenario
 from tasker.trace import read
 
 COST_STEPS = (1, 4)  # indices of the steps Alg. 2 decides by comparing costs and that happen
@@ -130,7 +130,7 @@ def test_the_checker_survives_inf_and_never_credits_a_non_finite_comparison(pape
 
 
 def test_the_report_replaces_only_its_block() -> None:
-    from experiments.paper_report import BEGIN, END, splice
+    from experiments.paper.report import BEGIN, END, splice
 
     text = f"# title\n\nprose\n\n{BEGIN}\nold\n{END}\n\nmore prose\n"
     out = splice(text, f"{BEGIN}\nnew\n{END}\n")

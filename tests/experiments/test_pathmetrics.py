@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from experiments.pathmetrics import abandonments, path_metrics, travel_m
+from experiments.metrics.paths import abandonments, path_metrics, travel_m
 from robot.recording import PersonState, Sample
 
 # The robot on the x axis, one sample a second; Ann lies at the origin from t = 0; Bob stands at (0, 5).

@@ -8,9 +8,10 @@ from typing import Any
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-from experiments import plots, synthetic
+from experiments.inputs import synthetic
+from experiments.report import plots
 
-DEMO = Path(__file__).resolve().parents[2] / "experiments" / "scenarios" / "synthetic_demo.toml"
+DEMO = Path(__file__).resolve().parents[2] / "experiments" / "inputs" / "scenarios" / "synthetic_demo.toml"
 PNG = b"\x89PNG\r\n\x1a\n"
 
 

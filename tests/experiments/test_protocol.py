@@ -6,11 +6,12 @@ from pathlib import Path
 
 import pytest
 
-from experiments import dayreport, protocol
+from experiments.days import protocol
+from experiments.days import report as dayreport
 from tasker import schedulers
 from tasker.support.reader import InputError
 
-TABSA = Path(__file__).resolve().parents[2] / "experiments" / "protocols" / "tabsa.toml"
+TABSA = Path(__file__).resolve().parents[2] / "experiments" / "days" / "protocols" / "tabsa.toml"
 
 
 @pytest.fixture(scope="module")
@@ -97,7 +98,7 @@ def test_a_day_of_no_requests_is_refused_and_a_day_of_one_type_runs(tmp_path: Pa
 def test_a_failed_fall_is_requested_again_until_its_death_at(tabsa: protocol.Protocol) -> None:
     """The fall's request carries its renewal (every 30 s after a failure, until death_at);
     the other types' failures stand."""
-    from experiments import days
+    from experiments.days import pipeline as days
 
     assert tabsa.robot is not None and tabsa.robot.tasks["fall"].renew_after_s == 30.0
     assert tabsa.robot.tasks["transport"].renew_after_s is None

@@ -8,8 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from experiments import report_tables
-from experiments.analysis import (
+from experiments.analysis.compare import (
     ALL,
     PrimaryOutcome,
     analyse,
@@ -19,11 +18,12 @@ from experiments.analysis import (
     primary_cells,
     summarise,
 )
-from experiments.report import build_report
-from experiments.report_metrics import higher_is_better, host_dependent, numeric_metrics
-from experiments.report_plots import plot_frontier
-from experiments.stats import holm
-from experiments.store import ResultStore, RunRow, Status, StoreError
+from experiments.analysis.stats import holm
+from experiments.metrics.registry import higher_is_better, host_dependent, numeric_metrics
+from experiments.metrics.store import ResultStore, RunRow, Status, StoreError
+from experiments.report import sweep_tables as report_tables
+from experiments.report.sweep_plots import plot_frontier
+from experiments.sweep.report import build_report
 
 STATIC = "update=static,suspension=static"
 PLANNED = "update=static,suspension=planned"

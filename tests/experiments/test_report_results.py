@@ -1,4 +1,4 @@
-"""docs/results.md from the stored runs (experiments.results): per scenario, paired, Holm over the
+"""docs/results.md from the stored runs (experiments.sweep.factorial): per scenario, paired, Holm over the
 tests shown, failures counted apart, a factor with no effect said so, deterministic."""
 
 from __future__ import annotations
@@ -8,10 +8,10 @@ from pathlib import Path
 
 import pytest
 
-from experiments import results
-from experiments.stats import holm
-from experiments.store import ResultStore, RunRow, Status
-from experiments.strategy import Strategy
+from experiments.analysis.stats import holm
+from experiments.inputs.strategy import Strategy
+from experiments.metrics.store import ResultStore, RunRow, Status
+from experiments.sweep import factorial as results
 
 STRATEGIES = [Strategy(update="planned", suspension=s, policy=p, hazard_waiting=h).label
               for s, p, h in itertools.product(("static", "planned"), ("strict", "conditional"), (False, True))]
@@ -54,10 +54,10 @@ def test_holm_family_is_exactly_the_tests_shown(rows: list[RunRow]) -> None:
 
 
 def test_document_is_deterministic_and_says_what_the_runs_show(rows: list[RunRow]) -> None:
-    text = results.render(rows, "python -m experiments.results --seeds 4")
-    assert text == results.render(list(reversed(rows)), "python -m experiments.results --seeds 4")
+    text = results.render(rows, "python -m experiments.sweep.factorial --seeds 4")
+    assert text == results.render(list(reversed(rows)), "python -m experiments.sweep.factorial --seeds 4")
     assert text.startswith("# Static versus planned suspension: results")
-    assert "python -m experiments.results --seeds 4" in text
+    assert "python -m experiments.sweep.factorial --seeds 4" in text
     assert results.DECLARATION.rstrip() in text
     # the seed where planned was less safe is named, with the hazard that grew
     assert "| hh | conditional/off | 2 | 22 | 32 | cooker_on |" in text
@@ -120,7 +120,7 @@ def test_main_reports_what_the_database_holds(rows: list[RunRow], tmp_path: Path
 
 
 def test_the_shipped_factorial_spec_is_the_declared_design() -> None:
-    from experiments.sweepspec import load_spec
+    from experiments.sweep.spec import load_spec
 
     spec = load_spec(Path(results.ROOT) / results.SPEC)
     assert {Strategy.parse(s.label) for s in spec.strategies} == {Strategy.parse(s) for s in STRATEGIES}

@@ -6,9 +6,9 @@ from pathlib import Path
 
 import pytest
 
-from experiments import scenario as scenarios
-from experiments.request_fields import asked_for
-from experiments.runner import run_scenario
+from experiments.inputs import scenario as scenarios
+from experiments.inputs.request_fields import asked_for
+from experiments.run.runner import run_scenario
 from tasker.trace import read
 
 TWO_GUIDES = """

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from experiments import runner
+from experiments.run import runner
 from tasker.errors import RunAborted
 from tasker.loop import SimulationLoop
 

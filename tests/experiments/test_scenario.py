@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from experiments import scenario as scenarios
 from experiments.cli import main
-from experiments.synthetic import ScenarioError
+from experiments.inputs import scenario as scenarios
+from experiments.inputs.synthetic import ScenarioError
 
 GOOD = """
 kind = "robot"
@@ -106,7 +106,7 @@ def test_cli_runs_a_synthetic_scenario(tmp_path: Path, capsys: pytest.CaptureFix
                                             ("name = 3", "mine"), ("", "mine"), ('name = "', "mine")])
 def test_a_scenario_names_its_output_folder_when_its_name_is_a_plain_folder_name(
         line: str, name: str, tmp_path: Path) -> None:
-    from experiments.scenario import name_of
+    from experiments.inputs.scenario import name_of
 
     path = tmp_path / "mine.toml"
     path.write_text(f'kind = "robot"\n{line}\n')

@@ -7,7 +7,7 @@ import math
 import pytest
 from scipy import stats
 
-from experiments.stats import estimate, holm, paired_p
+from experiments.analysis.stats import estimate, holm, paired_p
 
 
 def test_estimate_is_the_student_t_interval() -> None:

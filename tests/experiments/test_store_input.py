@@ -10,11 +10,11 @@ from pathlib import Path
 
 import pytest
 
-from experiments.report import EmptyDatabase, build_report
-from experiments.store import ResultStore, RunRow, Status, StoreError
-from experiments.strategy import Strategy
-from experiments.sweep import run_sweep
-from experiments.sweepspec import SweepSpec
+from experiments.inputs.strategy import Strategy
+from experiments.metrics.store import ResultStore, RunRow, Status, StoreError
+from experiments.sweep.driver import run_sweep
+from experiments.sweep.report import EmptyDatabase, build_report
+from experiments.sweep.spec import SweepSpec
 from tests.experiments import standin
 
 

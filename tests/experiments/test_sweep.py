@@ -16,11 +16,11 @@ from pathlib import Path
 
 import pytest
 
-from experiments.report import build_report
-from experiments.store import ResultStore, RunRow, Status, StoreError
-from experiments.strategy import Strategy
-from experiments.sweep import SweepError, run_sweep
-from experiments.sweepspec import Job, SpecError, SweepSpec, load_spec
+from experiments.inputs.strategy import Strategy
+from experiments.metrics.store import ResultStore, RunRow, Status, StoreError
+from experiments.sweep.driver import SweepError, run_sweep
+from experiments.sweep.report import build_report
+from experiments.sweep.spec import Job, SpecError, SweepSpec, load_spec
 from tests.experiments import standin
 
 ROOT = Path(__file__).parents[2]
@@ -245,9 +245,9 @@ def test_sweep_on_dask_stopped_half_way_and_resumed(tmp_path: Path, small_spec: 
 
 _KILLED_SWEEP = """
 import sys
-from experiments.strategy import Strategy
-from experiments.sweep import run_sweep
-from experiments.sweepspec import SweepSpec
+from experiments.inputs.strategy import Strategy
+from experiments.sweep.driver import run_sweep
+from experiments.sweep.spec import SweepSpec
 from tests.experiments import standin
 
 if __name__ == "__main__":
@@ -320,7 +320,7 @@ def test_bad_arguments_are_errors(tmp_path: Path, small_spec: SweepSpec) -> None
 def test_sweep_and_report_commands(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     import argparse
 
-    from experiments import sweep_cli
+    from experiments.cli import sweep as sweep_cli
 
     parser = argparse.ArgumentParser()
     sweep_cli.register(parser.add_subparsers(dest="command", required=True))

@@ -11,19 +11,19 @@ from pathlib import Path
 
 import pytest
 
-from experiments.store import ResultStore, Status
-from experiments.strategy import Strategy
-from experiments.sweep import SweepError, lease, run_sweep
-from experiments.sweepspec import Job, SweepSpec, load_spec
+from experiments.inputs.strategy import Strategy
+from experiments.metrics.store import ResultStore, Status
+from experiments.sweep.driver import SweepError, lease, run_sweep
+from experiments.sweep.spec import Job, SweepSpec, load_spec
 from tests.experiments import standin
 
 ROOT = Path(__file__).parents[2]
 
 _DRIVER = """
 import sys
-from experiments.strategy import Strategy
-from experiments.sweep import run_sweep
-from experiments.sweepspec import SweepSpec
+from experiments.inputs.strategy import Strategy
+from experiments.sweep.driver import run_sweep
+from experiments.sweep.spec import SweepSpec
 from tests.experiments import standin
 
 if __name__ == "__main__":

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from experiments.runner import run_scenario
+from experiments.run.runner import run_scenario
 
 SCENARIO = """\
 kind = "robot"

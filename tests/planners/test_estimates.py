@@ -290,8 +290,8 @@ def test_paper_scenario_trace_does_not_depend_on_what_earlier_runs_cached() -> N
     (warm caches) must write the same trace, byte for byte, as the first."""
     import json
 
-    from experiments import scenario as scenarios
-    from experiments.runner import run_scenario
+    from experiments.inputs import scenario as scenarios
+    from experiments.run.runner import run_scenario
 
     scn = replace(scenarios.load(scenarios.resolve("paper")), horizon=40.0)  # Alice greeted, decisions on
     runs = [run_scenario(scn, pictures=False).trace.events for _ in range(2)]
@@ -375,8 +375,8 @@ def test_after_a_leg_to_a_person_the_next_leg_starts_where_they_stand() -> None:
 def test_a_plan_estimated_across_a_closed_door_opens_it() -> None:
     """The reference table keeps closed doors closed (but for door_between pairs, which the
     plan may open): carry's first estimate is a plan through the door it opens, and finite."""
-    from experiments import scenario as scenarios
-    from experiments.runner import build_robot
+    from experiments.inputs import scenario as scenarios
+    from experiments.run.runner import build_robot
 
     loop, _ = build_robot(scenarios.load(scenarios.resolve("carry")), seed=1)
     trace = loop.run(until=0.5)
@@ -422,10 +422,10 @@ def test_a_waiting_task_is_estimated_from_the_state_the_executing_task_leaves() 
     start now) or completion (for Alg. 2's cc after it) leaves, cook is finite."""
     from pathlib import Path
 
-    from experiments import scenario as scenarios
-    from experiments.runner import build_robot
+    from experiments.inputs import scenario as scenarios
+    from experiments.run.runner import build_robot
 
-    path = Path(__file__).resolve().parents[2] / "experiments" / "sweeps" / "scenarios" / "compound.toml"
+    path = Path(__file__).resolve().parents[2] / "experiments" / "sweep" / "specs" / "scenarios" / "compound.toml"
     loop, _ = build_robot(scenarios.load(scenarios.resolve(str(path))), seed=1)
     trace = loop.run(until=40.0)
     held = [e for e in trace.events if e["event"] == "decision" and e.get("dac") == "d2" and e.get("exeDA") == "d1"]

@@ -382,7 +382,7 @@ def test_an_upper_case_scenario_object_is_refused(tmp_path: Path, capsys: pytest
 
 def test_a_binding_of_the_wrong_kind_for_the_world_is_a_warning(tmp_path: Path) -> None:
     """Before: kind = "device" for the held item ran silently: the robot "held" the vase only symbolically."""
-    from experiments import scenario as scenarios
+    from experiments.inputs import scenario as scenarios
     from tasker.support.reader import InputWarning
 
     folder = _new(tmp_path)

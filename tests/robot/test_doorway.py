@@ -226,7 +226,8 @@ def test_a_person_is_approached_from_their_side_of_a_wall() -> None:
 
     from robot.spec import load_world
 
-    world = load_world(Path(__file__).resolve().parents[2] / "experiments" / "protocols" / "tabsa_apartment.toml")
+    world = load_world(Path(__file__).resolve().parents[2] / "experiments" / "days" / "protocols"
+                       / "tabsa_apartment.toml")
     motion = motion_model(world, people=False)
     scene = motion.planner.scene
     scene.set_person("p13", 4.21, 4.9, "fallen")
@@ -288,7 +289,8 @@ def test_nobody_makes_room_by_stepping_into_a_dead_end() -> None:
 
     from robot.spec import load_world
 
-    world = load_world(Path(__file__).resolve().parents[2] / "experiments" / "protocols" / "tabsa_apartment.toml")
+    world = load_world(Path(__file__).resolve().parents[2] / "experiments" / "days" / "protocols"
+                       / "tabsa_apartment.toml")
 
     def person(name: str, x: float, y: float, posture: str = "standing") -> PersonSpec:
         return PersonSpec(name, (x, y, 0.0), posture, 0.5, (), ())

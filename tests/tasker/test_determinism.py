@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from experiments import synthetic
+from experiments.inputs import synthetic
 
-DEMO = Path(__file__).parents[2] / "experiments" / "scenarios" / "synthetic_demo.toml"
+DEMO = Path(__file__).parents[2] / "experiments" / "inputs" / "scenarios" / "synthetic_demo.toml"
 
 
 def test_same_scenario_and_seed_give_identical_traces(tmp_path: Path) -> None:

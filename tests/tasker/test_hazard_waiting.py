@@ -4,7 +4,7 @@ A synthetic system with a declared hazard: ``stew`` lights a flame (a fact the t
 world keeps), simmers, and puts the flame out.  Its suspension follows the two policies:
 ``conditional`` leaves the flame on for an interruption it expects to be short,
 ``strict`` puts it out.  ``chore`` interrupts it for much longer than the flame's budget.
-The hazard metric is the project's own (``experiments.metrics``, ``safety.budget_overruns``).
+The hazard metric is the project's own (``experiments.metrics.run``, ``safety.budget_overruns``).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from typing import Any
 
 import pytest
 
-from experiments import metrics
+from experiments.metrics import run as metrics
 from tasker import fsm, schedulers
 from tasker.agent import Rates
 from tasker.errors import ConfigError
@@ -278,8 +278,8 @@ def test_suspend_estimate_counts_the_blocking_stages_left() -> None:
 
 
 def test_the_runner_gives_the_harmoniser_the_monitors_hazards() -> None:
-    from experiments import scenario as scenarios
-    from experiments.runner import build_robot
+    from experiments.inputs import scenario as scenarios
+    from experiments.run.runner import build_robot
 
     loop, _ = build_robot(scenarios.load(scenarios.resolve("household")), seed=1, hazard_waiting=True)
     harm = loop.harmoniser

@@ -18,7 +18,8 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st_
 
-from experiments import days, synthetic
+from experiments.days import pipeline as days
+from experiments.inputs import synthetic
 from tasker import schedulers
 from tasker.agent import Rates
 from tasker.errors import ConfigError
@@ -34,7 +35,7 @@ from tasker.task import TaskContext
 from .helpers import BLOCK, st
 
 ROOT = Path(__file__).resolve().parents[2]
-DEMO = ROOT / "experiments" / "scenarios" / "synthetic_demo.toml"
+DEMO = ROOT / "experiments" / "inputs" / "scenarios" / "synthetic_demo.toml"
 INDEXED = sorted(n for n in schedulers.names() if schedulers.create(n).indexed)
 
 

@@ -1,0 +1,1 @@
+"""Statistics over many runs: estimates with intervals, paired comparisons, Markdown tables."""

@@ -1,0 +1,216 @@
+"""``tasker check PATH…``: every load-time check, on task folders, scenarios, worlds, sweep specs and day
+protocols.
+
+Each PATH is recognised by what it holds: a task folder (``task.toml``), a folder of
+task folders, a folder of ``.toml`` files, or one file — a scenario (``kind = …``),
+a sweep spec (``scenarios`` and ``seeds``), a day protocol (``[day]`` and ``[tasks]``),
+a world (``places``), a ``task.toml`` or a PDDL domain.  Every problem is listed (not
+only the first), one line each, and the command exits 1 when there is any (2 for bad
+arguments).  A task folder's ``[example]`` is solved again even when the check cache
+says it passed before.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import tomllib
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from experiments.cli.run import add_path_option, task_paths
+from tasker.support.cliargs import EXIT_FAILED, EXIT_OK, error_text
+from tasker.support.reader import InputWarning
+
+EXAMPLES = """\
+examples:
+  tasker check domains/cook                          # a task folder: PDDL, task.toml, the example solved
+  tasker check ~/my_tasks                            # a folder of task folders
+  tasker check experiments/inputs/scenarios experiments/sweep/specs robot/worlds experiments/days/protocols
+  tasker check my_scenario.toml --path ~/my_tasks    # a scenario that requests your own task types"""
+
+
+class Checker:
+    """Runs the checks and collects ``(path, problem)`` pairs and ``(path, what)`` successes."""
+
+    def __init__(self, paths: list[str]) -> None:
+        self.paths = paths
+        self.problems: list[tuple[str, str]] = []
+        self.passed: list[tuple[str, str]] = []
+        self._store: Any = None
+        self._store_error: str | None = None
+
+    def attempt(self, where: str | Path, what: str, fn: Callable[[], object]) -> bool:
+        from tasker.errors import TaskerError
+
+        try:
+            fn()
+        except (TaskerError, OSError, ValueError, tomllib.TOMLDecodeError) as exc:
+            self.problems.append((str(where), error_text(exc)))
+            return False
+        self.passed.append((str(where), what))
+        return True
+
+    # -- what a path is -------------------------------------------------------------------
+
+    def check(self, raw: str) -> None:
+        p = Path(raw)
+        if not p.exists():
+            self.problems.append((raw, "no such file or folder"))
+        elif p.is_dir():
+            self._folder(p)
+        elif p.suffix == ".pddl":
+            self._pddl(p)
+        elif p.suffix == ".toml":
+            self._toml(p)
+        else:
+            self.problems.append((raw, "expected a task folder, a .toml file (scenario, sweep spec, world, "
+                                       "task.toml) or a PDDL domain"))
+
+    def _folder(self, p: Path) -> None:
+        if (p / "task.toml").is_file():
+            self._task_folder(p)
+            for extra in sorted(p.glob("*.toml")):  # e.g. the scenario 'tasker new' writes beside task.toml
+                if extra.name != "task.toml":
+                    self._toml(extra, also=[str(p.resolve())])
+            return
+        subs = [q for q in sorted(p.iterdir()) if (q / "task.toml").is_file()]
+        files = sorted(p.glob("*.toml"))
+        if not subs and not files:
+            self.problems.append((str(p), "holds no task folder (a subfolder with task.toml) and no .toml file"))
+        for q in subs:
+            self._folder(q)
+        for f in files:
+            self._toml(f)
+
+    def _task_folder(self, p: Path) -> None:
+        from planners.loader import load_task
+
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", InputWarning)
+            ok = self.attempt(p, "task folder: PDDL, task.toml and the [example] solved",
+                              lambda: load_task(p, use_cache=False))
+        for w in caught:  # shown as any other warning; they only change what "ok" claims
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        if ok and any(issubclass(w.category, InputWarning) for w in caught):
+            self.passed[-1] = (str(p), "task folder: PDDL and task.toml (its [example]: see the warning)")
+
+    def _pddl(self, p: Path) -> None:
+        from planners.checks import load_domain
+
+        text = p.read_text(encoding="utf-8", errors="replace").lower()
+        if "(:domain" in text:
+            self.problems.append((str(p), "a PDDL problem is checked with its domain: tasker plan DOMAIN PROBLEM"))
+            return
+        self.attempt(p, "PDDL domain", lambda: load_domain(p))
+
+    def _toml(self, p: Path, also: list[str] | None = None) -> None:
+        try:
+            raw = tomllib.loads(p.read_text(encoding="utf-8-sig"))  # a byte-order mark as reader.read_text
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+            self.problems.append((str(p), f"not valid TOML: {exc}"))
+            return
+        if p.name == "task.toml" or "task" in raw and "actions" in raw:
+            self._task_folder(p.parent)
+        elif "kind" in raw:
+            self._scenario(p, also or [])
+        elif "scenarios" in raw and "seeds" in raw:
+            self._sweep(p)
+        elif "day" in raw and "tasks" in raw:
+            from experiments.days import protocol
+
+            self.attempt(p, "day protocol", lambda: protocol.load(p))
+        elif "places" in raw or "bounds" in raw:
+            from robot.spec import load_world
+
+            self.attempt(p, "world", lambda: load_world(p))
+        else:
+            self.problems.append((str(p), "cannot tell what this is: a scenario has 'kind', a sweep spec "
+                                          "'scenarios' and 'seeds', a day protocol '[day]' and '[tasks]', a world "
+                                          "'places', a task.toml '[task]'"))
+
+    # -- scenarios and sweeps -----------------------------------------------------------------
+
+    def _tasks(self, also: list[str], request_fields: bool = False) -> Any:
+        from experiments.inputs.request_fields import with_request_fields
+        from planners.bundled import task_types
+        from tasker.store import TaskStore
+
+        loaded = task_types([*self.paths, *also])
+        if request_fields:  # as the scenario's load and run take them (experiments.inputs.request_fields)
+            loaded = [with_request_fields(t) for t in loaded]
+        return TaskStore(loaded)
+
+    def _scenario(self, p: Path, also: list[str]) -> None:
+        from experiments.inputs import scenario as scenarios
+        from experiments.inputs import synthetic
+
+        if scenarios.kind_of(p) != "robot":
+            self.attempt(p, "synthetic scenario", lambda: synthetic.load(p))
+            return
+        loaded: list[Any] = []
+        paths = [*self.paths, *also]
+        if not self.attempt(p, "robot scenario", lambda: loaded.append(scenarios.load(p, task_paths=paths))):
+            return
+        scn = loaded[0]
+        world: list[Any] = []
+        from robot.spec import load_world
+
+        if self.attempt(p, f"world {scn.world}", lambda: world.append(load_world(scn.world))):
+            from tasker.support.cliargs import did_you_mean
+
+            for name in scn.people:
+                if name not in world[0].people:
+                    self.problems.append((f"{p}: people.{name}", f"no such person in world {scn.world!r}"
+                                                                 f"{did_you_mean(name, world[0].people)}; "
+                                                                 f"known: {sorted(world[0].people)}"))
+        from experiments.inputs.request_fields import asked_for
+
+        stores: list[Any] = []
+        wrap = asked_for(scn.actions)
+        if not self.attempt(p, "its task types loaded", lambda: stores.append(self._tasks(also, wrap))):
+            return
+        for k, a in enumerate(scn.actions):
+            if a.kind == "request":
+                task, task_args = a.fields["task"], a.fields["args"]
+                self.attempt(f"{p}: request {k} (t={a.t:g})", f"request {task}",
+                             functools.partial(stores[0].validate, task, task_args))
+
+    def _sweep(self, p: Path) -> None:
+        from experiments.sweep.spec import load_spec
+
+        specs: list[Any] = []
+        if self.attempt(p, "sweep spec", lambda: specs.append(load_spec(p))):
+            from experiments.inputs import scenario as scenarios
+
+            for sc in specs[0].scenarios:  # a file (absolute in sources), or a shipped scenario's name
+                self.check(specs[0].sources.get(sc) or str(scenarios.resolve(sc)))
+
+
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    p = sub.add_parser("check", help="check task folders, scenarios, worlds, sweep specs and day protocols; list "
+                                     "every problem",
+                       description="Run every load-time check on each PATH (task folders with their examples "
+                                   "solved, scenarios with their requests, worlds, sweep specs with their "
+                                   "scenarios, day protocols with their robot backend) and list every problem "
+                                   "found. Exits 1 if there is any.",
+                       epilog=EXAMPLES)
+    p.add_argument("targets", metavar="PATH", nargs="+", help="a task folder, a folder, or a .toml / .pddl file")
+    add_path_option(p)
+    p.set_defaults(func=_check)
+
+
+def _check(args: argparse.Namespace) -> int:
+    checker = Checker(task_paths(args))
+    for t in args.targets:
+        checker.check(t)
+    if not args.quiet:
+        for where, what in checker.passed:
+            print(f"ok     {where}: {what}")
+    for where, problem in checker.problems:
+        print(f"error  {where}: {problem}")
+    n = len(checker.problems)
+    print(f"{len(checker.passed)} checks passed, {n} problem{'s' if n != 1 else ''}")
+    return EXIT_FAILED if n else EXIT_OK

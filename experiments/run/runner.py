@@ -1,0 +1,437 @@
+"""Run one scenario: build the system, run it on the simulated clock, save what happened.
+
+:func:`run_scenario` is what ``tasker run`` and the sweeps call.  A robot scenario
+gets the TIAGo simulation (:class:`robot.sim.Simulation`, both the world and the core
+agent), the OMPL motion model, and the bundled PDDL task types; a synthetic one gets
+timed stages.  In ``out`` it writes ``trace.jsonl`` (reproducible byte for byte),
+``trajectory.jsonl`` (robot and people at a fixed rate, robot runs),
+``run.json`` (the record: scenario, seed, settings, planner, host, date, version),
+``metrics.json`` and the pictures.  If the run raises, the trace so far, ``run.json``
+(with ``status: "aborted"`` and the ``error``) and ``metrics.json`` are still written,
+then :class:`tasker.errors.RunAborted` is raised carrying the partial :class:`RunResult`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import datetime as _dt
+import json
+import platform
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import tasker
+from experiments.inputs import scenario as scenarios
+from experiments.inputs import synthetic
+from experiments.inputs.actions import TimedAction
+from experiments.inputs.request_fields import asked_for
+from tasker import schedulers
+from tasker.agent import Rates
+from tasker.errors import RunAborted, RunInterrupted
+from tasker.harmoniser import Mode
+from tasker.loop import SimulationLoop
+from tasker.meaning import Monitor
+from tasker.requester import Requester
+from tasker.store import TaskStore
+from tasker.task import Strategy
+from tasker.trace import FAILED, Trace
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """What one run produced: its record, its metrics and its trace."""
+
+    record: dict[str, Any]
+    metrics: dict[str, Any]
+    trace: Trace
+    trajectory: tuple[tuple[float, float, float, float], ...] = ()
+
+
+def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None = None,
+                suspension: str | None = None, scheduler: str | None = None,
+                trace: Trace | None = None, task_paths: tuple[str, ...] = (), policy: str | None = None,
+                hazard_waiting: bool = False, request_fields: bool = False) -> tuple[SimulationLoop, Any]:
+    """The loop and the simulation for a robot scenario, with every request and event scheduled.
+
+    ``task_paths`` are task folders loaded besides the bundled ones and ``$TASKER_TASKS``.
+    ``policy`` (default: the scenario's) reaches every task's :class:`Strategy`;
+    ``hazard_waiting`` is passed to the loop; ``request_fields`` lets every task type take
+    the requests' ``deadline`` and ``priority`` (:mod:`experiments.inputs.request_fields`); it is on
+    whenever the scenario's requests give one.
+    A ``people`` entry may set a person's ``pose``, ``walk`` and walking ``speed``."""
+    from planners.bundled import task_types
+    from robot.sim import Simulation
+    from robot.spec import load_world
+
+    spec = load_world(scn.world)
+    if scn.people:
+        people = dict(spec.people)
+        for name, entry in scn.people.items():
+            if name not in people:
+                raise scenarios.ScenarioError(f"{scn.source}: people.{name}: no such person in world {scn.world!r}; "
+                                              f"known: {sorted(people)}")
+            changes: dict[str, Any] = {}
+            if "pose" in entry:
+                changes["pose"] = tuple(entry["pose"])
+            if "walk" in entry:
+                changes["walk"] = tuple(tuple(w) for w in entry["walk"])
+            if "speed" in entry:
+                changes["speed"] = float(entry["speed"])
+            people[name] = dataclasses.replace(people[name], **changes)
+        spec = dataclasses.replace(spec, people=people)
+    spec = _with_objects(scn, spec)
+    sim = Simulation(spec, seed=seed)
+    loaded = task_types(task_paths)
+    if request_fields or asked_for(scn.actions):
+        from experiments.inputs.request_fields import with_request_fields
+
+        loaded = [with_request_fields(t) for t in loaded]
+    store = TaskStore(loaded)
+    types = [store.get(n) for n in store.names()]
+    sim.bind(b for t in types for b in t.meaning.bindings)  # the world reads the folders' bindings
+    default = Strategy(update or scn.update, suspension or scn.suspension, policy or scn.policy)
+    per_type = {t: Strategy(update or s.get("update", default.update),
+                            suspension or s.get("suspension", default.suspension), default.policy)
+                for t, s in scn.strategies.items()}
+    options = scn.scheduler_options if scheduler in (None, scn.scheduler) else {}
+    loop = SimulationLoop(
+        store, schedulers.create(scheduler or scn.scheduler, **options), seed=seed, trace=trace,
+        mode=Mode(scn.mode), s_freq=scn.s_freq, rates=Rates(scn.rep_rate, scn.task_exe_rate, scn.sp_up_rate),
+        strategy=default, strategies=per_type, core=sim, world=sim, motion=sim.motion, horizon=scn.horizon,
+        hazard_waiting=hazard_waiting,
+    )
+    monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning,
+                      lambda: sim.snapshot().facts, task_types=store.names(),
+                      version=sim.facts_key)
+    loop.observers.append(monitor.observe)
+    loop.harmoniser.hazards = monitor.active  # hazard-aware waiting learns of hazards from the monitor
+    made = _Made(loop, Requester(store, loop.harmoniser, "scenario"))
+    requests = 0  # the K-th request is the scenario's dK
+    for a in scn.actions:
+        if a.kind == "request":
+            requests += 1
+            store.validate(a.fields["task"], a.fields["args"])  # bad requests fail before the run
+        loop.at(a.t, _action(loop, sim, made, a, f"d{requests}"))
+    return loop, sim
+
+
+def _with_objects(scn: scenarios.RobotScenario, spec: Any) -> Any:
+    """The world with the scenario's ``[objects]``: each gets its type, ``("at", name, place)``
+    and its facts (its pose is its place's, see :meth:`robot.sim.Simulation.snapshot`)."""
+    if not scn.objects:
+        return spec
+    objects = dict(spec.objects)
+    facts = list(spec.facts)
+    for name, o in sorted(scn.objects.items()):
+        if o["place"] not in spec.places:
+            raise scenarios.ScenarioError(f"{scn.source}: objects.{name}.place: no place {o['place']!r} in world "
+                                          f"{scn.world!r}; known: {sorted(spec.places)}")
+        taken = set(spec.places) | set(spec.people) | set(spec.devices) | set(spec.doors) | {"robot"}
+        if name in taken:
+            raise scenarios.ScenarioError(f"{scn.source}: objects.{name}: the world already has something "
+                                          f"called {name!r}")
+        objects[name] = o["type"]
+        facts = [f for f in facts if not (f[0] == "at" and len(f) == 3 and f[1] == name)]
+        facts.append(("at", name, o["place"]))
+        facts += [tuple(f) for f in o.get("facts", [])]
+    return dataclasses.replace(spec, objects=objects, facts=tuple(dict.fromkeys(facts)))
+
+
+class _Made:
+    """The scenario's requests as made.  Its K-th request is ``dK`` in the scenario's own
+    terms (``after``, ``terminate``, ``change``); the agents made for it are the one the
+    request made and any that renew it.  A request with ``renew`` (``{"after_s", "until"}``)
+    whose task ends without doing its work (an ``end`` cause in :data:`tasker.trace.FAILED`)
+    is asked for again ``after_s`` later, if that is before ``until``: the need stands until
+    served (a day's fall, until the person is helped or dead).  Without renewals ``dK`` is
+    the K-th agent, as the harmoniser numbers them."""
+
+    def __init__(self, loop: SimulationLoop, requester: Requester) -> None:
+        self.loop, self.requester = loop, requester
+        self.agents: dict[str, list[str]] = {}
+        self._renewable: dict[str, tuple[str, TimedAction]] = {}  # agent -> (its scenario id, its request)
+        self._terminated: set[str] = set()  # scenario ids a requester terminated: never renewed
+        loop.trace.subscribe(self._watch)
+
+    def current(self, sid: str) -> str:
+        """The agent now standing for the scenario's ``sid`` (``sid`` itself before it is made)."""
+        made = self.agents.get(sid)
+        return made[-1] if made else sid
+
+    def terminate(self, sid: str, reason: str) -> None:
+        self._terminated.add(sid)
+        self.requester.terminate(self.current(sid), reason)
+
+    def submit(self, sid: str, a: TimedAction, renews: str | None = None) -> None:
+        if renews is not None and sid in self._terminated:
+            return
+        agent = self.requester.request(a.fields["task"], a.fields["args"], renews=renews)
+        self.agents.setdefault(sid, []).append(agent)
+        if "renew" in a.fields:
+            self._renewable[agent] = (sid, a)
+
+    def _watch(self, e: dict[str, Any]) -> None:
+        if e["event"] != "end" or e.get("cause") not in FAILED or e.get("agent") not in self._renewable:
+            return
+        sid, a = self._renewable.pop(e["agent"])
+        when = float(e["t"]) + float(a.fields["renew"]["after_s"])
+        if when < float(a.fields["renew"]["until"]):
+            self.loop.at(when, lambda: self.submit(sid, a, renews=e["agent"]))
+
+
+def _action(loop: SimulationLoop, sim: Any, made: _Made, a: TimedAction, sid: str) -> Callable[[], None]:
+    """What happens at ``a.t``; ``sid``: the scenario's id of the latest request (``a``'s own if it is one)."""
+    f = a.fields
+    requester = made.requester
+    if a.kind == "request":
+        return lambda: made.submit(sid, a)  # through the public requester, as any user's requests
+    if a.kind == "terminate":
+        return lambda: made.terminate(f["agent"], f["reason"])
+    if a.kind == "change":
+        return lambda: synthetic._change(loop, requester, made.current(f["agent"]), f["args"])
+    if a.kind == "mode":
+        return lambda: loop.harmoniser.set_mode(f["mode"])
+
+    def world_event() -> None:
+        what, value = f["what"], f["value"]
+        if what == "posture":
+            sim.people[value[0]].set_posture(value[1])
+        elif what == "walk":
+            sim.people[value[0]].go_to(loop.now, float(value[1]), float(value[2]))
+        elif what == "door":
+            sim.set_door(value[0], value[1])
+        elif what == "add":
+            sim.apply(add=value)
+        else:
+            sim.apply(delete=value)
+        loop.trace.emit(loop.now, "world", what=what, value=value, note=f.get("note", ""))
+
+    if "after" not in f:
+        return world_event
+    return _after(loop, made, f["after"], world_event)
+
+
+def _after(loop: SimulationLoop, made: _Made, sid: str, event: Callable[[], None]) -> Callable[[], None]:
+    """``event`` at its time if the scenario's request ``sid`` has been served by then (one of
+    its agents ended with cause ``finished``), else as soon as it is (in the tick that ``end``
+    event is traced); never if it is not."""
+    state = {"finished": False, "due": False}
+
+    def watch(e: dict[str, Any]) -> None:
+        if e["event"] == "end" and e.get("cause") == "finished" and e.get("agent") in made.agents.get(sid, ()) \
+                and not state["finished"]:
+            state["finished"] = True
+            if state["due"]:
+                loop.at(loop.now, event)
+
+    loop.trace.subscribe(watch)
+
+    def at_time() -> None:
+        state["due"] = True
+        if state["finished"]:
+            event()
+
+    return at_time
+
+
+def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | None = None,
+                 update: str | None = None, suspension: str | None = None, scheduler: str | None = None,
+                 mode: str | None = None, out: Path | None = None, randomize: bool = False,
+                 progress: bool = False, pictures: bool = True, task_paths: tuple[str, ...] = (),
+                 policy: str | None = None, hazard_waiting: bool | None = None,
+                 interruption: scenarios.InterruptionGrid | None = None,
+                 request_fields: bool = False) -> RunResult:
+    """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced.
+
+    ``task_paths``: task folders to load besides the bundled ones (``tasker run --path``).
+    ``policy`` (``strict``/``conditional``) overrides the scenario's; ``hazard_waiting`` switches
+    hazard-aware waiting on; ``interruption`` (with ``randomize``) places the interrupting request
+    in the seed's stratum (:class:`experiments.inputs.scenario.InterruptionGrid`); ``request_fields``: see
+    :func:`build_robot`."""
+    if isinstance(source, scenarios.RobotScenario):
+        kind, scn_path = "robot", Path(source.source)
+    else:
+        scn_path = scenarios.resolve(source)
+        kind = scenarios.kind_of(scn_path)
+    t0 = time.perf_counter()
+    trajectory: tuple[tuple[float, float, float, float], ...] = ()
+    if kind == "synthetic":
+        syn = synthetic.load(scn_path)
+        run_seed = syn.seed if seed is None else seed
+        loop = synthetic.build(syn, seed=run_seed, scheduler=scheduler, mode=mode)
+        spec_json: dict[str, Any] = {"kind": "synthetic", "name": syn.name, "source": str(scn_path)}
+        sim = None
+    elif kind == "robot":
+        scn = source if isinstance(source, scenarios.RobotScenario) else scenarios.load(scn_path, task_paths=task_paths)
+        run_seed = scn.seed if seed is None else seed
+        if randomize:
+            scn = scenarios.randomize(scn, run_seed, interruption=interruption)
+        if mode is not None:
+            scn = dataclasses.replace(scn, mode=mode)
+        loop, sim = build_robot(scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler,
+                                task_paths=task_paths, policy=policy, hazard_waiting=bool(hazard_waiting),
+                                request_fields=request_fields)
+        spec_json = {"kind": "robot", **scn.to_json()}
+    else:
+        raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")
+    error: BaseException | None = None
+    with _journal(kind) as journal:  # the PDDL of every planning call, for problems/
+        try:
+            _run(loop, progress)
+        except Exception as exc:  # the trace so far, run.json and metrics.json are still written, then it propagates
+            error = exc
+        except KeyboardInterrupt as exc:  # the user stopped it: keep what ran, closed like a run cut by its horizon
+            error = exc
+            loop.trace.emit(loop.now, "run", status="interrupted", active=sorted(loop.harmoniser.agents))
+    wall = time.perf_counter() - t0
+    trace = loop.trace
+    world_spec = None
+    if sim is not None:
+        trajectory = tuple(sim.trajectory)
+        world_spec = sim.spec
+    calls = loop.planner_calls
+    record = {
+        "scenario": spec_json, "seed": run_seed,
+        "settings": {"scheduler": loop.harmoniser.scheduler.name, "mode": loop.harmoniser.mode.value,
+                     # synthetic task types have only static strategies: say what was used
+                     "update": "static" if kind == "synthetic" else (update or loop.strategy.update),
+                     "suspension": "static" if kind == "synthetic" else (suspension or loop.strategy.suspension),
+                     "randomized": randomize,
+                     "policy": None if kind == "synthetic" else loop.strategy.policy,
+                     "hazard_waiting": bool(hazard_waiting),
+                     **({"interruption": interruption.to_json()} if interruption and randomize else {})},
+        "planner": _planner_config() if kind == "robot" else None,
+        "host": platform.node(), "platform": platform.platform(), "python": sys.version.split()[0],
+        "date": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "tasker_version": tasker.__version__,
+        "wall_time_s": round(wall, 3),
+    }
+    reason = ""
+    if error is None:
+        metrics = _metrics(trace, calls, wall)
+    else:
+        if isinstance(error, KeyboardInterrupt):
+            reason, record["status"] = f"interrupted by the user at t={loop.now:g} s", "interrupted"
+        else:
+            reason = error.reason if isinstance(error, RunAborted) else f"{type(error).__name__}: {error}"
+            record["status"] = "aborted"
+        record["error"] = reason
+        try:
+            metrics = _metrics(trace, calls, wall)
+        except Exception as exc:  # metrics of a cut trace may not compute: say so, keep the rest
+            metrics = {"error": f"metrics failed on the partial trace: {type(exc).__name__}: {exc}"}
+    if out is not None:
+        _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures and error is None, sim, journal)
+    result = RunResult(record, metrics, trace, trajectory)
+    if isinstance(error, KeyboardInterrupt):
+        raise RunInterrupted(reason, result) from error
+    if error is not None:
+        raise RunAborted(reason, result) from error
+    return result
+
+
+def _journal(kind: str) -> contextlib.AbstractContextManager[list[Any]]:
+    if kind != "robot":
+        return contextlib.nullcontext([])
+    from planners.pddl_task import planning_journal
+
+    return planning_journal()
+
+
+def _run(loop: SimulationLoop, progress: bool) -> None:
+    if not progress:
+        loop.run()
+        return
+    from tqdm import tqdm
+
+    horizon = loop.horizon
+    with tqdm(total=round(horizon), unit="sim s", desc="simulating", leave=False, file=sys.stderr) as bar:
+        while True:
+            before = loop.now
+            loop.run(until=loop.now + 10.0)
+            bar.update(round(loop.now) - bar.n)
+            if not loop.harmoniser.busy and loop._pending_events == 0 or loop.now <= before or loop.now >= horizon:
+                break
+
+
+def _planner_config() -> dict[str, Any]:
+    from planners.pddl_task import default_planner
+
+    p = default_planner()
+    return {"engine": getattr(p, "name", "tasker-fd"), "unified_planning": _version("unified-planning"),
+            "up_fast_downward": _version("up-fast-downward")}
+
+
+def _version(dist: str) -> str | None:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version(dist)
+    except PackageNotFoundError:
+        return None
+
+
+def _metrics(trace: Trace, calls: list[dict[str, Any]], wall: float) -> dict[str, Any]:
+    from experiments.metrics import run as metrics
+
+    m = metrics.compute(trace.events)
+    sim_time = trace.events[-1]["t"] if trace.events else 0.0
+    m["planner_wall_time_s"] = round(sum(float(c.get("planner_time_s", 0.0)) for c in calls), 6)
+    m["planner_cache_hits"] = sum(1 for c in calls if c.get("cached"))
+    m["wall_time_s"] = round(wall, 3)
+    m["real_time_factor"] = round(sim_time / wall, 2) if wall > 0 else None
+    return m
+
+
+OUTPUTS = ("trace.jsonl", "trajectory.jsonl", "run.json", "metrics.json", "timeline.png", "gantt.png",
+           "world.png", "report.html")
+"""The files a run writes into its folder (and ``problems/``), each only when it has one."""
+
+
+def _clear_outputs(out: Path) -> None:
+    """Remove what an earlier run wrote into ``out`` (:data:`OUTPUTS`, ``problems/``'s PDDL, plans and
+    index) and nothing else: a run writes only some of them (no pictures with ``--no-pictures``, no
+    trajectory for a synthetic scenario, fewer planning calls), so the rest would read as this run's."""
+    from experiments.report.explain import INDEX
+
+    if not ((out / "trace.jsonl").is_file() and (out / "run.json").is_file()):
+        return  # not a run's folder (e.g. --out . in a project): nothing of a run to remove
+    for name in OUTPUTS:
+        (out / name).unlink(missing_ok=True)
+    problems = out / "problems"
+    if problems.is_dir():
+        for f in problems.iterdir():
+            if f.is_file() and (f.name == INDEX or f.suffix in (".pddl", ".plan")):
+                f.unlink()
+        if not any(problems.iterdir()):
+            problems.rmdir()
+
+
+def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Trace,
+          trajectory: tuple[tuple[float, float, float, float], ...], world: Any, pictures: bool,
+          sim: Any = None, journal: Any = ()) -> None:
+    from experiments.report.explain import write_problems
+
+    out.mkdir(parents=True, exist_ok=True)
+    _clear_outputs(out)
+    trace.write(out / "trace.jsonl")
+    if sim is not None:  # poses and postures at a fixed rate (robot.recording)
+        sim.write_trajectory(out / "trajectory.jsonl")
+    (out / "run.json").write_text(json.dumps(record, indent=2, sort_keys=True, default=str) + "\n")
+    (out / "metrics.json").write_text(json.dumps(metrics_, indent=2, sort_keys=True) + "\n")
+    write_problems(out / "problems", journal)
+    if not pictures:
+        return
+    from experiments.report import plots
+    from experiments.report import run_page as report_html
+
+    plots.timeline(trace.events, out / "timeline.png")
+    plots.gantt(trace.events, out / "gantt.png")
+    report_html.write_run(out, trace.events, record=record, metrics=metrics_, world=world, trajectory=trajectory)
+    if world is not None:
+        plots.world_path(world, list(trajectory), out / "world.png", events=trace.events,
+                         recording=getattr(sim, "recording", None))
