@@ -3,7 +3,7 @@
     python benchmarks/bench_day.py                 # tabsa-short on both backends, tabsa synthetic
     python benchmarks/bench_day.py tabsa-short tabsa   # the robot day of each (tabsa: minutes)
 
-One day (seed 1, ``alg2``) through :func:`experiments.days.report.run_day`, the path the
+One day (seed 1, ``alg2``) through :func:`experiments.days.runner.run_day`, the path the
 day report takes; the baseline is the same day on the synthetic backend, measured in the
 same run.  Prints wall and CPU seconds, simulated seconds per CPU second, and the ratio
 robot / synthetic.  This is what decides how many robot days a machine can run
@@ -20,12 +20,12 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from experiments.days import pipeline as days  # noqa: E402
-from experiments.days import report as dayreport  # noqa: E402
+from experiments.days import runner as day_runner  # noqa: E402
 
 
 def one(protocol: str, backend: str) -> tuple[float, float, dict[str, object]]:
     wall, cpu = time.perf_counter(), time.process_time()
-    m = dayreport.run_day(protocol, 1, "alg2", backend)
+    m = day_runner.run_day(protocol, 1, "alg2", backend)
     return time.perf_counter() - wall, time.process_time() - cpu, m
 
 

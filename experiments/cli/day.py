@@ -1,8 +1,9 @@
 """``tasker day``: run a day protocol (N days x schedulers on a backend) and write its table.
 
-The same as ``python -m experiments.days.report``; this module holds only the options, so
-``tasker --help`` stays clear of numpy and scipy (the handler imports
-:mod:`experiments.days.report` when it runs).  See ``docs/benchmark.md``.
+The days run through :mod:`experiments.days.runner` and their table is
+:mod:`experiments.days.table`; this module checks the options and writes ``OUT``.  The
+heavy modules (numpy, scipy, the runner) are imported when the command runs, so
+``tasker --help`` stays fast.  See ``docs/benchmark.md``.
 """
 
 from __future__ import annotations
@@ -12,7 +13,17 @@ import sys
 from pathlib import Path
 
 from experiments.days import pipeline as days
-from tasker.support.cliargs import EXIT_INTERRUPTED, seed
+from tasker.errors import ConfigError
+from tasker.support.cliargs import (
+    EXIT_INTERRUPTED,
+    SEED_LIMIT,
+    UsageError,
+    seed,
+    show_progress,
+    writable_dir,
+    writable_file,
+)
+from tasker.support.reader import suggest
 
 EXAMPLES = """\
 examples:
@@ -51,11 +62,103 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                          "table.md")
 
 
-def _run(args: argparse.Namespace) -> int:
-    from experiments.days import report as dayreport
+def _days(a: argparse.Namespace) -> int:
+    """Run the days into ``OUT/days.db``; write ``days.jsonl`` and ``table.md``; print the table.
 
+    Bad input raises :class:`tasker.support.cliargs.UsageError` (or the protocol's
+    :class:`tasker.support.reader.InputError`) before the first day runs.  Returns 1 if a day failed
+    to run (it is listed under the table), else 0."""
+    import json
+
+    from experiments.cli.sweep import dask_scheduler
+    from experiments.days.resume import check_resumable, import_log, scenario_key
+    from experiments.days.runner import run_days
+    from experiments.days.table import report
+    from experiments.inputs.strategy import Strategy
+    from experiments.sweep.driver import lease
+    from experiments.sweep.spec import MAX_JOBS
+    from tasker import schedulers
+
+    unknown = [n for n in a.schedulers if n not in schedulers.names()]
+    if unknown:
+        raise UsageError("--schedulers", f"unknown scheduler {unknown[0]!r}{suggest(unknown[0], schedulers.names())}; "
+                                         f"known: {', '.join(schedulers.names())}")
+    twice = sorted({n for n in a.schedulers if a.schedulers.count(n) > 1})
+    if twice:
+        raise UsageError("--schedulers", f"{twice[0]!r} is given twice")
+    if a.days < 1:
+        raise UsageError("--days", f"expected >= 1, got {a.days}")
+    if a.first_seed + a.days > SEED_LIMIT:
+        raise UsageError("--days", f"the last day's seed would be {a.first_seed + a.days - 1}: seeds are < 2**32")
+    if a.workers is not None and a.workers < 1:
+        raise UsageError("--workers", f"expected >= 1, got {a.workers}")
+    strategies = []
+    for text in a.strategies or ["default"]:
+        try:
+            st = Strategy.parse(text)
+        except ValueError as exc:
+            raise UsageError("--strategies", str(exc)) from exc
+        if st.scheduler is not None:
+            raise UsageError("--strategies", f"{text!r} names a scheduler: schedulers are --schedulers")
+        strategies.append(st)
+    if len({st.label for st in strategies}) != len(strategies):
+        raise UsageError("--strategies", "a strategy is given twice")
+    n_jobs = a.days * len(a.schedulers) * len(strategies)
+    if n_jobs > MAX_JOBS:  # as a sweep refuses: a typo such as --days 1000000 would fill memory before any day
+        raise UsageError("--days", f"{a.days} days x {len(a.schedulers)} schedulers x {len(strategies)} strategies "
+                                   f"= {n_jobs} days to run, more than the {MAX_JOBS} a run may have")
+    for st in strategies:
+        try:
+            days.check_settings(a.backend, dict(st.items()))
+        except ConfigError as exc:
+            raise UsageError("--strategies", str(exc)) from exc
     try:
-        return dayreport.run(args)
+        proto = days.load(a.protocol)
+    except ConfigError as exc:
+        raise UsageError("--protocol", str(exc)) from exc
+    if a.backend == "robot" and proto.robot is None:
+        raise UsageError("--backend", f"{proto.source} has no [robot_backend]: it runs on the synthetic backend only")
+    try:  # what only a drawn day shows (e.g. more people than the world has): once, before any day runs
+        days.make(a.protocol, a.first_seed, backend=a.backend, scheduler=a.schedulers[0])
+    except ConfigError as exc:
+        raise UsageError("--protocol", str(exc)) from exc
+    workers = a.workers if a.workers is not None else (2 if a.backend == "synthetic" else 1)
+    writable_dir(a.out, "--out")
+    db, log = a.out / "days.db", a.out / "days.jsonl"
+    for written in (db, log, a.out / "table.md"):  # now, not after hours of days: their table would be lost
+        writable_file(written, "--out")
+    if not a.resume:
+        with lease(db):  # a run still writing into OUT keeps its days: this one stops instead
+            for old in (db, log):
+                old.unlink(missing_ok=True)
+    elif not db.exists() and log.is_file():
+        import_log(log, db, a.protocol, a.backend)
+    else:
+        try:
+            check_resumable(db, scenario_key(a.protocol, a.backend), proto)
+        except ConfigError as exc:
+            raise UsageError("--resume", f"{exc}; run without --resume to start afresh, or give another --out") \
+                from None
+    with dask_scheduler(a.scheduler_address):
+        results = run_days(a.protocol, a.days, a.schedulers, first_seed=a.first_seed, workers=workers,
+                           backend=a.backend, db=db, keep=a.out / "runs" if a.keep_runs else None,
+                           strategies=strategies, address=a.scheduler_address, progress=show_progress(a),
+                           retry_errors=a.retry_errors)
+    log.write_text("".join(json.dumps(r, sort_keys=True) + "\n" for r in results), encoding="utf-8")
+    backend = "" if a.backend == "synthetic" else f" --backend {a.backend}"
+    chosen = "" if not a.strategies else " --strategies " + " ".join(st.label for st in strategies)
+    cmd = (f"tasker day --protocol {a.protocol}{backend} --days {a.days} "
+           f"--first-seed {a.first_seed} --schedulers {' '.join(a.schedulers)}{chosen} --out {a.out}")
+    title = f"{proto.name} ({a.backend} backend): seeds {a.first_seed}–{a.first_seed + a.days - 1}"
+    text = report(results, title=title)
+    (a.out / "table.md").write_text(text + f"\nGenerated by `{cmd}`.\n", encoding="utf-8")
+    print(text)
+    return 1 if any("error" in r for r in results) else 0
+
+
+def _run(args: argparse.Namespace) -> int:
+    try:
+        return _days(args)
     except KeyboardInterrupt:  # every day that ended is already in days.db
         db = Path(args.out) / "days.db"
         if db.is_file():

@@ -39,6 +39,7 @@ from experiments.inputs.actions import TimedAction
 from experiments.inputs.strategy import FACTORS
 from experiments.inputs.synthetic import SyntheticScenario
 from tasker.errors import ConfigError
+from tasker.loop import SimulationLoop
 from tasker.support.reader import suggest
 
 PROTOCOLS_DIR = Path(__file__).resolve().parent / "protocols"
@@ -310,3 +311,12 @@ def scheduler_options_for(proto: Protocol, scheduler: str, backend: str) -> dict
     if backend == "robot" and proto.robot is None:
         return {}
     return scheduler_options(proto, scheduler, backend)
+
+
+def build_day(protocol: Protocol, seed: int, scheduler: str, scheduler_options: dict[str, Any] | None = None,
+              ) -> SimulationLoop:
+    """A ready-to-run synthetic loop for day ``seed`` under ``scheduler`` (robot at ``start_site``);
+    the same as ``make(protocol, seed, scheduler=...).build()``."""
+    day = make(protocol, seed, scheduler=scheduler, scheduler_options=scheduler_options or {})
+    loop: SimulationLoop = day.build()
+    return loop

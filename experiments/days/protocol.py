@@ -31,7 +31,6 @@ from experiments.inputs.actions import TimedAction
 from experiments.inputs.filekinds import expect
 from experiments.inputs.synthetic import SyntheticScenario
 from tasker.agent import Rates
-from tasker.loop import SimulationLoop
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
 from tasker.stage import Purpose, Stage, StageKind, StagePlan
 from tasker.support.reader import Table, check_name, suggest
@@ -530,14 +529,3 @@ def generate(protocol: Protocol, seed: int, *, scheduler: str = "alg2",
         scheduler_options=dict(scheduler_options or {}), mode="IT", s_freq=rate, rates=Rates(rate, rate, rate),
         jitter=0.0, seed=seed, horizon=protocol.length_s,
     )
-
-
-def build_day(protocol: Protocol, seed: int, scheduler: str, scheduler_options: dict[str, Any] | None = None,
-              ) -> SimulationLoop:
-    """A ready-to-run synthetic loop for day ``seed`` under ``scheduler`` (robot at ``start_site``);
-    the same as ``experiments.days.pipeline.make(protocol, seed, scheduler=...).build()``."""
-    from experiments.days import pipeline as days
-
-    day = days.make(protocol, seed, scheduler=scheduler, scheduler_options=scheduler_options or {})
-    loop: SimulationLoop = day.build()
-    return loop

@@ -18,7 +18,7 @@ import math
 import random
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -28,48 +28,12 @@ from experiments.inputs import fields
 from experiments.inputs.actions import TABLES, TimedAction, read_actions
 from experiments.inputs.fields import MODES, POLICIES, STRATEGIES, ScenarioError
 from experiments.inputs.filekinds import expect
+from experiments.inputs.robot_scenario import RobotScenario
 from tasker.support import reader
 
 __all__ = ["InterruptionGrid", "RobotScenario", "ScenarioError", "load", "randomize", "resolve", "kind_of", "SCENARIOS"]
 
 SCENARIOS = Path(__file__).resolve().parent / "scenarios"
-
-
-@dataclass(frozen=True)
-class RobotScenario:
-    """A checked robot scenario.
-
-    ``objects`` are the scenario's own things (``[objects.NAME]``):
-    ``{name: {"type", "place", "facts"}}``; ``warnings`` what the loader accepted but
-    doubts (a request after the horizon, two identical requests that overlap).
-    """
-
-    name: str
-    source: str
-    world: str
-    actions: tuple[TimedAction, ...]
-    scheduler: str = "alg2"
-    scheduler_options: dict[str, Any] = field(default_factory=dict)
-    mode: str = "IT"
-    s_freq: float = 1.0
-    rep_rate: float = 1.0
-    task_exe_rate: float = 10.0
-    sp_up_rate: float = 1.0
-    update: str = "planned"
-    suspension: str = "planned"
-    strategies: dict[str, dict[str, str]] = field(default_factory=dict)
-    seed: int = 1
-    horizon: float = 1800.0
-    people: dict[str, dict[str, Any]] = field(default_factory=dict)
-    objects: dict[str, dict[str, Any]] = field(default_factory=dict)
-    policy: str = "strict"
-    warnings: tuple[str, ...] = field(default=(), compare=False)
-
-    def to_json(self) -> dict[str, Any]:
-        out = dataclasses.asdict(self)
-        out["actions"] = [{"t": a.t, "kind": a.kind, **a.fields} for a in self.actions]
-        out.pop("warnings", None)
-        return out
 
 
 SCENARIO_KEYS = ("kind", "name", "world", "seed", "settings", "people", "objects", *(k for k, _ in TABLES))

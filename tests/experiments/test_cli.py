@@ -351,13 +351,13 @@ def test_a_task_ended_by_an_exception_counts_as_failed(tmp_path: Path, monkeypat
 def test_day_stopped_by_ctrl_c_says_how_to_go_on(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
                                                  capsys: pytest.CaptureFixture[str]) -> None:
     """Before: a bare "interrupted", though the days that ended were kept and --resume goes on."""
-    import experiments.days.report
+    import experiments.cli.day
 
     def stopped(args: Any) -> int:
         (Path(args.out) / "days.db").write_bytes(b"")
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(experiments.days.report, "run", stopped)
+    monkeypatch.setattr(experiments.cli.day, "_days", stopped)
     out = tmp_path / "day"
     out.mkdir()
     assert main(["day", "--protocol", "tabsa", "--days", "1", "--out", str(out)]) == 130

@@ -1,7 +1,7 @@
 """The one scenario pipeline: (protocol, seed, backend) → a scenario, on both backends.
 
 Robot days here are tiny (one request of each type in a few minutes) so the suite stays
-fast; the shipped protocols' days are run by ``python -m experiments.days.report``.
+fast; the shipped protocols' days are run by ``tasker day``.
 """
 
 from __future__ import annotations
@@ -15,7 +15,8 @@ import pytest
 
 from experiments.days import pipeline as days
 from experiments.days import protocol
-from experiments.days import report as dayreport
+from experiments.days import runner as day_runner
+from experiments.metrics import day as day_metrics_mod
 from robot.estimator import motion_model
 from robot.spec import load_world
 from tasker import schedulers
@@ -120,7 +121,7 @@ def test_every_scheduler_runs_every_task_type_synthetic(name: str) -> None:
 
 @pytest.mark.parametrize("name", schedulers.names())
 def test_every_scheduler_runs_every_task_type_robot(tiny_protocol: protocol.Protocol, name: str) -> None:
-    m = dayreport.run_day(tiny_protocol.source, 1, name, "robot")
+    m = day_runner.run_day(tiny_protocol.source, 1, name, "robot")
     assert {t: v["completed"] for t, v in m["per_type"].items()} == {"transport": 1, "fall": 1, "pick_place": 1}
     assert m["dead_falls"] == 0 and m["travel_m"] > 0
 
@@ -128,7 +129,7 @@ def test_every_scheduler_runs_every_task_type_robot(tiny_protocol: protocol.Prot
 def test_a_robot_day_runs_under_the_strategy_it_is_given(tiny_protocol: protocol.Protocol, tmp_path: Path) -> None:
     from experiments.inputs.strategy import Strategy
 
-    m = dayreport.run_day(tiny_protocol.source, 1, "alg2", "robot", keep=str(tmp_path),
+    m = day_runner.run_day(tiny_protocol.source, 1, "alg2", "robot", keep=str(tmp_path),
                           strategy=Strategy(update="static", suspension="static"))
     assert m["strategy"] == "update=static,suspension=static"
     run = json.loads((tmp_path / "trace.jsonl").read_text().splitlines()[0])
@@ -266,7 +267,7 @@ def test_a_failed_fall_is_requested_again_and_served(tiny_protocol: protocol.Pro
         return real(self, name)
 
     monkeypatch.setattr(skills.Navigate, "_approach", first_fails)
-    dayreport.run_day(tiny_protocol.source, 1, "alg2", "robot", keep=str(tmp_path))
+    day_runner.run_day(tiny_protocol.source, 1, "alg2", "robot", keep=str(tmp_path))
     events = [json.loads(line) for line in (tmp_path / "trace.jsonl").read_text().splitlines()]
     falls = [e for e in events if e["event"] == "request" and e["task_type"] == "human_fell"]
     assert len(falls) == 2 and falls[1]["renews"] == falls[0]["agent"] and falls[1]["args"] == falls[0]["args"]
@@ -278,7 +279,7 @@ def test_a_failed_fall_is_requested_again_and_served(tiny_protocol: protocol.Pro
     up = next(e for e in events if e["event"] == "world" and e["value"] == [person, "standing"])
     assert up["t"] == renewed["t"] and "help done" in up["note"]  # taken away after the renewal's help
     kinds = {v: k for k, v in days.task_names(tiny_protocol, "robot").items()}
-    m = dayreport.day_metrics(events, day_end=tiny_protocol.length_s, kinds=kinds)
+    m = day_metrics_mod.day_metrics(events, day_end=tiny_protocol.length_s, kinds=kinds)
     f = m["per_type"]["fall"]
     assert (f["requested"], f["completed"], f["failed"], f["renewals"]) == (1, 1, 0, 1) and m["dead_falls"] == 0
 

@@ -6,8 +6,12 @@ from pathlib import Path
 
 import pytest
 
+from experiments.analysis import stats
+from experiments.days import pipeline as day_pipeline
 from experiments.days import protocol
-from experiments.days import report as dayreport
+from experiments.days import runner as day_runner
+from experiments.days import table as day_table
+from experiments.metrics import day as day_metrics_mod
 from tasker import schedulers
 from tasker.support.reader import InputError
 
@@ -33,21 +37,21 @@ def test_a_day_is_reproducible_per_seed(tabsa: protocol.Protocol) -> None:
     falls = [x.fields["args"] for x in a.actions if x.fields["task"] == "fall"]
     assert all(f["death_at"] == pytest.approx(f["deadline"] + 900.0) for f in falls)
     assert all(60.0 <= f["work"] <= 300.0 for f in falls)
-    t1 = protocol.build_day(tabsa, 7, "lookahead").run().dumps()
-    t2 = protocol.build_day(tabsa, 7, "lookahead").run().dumps()
+    t1 = day_pipeline.build_day(tabsa, 7, "lookahead").run().dumps()
+    t2 = day_pipeline.build_day(tabsa, 7, "lookahead").run().dumps()
     assert t1 == t2  # byte for byte
 
 
 @pytest.mark.parametrize("name", schedulers.names())
 def test_every_scheduler_runs_every_task_type(tabsa: protocol.Protocol, name: str) -> None:
-    trace = protocol.build_day(tabsa, 2, name, dayreport.scheduler_options(tabsa, name)).run()
+    trace = day_pipeline.build_day(tabsa, 2, name, day_runner.scheduler_options(tabsa, name)).run()
     finished = {e["task_type"] for e in trace.of("end", cause="finished")}
     assert finished == {"transport", "fall", "pick_place"}
     assert not trace.of("end", cause="failed")
 
 
 def test_a_transport_interrupted_while_escorting_asks_to_wait_and_goes_back(tabsa: protocol.Protocol) -> None:
-    trace = protocol.build_day(tabsa, 2, "alg2", dayreport.scheduler_options(tabsa, "alg2")).run()
+    trace = day_pipeline.build_day(tabsa, 2, "alg2", day_runner.scheduler_options(tabsa, "alg2")).run()
     susp = [e for e in trace.of("plan", purpose="genSusp") if e["stages"]]
     assert susp, "day 2 under alg2 interrupts a task mid-motion"
     agent = susp[0]["agent"]
@@ -190,7 +194,7 @@ HAND = [
 
 
 def test_metrics_agree_with_hand_computed_values() -> None:
-    m = dayreport.day_metrics(HAND, day_end=2000.0)
+    m = day_metrics_mod.day_metrics(HAND, day_end=2000.0)
     assert m["requested"] == 3 and m["completed"] == 2
     assert m["dead_falls"] == 1 and m["first_death_t"] == 1000.0  # d3 never finished
     assert m["interruptions"] == 2 and m["suspensions"] == 1
@@ -206,21 +210,21 @@ def test_metrics_agree_with_hand_computed_values() -> None:
 
 
 def test_endings() -> None:
-    before_death = dayreport.day_metrics(HAND[:11], day_end=500.0)  # d3 not requested, d1 unfinished
+    before_death = day_metrics_mod.day_metrics(HAND[:11], day_end=500.0)  # d3 not requested, d1 unfinished
     assert before_death["ending"] == "time ran out" and before_death["dead_falls"] == 0
     done = [e for e in HAND if e.get("agent") != "d3" and not (e["t"] == 95)]
-    assert dayreport.day_metrics(done, day_end=2000.0)["ending"] == "all done"
+    assert day_metrics_mod.day_metrics(done, day_end=2000.0)["ending"] == "all done"
     no_osc = [e for e in HAND if e["t"] != 95]
-    assert dayreport.day_metrics(no_osc, day_end=2000.0)["ending"] == "a fall died"
+    assert day_metrics_mod.day_metrics(no_osc, day_end=2000.0)["ending"] == "a fall died"
 
 
 def test_holm_adjustment() -> None:
-    assert dayreport.holm([0.01, 0.04, 0.03]) == pytest.approx([0.03, 0.06, 0.06])
+    assert stats.holm([0.01, 0.04, 0.03]) == pytest.approx([0.03, 0.06, 0.06])
 
 
 def test_table_has_every_scheduler_and_the_paired_tests(tabsa: protocol.Protocol) -> None:
-    results = dayreport.run_days(TABSA, 3, ["lookahead", "simple2"], workers=1)
-    text = dayreport.table(results)
+    results = day_runner.run_days(TABSA, 3, ["lookahead", "simple2"], workers=1)
+    text = day_table.table(results)
     assert "| metric | lookahead | simple2 |" in text
     assert "| dead falls | simple2 |" in text and "Holm" in text
 
@@ -237,7 +241,7 @@ def test_a_failed_tasks_own_safe_suspension_is_not_an_interruption() -> None:
         ev(9, "transition", agent="d1", trigger="finished", **{"from": "exeSusp", "to": "end"}),
         ev(9, "end", agent="d1", task_type="pick_place", cause="failed"),
     ]
-    m = dayreport.day_metrics(events, day_end=100.0)
+    m = day_metrics_mod.day_metrics(events, day_end=100.0)
     assert m["interruptions"] == 0 and m["suspensions"] == 1 and m["suspension_time_s"] == pytest.approx(4.0)
     assert m["failed"] == 1 and m["completed"] == 0
 
@@ -261,13 +265,13 @@ def _renewed(second: str) -> list[dict[str, object]]:
 def test_a_fall_requested_again_is_one_need() -> None:
     """A renewed request is the same need: served when any of its tasks finishes, dead only
     if none did by death_at, and counted once among the requests."""
-    served = dayreport.day_metrics(_renewed("finished"), day_end=2000.0)
+    served = day_metrics_mod.day_metrics(_renewed("finished"), day_end=2000.0)
     assert (served["requested"], served["completed"], served["failed"], served["renewals"]) == (1, 1, 0, 2)
     assert served["dead_falls"] == 0 and served["ending"] == "all done"
     assert served["completion_minus_deadline_s"] == pytest.approx(100.0)  # served at 400, deadline 300
     f = served["per_type"]["fall"]
     assert (f["requested"], f["completed"], f["failed"], f["renewals"]) == (1, 1, 0, 2)
-    never = dayreport.day_metrics(_renewed("failed"), day_end=2000.0)
+    never = day_metrics_mod.day_metrics(_renewed("failed"), day_end=2000.0)
     assert (never["requested"], never["completed"], never["failed"], never["renewals"]) == (1, 0, 1, 2)
     assert never["dead_falls"] == 1 and never["first_death_t"] == 1200.0 and never["ending"] == "a fall died"
 

@@ -1,0 +1,99 @@
+"""``experiments/`` is layered: a sub-package imports only the layers below it (and itself).
+
+The order, lowest first, is :data:`LAYERS`; ``sweep`` is below ``days`` (a day runs as
+sweep jobs), ``days`` and ``paper`` share a level, ``cli`` is on top, and modules directly
+in ``experiments/`` (the facade) may use every layer but ``cli``.  Every import counts:
+module level, inside functions, and under ``TYPE_CHECKING``.  No two project modules
+import each other, in any package.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+LAYERS = {"inputs": 0, "trace": 1, "metrics": 2, "analysis": 3, "report": 4, "run": 5, "sweep": 6,
+          "days": 7, "paper": 7, "cli": 9}
+FACADE = 8
+PACKAGES = ("tasker", "planners", "robot", "experiments", "domains")
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for pkg in PACKAGES:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            name = ".".join(path.relative_to(ROOT).with_suffix("").parts)
+            out[name.removesuffix(".__init__")] = path
+    return out
+
+
+MODULES = _modules()
+
+
+def _resolve(name: str) -> str | None:
+    while name and name not in MODULES:
+        name = name.rpartition(".")[0]
+    return name or None
+
+
+def _imports(name: str) -> set[str]:
+    path = MODULES[name]
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            found |= {m for a in node.names if (m := _resolve(a.name))}
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parts = package.split(".")
+                parts = parts[: len(parts) - node.level + 1]
+                base = ".".join(parts + ([base] if base else []))
+            for alias in node.names:
+                m = _resolve(f"{base}.{alias.name}") if base else None
+                if m and m != _resolve(base):
+                    found.add(m)
+                elif (b := _resolve(base)) is not None:
+                    found.add(b)
+    return {m for m in found if m != name}
+
+
+def _rank(module: str) -> int | None:
+    parts = module.split(".")
+    if parts[0] != "experiments" or len(parts) == 1:
+        return None
+    return LAYERS.get(parts[1], FACADE)
+
+
+def test_every_experiments_module_lives_in_a_known_layer_or_is_the_facade() -> None:
+    for name, path in MODULES.items():
+        parts = name.split(".")
+        if parts[0] == "experiments" and len(parts) > 2:
+            assert parts[1] in LAYERS, f"{path}: {parts[1]!r} is not a layer of experiments/ ({sorted(LAYERS)})"
+
+
+def test_layers_import_only_downward() -> None:
+    wrong = []
+    for name in MODULES:
+        mine = _rank(name)
+        if mine is None:
+            continue
+        for dep in _imports(name):
+            theirs = _rank(dep)
+            if theirs is not None and theirs > mine:
+                wrong.append(f"{name} imports {dep}")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_no_other_package_imports_experiments() -> None:
+    wrong = [f"{n} imports {d}" for n in MODULES if not n.startswith("experiments")
+             for d in _imports(n) if d.startswith("experiments")]
+    assert not wrong, "\n".join(wrong)
+
+
+def test_no_two_modules_import_each_other() -> None:
+    graph = {n: {d for d in _imports(n) if not d.startswith(n + ".") and not n.startswith(d + ".")}
+             for n in MODULES}
+    pairs = sorted({tuple(sorted((a, b))) for a in graph for b in graph[a] if a in graph.get(b, ())})
+    assert not pairs, pairs
