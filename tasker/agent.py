@@ -33,6 +33,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
+from tasker import events as ev
 from tasker import fsm, securing
 from tasker.errors import AgentEnded, ConfigError, FSMError, InvariantViolation, PlanningFailed, WorldError
 from tasker.messages import Command, Flag, FsmState, Report, ScheduleParams, SPRequest
@@ -139,7 +140,7 @@ class DynamicAgent:
         changed = {k: v for k, v in args.items() if self.ctx.args.get(k) != v}
         self.ctx.args = dict(args)
         self._params_at = self._fresh = None
-        self._trace.emit(now, "change", agent=self.id, args=changed, requester=requester)
+        self._trace.emit(ev.ArgsChanged(now, self.id, changed, requester))
         if self._waker is not None:
             self._waker(self)
 
@@ -481,8 +482,7 @@ class DynamicAgent:
     def _fire(self, event: str, now: float) -> None:
         """Fire ``event`` through the FSM table: the table picks the target; traced and reported."""
         t = fsm.resolve(self.state, event, self._guard)
-        self._trace.emit(now, "transition", agent=self.id, trigger=event,
-                         **{"from": self.state.value, "to": t.target.value})
+        self._trace.emit(ev.Transition(now, self.id, event, self.state.value, t.target.value))
         self.state = t.target
         if t.target is S.END:
             self.next_wake = math.inf
@@ -496,7 +496,7 @@ class DynamicAgent:
         if self.state is not S.END:
             raise FSMError(f"agent {self.id}: event {event!r} did not end the task")
         self.end_reason = reason
-        self._trace.emit(now, "end", agent=self.id, task_type=self.ctx.task_type, reason=reason, cause=cause)
+        self._trace.emit(ev.TaskEnded(now, self.id, self.ctx.task_type, reason, cause))
         self._publish()
 
     def _fail(self, now: float, exc: BaseException) -> None:
@@ -544,25 +544,16 @@ class DynamicAgent:
         runner = self._runner
         assert runner is not None and runner.stage is not None
         stage = runner.stage
-        self._trace.emit(now, "stage", agent=self.id, fsm=self.state.value, index=runner.index,
-                         action=stage.action, args=list(stage.args), kind=stage.kind.value, status=status, **extra)
+        self._trace.emit(ev.StageChanged(now, self.id, self.state.value, runner.index, stage.action, list(stage.args),
+                                         stage.kind.value, status, **extra))
 
     def _emit_plan(self, now: float, plan: StagePlan) -> None:
         if not isinstance(plan, StagePlan):
             raise ConfigError(f"task type {self.ctx.task_type!r} returned a {type(plan).__name__} in "
                               f"{self.state.value}, expected a StagePlan")
-        fields: dict[str, Any] = {
-            "agent": self.id,
-            "purpose": plan.purpose.value,
-            "strategy": plan.strategy,
-            "stages": [s.to_json() for s in plan.stages],
-        }
-        if plan.note:
-            fields["note"] = plan.note
+        info = None
         if plan.info:
-            stable = {k: v for k, v in plan.info.items() if k not in VOLATILE_INFO}
-            if stable:
-                fields["info"] = stable
+            info = {k: v for k, v in plan.info.items() if k not in VOLATILE_INFO} or None
             self.planner_calls.append({"t": now, "agent": self.id, "purpose": plan.purpose.value,
                                        "strategy": plan.strategy, **dict(plan.info)})
         expected = Purpose.UP_TSK if self.state is S.UP_TSK else Purpose.GEN_SUSP
@@ -570,7 +561,8 @@ class DynamicAgent:
             raise ConfigError(
                 f"task type {self.ctx.task_type!r} returned a {plan.purpose.value} plan in {self.state.value}"
             )
-        self._trace.emit(now, "plan", **fields)
+        self._trace.emit(ev.PlanMade(now, self.id, plan.purpose.value, plan.strategy,
+                                     [s.to_json() for s in plan.stages], plan.note or None, info))
 
 
 _UNCONTAINED = (InvariantViolation, WorldError)

@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any, overload
 
+from tasker import events as ev
 from tasker.agent import DynamicAgent
 from tasker.errors import AgentEnded, ConfigError, InvariantViolation, TaskerError, WorldError
 from tasker.messages import Command, Flag, FsmState, ScheduleParams, SPRequest
@@ -227,7 +228,7 @@ class TaskHarmoniser:
         new = Mode(mode)
         if new is not self.mode:
             self.mode = new
-            self._trace.emit(self.now, "mode", mode=new.value)
+            self._trace.emit(ev.ModeChanged(self.now, new.value))
 
     @property
     def idle_da(self) -> list[str]:
@@ -278,9 +279,8 @@ class TaskHarmoniser:
             self.agents[agent_id] = agent
             self._order[agent_id] = len(self._order)
             self._idle[agent_id] = None
-            again = {"renews": request.renews} if request.renews is not None else {}
-            self._trace.emit(now, "request", agent=agent_id, task_type=request.task_type,
-                             args=dict(request.args), requester=request.requester, **again)
+            self._trace.emit(ev.TaskRequested(now, agent_id, request.task_type, dict(request.args),
+                                              request.requester, request.renews))
         self._requests.clear()
         self._became.clear()  # a new request may legitimately preempt again
         self._roles_dirty = True
@@ -305,7 +305,7 @@ class TaskHarmoniser:
             if self.irr_da == agent_id:
                 self.irr_da = None
             if self._securing is not None and self._securing.agent == agent_id:
-                self._trace.emit(self.now, "secure", agent=agent_id, status="ended")
+                self._trace.emit(ev.SecureChanged(self.now, agent_id, "ended"))
                 self._securing = None
         self._ended.clear()
         self._roles_dirty = True
@@ -335,16 +335,17 @@ class TaskHarmoniser:
             except (InvariantViolation, WorldError):
                 raise
             except Exception as exc:
-                self._trace.emit(now, "decision", algorithm=name, rule="error", switch=False,
-                                 error=f"{type(exc).__name__}: {exc}")
+                self._trace.emit(ev.Decision(now, {"algorithm": name, "rule": "error", "switch": False,
+                                                   "error": f"{type(exc).__name__}: {exc}"}))
                 return
             break
         else:
             return
         choice = decision.irr_da
         if choice is not None and choice not in self._idle:
-            self._trace.emit(now, "decision", algorithm=name, rule="error", switch=False,
-                             error=f"the scheduler chose {choice!r}, which is not idle; idle: {list(self._idle)}")
+            self._trace.emit(ev.Decision(now, {
+                "algorithm": name, "rule": "error", "switch": False,
+                "error": f"the scheduler chose {choice!r}, which is not idle; idle: {list(self._idle)}"}))
             return
         record = decision.record
         if choice is not None and record is None:  # every choice leaves a decision, whatever the scheduler
@@ -356,7 +357,7 @@ class TaskHarmoniser:
                 record = {**record, "switch": False, "held": held}
                 choice = None
         if record is not None:
-            self._trace.emit(now, "decision", **record)
+            self._trace.emit(ev.Decision(now, record))
         if choice is not None:
             del self._idle[choice]
             self.irr_da = choice
@@ -436,12 +437,13 @@ class TaskHarmoniser:
             return
         agent, hz = due.agent, due.hazard
         self._securing = _Securing(agent, due.secure_s)
-        self._trace.emit(now, "decision", algorithm=self.scheduler.name, rule="secure", dac=agent,
-                         exeDA=self.exe_da, switch=True, hazard=str(hz.name), args=list(hz.fact[1:]),
-                         remaining_s=due.remaining_s, secure_s=due.secure_s, suspend_s=due.suspend_s,
-                         margin_s=self.watch.margin_s + self.watch.period_s)
-        self._trace.emit(now, "secure", agent=agent, status="start",
-                         hazards=[{"hazard": e[1], "args": list(e[2][1:])} for e in due.episodes])
+        self._trace.emit(ev.Decision(now, {
+            "algorithm": self.scheduler.name, "rule": "secure", "dac": agent, "exeDA": self.exe_da, "switch": True,
+            "hazard": str(hz.name), "args": list(hz.fact[1:]), "remaining_s": due.remaining_s,
+            "secure_s": due.secure_s, "suspend_s": due.suspend_s,
+            "margin_s": self.watch.margin_s + self.watch.period_s}))
+        self._trace.emit(ev.SecureChanged(now, agent, "start",
+                                          [{"hazard": e[1], "args": list(e[2][1:])} for e in due.episodes]))
         if self.irr_da is not None:  # a switch already under way: the hazard goes first
             self._idle[self.irr_da] = None
         del self._idle[agent]
@@ -450,7 +452,7 @@ class TaskHarmoniser:
         self._roles_dirty = True
 
     def _secure_done(self, now: float, agent: str) -> None:
-        self._trace.emit(now, "secure", agent=agent, status="done")
+        self._trace.emit(ev.SecureChanged(now, agent, "done"))
         self._securing = None
         self._idle[agent] = None
         self._idle = dict.fromkeys(sorted(self._idle, key=lambda a: self._order.get(a, 0)))
@@ -462,7 +464,7 @@ class TaskHarmoniser:
     def _send(self, agent_id: str, flag: Flag, data: Mapping[str, Any] | None = None) -> int:
         self._seq += 1
         fields = {k: v for k, v in (data or {}).items() if k in _TRACED}
-        self._trace.emit(self.now, "command", agent=agent_id, flag=flag.value, **fields)
+        self._trace.emit(ev.CommandSent(self.now, agent_id, flag.value, **fields))
         self.agents[agent_id].deliver(Command(flag, self._seq, dict(data or {})))
         return self._seq
 
@@ -577,4 +579,4 @@ class TaskHarmoniser:
         roles = (self.exe_da, self.irr_da, tuple(self._idle))
         if roles != self._last_roles:
             self._last_roles = roles
-            self._trace.emit(now, "roles", exeDA=self.exe_da, irrDA=self.irr_da, idleDA=list(self._idle))
+            self._trace.emit(ev.RolesChanged(now, self.exe_da, self.irr_da, list(self._idle)))

@@ -24,6 +24,7 @@ import random
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from tasker import events as ev
 from tasker.agent import DynamicAgent, Rates
 from tasker.errors import ConfigError, RunAborted, WorldError
 from tasker.harmoniser import HazardSource, Mode, Request, TaskHarmoniser
@@ -179,7 +180,7 @@ class SimulationLoop:
                     agent.abort(now, f"run aborted: {reason}")
                 except Exception:  # ending the others matters more than this one's report
                     pass
-        self.trace.emit(now, "run", status="aborted", reason=reason, active=sorted(a.id for a in live))
+        self.trace.emit(ev.RunStopped(now, "aborted", reason, sorted(a.id for a in live)))
         self._heap.clear()
         return RunAborted(reason)
 
@@ -195,11 +196,10 @@ class SimulationLoop:
 
     def _start(self) -> None:
         self._started = True
-        self.trace.emit(self.now, "run", seed=self.seed, scheduler=self.harmoniser.scheduler.name,
-                        mode=self.harmoniser.mode.value, sFreq=self.harmoniser.s_freq,
-                        repRate=self.rates.rep_rate, taskExeRate=self.rates.task_exe_rate,
-                        SPupRate=self.rates.sp_up_rate,
-                        update=self.strategy.update, suspension=self.strategy.suspension)
+        self.trace.emit(ev.RunStarted(self.now, self.seed, self.harmoniser.scheduler.name,
+                                      self.harmoniser.mode.value, self.harmoniser.s_freq, self.rates.rep_rate,
+                                      self.rates.task_exe_rate, self.rates.sp_up_rate,
+                                      self.strategy.update, self.strategy.suspension))
         self._push(self._tick, _TIMER, None)
         if self.world is not None:
             self._push(self._tick, _WORLD, None)
@@ -243,7 +243,7 @@ class SimulationLoop:
                 break
             if tick > horizon_tick:
                 self._tick = horizon_tick
-                self.trace.emit(self.now, "run", status="horizon reached", active=sorted(harm.agents))
+                self.trace.emit(ev.RunStopped(self.now, "horizon reached", None, sorted(harm.agents)))
                 break
             self._tick = tick
             now = tick * self.resolution

@@ -22,6 +22,8 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+from tasker import events as ev
+
 Literal = tuple[str, ...]
 Fact = tuple[str, ...]
 
@@ -237,9 +239,9 @@ class Monitor:
         self._live: set[str] = set()
         trace.subscribe(self._on_event)
 
-    def _on_event(self, e: Mapping[str, Any]) -> None:
-        if e.get("event") == "stage" and e.get("status") == "done":
-            self._done_in_tick.append(str(e.get("agent")))
+    def _on_event(self, e: ev.Event) -> None:
+        if isinstance(e, ev.StageChanged) and e.status == "done":
+            self._done_in_tick.append(e.agent)
 
     def observe(self, now: float) -> None:
         made_by, self._done_in_tick = self._done_in_tick, []
@@ -316,8 +318,8 @@ class Monitor:
 
     def _emit_hazard(self, now: float, key: tuple[str | None, str, Fact], hz: Hazard, status: str) -> None:
         agent, name, fact = key
-        self.trace.emit(now, "hazard", agent=agent, hazard=name, args=list(fact[1:]), fact=list(fact),
-                        status=status, budget_s=hz.budget_s, severity=hz.severity)
+        self.trace.emit(ev.HazardChanged(now, agent, name, list(fact[1:]), list(fact), status, hz.budget_s,
+                                         hz.severity))
 
     def _people(self, now: float, facts: frozenset[Fact], agents: list[Any], robot: str) -> None:
         """Roles of live agents; an agent that ended since the last look is evaluated once
@@ -339,12 +341,12 @@ class Monitor:
                         found[(a.id, role)] = person
                         break
         for key in sorted(set(self.roles) - set(found)):
-            self.trace.emit(now, "role", agent=key[0], role=key[1], person=self.roles.pop(key), status="off")
+            self.trace.emit(ev.RoleChanged(now, key[0], key[1], self.roles.pop(key), "off"))
         for key in sorted(set(found) - set(self.roles)):
             self.roles[key] = found[key]
-            self.trace.emit(now, "role", agent=key[0], role=key[1], person=found[key], status="on")
+            self.trace.emit(ev.RoleChanged(now, key[0], key[1], found[key], "on"))
         for key in sorted(k for k in self.roles if k[0] in ended_now):
-            self.trace.emit(now, "role", agent=key[0], role=key[1], person=self.roles.pop(key), status="off")
+            self.trace.emit(ev.RoleChanged(now, key[0], key[1], self.roles.pop(key), "off"))
         self._live = {a.id for a in agents if not a.ended}
 
 

@@ -8,16 +8,17 @@ the strings ``"inf"``/``"-inf"`` (JSON has no infinity), no wall-clock values.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import IO, Any
 
-EVENTS = (
-    "run", "request", "transition", "command", "roles", "decision", "plan",
-    "stage", "mode", "change", "world", "hazard", "role", "secure", "end",
-)
+from tasker.events import KINDS, Event, TraceError, parse
+
+EVENTS = KINDS
+"""Every event kind a trace may hold (:data:`tasker.events.KINDS`)."""
 
 FAILED = frozenset({"failed", "error"})
 """``end`` causes of an agent that did not do its task and was not stopped on purpose: a plan
@@ -52,35 +53,51 @@ def encode(event: Mapping[str, Any]) -> str:
 class Trace:
     """Collects events in order; optionally streams them to a file and to observers.
 
-    Observers (metrics collectors) get each event dict after it is recorded; they
-    must not modify it.
+    :meth:`emit` takes only the event types of :mod:`tasker.events`.  Observers (metrics
+    collectors, the hazard monitor) get each typed event after it is recorded.
+    :attr:`events` are the events as JSON-ready records (dicts), :attr:`typed` the events
+    themselves.
     """
 
     def __init__(self, sink: IO[str] | None = None, keep: bool = True) -> None:
         self._events: list[dict[str, Any]] = []
+        self._typed: list[Event] = []
         self._sink = sink
         self._keep = keep
-        self._observers: list[Callable[[dict[str, Any]], None]] = []
+        self._observers: list[Callable[[Event], None]] = []
 
-    def emit(self, t: float, event: str, **fields: Any) -> None:
-        record: dict[str, Any] = {"t": round(t, 6), "event": event}
-        record.update(fields)
+    def emit(self, event: Event) -> None:
+        """Record one event (its ``t`` rounded to 1 µs, as the trace writes it)."""
+        if not isinstance(event, Event) or not event.KIND:
+            raise TypeError(f"Trace.emit takes a tasker.events event, got {type(event).__name__}")
+        t = round(event.t, 6)
+        if t != event.t:  # the typed event says what the trace says
+            event = dataclasses.replace(event, t=t)
+        record: dict[str, Any] = {"t": t, "event": event.KIND}
+        record.update(event.fields())
         if self._keep:
             self._events.append(record)
+            self._typed.append(event)
         if self._sink is not None:
             self._sink.write(encode(record) + "\n")
         for obs in self._observers:
-            obs(record)
+            obs(event)
 
-    def subscribe(self, observer: Callable[[dict[str, Any]], None]) -> None:
+    def subscribe(self, observer: Callable[[Event], None]) -> None:
         self._observers.append(observer)
 
     @property
     def events(self) -> list[dict[str, Any]]:
+        """The events as records: ``{"t", "event", ...fields}``, as ``trace.jsonl`` has them (before rounding)."""
         return self._events
 
+    @property
+    def typed(self) -> list[Event]:
+        """The events themselves, in order."""
+        return self._typed
+
     def of(self, event: str, **match: Any) -> list[dict[str, Any]]:
-        """Events of one kind whose fields equal ``match``."""
+        """Records of one kind whose fields equal ``match``."""
         return [e for e in self._events if e["event"] == event and all(e.get(k) == v for k, v in match.items())]
 
     def lines(self) -> Iterator[str]:
@@ -100,26 +117,47 @@ def read(path: str | Path) -> list[dict[str, Any]]:
     Every line must be an event: a JSON object with ``t`` (a number) and ``event`` (a
     string).  A damaged file (cut short, a stray byte, a line that is no event) is a
     ``ValueError`` naming the file and the line."""
+    return [record for _, record in _records(path)]
+
+
+def _records(path: str | Path) -> Iterator[tuple[int, dict[str, Any]]]:
     data = Path(path).read_bytes()
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
         at = data[: exc.start].count(b"\n") + 1
         raise ValueError(f"{path}:{at}: not UTF-8 text (byte {data[exc.start]:#04x})") from None
-    out = []
     for n, line in enumerate(text.splitlines(), start=1):
         if line.strip():
             try:
                 event = json.loads(line)
             except json.JSONDecodeError as exc:
                 raise ValueError(f"{path}:{n}: not a JSON object: {exc.msg}") from None
+            except RecursionError:
+                raise ValueError(f"{path}:{n}: nested too deeply to be an event") from None
             if not isinstance(event, dict):
                 raise ValueError(f"{path}:{n}: not a JSON object: {line.strip()[:40]}")
             t = event.get("t")
             if not isinstance(event.get("event"), str) or isinstance(t, bool) or not isinstance(t, int | float):
                 raise ValueError(f"{path}:{n}: not an event: expected \"t\" (a number) and \"event\" (a string)")
-            out.append(event)
+            yield n, event
+
+
+def read_events(path: str | Path) -> list[Event]:
+    """:func:`read`, each event typed (:func:`tasker.events.parse`): a damaged event (a missing
+    or wrong field) is a ``ValueError`` naming the file, the line and the field."""
+    out = []
+    for n, record in _records(path):
+        try:
+            out.append(parse(record))
+        except TraceError as exc:
+            raise ValueError(f"{path}:{n}: {exc}") from None
     return out
+
+
+def typed(records: Iterable[Mapping[str, Any]]) -> list[Event]:
+    """Records (a live trace's :attr:`Trace.events`, or :func:`read`'s) as typed events."""
+    return [parse(r) for r in records]
 
 
 def number(value: Any) -> float:

@@ -18,6 +18,7 @@ from experiments.inputs.actions import NO_REQUESTS, TABLES, TimedAction, located
 from experiments.inputs.crossref import validate_request
 from experiments.inputs.fields import MODES, ScenarioError
 from experiments.inputs.filekinds import expect
+from tasker import events as ev
 from tasker import schedulers
 from tasker.agent import Rates
 from tasker.errors import TaskerError
@@ -188,7 +189,7 @@ def _change(loop: SimulationLoop, requester: Requester, agent: str, args: dict[s
     if agent in loop.harmoniser.agents:
         requester.change(agent, args)
     else:
-        loop.trace.emit(loop.now, "change", agent=agent, args=args, ignored="the task has ended")
+        loop.trace.emit(ev.ArgsChanged(loop.now, agent, args, ignored="the task has ended"))
 
 
 def run(scenario: SyntheticScenario, *, seed: int | None = None, scheduler: str | None = None,

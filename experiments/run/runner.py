@@ -30,6 +30,7 @@ from experiments.inputs import scenario as scenarios
 from experiments.inputs import synthetic
 from experiments.inputs.actions import TimedAction
 from experiments.inputs.request_fields import asked_for
+from tasker import events as ev
 from tasker import schedulers
 from tasker.agent import Rates
 from tasker.errors import RunAborted, RunInterrupted
@@ -175,13 +176,13 @@ class _Made:
         if "renew" in a.fields:
             self._renewable[agent] = (sid, a)
 
-    def _watch(self, e: dict[str, Any]) -> None:
-        if e["event"] != "end" or e.get("cause") not in FAILED or e.get("agent") not in self._renewable:
+    def _watch(self, e: ev.Event) -> None:
+        if not isinstance(e, ev.TaskEnded) or e.cause not in FAILED or e.agent not in self._renewable:
             return
-        sid, a = self._renewable.pop(e["agent"])
-        when = float(e["t"]) + float(a.fields["renew"]["after_s"])
+        sid, a = self._renewable.pop(e.agent)
+        when = e.t + float(a.fields["renew"]["after_s"])
         if when < float(a.fields["renew"]["until"]):
-            self.loop.at(when, lambda: self.submit(sid, a, renews=e["agent"]))
+            self.loop.at(when, lambda: self.submit(sid, a, renews=e.agent))
 
 
 def _action(loop: SimulationLoop, sim: Any, made: _Made, a: TimedAction, sid: str) -> Callable[[], None]:
@@ -209,7 +210,7 @@ def _action(loop: SimulationLoop, sim: Any, made: _Made, a: TimedAction, sid: st
             sim.apply(add=value)
         else:
             sim.apply(delete=value)
-        loop.trace.emit(loop.now, "world", what=what, value=value, note=f.get("note", ""))
+        loop.trace.emit(ev.WorldChanged(loop.now, what, value, f.get("note", "")))
 
     if "after" not in f:
         return world_event
@@ -222,8 +223,8 @@ def _after(loop: SimulationLoop, made: _Made, sid: str, event: Callable[[], None
     event is traced); never if it is not."""
     state = {"finished": False, "due": False}
 
-    def watch(e: dict[str, Any]) -> None:
-        if e["event"] == "end" and e.get("cause") == "finished" and e.get("agent") in made.agents.get(sid, ()) \
+    def watch(e: ev.Event) -> None:
+        if isinstance(e, ev.TaskEnded) and e.cause == "finished" and e.agent in made.agents.get(sid, ()) \
                 and not state["finished"]:
             state["finished"] = True
             if state["due"]:
@@ -287,7 +288,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
             error = exc
         except KeyboardInterrupt as exc:  # the user stopped it: keep what ran, closed like a run cut by its horizon
             error = exc
-            loop.trace.emit(loop.now, "run", status="interrupted", active=sorted(loop.harmoniser.agents))
+            loop.trace.emit(ev.RunStopped(loop.now, "interrupted", None, sorted(loop.harmoniser.agents)))
     wall = time.perf_counter() - t0
     trace = loop.trace
     world_spec = None

@@ -222,7 +222,7 @@ def test_compute_file_reads_a_saved_trace(demo: Trace, tmp_path: Path) -> None:
 def test_collectors_observe_a_live_trace(demo: Trace) -> None:
     live = metrics.HazardCollector()
     trace = Trace()
-    trace.subscribe(live.on_event)
+    trace.subscribe(lambda e: live.on_event(e.record()))
     synthetic.run(synthetic.load(DEMO), seed=1, trace=trace)
     assert metrics._clean(live.result()) == metrics.compute(demo.events)["safety"]
 

@@ -43,6 +43,7 @@ from typing import Any
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st_
 
+from tasker.events import TaskEnded
 from tasker.messages import FsmState
 from tasker.requester import Requester
 from tasker.synthetic import ManualExecutor, SyntheticTask
@@ -137,7 +138,7 @@ def test_random_interleavings_keep_the_invariants(program: list[tuple[Any, ...]]
     req = Requester(loop.store, h)
     ids: list[str] = []
     ends: Counter[str] = Counter()
-    loop.trace.subscribe(lambda e: ends.update([e["agent"]]) if e["event"] == "end" else None)
+    loop.trace.subscribe(lambda e: ends.update([e.agent]) if isinstance(e, TaskEnded) else None)
 
     def advance(dt: float) -> None:
         loop.run(until=loop.now + dt)

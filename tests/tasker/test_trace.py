@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+from tasker.events import ModeChanged
 from tasker.trace import EVENTS, Trace, encode, read
 
 from .helpers import guide, make_loop
@@ -56,5 +57,5 @@ def test_every_event_kind_is_documented() -> None:
 def test_streaming_sink_matches_memory(tmp_path: Path) -> None:
     with open(tmp_path / "t.jsonl", "w", encoding="utf-8") as f:
         tr = Trace(sink=f)
-        tr.emit(0.5, "mode", mode="IT")
+        tr.emit(ModeChanged(0.5, "IT"))
     assert (tmp_path / "t.jsonl").read_text() == tr.dumps()
