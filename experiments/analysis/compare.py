@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 
 from experiments.analysis.stats import Estimate, estimate, holm, paired_p
 from experiments.inputs.strategy import FACTORS, Strategy
-from experiments.metrics.registry import higher_is_better, host_dependent, lookup, numeric_metrics
+from experiments.metrics.registry import direction, has_verdict, host_dependent, lookup, numeric_metrics, outcome
 from experiments.metrics.store import RunRow, Status
 
 ALL = "*"
@@ -84,9 +84,12 @@ class Paired:
 
     @property
     def better(self) -> str:
-        if host_dependent(self.metric):
-            return "–"  # a property of the host, not of the strategy
-        return "higher" if higher_is_better(self.metric) else "lower"
+        """``higher`` or ``lower`` as the metric's registration says; ``–`` when it gives no verdict
+        (unregistered, a property of the host, or neither way better)."""
+        if not has_verdict(self.metric):
+            return "–"
+        d = direction(self.metric)
+        return d.value if d is not None else "–"
 
 
 @dataclass(frozen=True)
@@ -157,14 +160,6 @@ def comparisons(strategies: Iterable[str]) -> list[tuple[str, str, str]]:
     return sorted(out)
 
 
-def _outcome(metric: str, treatment: float, baseline: float) -> int:
-    """+1 if the treatment is better, 0 if equal, -1 if worse."""
-    if abs(treatment - baseline) <= 1e-9 * max(1.0, abs(treatment), abs(baseline)):
-        return 0
-    better = treatment > baseline if higher_is_better(metric) else treatment < baseline
-    return 1 if better else -1
-
-
 def paired(rows: Iterable[RunRow], *, drop: Iterable[str] = ()) -> list[Paired]:
     """Treatment − baseline per metric and scenario (never pooled), for every pair of strategies that
     differ in one factor, over the seeds where both ran ``ok``; Holm-adjusted over every test returned.
@@ -189,7 +184,9 @@ def paired(rows: Iterable[RunRow], *, drop: Iterable[str] = ()) -> list[Paired]:
                 for metric in sorted((set(a) & set(b)) - skip):
                     if math.isfinite(a[metric]) and math.isfinite(b[metric]):
                         diffs[metric].append(a[metric] - b[metric])
-                        counts[metric][1 - _outcome(metric, a[metric], b[metric])] += 1
+                        verdict = outcome(metric, a[metric], b[metric])
+                        if verdict is not None:  # a metric without a verdict has no wins or losses
+                            counts[metric][1 - verdict] += 1
                     else:
                         nonfinite[metric] += 1
             for metric in sorted(set(diffs) | set(nonfinite)):

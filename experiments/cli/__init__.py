@@ -28,7 +28,7 @@ SUBCOMMAND_MODULES = (
     "experiments.cli.check",  # check
     "planners.cli",           # plan, domains, fsm, new
     "robot.cli",              # world, cost
-    "experiments.report.explain",    # explain
+    "experiments.cli.explain",  # explain
     "experiments.cli.day",    # day
     # Add a subcommand here: a module with ``register(subparsers)`` (e.g. explain, an HTML report).
 )

@@ -26,6 +26,7 @@ from experiments.metrics.paths import path_metrics
 from experiments.metrics.store import ResultStore, Status
 from experiments.sweep.driver import run_sweep
 from experiments.sweep.spec import Job
+from experiments.trace.timeline import Timeline
 from tasker.errors import ConfigError
 
 
@@ -48,11 +49,12 @@ def run_day(protocol: str, seed: int, scheduler: str, backend: str = "synthetic"
     run = day.run(out=keep, **settings)
     proto = day.protocol
     kinds = {v: k for k, v in day_pipeline.task_names(proto, backend).items()}
+    tl = Timeline.of(run.events)  # the day's trace, read once
     out = {"scheduler": scheduler, "seed": seed, "backend": backend, "strategy": Strategy(**settings).label,
-           **day_metrics(run.events, day_end=proto.length_s, kinds=kinds)}
+           **day_metrics(tl, day_end=proto.length_s, kinds=kinds)}
     if backend == "robot":
-        out |= path_metrics(run.events, run.samples)
-        out |= hazard_metrics(run.events)
+        out |= path_metrics(tl, run.samples)
+        out |= hazard_metrics(tl)
         out["wall_time_s"] = run.record.get("wall_time_s")  # not in the table: how long the day took here
     return out
 

@@ -52,7 +52,9 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
         ("interruptions", "interruptions", lambda r: r["interruptions"]),
         *((f"interruptions per task: {t}", f"int_{t}",
            lambda r, t=t: r["per_type"].get(t, {}).get("interruptions_per_task")) for t in types),
-        ("suspensions with exeSusp (ours)", "suspensions", lambda r: r["suspensions"]),
+        # a day stored before suspensions_with_stages existed called it suspensions
+        ("suspensions that ran an exeSusp (ours)", "suspensions",
+         lambda r: r.get("suspensions_with_stages", r.get("suspensions"))),
         ("time suspending (s, ours)", "susp_time", lambda r: r["suspension_time_s"]),
         ("switches (ours)", "switches", lambda r: r["switches"]),
         ("hazard time unattended (s, ours)", "hazard_s", lambda r: r.get("hazard_unattended_s")),

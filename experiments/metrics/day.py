@@ -3,7 +3,8 @@
 :func:`day_metrics` reads one day's trace (never the model) and returns the TaBSA-like
 metrics — tasks completed per type, completion minus deadline, falls that died,
 interruptions per type and per task, oscillation, how the day ended — plus ours:
-suspensions that ran an ``exeSusp``, time spent suspending, switches, and for whole-queue
+suspensions (every entry into ``genSusp``, as every run counts them) and those whose
+``exeSusp`` ran stages, time spent suspending, switches, and for whole-queue
 schedulers the longest queue ordered and the decisions whose search hit its budget.  On
 the robot backend, :mod:`experiments.metrics.paths` adds abandonment and travel distance
 from the recorded trajectory, and :func:`hazard_metrics` the task folders' hazards as every
@@ -20,15 +21,17 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
-from experiments.metrics.run import HazardCollector
-from tasker.trace import FAILED, needs, number
+from experiments.metrics.run import safety
+from experiments.trace.timeline import Timeline, timeline
+from tasker import events as ev
+from tasker.trace import FAILED, number
 
 OSCILLATION_SWITCHES = 3
 OSCILLATION_WINDOW_S = 180.0
 ENDINGS = ("all done", "a fall died", "oscillation", "time ran out")
 
 
-def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = None,
+def day_metrics(events: Timeline | Iterable[ev.Event | Mapping[str, Any]], *, day_end: float | None = None,
                 kinds: Mapping[str, str] | None = None) -> dict[str, Any]:
     """The protocol metrics of one day's trace (see the module docstring and ``docs/benchmark.md``).
 
@@ -39,60 +42,40 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
     dead when it was not finished by its request's ``death_at`` and that time falls
     within the day.  A switch to a task is a ``start`` command to its agent; the day
     oscillates when a task gets its third switch within 180 s of the first of the three.
+    An interruption is a suspension not made because the task's own stage failed.
     """
-    events = list(events)
-    end_t = day_end if day_end is not None else (events[-1]["t"] if events else 0.0)
-    kind: dict[str, str] = {}
-    args: dict[str, Mapping[str, Any]] = {}
-    finished: dict[str, float] = {}
-    failed: set[str] = set()
-    starts: dict[str, list[float]] = {}
-    interruptions: dict[str, int] = {}
-    suspensions = 0
-    suspension_time = 0.0
-    entered: dict[str, float] = {}
-    longest_order = anytime = 0
-    for e in events:
-        ev = e["event"]
-        if ev == "request":
-            kind[e["agent"]] = (kinds or {}).get(e["task_type"], e["task_type"])
-            args[e["agent"]] = e["args"]
-        elif ev == "end" and e.get("cause") == "finished":
-            finished[e["agent"]] = e["t"]
-        elif ev == "end" and e.get("cause") in FAILED:  # a plan, a skill or a hook failed: not the scheduler's choice
-            failed.add(e["agent"])
-        elif ev == "command" and e.get("flag") == "start":
-            starts.setdefault(e["agent"], []).append(e["t"])
-        elif ev == "transition":
-            a, to = e["agent"], e["to"]
-            if to == "genSusp":
-                if e.get("trigger") != "stage_failed":  # a failed task making itself safe was not interrupted
-                    interruptions[a] = interruptions.get(a, 0) + 1
-                entered[a] = e["t"]
-            elif e["from"] == "exeSusp" or (e["from"] == "genSusp" and to != "exeSusp"):
-                suspension_time += e["t"] - entered.pop(a, e["t"])
-        elif ev == "plan" and e.get("purpose") == "genSusp" and e.get("stages"):
-            suspensions += 1
-        elif ev == "decision" and "order" in e:  # whole-queue decisions (lookahead)
-            longest_order = max(longest_order, len(e["order"]))
-            anytime += e.get("rule") == "anytime"
-    first = needs(events)  # a renewed request (a failed fall asked again) is the same need
-    firsts = {a for a in kind if first[a] == a}
+    tl = timeline(events)
+    end_t = day_end if day_end is not None else tl.t_end
+    agents = tl.agents
+    kind = {a: (kinds or {}).get(x.task_type, x.task_type) for a, x in agents.items()}
+    finished = {a: x.end.t for a, x in agents.items() if x.end is not None and x.cause == "finished"}
+    failed = {a for a, x in agents.items() if x.cause in FAILED}  # a plan, a skill or a hook: not the scheduler's
+    starts = {a: [c.t for c in x.commands if c.flag == "start"] for a, x in agents.items()}
+    starts = {a: ts for a, ts in starts.items() if ts}
+    interruptions = {a: sum(1 for s in x.suspensions if s.trigger != "stage_failed") for a, x in agents.items()}
+    episodes = [s for x in agents.values() for s in x.suspensions]
+    with_stages = sum(1 for x in agents.values() for p in x.plans if p.purpose == "genSusp" and p.stages)
+    suspension_time = math.fsum(s.duration for s in episodes if s.outcome != "open")
+    orders = [d for d in tl.decisions if "order" in d.data]  # whole-queue decisions (lookahead)
+    longest_order = max((len(d.data["order"]) for d in orders), default=0)
+    anytime = sum(1 for d in orders if d.rule == "anytime")
+    first = tl.needs  # a renewed request (a failed fall asked again) is the same need
+    firsts = set(tl.first_needs())
     served: dict[str, float] = {}
     for a, when in finished.items():
         served[first[a]] = min(when, served.get(first[a], math.inf))
     unserved_failed = {first[a] for a in failed} - set(served)
-    types = sorted(set(kind.values()))
+    args = {a: x.args for a, x in agents.items()}
     per_type: dict[str, dict[str, Any]] = {}
     dead: list[float] = []
-    for t in types:
-        agents = [a for a in kind if kind[a] == t]
-        asked = [a for a in agents if a in firsts]
+    for t in sorted(set(kind.values())):
+        mine = [a for a in kind if kind[a] == t]
+        asked = [a for a in mine if a in firsts]
         done = [a for a in asked if a in served]
         gaps = [served[a] - number(args[a]["deadline"]) for a in done if args[a].get("deadline") is not None]
-        n_int = sum(interruptions.get(a, 0) for a in agents)
+        n_int = sum(interruptions.get(a, 0) for a in mine)
         per_type[t] = {"requested": len(asked), "completed": len(done),
-                       "failed": sum(a in unserved_failed for a in asked), "renewals": len(agents) - len(asked),
+                       "failed": sum(a in unserved_failed for a in asked), "renewals": len(mine) - len(asked),
                        "completion_minus_deadline_s": _mean(gaps), "lateness_s": sum(max(0.0, g) for g in gaps),
                        "late": sum(1 for g in gaps if g > 0), "interruptions": n_int,
                        "interruptions_per_task": n_int / len(asked) if asked else None}
@@ -114,22 +97,20 @@ def day_metrics(events: Iterable[Mapping[str, Any]], *, day_end: float | None = 
         "renewals": len(kind) - len(firsts),
         "completion_minus_deadline_s": _mean(all_gaps), "lateness_s": sum(max(0.0, g) for g in all_gaps),
         "dead_falls": len(dead), "first_death_t": first_death,
-        "interruptions": sum(interruptions.values()), "suspensions": suspensions,
+        "interruptions": sum(interruptions.values()), "suspensions": len(episodes),
+        "suspensions_with_stages": with_stages,
         "suspension_time_s": suspension_time, "switches": sum(len(v) for v in starts.values()),
         "oscillation_t": oscillation, "ending": ending, "per_type": per_type,
         "longest_order": longest_order, "anytime_decisions": anytime,
     }
 
 
-def hazard_metrics(events: Iterable[Mapping[str, Any]]) -> dict[str, Any]:
+def hazard_metrics(events: Timeline | Iterable[ev.Event | Mapping[str, Any]]) -> dict[str, Any]:
     """Ours, robot backend: the hazards the task folders declare, as :mod:`experiments.metrics.run`
     counts them for every run (``safety``): time unattended (including what a task left on
     when it ended, to the day's end) and the part of it after the task ended, budget
     overruns, hazards left on at a switch."""
-    c = HazardCollector()
-    for e in events:
-        c.on_event(e)
-    h = c.result()
+    h = safety(timeline(events))
     return {"hazard_unattended_s": h["unattended_s"], "hazard_after_end_s": h["after_end_s"],
             "hazard_overruns": h["budget_overruns"], "hazards_left_at_switch": h["violations_at_switch"]}
 

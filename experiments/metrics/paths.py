@@ -30,7 +30,8 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any, Protocol
 
-from tasker.trace import needs
+from experiments.trace.timeline import Timeline, timeline
+from tasker import events as ev
 
 RADIUS_M = 2.0
 FALLEN = "fallen"
@@ -55,32 +56,23 @@ def travel_m(samples: Sequence[_Sample]) -> float:
                                                                                              strict=False))
 
 
-def abandonments(events: Iterable[Mapping[str, Any]], samples: Sequence[_Sample], *,
+def abandonments(events: Timeline | Iterable[ev.Event | Mapping[str, Any]], samples: Sequence[_Sample], *,
                  radius: float = RADIUS_M, for_another_task: bool = False) -> dict[str, int]:
     """Per agent whose request is about a fallen person: how many times the robot left them
     (see above); with ``for_another_task``, only while another agent was ``exeDA``."""
-    events = list(events)
-    need = needs(events)  # a request made again after its task failed is the same need
-    requests: list[tuple[str, float, list[str]]] = []
+    tl = timeline(events)
+    need = tl.needs  # a request made again after its task failed is the same need
     ended: dict[str, float] = {}  # need -> when its last task ended (inf while one is requested or runs)
-    roles: list[tuple[float, str | None]] = []  # (t, exeDA) as the trace's roles events set it
-    for e in events:
-        if e["event"] == "request":
-            if e["agent"] == need[e["agent"]]:
-                names = [v for v in e["args"].values() if isinstance(v, str)]
-                requests.append((e["agent"], float(e["t"]), names))
-            ended[need[e["agent"]]] = math.inf
-        elif e["event"] == "end" and e["agent"] in need:
-            ended[need[e["agent"]]] = float(e["t"])
-        elif e["event"] == "roles":
-            roles.append((float(e["t"]), e.get("exeDA")))
-    role_times = [t for t, _ in roles]
+    for a in tl.agents.values():
+        ended[need[a.id]] = a.end.t if a.end is not None else math.inf
     out: dict[str, int] = {}
     times = [s.t for s in samples]
-    for agent, t0, names in requests:
-        first = _first_at(times, t0)
+    for agent in tl.first_needs():
+        a = tl.agents[agent]
+        first = _first_at(times, a.request_t)
         if first is None:
             continue
+        names = [v for v in a.args.values() if isinstance(v, str)]
         at_call = {p.name: p for p in samples[first].people}
         person = next((n for n in names if n in at_call and at_call[n].posture == FALLEN), None)
         if person is None:
@@ -95,18 +87,11 @@ def abandonments(events: Iterable[Mapping[str, Any]], samples: Sequence[_Sample]
             if p.posture != FALLEN:
                 break
             near = math.hypot(s.robot[0] - p.x, s.robot[1] - p.y) <= radius
-            if inside and not near and not (for_another_task and need.get(_executing(roles, role_times, s.t) or "")
-                                                == agent):
+            if inside and not near and not (for_another_task and need.get(tl.exe_at(s.t) or "") == agent):
                 left += 1
             inside = near
         out[agent] = left
     return out
-
-
-def _executing(roles: Sequence[tuple[float, str | None]], times: Sequence[float], t: float) -> str | None:
-    """``exeDA`` at time ``t``: the last ``roles`` event at or before it."""
-    k = bisect.bisect_right(times, t) - 1
-    return roles[k][1] if k >= 0 else None
 
 
 def _first_at(times: Sequence[float], t: float) -> int | None:
@@ -114,11 +99,12 @@ def _first_at(times: Sequence[float], t: float) -> int | None:
     return k if k < len(times) else None
 
 
-def path_metrics(events: Iterable[Mapping[str, Any]], samples: Sequence[_Sample]) -> dict[str, Any]:
+def path_metrics(events: Timeline | Iterable[ev.Event | Mapping[str, Any]], samples: Sequence[_Sample],
+                 ) -> dict[str, Any]:
     """``abandonments`` (total, TaBSA's), ``abandoned_falls`` (falls left at least once),
     ``abandonments_other_task`` (left while another task ran), ``travel_m``."""
-    events = list(events)
-    per = abandonments(events, samples)
-    other = abandonments(events, samples, for_another_task=True)
+    tl = timeline(events)
+    per = abandonments(tl, samples)
+    other = abandonments(tl, samples, for_another_task=True)
     return {"abandonments": sum(per.values()), "abandoned_falls": sum(1 for v in per.values() if v),
             "abandonments_other_task": sum(other.values()), "travel_m": round(travel_m(samples), 3)}

@@ -21,19 +21,23 @@ cause shows in the trace too:
 
 What a person does (follows the robot, is told to wait, waits) is read from the
 trace's ``role`` events, which the task folders declare, never from action names.
-Trace values may be ``inf`` (written as the string ``"inf"``): every number is read
-through :func:`num`, and a non-finite comparison never counts as a cost-decided step.
+The trace is read once, as a :class:`~experiments.trace.timeline.Timeline`.  Decision
+values may be ``inf`` (written as the string ``"inf"``): every number is read through
+:func:`num`, and a non-finite comparison never counts as a cost-decided step.
 ``docs/paper.md`` explains each step; ``experiments/paper/report.py`` tabulates them.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-Event = Mapping[str, Any]
+from experiments.trace.timeline import Timeline, timeline
+from tasker import events as ev
+
+Source = Timeline | Iterable[ev.Event | Mapping[str, Any]]
 
 
 @dataclass(frozen=True)
@@ -72,37 +76,33 @@ def _fmt(x: float) -> str:
     return f"{x:.1f}" if math.isfinite(x) else str(x)
 
 
-def _first(events: Sequence[Event], after: float, **match: Any) -> Event | None:
-    for e in events:
-        if num(e.get("t")) >= after and all(e.get(k) == v for k, v in match.items()):
-            return e
-    return None
+def _start(tl: Timeline, agent: str, after: float) -> ev.CommandSent | None:
+    """``agent``'s first ``start`` command at or after ``after``."""
+    return next(iter(tl.commands_to(agent, "start", after)), None)
 
 
-def _switch(events: Sequence[Event], after: float, dac: str, exe: str, rule: str) -> tuple[Event | None, Event | None]:
+def _switch(tl: Timeline, after: float, dac: str, exe: str, rule: str) -> tuple[ev.Decision | None,
+                                                                                ev.CommandSent | None]:
     """The first switching decision ``dac`` over ``exe`` by ``rule`` at or after ``after``, and ``dac``'s start."""
-    d = next((e for e in events if e.get("event") == "decision" and num(e.get("t")) >= after
-              and e.get("dac") == dac and e.get("exeDA") == exe and e.get("rule") == rule and e.get("switch")), None)
+    d = next(iter(tl.decisions_by(rule=rule, dac=dac, exe=exe, switched=True, after=after)), None)
     if d is None:
         return None, None
-    return d, _first(events, num(d["t"]), event="command", agent=dac, flag="start")
+    return d, _start(tl, dac, d.t)
 
 
-def _closest(events: Sequence[Event], after: float, dac: str, exe: str) -> Event | None:
+def _closest(tl: Timeline, after: float, dac: str, exe: str) -> ev.Decision | None:
     """The finite cost comparison of ``dac`` over ``exe`` at or after ``after`` with the lowest
     ``c_switch / c_wait`` (the one that came closest to switching), or None."""
     best: tuple[float, float] | None = None
     found = None
-    for e in events:
-        if (e.get("event") == "decision" and e.get("rule") == "cost" and e.get("dac") == dac
-                and e.get("exeDA") == exe and num(e.get("t")) >= after):
-            cs, cw = num(e.get("c_switch")), num(e.get("c_wait"))
-            if math.isfinite(cs) and math.isfinite(cw) and cw > 0 and (best is None or (cs / cw, num(e["t"])) < best):
-                best, found = (cs / cw, num(e["t"])), e
+    for d in tl.decisions_by(rule="cost", dac=dac, exe=exe, after=after):
+        cs, cw = num(d.get("c_switch")), num(d.get("c_wait"))
+        if math.isfinite(cs) and math.isfinite(cw) and cw > 0 and (best is None or (cs / cw, d.t) < best):
+            best, found = (cs / cw, d.t), d
     return found
 
 
-def _compared(d: Event | None) -> tuple[bool, float | None, float | None, str]:
+def _compared(d: ev.Decision | None) -> tuple[bool, float | None, float | None, str]:
     """Is ``d`` a finite cost comparison that switched, and its numbers."""
     if d is None:
         return False, None, None, "no such decision"
@@ -113,20 +113,27 @@ def _compared(d: Event | None) -> tuple[bool, float | None, float | None, str]:
         f"not a finite comparison won: c_switch={_fmt(cs)}, c_wait={_fmt(cw)}"
 
 
-def _last_stage(events: Sequence[Event], agent: str, before: float) -> Event | None:
-    """``agent``'s last ``exeTsk`` stage event at or before ``before``."""
-    return next((e for e in reversed(events) if e.get("event") == "stage" and e.get("agent") == agent
-                 and e.get("fsm") == "exeTsk" and num(e.get("t")) <= before), None)
+def _last_stage(tl: Timeline, agent: str, before: float) -> tuple[str, str] | None:
+    """``agent``'s last ``exeTsk`` stage event at or before ``before``: (action, begin or how it closed)."""
+    a = tl.agents.get(agent)
+    last: tuple[float, str, str] | None = None
+    for r in (a.stages if a else []):
+        if r.fsm != "exeTsk":
+            continue
+        if r.begin <= before:
+            last = (r.begin, r.action, "begin")
+        if r.end is not None and r.end <= before:
+            last = (r.end, r.action, r.status)
+    return (last[1], last[2]) if last else None
 
 
-def _role_at(events: Sequence[Event], t: float, agent: str, role: str) -> bool:
+def _role_at(tl: Timeline, t: float, agent: str, role: str) -> bool:
     """Whether ``agent``'s person had ``role`` at time ``t`` (the last role edge at or before it)."""
-    edges = [e for e in events if e.get("event") == "role" and num(e.get("t")) <= t and e.get("agent") == agent
-             and e.get("role") == role]
-    return bool(edges) and edges[-1].get("status") == "on"
+    a = tl.agents.get(agent)
+    return a is not None and a.person_role_at(role, t)
 
 
-def _apologies(events: Sequence[Event], agent: str) -> frozenset[str]:
+def _apologies(tl: Timeline, agent: str) -> frozenset[str]:
     """The actions ``agent``'s task folder runs instead of a stage after a suspension (Alg. 3).
 
     Read from the folder the trace's ``request`` names (``[static] update``'s ``suspended``),
@@ -135,107 +142,106 @@ def _apologies(events: Sequence[Event], agent: str) -> frozenset[str]:
     from planners.bundled import task_types
     from planners.pddl_task import PddlTaskType
 
-    req = next((e for e in events if e.get("event") == "request" and e.get("agent") == agent), None)
-    if req is None:
+    a = tl.agents.get(agent)
+    if a is None:
         return frozenset()
     for tt in task_types():
-        if isinstance(tt, PddlTaskType) and tt.name == req.get("task_type"):
+        if isinstance(tt, PddlTaskType) and tt.name == a.task_type:
             return frozenset(st.suspended for st in tt.spec.static_update if st.suspended)
     return frozenset()
 
 
-def check(events: Sequence[Event]) -> list[Step]:
+def _plan_after(tl: Timeline, agent: str, purpose: str, after: float) -> ev.PlanMade | None:
+    a = tl.agents.get(agent)
+    return next((p for p in (a.plans if a else []) if p.purpose == purpose and p.t >= after), None)
+
+
+def check(source: Source) -> list[Step]:
     """The steps of Appendix B in order; each later step is searched after the one before."""
+    tl = timeline(source)
     steps: list[Step] = []
     t = 0.0
 
-    start = _first(events, 0.0, event="command", flag="start")
-    ok = start is not None and start.get("agent") == "d1"
-    steps.append(Step("guide John (d1) starts", ok, num(start["t"]) if start else None,
-                      f"first start goes to {start.get('agent') if start else 'nobody'}"))
+    start = next((c for c in tl.commands if c.flag == "start"), None)
+    ok = start is not None and start.agent == "d1"
+    steps.append(Step("guide John (d1) starts", ok, start.t if start else None,
+                      f"first start goes to {start.agent if start else 'nobody'}"))
 
     # 2. guide Alice takes over on cost; d1 (John not greeted) suspends with `save`
-    d2_dec, s = _switch(events, t, "d2", "d1", "cost")
+    d2_dec, s = _switch(tl, t, "d2", "d1", "cost")
     won, cs, cw, why = _compared(d2_dec)
-    saved = None
-    if d2_dec is not None:
-        saved = next((e for e in events if e.get("event") == "plan" and e.get("agent") == "d1"
-                      and e.get("purpose") == "genSusp" and num(e["t"]) >= num(d2_dec["t"])), None)
+    saved = _plan_after(tl, "d1", "genSusp", d2_dec.t) if d2_dec is not None else None
     # eq. 47's save: nothing to do to suspend (John was not greeted, so he is not told to wait)
-    is_save = saved is not None and not saved.get("stages") and d2_dec is not None and not _role_at(
-        events, num(d2_dec["t"]), "d1", "told_to_wait") and not _role_at(events, num(d2_dec["t"]), "d1", "following")
+    is_save = saved is not None and not saved.stages and d2_dec is not None and not _role_at(
+        tl, d2_dec.t, "d1", "told_to_wait") and not _role_at(tl, d2_dec.t, "d1", "following")
     steps.append(Step("guide Alice (d2) takes over: c_switch < c_wait; guide John suspends with save",
-                      s is not None and won and is_save, num(s["t"]) if s else None,
-                      f"{why}; d1 genSusp stages: {saved.get('stages') if saved else None} "
-                      f"({saved.get('note') if saved else None})",
+                      s is not None and won and is_save, s.t if s else None,
+                      f"{why}; d1 genSusp stages: {list(saved.stages) if saved else None} "
+                      f"({saved.note if saved else None})",
                       cs, cw))
-    t = num(s["t"]) if s else t
+    t = s.t if s else t
 
     # 3. John walked: d1's cTime fell since it lost the robot, and that wins the comparison
-    d, s = _switch(events, t, "d1", "d2", "cost")
+    d, s = _switch(tl, t, "d1", "d2", "cost")
     if d is None:  # it did not happen: show the comparison that came closest, and how far it was
-        d = _closest(events, t, "d1", "d2")
+        d = _closest(tl, t, "d1", "d2")
     won, cs, cw, why = _compared(d)
     before = num(d2_dec.get("cTime_exeDA")) if d2_dec else math.nan
     after = num(d.get("cTime_dac")) if d else math.nan
     cheaper = math.isfinite(before) and math.isfinite(after) and after < before
-    resumed = None
-    if s is not None:
-        resumed = next((e for e in events if e.get("event") == "plan" and e.get("agent") == "d1"
-                        and e.get("purpose") == "upTsk" and num(e["t"]) >= num(s["t"])), None)
-    apologies = _apologies(events, "d1")
-    apologises = resumed is not None and any(st.get("action") in apologies for st in resumed.get("stages", ()))
-    where = "" if s is not None or d is None else f"no switch; closest at t={_fmt(num(d['t']))}: "
+    resumed = _plan_after(tl, "d1", "upTsk", s.t) if s is not None else None
+    apologies = _apologies(tl, "d1")
+    apologises = resumed is not None and any(st.get("action") in apologies for st in resumed.stages)
+    where = "" if s is not None or d is None else f"no switch; closest at t={_fmt(d.t)}: "
     steps.append(Step("John walked toward his destination: guide John (d1) takes back over",
-                      s is not None and won and cheaper and apologises, num(s["t"]) if s else None,
+                      s is not None and won and cheaper and apologises, s.t if s else None,
                       f"{where}{why}; d1 cTime {_fmt(before)} s when suspended, {_fmt(after)} s at this decision; "
                       f"resumes with the apology {sorted(apologies)}: {apologises}", cs, cw))
-    t = num(s["t"]) if s else t
+    t = s.t if s else t
 
     # 4. Peter fell preempts by class while John follows the robot; John is asked to wait
-    d, s = _switch(events, t, "d3", "d1", "priority class")
+    d, s = _switch(tl, t, "d3", "d1", "priority class")
     following = False
-    told = None
+    told: float | None = None
     if d is not None:
         # read from the trace's role edges, which the task folder declares: no task or action names here
-        following = _role_at(events, num(d["t"]), "d1", "following")
-        told = next((e for e in events if e.get("event") == "role" and num(e["t"]) >= num(d["t"])
-                     and e.get("agent") == "d1" and e.get("role") == "told_to_wait" and e.get("status") == "on"), None)
-    stage = _last_stage(events, "d1", num(d["t"])) if d is not None else None
-    ok = s is not None and following and told is not None and num(told["t"]) <= num(s["t"])
+        following = _role_at(tl, d.t, "d1", "following")
+        john = tl.agents.get("d1")
+        told = min((r.start for r in (john.person_roles if john else []) if r.role == "told_to_wait"
+                    and r.start >= d.t), default=None)
+    stage = _last_stage(tl, "d1", d.t) if d is not None else None
+    ok = s is not None and following and told is not None and told <= s.t
     steps.append(Step("Peter fell (d3) preempts guide John at once while John is guided; John is asked to wait",
-                      ok, num(s["t"]) if s else None,
+                      ok, s.t if s else None,
                       f"John following d1 at the decision: {following} (d1's stage: "
-                      f"{stage.get('action') if stage else None} {stage.get('status') if stage else None}); "
-                      f"told to wait at {told['t'] if told else None}"))
-    t = num(s["t"]) if s else t
+                      f"{stage[0] if stage else None} {stage[1] if stage else None}); "
+                      f"told to wait at {told}"))
+    t = s.t if s else t
 
     # 5. Sara fell wins the comparison: her task is the shorter one
-    d, s = _switch(events, t, "d4", "d3", "cost")
+    d, s = _switch(tl, t, "d4", "d3", "cost")
     won, cs, cw, why = _compared(d)
     shorter = d is not None and num(d.get("cTime_dac")) < num(d.get("cTime_exeDA"))
     steps.append(Step("Sara fell (d4) takes over from Peter fell after comparing costs", s is not None and won
-                      and shorter, num(s["t"]) if s else None,
+                      and shorter, s.t if s else None,
                       f"{why}; cTime d4 {_fmt(num(d.get('cTime_dac')))} vs d3 {_fmt(num(d.get('cTime_exeDA')))}"
                       if d else why, cs, cw))
-    t = num(s["t"]) if s else t
+    t = s.t if s else t
 
     # 6. Peter gets up while d3 waits: d3 ends itself from wait
-    up = next((e for e in events if e.get("event") == "world" and e.get("value") == ["peter", "standing"]
-               and num(e["t"]) >= t), None)
-    w = next((e for e in events if e.get("event") == "transition" and e.get("agent") == "d3" and e.get("to") == "end"),
-             None)
-    end = _first(events, 0.0, event="end", agent="d3")
-    restarted = any(e.get("event") == "command" and e.get("agent") == "d3" and e.get("flag") == "start"
-                    and num(e["t"]) > t for e in events)
-    ok = (up is not None and w is not None and w.get("from") == "wait" and num(w["t"]) >= num(up["t"])
-          and end is not None and "fine" in str(end.get("reason")) and end.get("cause") == "self" and not restarted)
-    steps.append(Step("Peter fell (d3) ends while waiting: Peter is fine", ok, num(w["t"]) if w else None,
-                      f"Peter up at {up['t'] if up else None}; d3 ended from {w.get('from') if w else None}: "
-                      f"{end.get('reason') if end else None} ({end.get('cause') if end else None})"))
+    up = next((w for w in tl.world if w.value == ["peter", "standing"] and w.t >= t), None)
+    peter = tl.agents.get("d3")
+    w = next((x for x in (peter.transitions if peter else []) if x.target == "end"), None)
+    end = peter.end if peter else None
+    restarted = any(c.t > t for c in tl.commands_to("d3", "start"))
+    ok = (up is not None and w is not None and w.source == "wait" and w.t >= up.t
+          and end is not None and "fine" in end.reason and end.cause == "self" and not restarted)
+    steps.append(Step("Peter fell (d3) ends while waiting: Peter is fine", ok, w.t if w else None,
+                      f"Peter up at {up.t if up else None}; d3 ended from {w.source if w else None}: "
+                      f"{end.reason if end else None} ({end.cause if end else None})"))
 
-    ends = {e["agent"]: e for e in events if e.get("event") == "end"}
-    rest = {a: ends.get(a, {}).get("reason") for a in ("d1", "d2", "d4")}
+    ends = {a: (tl.agents[a].end if a in tl.agents else None) for a in ("d1", "d2", "d4")}
+    rest = {a: (e.reason if e is not None else None) for a, e in ends.items()}
     steps.append(Step("the rest complete", all(r == "finished" for r in rest.values()),
-                      max((num(ends[a]["t"]) for a in rest if a in ends), default=None), f"end reasons: {rest}"))
+                      max((e.t for e in ends.values() if e is not None), default=None), f"end reasons: {rest}"))
     return steps

@@ -11,23 +11,22 @@ that moved the agent: ``decision``, ``command``, ``transition`` and ``end``.
 
 from __future__ import annotations
 
-import argparse
 import difflib
 import json
 import math
-import sys
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from experiments.trace.timeline import Timeline
+from tasker import events as ev
 from tasker.errors import TaskerError
-from tasker.support.cliargs import UsageError, non_negative_seconds
-from tasker.trace import number, read
 
 PROBLEMS = "problems"
 INDEX = "index.json"
-MOVING_EVENTS = ("decision", "command", "transition", "end")
+MOVING_EVENTS = (ev.Decision, ev.CommandSent, ev.Transition, ev.TaskEnded)
+"""The events that move an agent: what ``tasker explain`` lists."""
 """The trace events that move an agent, which :func:`explain` lists."""
 
 
@@ -88,7 +87,7 @@ class Explanation:
     domain: str
     problem: str
     plan: str | None
-    events: tuple[Mapping[str, Any], ...]
+    events: tuple[ev.Event, ...]
 
     def text(self) -> str:
         """The explanation as one readable text (what ``tasker explain`` prints)."""
@@ -103,18 +102,21 @@ class Explanation:
                           "; ---- what moved the agent (trace)", *_event_lines(self.events)]) + "\n"
 
 
-def _event_lines(events: Sequence[Mapping[str, Any]]) -> list[str]:
+def _event_lines(events: Sequence[ev.Event]) -> list[str]:
     """One line per event; a run of decisions that kept the same pair and did not switch is
     shown by its first and last line and a count (Alg. 2 decides every period)."""
     out: list[str] = []
     i = 0
+
+    def key(e: ev.Event) -> tuple[Any, ...] | None:
+        return (e.dac, e.exe_da, e.rule) if isinstance(e, ev.Decision) and not e.switch else None
+
     while i < len(events):
         e = events[i]
         j = i
-        if e["event"] == "decision" and not e.get("switch"):
-            same = (e.get("dac"), e.get("exeDA"), e.get("rule"))
-            while (j + 1 < len(events) and events[j + 1]["event"] == "decision" and not events[j + 1].get("switch")
-                   and (events[j + 1].get("dac"), events[j + 1].get("exeDA"), events[j + 1].get("rule")) == same):
+        same = key(e)
+        if same is not None:
+            while j + 1 < len(events) and key(events[j + 1]) == same:
                 j += 1
         out.append(_event_line(e))
         if j > i + 1:
@@ -125,18 +127,17 @@ def _event_lines(events: Sequence[Mapping[str, Any]]) -> list[str]:
     return out
 
 
-def _event_line(e: Mapping[str, Any]) -> str:
-    t = f"t={float(e['t']):10.3f}"
-    kind = e["event"]
-    if kind == "transition":
-        return f"{t} transition {e['from']} -> {e['to']}"
-    if kind == "command":
-        return f"{t} command {e['flag']}"
-    if kind == "end":
-        return f"{t} end ({e.get('cause', '?')}): {e.get('reason', '')}"
-    keys = [k for k in e if k not in ("t", "event", "algorithm")]
-    fields = ", ".join(f"{k}={_short(e[k])}" for k in keys)
-    return f"{t} decision [{e.get('algorithm', '?')}] {fields}"
+def _event_line(e: ev.Event) -> str:
+    t = f"t={e.t:10.3f}"
+    if isinstance(e, ev.Transition):
+        return f"{t} transition {e.source} -> {e.target}"
+    if isinstance(e, ev.CommandSent):
+        return f"{t} command {e.flag}"
+    if isinstance(e, ev.TaskEnded):
+        return f"{t} end ({e.cause}): {e.reason}"
+    fields = e.fields()
+    shown = ", ".join(f"{k}={_short(v)}" for k, v in fields.items() if k != "algorithm")
+    return f"{t} {e.KIND} [{fields.get('algorithm', '?')}] {shown}"
 
 
 def _short(v: Any) -> str:
@@ -193,25 +194,29 @@ def _json_kind(value: Any) -> str:
     return json.dumps(value)
 
 
-def load_trace(run_dir: Path) -> list[dict[str, Any]]:
+def load_trace(run_dir: Path) -> Timeline:
+    """The run's timeline (empty if it has no trace); a damaged trace is an :class:`ExplainError`."""
     path = run_dir / "trace.jsonl"
     if not path.is_file():
-        return []
+        return Timeline([])
     try:
-        return read(path)
+        return Timeline.read(path)
     except ValueError as exc:
         raise ExplainError(str(exc)) from None
 
 
-def moved(events: Iterable[Mapping[str, Any]], agent: str, until: float | None = None) -> list[Mapping[str, Any]]:
-    """The ``decision``/``command``/``transition``/``end`` events about ``agent`` (up to ``until``)."""
-    out = []
-    for e in events:
-        if until is not None and number(e["t"]) > until:
+def moved(tl: Timeline, agent: str, until: float | None = None) -> list[ev.Event]:
+    """The decision, command, transition and end events about ``agent`` (up to ``until``)."""
+    out: list[ev.Event] = []
+    for e in tl.events:
+        if until is not None and e.t > until:
             break
-        if e["event"] not in MOVING_EVENTS:
+        if not isinstance(e, MOVING_EVENTS):
             continue
-        if e.get("agent") == agent or (e["event"] == "decision" and agent in (e.get("dac"), e.get("exeDA"))):
+        if isinstance(e, ev.Decision):
+            if agent in (e.dac, e.exe_da):
+                out.append(e)
+        elif e.agent == agent:
             out.append(e)
     return out
 
@@ -244,16 +249,6 @@ def explain(run_dir: str | Path, agent: str, at: float | None = None) -> Explana
     return Explanation(agent, at, entry, domain, problem, plan, tuple(moved(load_trace(run), agent, at)))
 
 
-def _planned_in(run_dir: str) -> str:
-    """``"; agents that planned in RUN: d1, d2"`` when ``run_dir`` is a run that planned, else ``""``."""
-    try:
-        index = load_index(Path(run_dir))
-    except TaskerError:
-        return ""
-    agents = sorted({str(e["agent"]) for e in index}, key=lambda a: (len(a), a))
-    return f"; agents that planned in {run_dir}: {', '.join(agents)}" if agents else ""
-
-
 def write(ex: Explanation, out: Path) -> list[Path]:
     """``domain.pddl``, ``problem.pddl``, ``plan`` (if any) and ``explain.txt`` in ``out``."""
     out.mkdir(parents=True, exist_ok=True)
@@ -269,54 +264,3 @@ def write(ex: Explanation, out: Path) -> list[Path]:
 
 
 # ----------------------------------------------------------------------------------------- command
-
-
-EXAMPLES = """\
-examples:
-  tasker explain out/paper --agent d3                 # d3's last problem, plan and what moved it
-  tasker explain out/paper --agent d1 --at 60         # the problem d1 planned from at t = 60 s
-  tasker explain out/run --agent d2 --out /tmp/d2     # domain.pddl, problem.pddl, plan, explain.txt"""
-
-
-def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    p = sub.add_parser("explain", help="the PDDL an agent planned from, its plan and what moved it",
-                       description="Print (or write with --out) the domain and problem an agent of a run planned "
-                                   "from at a time (default: its last planning call), the plan, and the decisions, "
-                                   "commands and transitions of the trace that moved it. The PDDL is read by any "
-                                   "planner and by unified-planning's PDDLReader.",
-                       epilog=EXAMPLES)
-    _arguments(p)
-    p.set_defaults(func=_command)
-
-
-def _arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("run_dir", metavar="RUN_DIR", help="the output folder of `tasker run`")
-    p.add_argument("--agent", default=None, help="agent id: d1, d2, ... (required; without it the error lists the "
-                                                 "run's agents that planned)")
-    p.add_argument("--at", type=non_negative_seconds, default=None,
-                   help="simulated time in s (default: the agent's last plan)")
-    p.add_argument("--out", default=None, help="write domain.pddl, problem.pddl, plan and explain.txt here")
-
-
-def _command(args: argparse.Namespace) -> int:
-    if args.agent is None:
-        raise UsageError("--agent", f"which agent? an id such as d1{_planned_in(args.run_dir)}")
-    ex = explain(args.run_dir, args.agent, args.at)
-    if args.out:
-        files = write(ex, Path(args.out))
-        print(f"wrote {', '.join(str(f) for f in files)}", file=sys.stderr)
-    else:
-        sys.stdout.write(ex.text())
-    return 0
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """``tasker explain`` on its own: exit status 0, or 2 with a one-line error."""
-    p = argparse.ArgumentParser(prog="tasker explain")
-    _arguments(p)
-    args = p.parse_args(argv)
-    try:
-        return _command(args)
-    except TaskerError as exc:
-        print(f"tasker explain: error: {exc}", file=sys.stderr)
-        return 2

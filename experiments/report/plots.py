@@ -7,8 +7,8 @@
   lanes that never overlap.
 * :func:`world_path` draws the robot's path over a world with :mod:`robot.picture`.
 
-Plots read events only (STYLE principle 10), draw on bare :class:`Figure` objects
-(Agg canvas, no pyplot state, no display), write
+Plots read the run's timeline only (:mod:`experiments.trace.timeline`; STYLE principle 10),
+draw on bare :class:`Figure` objects (Agg canvas, no pyplot state, no display), write
 PNGs with fixed metadata (same events, same bytes) and never fail on an empty or
 tiny trace: they draw a note such as "no decisions" instead.
 """
@@ -24,9 +24,13 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
+from experiments.trace.timeline import Timeline
+from experiments.trace.timeline import timeline as timeline_of
+from tasker import events as ev
 from tasker.trace import number
 
-Event = Mapping[str, Any]
+Source = Timeline | Iterable[ev.Event | Mapping[str, Any]]
+"""What a plot reads: a run's timeline, or its events (typed, or records as a trace file has them)."""
 
 COSTS = ("cost_dac", "cost_exeDA", "cc_dac", "cc_exeDA", "c_switch", "c_wait")
 """Alg. 2's costs of Fig. 11 (discomfort accumulated by completion; they add up)."""
@@ -43,8 +47,8 @@ STATE_COLOURS = {"initComm": "#d9d9d9", "compSP": "#a6cee3", "upTsk": "#1f78b4",
 _METADATA = {"Software": "tasker"}  # no matplotlib version in the file: same events, same bytes
 
 
-def _value(e: Event, key: str) -> float:
-    """A trace number as a float; missing or infinite values become NaN (a gap in the line)."""
+def _value(e: ev.Decision, key: str) -> float:
+    """A decision's number as a float; missing or infinite values become NaN (a gap in the line)."""
     v = e.get(key)
     if v is None:
         return math.nan
@@ -52,18 +56,14 @@ def _value(e: Event, key: str) -> float:
     return f if math.isfinite(f) else math.nan
 
 
-def _is_inf(e: Event, key: str) -> bool:
+def _is_inf(e: ev.Decision, key: str) -> bool:
     v = e.get(key)
     return v is not None and number(v) == math.inf
 
 
-def _end_time(events: Sequence[Event]) -> float:
-    return max((float(e["t"]) for e in events), default=0.0)
-
-
-def _agents(events: Sequence[Event]) -> dict[str, str]:
+def _agents(tl: Timeline) -> dict[str, str]:
     """Agent id -> task type, in request order."""
-    return {e["agent"]: e.get("task_type", "?") for e in events if e["event"] == "request"}
+    return {a.id: a.task_type for a in tl.agents.values()}
 
 
 def _note(ax: Axes, text: str) -> None:
@@ -80,53 +80,31 @@ def _save(fig: Figure, out: str | Path) -> Path:
     return out
 
 
-def _mark_commands(ax: Axes, events: Sequence[Event]) -> None:
+def _mark_commands(ax: Axes, tl: Timeline) -> None:
     """Vertical lines at ``susp`` (red dashed) and ``start`` (green dotted) commands."""
-    for e in events:
-        if e["event"] == "command" and e["flag"] in ("susp", "start"):
-            style = ("#c0392b", "--") if e["flag"] == "susp" else ("#2e8b57", ":")
-            ax.axvline(float(e["t"]), color=style[0], ls=style[1], lw=0.8, alpha=0.7)
+    for c in tl.commands:
+        if c.flag in ("susp", "start"):
+            style = ("#c0392b", "--") if c.flag == "susp" else ("#2e8b57", ":")
+            ax.axvline(c.t, color=style[0], ls=style[1], lw=0.8, alpha=0.7)
 
 
-def _role_spans(events: Sequence[Event], t_end: float) -> list[tuple[str, str, float, float]]:
-    """(agent, role, start, end) for every stretch an agent held a role."""
-    spans: list[tuple[str, str, float, float]] = []
-    current: dict[str, tuple[str, float]] = {}
-
-    def close(agent: str, t: float) -> None:
-        role, t0 = current.pop(agent)
-        if t > t0:
-            spans.append((agent, role, t0, t))
-
-    for e in events:
-        if e["event"] != "roles":
-            continue
-        t = float(e["t"])
-        now = {a: "idleDA" for a in e.get("idleDA") or []}
-        for role in ("exeDA", "irrDA"):
-            if e.get(role):
-                now[e[role]] = role
-        for agent in [a for a in current if now.get(a) != current[a][0]]:
-            close(agent, t)
-        for agent, role in now.items():
-            current.setdefault(agent, (role, t))
-    for agent in list(current):
-        close(agent, t_end)
-    return spans
+def role_spans(tl: Timeline) -> list[tuple[str, str, float, float]]:
+    """(agent, role, start, end) for every stretch an agent held a harmoniser role, by end time."""
+    spans = [(s.agent, s.role, s.start, s.end) for a in tl.agents.values() for s in a.roles if s.end > s.start]
+    return sorted(spans, key=lambda s: (s[3], s[2]))
 
 
-def _with_gaps(costs: list[Event]) -> tuple[list[float], list[Event | None]]:
+def _with_gaps(costs: list[ev.Decision]) -> tuple[list[float], list[ev.Decision | None]]:
     """Decision times and events, with a gap (None) wherever no decision was made for a while
     or the compared pair changed: Fig. 11 shows no values while there is no candidate."""
-    ts = [float(e["t"]) for e in costs]
+    ts = [e.t for e in costs]
     steps = sorted(b - a for a, b in zip(ts, ts[1:], strict=False) if b > a)
     usual = steps[len(steps) // 2] if steps else 0.0
     out_t: list[float] = []
-    out_e: list[Event | None] = []
+    out_e: list[ev.Decision | None] = []
     for i, e in enumerate(costs):
         prev = costs[i - 1] if i else None
-        if prev is not None and (ts[i] - ts[i - 1] > 3 * usual or (prev.get("dac"), prev.get("exeDA"))
-                                 != (e.get("dac"), e.get("exeDA"))):
+        if prev is not None and (ts[i] - ts[i - 1] > 3 * usual or (prev.dac, prev.exe_da) != (e.dac, e.exe_da)):
             out_t.append((ts[i - 1] + ts[i]) / 2)
             out_e.append(None)
         out_t.append(ts[i])
@@ -134,44 +112,33 @@ def _with_gaps(costs: list[Event]) -> tuple[list[float], list[Event | None]]:
     return out_t, out_e
 
 
-def hazard_spans(events: Sequence[Event], t_end: float) -> list[tuple[str, str, float, float]]:
-    """(agent, hazard label, start, end) from ``hazard`` events (``status`` on/off); a hazard
-    still on at the end of the trace lasts until ``t_end``; one no agent owns (``agent: null``,
-    e.g. a door open in the world file) is labelled ``unowned``."""
-    spans: list[tuple[str, str, float, float]] = []
-    on: dict[tuple[str, str], float] = {}
-    for e in events:
-        if e["event"] != "hazard":
-            continue
-        label = " ".join([str(e.get("hazard", "?")), *(str(a) for a in e.get("args") or [])])
-        key = (str(e.get("agent") or "unowned"), label)
-        if e.get("status") == "on":
-            on.setdefault(key, float(e["t"]))
-        elif key in on:
-            spans.append((*key, on.pop(key), float(e["t"])))
-    spans += [(*key, t0, t_end) for key, t0 in on.items()]
+def hazard_spans(tl: Timeline) -> list[tuple[str, str, float, float]]:
+    """(agent, hazard label, start, end) of every hazard episode; one still on at the end of the
+    trace lasts until its last time; one no agent owns (e.g. a door open in the world file) is
+    labelled ``unowned``."""
+    spans = [(h.owner or "unowned", h.label, h.start, h.end if h.end is not None else tl.t_end) for h in tl.hazards]
     return sorted(spans, key=lambda s: (s[2], s[0], s[1]))
 
 
-def _mark_other_decisions(axes: Sequence[Axes], events: Sequence[Event]) -> None:
+def _mark_other_decisions(axes: Sequence[Axes], tl: Timeline) -> None:
     """Decisions without costs (priority class, baselines) that switched: a purple line on each panel."""
-    for e in events:
-        if e["event"] == "decision" and e.get("rule") != "cost" and e.get("switch"):
+    for d in tl.decisions:
+        if d.rule != "cost" and d.switch:
             for ax in axes:
-                ax.axvline(float(e["t"]), color="#8e44ad", lw=0.8, alpha=0.6)
+                ax.axvline(d.t, color="#8e44ad", lw=0.8, alpha=0.6)
 
 
-def _decision_rug(ax: Axes, events: Sequence[Event]) -> None:
+def _decision_rug(ax: Axes, tl: Timeline) -> None:
     """Without cost decisions: every decision as a tick on a row per rule, switches as diamonds."""
-    decisions = [e for e in events if e["event"] == "decision"]
+    decisions = tl.decisions
     if not decisions:
         _note(ax, "no decisions")
         return
-    rules = sorted({str(e.get("rule") or e.get("algorithm", "?")) for e in decisions})
+    rules = sorted({str(d.rule or d.algorithm) for d in decisions})
     row = {r: i for i, r in enumerate(rules)}
-    ys = [row[str(e.get("rule") or e.get("algorithm", "?"))] for e in decisions]
-    ax.plot([float(e["t"]) for e in decisions], ys, "|", color="#8e44ad", ms=8, label="decision")
-    sw = [(float(e["t"]), y) for e, y in zip(decisions, ys, strict=True) if e.get("switch")]
+    ys = [row[str(d.rule or d.algorithm)] for d in decisions]
+    ax.plot([d.t for d in decisions], ys, "|", color="#8e44ad", ms=8, label="decision")
+    sw = [(d.t, y) for d, y in zip(decisions, ys, strict=True) if d.switch]
     if sw:
         ax.plot(*zip(*sw, strict=True), "D", color="#c0392b", ms=5, label="switch")
     ax.set_yticks(range(len(rules)), rules, fontsize=8)
@@ -180,22 +147,22 @@ def _decision_rug(ax: Axes, events: Sequence[Event]) -> None:
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.005, 1.0))
 
 
-def _plot_keys(ax: Axes, costs: list[Event], keys: Sequence[str]) -> None:
+def _plot_keys(ax: Axes, costs: list[ev.Decision], keys: Sequence[str]) -> None:
     ts, points = _with_gaps(costs)
     for key in keys:
-        if not any(key in e for e in costs):
+        if not any(key in e.data for e in costs):
             continue
         style = "--" if key.startswith("cc") else "-"  # cc_* often equals cost_*: keep both visible
         (line,) = ax.plot(ts, [_value(e, key) if e else math.nan for e in points], marker=".", ls=style, ms=2.5,
                           lw=1.2 if style == "-" else 1.0, label=key)
-        inf = [float(e["t"]) for e in costs if _is_inf(e, key)]
+        inf = [e.t for e in costs if _is_inf(e, key)]
         if inf:  # infinite costs (no way to do the task from there): triangles along the top edge
             ax.plot(inf, [0.98] * len(inf), "^", ms=3, color=line.get_color(), transform=ax.get_xaxis_transform())
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.005, 1.0))
 
 
-def timeline(events: Sequence[Event], out_png: str | Path, *, title: str | None = None) -> Path:
+def timeline(events: Source, out_png: str | Path, *, title: str | None = None) -> Path:
     """Fig. 11: Alg. 2's costs, its cost rates (own axis), and the roles below; returns the PNG path.
 
     Switches decided by priority class (or by a baseline) are purple lines; ``susp`` commands
@@ -205,11 +172,11 @@ def timeline(events: Sequence[Event], out_png: str | Path, *, title: str | None 
     return _save(timeline_figure(events, title=title), out_png)
 
 
-def timeline_figure(events: Sequence[Event], *, title: str | None = None) -> Figure:
+def timeline_figure(events: Source, *, title: str | None = None) -> Figure:
     """The figure :func:`timeline` saves (for tests and other outputs)."""
-    events = list(events)
-    t_end = _end_time(events)
-    costs = [e for e in events if e["event"] == "decision" and e.get("rule") == "cost"]
+    tl = timeline_of(events)
+    t_end = tl.t_end
+    costs = [d for d in tl.decisions if d.rule == "cost"]
     fig = Figure(figsize=(11, 7 if costs else 5), layout="constrained")
     if costs:
         top, mid, bottom = fig.subplots(3, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.2, 1.6]})
@@ -220,14 +187,14 @@ def timeline_figure(events: Sequence[Event], *, title: str | None = None) -> Fig
         panels: tuple[Axes, ...] = (top, mid)
     else:  # priority class or a baseline: no costs to draw, but when it decided and switched
         top, bottom = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [1.2, 1.6]})
-        _decision_rug(top, events)
+        _decision_rug(top, tl)
         panels = (top,)
-    _mark_other_decisions((*panels, bottom), events)
+    _mark_other_decisions((*panels, bottom), tl)
     for ax in panels:
-        _mark_commands(ax, events)
-    agents = list(_agents(events))
-    spans = _role_spans(events, t_end)
-    hazards = hazard_spans(events, t_end)
+        _mark_commands(ax, tl)
+    agents = list(_agents(tl))
+    spans = role_spans(tl)
+    hazards = hazard_spans(tl)
     if spans:
         rows = {a: i for i, a in enumerate(agents + sorted({s[0] for s in spans} - set(agents)))}
         for agent, role, t0, t1 in spans:
@@ -241,7 +208,7 @@ def timeline_figure(events: Sequence[Event], *, title: str | None = None) -> Fig
         if hazards:
             handles.append(Patch(color=HAZARD_COLOUR, label="hazard on"))
         bottom.legend(handles=handles, fontsize=7, loc="upper left", bbox_to_anchor=(1.005, 1.0))
-        _mark_commands(bottom, events)
+        _mark_commands(bottom, tl)
     else:
         _note(bottom, "no roles")
     bottom.set_xlabel("time [s]")
@@ -252,24 +219,9 @@ def timeline_figure(events: Sequence[Event], *, title: str | None = None) -> Fig
     return fig
 
 
-def _state_spans(events: Sequence[Event], t_end: float) -> dict[str, list[tuple[str, float, float]]]:
+def state_spans(tl: Timeline) -> dict[str, list[tuple[str, float, float]]]:
     """Agent -> (state, start, end) from the request to ``end`` (or the end of the trace)."""
-    spans: dict[str, list[tuple[str, float, float]]] = {}
-    current: dict[str, tuple[str, float]] = {}
-    for e in events:
-        t = float(e["t"])
-        if e["event"] == "request":
-            current[e["agent"]] = ("initComm", t)
-            spans.setdefault(e["agent"], [])
-        elif e["event"] == "transition":
-            agent = e["agent"]
-            state, t0 = current.pop(agent, (e["from"], t))
-            spans.setdefault(agent, []).append((state, t0, t))
-            if e["to"] != "end":
-                current[agent] = (e["to"], t)
-    for agent, (state, t0) in current.items():
-        spans[agent].append((state, t0, t_end))
-    return spans
+    return {a.id: [(s.state, s.start, s.end) for s in a.states] for a in tl.agents.values()}
 
 
 LABEL_FONT = 7
@@ -296,23 +248,22 @@ def _label_lanes(labels: Sequence[tuple[float, str]], seconds_per_point: float) 
     return out
 
 
-def gantt(events: Sequence[Event], out_png: str | Path, *, title: str | None = None) -> Path:
+def gantt(events: Source, out_png: str | Path, *, title: str | None = None) -> Path:
     """Every agent's FSM state over time, one row per agent, stage names in lanes above the bars
     (never on top of each other; suspension stages in orange italics; x: stopped or failed)."""
     return _save(gantt_figure(events, title=title), out_png)
 
 
-def gantt_figure(events: Sequence[Event], *, title: str | None = None) -> Figure:
+def gantt_figure(events: Source, *, title: str | None = None) -> Figure:
     """The figure :func:`gantt` saves."""
-    events = list(events)
-    kinds = _agents(events)
-    t_end = max(_end_time(events), 1.0)
-    spans = _state_spans(events, t_end)
+    tl = timeline_of(events)
+    kinds = _agents(tl)
+    t_end = max(tl.t_end, 1.0)
+    spans = state_spans(tl)
     width_in = 11.0
     seconds_per_point = t_end * 1.02 / ((width_in - 2.2) * 72)  # axes ≈ figure minus the row labels
-    stages = {a: [e for e in events if e["event"] == "stage" and e.get("agent") == a] for a in spans}
-    lanes = {a: _label_lanes([(float(e["t"]), e["action"]) for e in stages[a] if e["status"] == "begin"],
-                             seconds_per_point) for a in spans}
+    stages = {a: tl.agents[a].stages for a in spans}
+    lanes = {a: _label_lanes([(r.begin, r.action) for r in stages[a]], seconds_per_point) for a in spans}
     lane_h = 0.32
     heights = {a: 1.0 + lane_h * (max(lanes[a], default=-1) + 1) for a in spans}
     fig = Figure(figsize=(width_in, 1.6 + 0.45 * max(1.0, sum(heights.values()))), layout="constrained")
@@ -329,17 +280,15 @@ def gantt_figure(events: Sequence[Event], *, title: str | None = None) -> Figure
     for agent, stretch in spans.items():
         for state, t0, t1 in stretch:
             ax.broken_barh([(t0, max(t1 - t0, 1e-3))], (base[agent] - 0.3, 0.6), color=STATE_COLOURS.get(state, "#555"))
-        begins = [e for e in stages[agent] if e["status"] == "begin"]
-        for e, lane in zip(begins, lanes[agent], strict=True):
-            susp = e.get("fsm") == "exeSusp"  # suspension stages in the exeSusp colour
-            t = float(e["t"])
+        for r, lane in zip(stages[agent], lanes[agent], strict=True):
+            susp = r.fsm == "exeSusp"  # suspension stages in the exeSusp colour
             top = base[agent] - 0.32 - lane_h * lane
-            ax.plot([t, t], [base[agent] - 0.3, top], color="#999", lw=0.5)
-            ax.text(t, top, e["action"], fontsize=LABEL_FONT, va="bottom", ha="left",
+            ax.plot([r.begin, r.begin], [base[agent] - 0.3, top], color="#999", lw=0.5)
+            ax.text(r.begin, top, r.action, fontsize=LABEL_FONT, va="bottom", ha="left",
                     color=STATE_COLOURS["exeSusp"] if susp else "#222", style="italic" if susp else "normal")
-        for e in stages[agent]:
-            if e["status"] in ("stopped", "failed"):
-                ax.plot(float(e["t"]), base[agent], "x", color="#000", ms=6)
+        for r in stages[agent]:
+            if r.status in ("stopped", "failed") and r.end is not None:
+                ax.plot(r.end, base[agent], "x", color="#000", ms=6)
     ax.set_yticks([base[a] for a in spans], [f"{a} {kinds.get(a, '?')}" for a in spans], fontsize=8)
     ax.set_ylim(y + 0.1, -0.1)
     ax.set_xlim(0.0, t_end * 1.02)
@@ -355,15 +304,6 @@ TASK_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b", "#e377c2"
 IDLE_COLOUR = "#9a9a9a"
 
 
-def _executing(events: Sequence[Event]) -> list[tuple[float, str | None]]:
-    """(time, exeDA) at every change of the harmoniser's executing agent."""
-    out: list[tuple[float, str | None]] = []
-    for e in events:
-        if e["event"] == "roles" and (not out or out[-1][1] != e.get("exeDA")):
-            out.append((float(e["t"]), e.get("exeDA")))
-    return out
-
-
 def _pose_at(samples: Sequence[tuple[float, ...]], t: float) -> tuple[float, float] | None:
     """The robot's position at ``t``: the last sample at or before it."""
     best = None
@@ -376,7 +316,7 @@ def _pose_at(samples: Sequence[tuple[float, ...]], t: float) -> tuple[float, flo
 
 def world_path(world_name_or_path: Any, trajectory: Iterable[Sequence[float]], out_png: str | Path,
                people: Mapping[str, tuple[tuple[float, float, float], str]] | None = None,
-               *, title: str | None = None, events: Sequence[Event] | None = None,
+               *, title: str | None = None, events: Source | None = None,
                recording: Any = None) -> Path:
     """The world seen from above with the robot's path (``trajectory``: (t, x, y, yaw) samples).
 
@@ -400,12 +340,12 @@ def world_path(world_name_or_path: Any, trajectory: Iterable[Sequence[float]], o
     if title is None:
         title = f"{spec.name}: robot path, {samples[-1][0] - samples[0][0]:.1f} s" if samples else \
             f"{spec.name}: no trajectory"
-    evs = list(events or [])
-    agents = _agents(evs)
+    tl = timeline_of(events if events is not None else [])
+    agents = _agents(tl)
     colour = {a: TASK_COLOURS[k % len(TASK_COLOURS)] for k, a in enumerate(agents)}
 
     def decorate(ax: Axes) -> None:
-        changes = _executing(evs) or [(0.0, None)]
+        changes = tl.exe_changes() or [(0.0, None)]
         handles: dict[str, Any] = {}
         for k, (t0, agent) in enumerate(changes):
             t1 = changes[k + 1][0] if k + 1 < len(changes) else math.inf
@@ -420,18 +360,14 @@ def world_path(world_name_or_path: Any, trajectory: Iterable[Sequence[float]], o
                 if len(samples) > 1 else []:
             ax.plot(s[1], s[2], ".", color="#333", ms=3)
             ax.text(s[1] + 0.08, s[2] + 0.08, f"{s[0]:.0f}s", fontsize=5, color="#333")
-        for e in evs:
-            at = _pose_at(samples, float(e["t"]))
-            if at is None:
-                continue
-            if e["event"] == "command" and e.get("flag") == "susp":
-                h = ax.plot(*at, "x", color=colour.get(e["agent"], "k"), ms=9, mew=2.2)[0]
-                ax.text(at[0] + 0.1, at[1] - 0.25, f"susp {e['agent']} {float(e['t']):.0f}s", fontsize=6)
+        for e in tl.events:
+            if isinstance(e, ev.CommandSent) and e.flag == "susp" and (at := _pose_at(samples, e.t)) is not None:
+                h = ax.plot(*at, "x", color=colour.get(e.agent, "k"), ms=9, mew=2.2)[0]
+                ax.text(at[0] + 0.1, at[1] - 0.25, f"susp {e.agent} {e.t:.0f}s", fontsize=6)
                 handles.setdefault("suspension", h)
-            elif e["event"] == "end":
-                h = ax.plot(*at, "o", mfc="none", color=colour.get(e["agent"], "k"), ms=10, mew=1.5)[0]
-                ax.text(at[0] + 0.1, at[1] + 0.15, f"{e['agent']} {e.get('reason', 'end')} {float(e['t']):.0f}s",
-                        fontsize=6)
+            elif isinstance(e, ev.TaskEnded) and (at := _pose_at(samples, e.t)) is not None:
+                h = ax.plot(*at, "o", mfc="none", color=colour.get(e.agent, "k"), ms=10, mew=1.5)[0]
+                ax.text(at[0] + 0.1, at[1] + 0.15, f"{e.agent} {e.reason} {e.t:.0f}s", fontsize=6)
                 handles.setdefault("task ends", h)
         for m in getattr(recording, "marks", []):
             h = ax.plot(m.x, m.y, "s", color="#6a3d9a", ms=6)[0]
@@ -446,7 +382,8 @@ def world_path(world_name_or_path: Any, trajectory: Iterable[Sequence[float]], o
                       show_walks=recording is None)
 
 
-def all_plots(events: Sequence[Event], out_dir: str | Path) -> list[Path]:
+def all_plots(events: Source, out_dir: str | Path) -> list[Path]:
     """:func:`timeline` and :func:`gantt` of one run into ``out_dir``; returns the files."""
     out = Path(out_dir)
-    return [timeline(events, out / "timeline.png"), gantt(events, out / "gantt.png")]
+    tl = timeline_of(events)
+    return [timeline(tl, out / "timeline.png"), gantt(tl, out / "gantt.png")]

@@ -30,9 +30,11 @@ from typing import Any
 
 from experiments.metrics.registry import host_dependent
 from experiments.report.page import Raw, figure_div, page, table
-from experiments.report.plots import Event, _agents, _end_time, hazard_spans
+from experiments.report.plots import Source, hazard_spans
 from experiments.report.timeline_figures import gantt_figure, timeline_figure
 from experiments.report.world_figure import Sample, read_trajectory, world_figure
+from experiments.trace.timeline import Timeline
+from experiments.trace.timeline import timeline as timeline_of
 
 
 def _fmt(v: Any) -> str:
@@ -41,11 +43,10 @@ def _fmt(v: Any) -> str:
     return str(v)
 
 
-def hazards_of(events: Sequence[Event], metrics: Mapping[str, Any] | None) -> list[tuple[str, str, float, float]]:
+def hazards_of(events: Source, metrics: Mapping[str, Any] | None) -> list[tuple[str, str, float, float]]:
     """Hazard stretches: from ``hazard`` events if the trace has them, else from the metrics'
     ``safety.episodes`` (``agent``, ``hazard``, ``subject``, ``start``, ``end``) if present."""
-    t_end = _end_time(events)
-    spans = hazard_spans(events, t_end)
+    spans = hazard_spans(timeline_of(events))
     if spans or not metrics:
         return spans
     episodes = (metrics.get("safety") or {}).get("episodes") if isinstance(metrics.get("safety"), Mapping) else None
@@ -70,19 +71,19 @@ def _flatten(m: Mapping[str, Any], prefix: str = "") -> list[tuple[str, Any]]:
     return out
 
 
-def run_page(events: Sequence[Event], *, record: Mapping[str, Any] | None = None,
+def run_page(events: Source, *, record: Mapping[str, Any] | None = None,
              metrics: Mapping[str, Any] | None = None, world: Any = None, trajectory: Sequence[Sample] = (),
              people: Mapping[str, Sequence[tuple[float, float, float, str]]] | None = None,
              problems: Sequence[Mapping[str, Any]] = ()) -> str:
     """The HTML of a run's report (see the module docstring)."""
-    events = list(events)
+    tl = timeline_of(events)
     record = record or {}
     scenario = record.get("scenario") or {}
     name = str(scenario.get("name") or "run")
-    hazards = hazards_of(events, metrics)
-    sections = [_summary(events, record)]
-    sections += ["<h2>Timeline (cf. Fig. 11)</h2>", figure_div(timeline_figure(events, hazards), "timeline")]
-    sections += ["<h2>FSM states and stages</h2>", figure_div(gantt_figure(events), "gantt")]
+    hazards = hazards_of(tl, metrics)
+    sections = [_summary(tl, record)]
+    sections += ["<h2>Timeline (cf. Fig. 11)</h2>", figure_div(timeline_figure(tl, hazards), "timeline")]
+    sections += ["<h2>FSM states and stages</h2>", figure_div(gantt_figure(tl), "gantt")]
     sections.append("<h2>World</h2>")
     if world is None:
         sections.append('<p class="note">This run has no world (a synthetic scenario, or run without a '
@@ -91,27 +92,23 @@ def run_page(events: Sequence[Event], *, record: Mapping[str, Any] | None = None
         robot = list(trajectory)
         if not robot:
             sections.append('<p class="note">No trajectory was recorded: the world at its start.</p>')
-        sections.append(figure_div(world_figure(world, robot, people or {}, events, hazards), "world"))
+        sections.append(figure_div(world_figure(world, robot, people or {}, tl, hazards), "world"))
     sections.append(_details(metrics, problems))
     return page(f"tasker run: {name}", sections)
 
 
-def _summary(events: Sequence[Event], record: Mapping[str, Any]) -> str:
+def _summary(tl: Timeline, record: Mapping[str, Any]) -> str:
     settings = record.get("settings") or {}
     scenario = record.get("scenario") or {}
     facts = [("scenario", scenario.get("name", "?")), ("source", scenario.get("source", "")),
              ("seed", record.get("seed", "?")), *sorted(settings.items()),
              ("tasker", record.get("tasker_version", "?"))]
     out = [table(["", ""], [(k, _fmt(v)) for k, v in facts])]
-    kinds = _agents(events)
-    ends = {e["agent"]: e for e in events if e["event"] == "end"}
     out.append("<h2>Tasks</h2>")
     out.append(table(["agent", "task type", "requested at [s]", "ended at [s]", "cause", "reason"],
-                     [(a, kinds[a], _fmt(next(float(e["t"]) for e in events if e["event"] == "request"
-                                              and e["agent"] == a)),
-                       _fmt(float(ends[a]["t"])) if a in ends else "–", ends[a].get("cause", "") if a in ends else
-                       "still running", ends[a].get("reason", "") if a in ends else "") for a in kinds],
-                     numeric=(False, False, True, True)))
+                     [(a.id, a.task_type, _fmt(a.request_t), _fmt(a.end.t) if a.end else "–",
+                       a.end.cause if a.end else "still running", a.end.reason if a.end else "")
+                      for a in tl.agents.values()], numeric=(False, False, True, True)))
     return "\n".join(out)
 
 
@@ -140,7 +137,7 @@ def _details(metrics: Mapping[str, Any] | None, problems: Sequence[Mapping[str, 
     return "\n".join(out)
 
 
-def write_run(out: Path, events: Sequence[Event], *, record: Mapping[str, Any] | None = None,
+def write_run(out: Path, events: Source, *, record: Mapping[str, Any] | None = None,
               metrics: Mapping[str, Any] | None = None, world: Any = None, trajectory: Sequence[Sample] = ()) -> Path:
     """Write ``out/report.html`` for a run; a recorded trajectory file in ``out`` wins over
     ``trajectory`` (the run's own), and ``out/problems/index.json`` is listed when present."""

@@ -15,7 +15,15 @@ from pathlib import Path
 from experiments.analysis.compare import INFEASIBLE, Analysis, MetricSummary, Paired, PrimaryOutcome, primary_cells
 from experiments.analysis.stats import ALPHA, Estimate
 from experiments.inputs.strategy import Strategy
-from experiments.metrics.registry import headline, higher_is_better, host_dependent, lookup, numeric_metrics
+from experiments.metrics.registry import (
+    has_verdict,
+    headline,
+    higher_is_better,
+    host_dependent,
+    lookup,
+    metric,
+    numeric_metrics,
+)
 from experiments.metrics.store import RunRow, Status
 
 
@@ -147,12 +155,15 @@ def markdown(analysis: Analysis, title: str = "Sweep report") -> str:
 
 
 def _counts(p: Paired) -> str:
-    return "–" if host_dependent(p.metric) else f"{p.wins}/{p.ties}/{p.losses}"
+    return f"{p.wins}/{p.ties}/{p.losses}" if has_verdict(p.metric) else "–"
 
 
 def _verdict(p: Paired, short: bool = False) -> str:
-    if host_dependent(p.metric):
-        return "" if short else "host-dependent: no verdict"
+    """Which side is better, as the metric's registration says (``experiments.metrics.registry``)."""
+    if not has_verdict(p.metric):
+        why = "host-dependent" if host_dependent(p.metric) else (
+            "not registered" if metric(p.metric) is None else "neither way better")
+        return "" if short else f"{why}: no verdict"
     if p.wins == p.losses == 0:
         return "=" if short else "identical"
     if math.isnan(p.p_holm):

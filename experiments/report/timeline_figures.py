@@ -1,6 +1,6 @@
 """The trace over time as plotly figures: the Fig. 11 timeline and the Gantt of FSM states and stages.
 
-Drawn from the saved trace only (STYLE principle 10: plots read what was saved, never the
+Drawn from the run's timeline only (STYLE principle 10: plots read what was saved, never the
 model); the spans they draw are those of the PNGs (:mod:`experiments.report.plots`).
 
 * :func:`timeline_figure`: Alg. 2's costs and its cost rates on separate axes, the roles
@@ -25,21 +25,21 @@ from experiments.report.plots import (
     ROLE_COLOURS,
     STATE_COLOURS,
     STATES,
-    Event,
+    Source,
     _agents,
-    _end_time,
     _label_lanes,
-    _role_spans,
-    _state_spans,
     _value,
     _with_gaps,
+    role_spans,
+    state_spans,
 )
+from experiments.trace.timeline import Timeline
+from experiments.trace.timeline import timeline as timeline_of
 
 
-def _roles_bars(fig: go.Figure, events: Sequence[Event], hazards: Sequence[tuple[str, str, float, float]],
-                row: int, t_end: float) -> None:
-    spans = _role_spans(events, t_end)
-    order = list(_agents(events))
+def _roles_bars(fig: go.Figure, tl: Timeline, hazards: Sequence[tuple[str, str, float, float]], row: int) -> None:
+    spans = role_spans(tl)
+    order = list(_agents(tl))
     for role, colour in ROLE_COLOURS.items():
         mine = [s for s in spans if s[1] == role]
         fig.add_trace(go.Bar(
@@ -58,16 +58,13 @@ def _roles_bars(fig: go.Figure, events: Sequence[Event], hazards: Sequence[tuple
     fig.update_yaxes(categoryorder="array", categoryarray=cats[::-1], row=row, col=1)
 
 
-def _mark_commands(events: Sequence[Event], panels: int = 1) -> list[dict[str, Any]]:
+def _mark_commands(tl: Timeline, panels: int = 1) -> list[dict[str, Any]]:
     """Vertical lines on every panel: ``susp`` red dashed, ``start`` green dotted, a switch decided
     by priority class (or a baseline) purple.  Built as plain shapes, set once (fast)."""
-    lines = []
-    for e in events:
-        if e["event"] == "command" and e["flag"] in ("susp", "start"):
-            susp = e["flag"] == "susp"
-            lines.append((float(e["t"]), "#c0392b" if susp else "#2e8b57", "dash" if susp else "dot"))
-        elif e["event"] == "decision" and e.get("rule") != "cost" and e.get("switch"):
-            lines.append((float(e["t"]), "#8e44ad", "solid"))
+    lines = [(c.t, "#c0392b" if c.flag == "susp" else "#2e8b57", "dash" if c.flag == "susp" else "dot")
+             for c in tl.commands if c.flag in ("susp", "start")]
+    lines += [(d.t, "#8e44ad", "solid") for d in tl.decisions if d.rule != "cost" and d.switch]
+    lines.sort(key=lambda x: x[0])
     shapes = []
     for i in range(1, panels + 1):
         axis = "" if i == 1 else str(i)
@@ -76,11 +73,11 @@ def _mark_commands(events: Sequence[Event], panels: int = 1) -> list[dict[str, A
     return shapes
 
 
-def timeline_figure(events: Sequence[Event], hazards: Sequence[tuple[str, str, float, float]] = ()) -> go.Figure:
+def timeline_figure(events: Source, hazards: Sequence[tuple[str, str, float, float]] = ()) -> go.Figure:
     """Fig. 11: costs (row 1), cost rates (row 2, own axis), roles and hazards (row 3)."""
-    events = list(events)
-    t_end = max(_end_time(events), 1.0)
-    costs = [e for e in events if e["event"] == "decision" and e.get("rule") == "cost"]
+    tl = timeline_of(events)
+    t_end = max(tl.t_end, 1.0)
+    costs = [d for d in tl.decisions if d.rule == "cost"]
     fig = make_subplots(rows=3, cols=1, shared_xaxes=True, vertical_spacing=0.04, row_heights=[0.5, 0.18, 0.32],
                         subplot_titles=("Alg. 2 costs" if costs else "decisions (no cost decisions in this run)",
                                         "cost rates [cost/s]", "harmoniser roles and hazards"))
@@ -88,23 +85,23 @@ def timeline_figure(events: Sequence[Event], hazards: Sequence[tuple[str, str, f
         ts, points = _with_gaps(costs)
         for row, keys in ((1, COSTS), (2, RATES)):
             for key in keys:
-                if any(key in e for e in costs):
+                if any(key in e.data for e in costs):
                     ys = [None if p is None or math.isnan(_value(p, key)) else _value(p, key) for p in points]
                     fig.add_trace(go.Scatter(x=ts, y=ys, name=key, mode="lines", legendgroup=f"r{row}",
                                              line={"dash": "dash" if key.startswith("cc") else "solid", "width": 1.5},
                                              hovertemplate=f"{key}: %{{y:.4g}} at %{{x:.1f}} s<extra></extra>"),
                                   row=row, col=1)
-    decisions = [e for e in events if e["event"] == "decision" and e.get("rule") != "cost"]
+    decisions = [d for d in tl.decisions if d.rule != "cost"]
     if decisions:
         fig.add_trace(go.Scatter(
-            x=[float(e["t"]) for e in decisions], y=[str(e.get("rule") or e.get("algorithm")) for e in decisions]
+            x=[d.t for d in decisions], y=[str(d.rule or d.algorithm) for d in decisions]
             if not costs else [None] * len(decisions), mode="markers", name="other decisions",
-            marker={"symbol": ["diamond" if e.get("switch") else "line-ns-open" for e in decisions], "size": 9,
+            marker={"symbol": ["diamond" if d.switch else "line-ns-open" for d in decisions], "size": 9,
                     "color": "#8e44ad"},
-            text=[f"{e.get('rule')}: dac={e.get('dac')}, exeDA={e.get('exeDA')}, switch={e.get('switch')}"
-                  for e in decisions], hovertemplate="%{text} at %{x:.1f} s<extra></extra>"), row=1, col=1)
-    _roles_bars(fig, events, hazards, 3, t_end)
-    fig.update_layout(shapes=_mark_commands(events, panels=3), barmode="overlay", height=720,
+            text=[f"{d.rule}: dac={d.dac}, exeDA={d.exe_da}, switch={d.switch}" for d in decisions],
+            hovertemplate="%{text} at %{x:.1f} s<extra></extra>"), row=1, col=1)
+    _roles_bars(fig, tl, hazards, 3)
+    fig.update_layout(shapes=_mark_commands(tl, panels=3), barmode="overlay", height=720,
                       template="plotly_white", hovermode="closest",
                       legend={"groupclick": "toggleitem"}, margin={"t": 40, "r": 10})
     fig.update_xaxes(range=[0, t_end * 1.01])
@@ -116,33 +113,26 @@ def timeline_figure(events: Sequence[Event], hazards: Sequence[tuple[str, str, f
 # ----------------------------------------------------------------------------------------- gantt
 
 
-def _stage_spans(events: Sequence[Event], t_end: float) -> dict[str, list[dict[str, Any]]]:
-    """Agent -> stages with begin, end and how they ended, from ``stage`` events."""
+def _stage_spans(tl: Timeline) -> dict[str, list[dict[str, Any]]]:
+    """Agent -> stages with begin, end and how they ended."""
     out: dict[str, list[dict[str, Any]]] = {}
-    open_: dict[tuple[str, str, int], dict[str, Any]] = {}
-    for e in events:
-        if e["event"] != "stage":
-            continue
-        key = (e["agent"], str(e.get("fsm")), int(e.get("index", 0)))
-        if e["status"] == "begin":
-            s = {"action": e["action"], "args": e.get("args", []), "fsm": e.get("fsm"), "kind": e.get("kind"),
-                 "t0": float(e["t"]), "t1": t_end, "status": "running at end"}
-            open_[key] = s
-            out.setdefault(e["agent"], []).append(s)
-        elif key in open_:
-            s = open_.pop(key)
-            s["t1"], s["status"] = float(e["t"]), e["status"] + (f": {e['reason']}" if e.get("reason") else "")
+    for a in tl.agents.values():
+        for r in a.stages:
+            status = "running at end" if r.status == "running" else r.status + (f": {r.reason}" if r.reason else "")
+            out.setdefault(a.id, []).append({"action": r.action, "args": list(r.args), "fsm": r.fsm, "kind": r.kind,
+                                             "t0": r.begin, "t1": r.end if r.end is not None else tl.t_end,
+                                             "status": status})
     return out
 
 
-def gantt_figure(events: Sequence[Event]) -> go.Figure:
+def gantt_figure(events: Source) -> go.Figure:
     """Per agent: its FSM states, under them its stages, under those the stage names in lanes
     that never overlap (at the page's default width; zooming only adds room)."""
-    events = list(events)
-    t_end = max(_end_time(events), 1.0)
-    kinds = _agents(events)
-    spans = _state_spans(events, t_end)
-    stages = _stage_spans(events, t_end)
+    tl = timeline_of(events)
+    t_end = max(tl.t_end, 1.0)
+    kinds = _agents(tl)
+    spans = state_spans(tl)
+    stages = _stage_spans(tl)
     seconds_per_point = t_end * 1.02 / (900 * 0.75)  # ≈ 900 px of plot area, 0.75 pt a px
     lane_h = 0.42
     y, ticks, rows = 0.0, [], {}
@@ -188,7 +178,7 @@ def gantt_figure(events: Sequence[Event]) -> go.Figure:
                                  mode="text", textposition="middle right", textfont={"size": 10,
                                                                                      "color": [n[3] for n in names]},
                                  name="stage names", hoverinfo="skip"))
-    fig.update_layout(shapes=_mark_commands(events), barmode="overlay", height=140 + 34 * max(y, 2.0),
+    fig.update_layout(shapes=_mark_commands(tl), barmode="overlay", height=140 + 34 * max(y, 2.0),
                       template="plotly_white",
                       margin={"t": 30, "r": 10}, legend={"groupclick": "toggleitem"},
                       xaxis_title="time [s] (hover a stage for its arguments)")

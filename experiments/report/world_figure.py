@@ -17,7 +17,10 @@ from typing import Any, TypeVar
 
 import plotly.graph_objects as go
 
-from experiments.report.plots import Event, _end_time
+from experiments.report.plots import Source
+from experiments.trace.timeline import Timeline
+from experiments.trace.timeline import timeline as timeline_of
+from tasker import events as ev
 
 _S = TypeVar("_S", bound=tuple[Any, ...])
 Sample = tuple[float, float, float, float]
@@ -102,13 +105,14 @@ _FILL = {"wall": "#444", "furniture": "#c8b48a", "door": "#7a4f2a"}
 
 
 def world_figure(world: Any, robot: Sequence[Sample], people: Mapping[str, Sequence[tuple[float, float, float, str]]],
-                 events: Sequence[Event], hazards: Sequence[tuple[str, str, float, float]]) -> dict[str, Any]:
+                 events: Source, hazards: Sequence[tuple[str, str, float, float]]) -> dict[str, Any]:
     """The world from above, a time slider over the trajectory: the robot, its path so far,
     people, the hazards on and the agent executing at that moment; red crosses where the robot
     was at each ``susp`` command.  A figure dict: its
     frames are built as plain data (validating hundreds of frames would cost seconds)."""
+    tl = timeline_of(events)
     robot = _thin(robot, MAX_POINTS)
-    people = {n: _thin(track, MAX_POINTS) for n, track in people.items()} or _people_from_trace(world, events)
+    people = {n: _thin(track, MAX_POINTS) for n, track in people.items()} or _people_from_trace(world, tl)
     fig = go.Figure()
     shapes: list[dict[str, Any]] = []
     for o in world.obstacles:
@@ -128,17 +132,16 @@ def world_figure(world: Any, robot: Sequence[Sample], people: Mapping[str, Seque
                              textfont={"size": 9, "color": "#2a7a2a"}, hoverinfo="text"))
     fig.add_trace(go.Scatter(x=[s[1] for s in robot], y=[s[2] for s in robot], mode="lines", name="robot path",
                              line={"color": "#1f5fbf", "width": 1}, opacity=0.25, hoverinfo="skip"))
-    susp_at = [(float(e["t"]), e["agent"], _at(robot, float(e["t"]))) for e in events
-               if e["event"] == "command" and e["flag"] == "susp"]
+    susp_at = [(c.t, c.agent, _at(robot, c.t)) for c in tl.commands if c.flag == "susp"]
     fig.add_trace(go.Scatter(x=[p[1] for _, _, p in susp_at if p], y=[p[2] for _, _, p in susp_at if p],
                              text=[f"susp {a} at {t:.1f} s" for t, a, p in susp_at if p], mode="markers",
                              marker={"symbol": "x-thin-open", "size": 14, "color": "#c0392b", "line": {"width": 3}},
                              name="robot at susp", hoverinfo="text"))
-    t_end = max(robot[-1][0] if robot else 0.0, _end_time(events))
+    t_end = max(robot[-1][0] if robot else 0.0, tl.t_end)
     n = min(MAX_FRAMES, max(2, len(robot)))
     times = [round(t_end * i / (n - 1), 3) for i in range(n)]
-    suspended = _suspension_spans(events, t_end)
-    roles = [(float(e["t"]), e.get("exeDA")) for e in events if e["event"] == "roles"]
+    suspended = _suspension_spans(tl, t_end)
+    roles = [(r.t, r.exe_da) for r in tl.roles]
     frames = [{"name": f"{t:g}", "data": _world_state(t, robot, people), "traces": [3, 4, 5],
                "layout": {"title": {"text": _world_title(t, hazards, suspended, roles, t_end)}}} for t in times]
     for trace in _world_state(times[0], robot, people):
@@ -165,15 +168,14 @@ def world_figure(world: Any, robot: Sequence[Sample], people: Mapping[str, Seque
     return out
 
 
-def _people_from_trace(world: Any, events: Sequence[Event]) -> dict[str, list[tuple[float, float, float, str]]]:
+def _people_from_trace(world: Any, tl: Timeline) -> dict[str, list[tuple[float, float, float, str]]]:
     """Without recorded people: each at the world's initial pose, postures from ``world`` events."""
     out = {n: [(0.0, p.pose[0], p.pose[1], p.posture)] for n, p in world.people.items()}
-    for e in events:
-        value = e.get("value")
-        if e["event"] == "world" and e.get("what") == "posture" and isinstance(value, list) and len(value) == 2 \
-                and value[0] in out:
+    for e in tl.world:
+        value = e.value
+        if e.what == "posture" and isinstance(value, list) and len(value) == 2 and value[0] in out:
             last = out[value[0]][-1]
-            out[value[0]].append((float(e["t"]), last[1], last[2], str(value[1])))
+            out[value[0]].append((e.t, last[1], last[2], str(value[1])))
     return out
 
 
@@ -198,15 +200,16 @@ def _world_state(t: float, robot: Sequence[Sample], people: Mapping[str, Sequenc
     ]
 
 
-def _suspension_spans(events: Sequence[Event], t_end: float) -> list[tuple[str, float, float]]:
-    """(agent, from, to) for every stretch from a ``susp`` command to the agent's next ``start``."""
+def _suspension_spans(tl: Timeline, t_end: float) -> list[tuple[str, float, float]]:
+    """(agent, from, to) for every stretch from a ``susp`` command to the agent's next ``start`` (or end)."""
     out: list[tuple[str, float, float]] = []
     since: dict[str, float] = {}
-    for e in events:
-        if e["event"] == "command" and e["flag"] == "susp":
-            since.setdefault(e["agent"], float(e["t"]))
-        elif e["event"] in ("command", "end") and e.get("agent") in since and e.get("flag", "start") == "start":
-            out.append((e["agent"], since.pop(e["agent"]), float(e["t"])))
+    for e in tl.events:
+        if isinstance(e, ev.CommandSent) and e.flag == "susp":
+            since.setdefault(e.agent, e.t)
+        elif (isinstance(e, ev.CommandSent) and e.flag == "start" or isinstance(e, ev.TaskEnded)) \
+                and e.agent in since:
+            out.append((e.agent, since.pop(e.agent), e.t))
     return out + [(a, t0, t_end) for a, t0 in since.items()]
 
 

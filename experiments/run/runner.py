@@ -30,6 +30,9 @@ from experiments.inputs import scenario as scenarios
 from experiments.inputs import synthetic
 from experiments.inputs.actions import TimedAction
 from experiments.inputs.request_fields import asked_for
+from experiments.metrics import run as metrics
+from experiments.report.explain import INDEX, write_problems
+from experiments.trace.timeline import Timeline
 from tasker import events as ev
 from tasker import schedulers
 from tasker.agent import Rates
@@ -377,10 +380,9 @@ def _version(dist: str) -> str | None:
 
 
 def _metrics(trace: Trace, calls: list[dict[str, Any]], wall: float) -> dict[str, Any]:
-    from experiments.metrics import run as metrics
-
-    m = metrics.compute(trace.events)
-    sim_time = trace.events[-1]["t"] if trace.events else 0.0
+    tl = Timeline(trace.typed)
+    m = metrics.compute(tl)
+    sim_time = tl.t_end
     m["planner_wall_time_s"] = round(sum(float(c.get("planner_time_s", 0.0)) for c in calls), 6)
     m["planner_cache_hits"] = sum(1 for c in calls if c.get("cached"))
     m["wall_time_s"] = round(wall, 3)
@@ -397,8 +399,6 @@ def _clear_outputs(out: Path) -> None:
     """Remove what an earlier run wrote into ``out`` (:data:`OUTPUTS`, ``problems/``'s PDDL, plans and
     index) and nothing else: a run writes only some of them (no pictures with ``--no-pictures``, no
     trajectory for a synthetic scenario, fewer planning calls), so the rest would read as this run's."""
-    from experiments.report.explain import INDEX
-
     if not ((out / "trace.jsonl").is_file() and (out / "run.json").is_file()):
         return  # not a run's folder (e.g. --out . in a project): nothing of a run to remove
     for name in OUTPUTS:
@@ -415,8 +415,6 @@ def _clear_outputs(out: Path) -> None:
 def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Trace,
           trajectory: tuple[tuple[float, float, float, float], ...], world: Any, pictures: bool,
           sim: Any = None, journal: Any = ()) -> None:
-    from experiments.report.explain import write_problems
-
     out.mkdir(parents=True, exist_ok=True)
     _clear_outputs(out)
     trace.write(out / "trace.jsonl")
@@ -430,9 +428,10 @@ def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Tr
     from experiments.report import plots
     from experiments.report import run_page as report_html
 
-    plots.timeline(trace.events, out / "timeline.png")
-    plots.gantt(trace.events, out / "gantt.png")
-    report_html.write_run(out, trace.events, record=record, metrics=metrics_, world=world, trajectory=trajectory)
+    tl = Timeline(trace.typed)  # read once by every picture
+    plots.timeline(tl, out / "timeline.png")
+    plots.gantt(tl, out / "gantt.png")
+    report_html.write_run(out, tl, record=record, metrics=metrics_, world=world, trajectory=trajectory)
     if world is not None:
-        plots.world_path(world, list(trajectory), out / "world.png", events=trace.events,
+        plots.world_path(world, list(trajectory), out / "world.png", events=tl,
                          recording=getattr(sim, "recording", None))

@@ -7,10 +7,11 @@ from typing import Any
 import pytest
 
 from experiments.metrics import run as metrics
+from tests.experiments.events import complete
 
 
 def ev(t: float, event: str, **fields: Any) -> dict[str, Any]:
-    return {"t": t, "event": event, **fields}
+    return complete({"t": t, "event": event, **fields})
 
 
 def go(t: float, agent: str, *states: str) -> list[dict[str, Any]]:

@@ -18,16 +18,17 @@ from experiments.days import table as day_table
 from experiments.metrics import day as day_metrics_mod
 from experiments.sweep.spec import Job
 from tasker.errors import ConfigError
+from tests.experiments.events import completed
 
 
 def _day_main(argv: list[str]) -> int:
     return _tasker(["day", *argv])
 
 
-EVENTS = [
+EVENTS = completed([
     {"t": 0.0, "event": "request", "agent": "d1", "task_type": "folder_a", "args": {"deadline": 10.0}},
     {"t": 12.0, "event": "end", "agent": "d1", "task_type": "folder_a", "cause": "finished"},
-]
+])
 
 
 def test_trace_task_types_are_reported_under_the_protocols_names() -> None:

@@ -18,8 +18,10 @@ from planners.pddl_task import PddlTaskType, planning_journal
 from planners.planner import PddlText, Planner
 from planners.problem import portable
 from planners.results import PlanStatus
+from tasker.events import parse
 from tasker.stage import Purpose
 from tasker.task import Strategy
+from tests.experiments.events import complete
 
 UNSOLVABLE = """
 kind = "robot"
@@ -124,21 +126,21 @@ def test_explain_picks_the_problem_in_force(tmp_path: Path) -> None:
 def test_explain_without_an_agent_names_the_agents_of_the_run(unsolvable_run: Path,
                                                               capsys: pytest.CaptureFixture[str]) -> None:
     """Before: argparse's bare "the following arguments are required: --agent", whatever the folder held."""
-    assert explain.main([str(unsolvable_run)]) == 2
+    assert cli_main(["explain", str(unsolvable_run)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("tasker explain: error: argument --agent: which agent? an id such as d1; agents that "
                           f"planned in {unsolvable_run}: d1") and "Traceback" not in err
 
 
 def test_explain_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert explain.main([str(tmp_path / "nope"), "--agent", "d1"]) == 2
+    assert cli_main(["explain", str(tmp_path / "nope"), "--agent", "d1"]) == 2
     assert "no such run folder" in capsys.readouterr().err
-    assert explain.main([str(tmp_path), "--agent", "d1"]) == 2
+    assert cli_main(["explain", str(tmp_path), "--agent", "d1"]) == 2
     err = capsys.readouterr().err
     assert "problems/index.json: no planning record" in err and "Traceback" not in err
     (tmp_path / "problems").mkdir()
     (tmp_path / "problems" / "index.json").write_text("[{")
-    assert explain.main([str(tmp_path), "--agent", "d1"]) == 2
+    assert cli_main(["explain", str(tmp_path), "--agent", "d1"]) == 2
     assert "index.json:1: not valid JSON" in capsys.readouterr().err
 
 
@@ -164,7 +166,8 @@ def test_a_damaged_index_or_trace_is_a_clean_error(tmp_path: Path, record: objec
     err = capsys.readouterr().err
     assert re.search(r"problems/index\.json: " + message, err), err
     (tmp_path / "problems" / "index.json").write_text(json.dumps([GOOD_RECORD]))
-    (tmp_path / "trace.jsonl").write_text('{"t":0.0,"event":"run"}\n[1, 2]\n')
+    run = json.dumps(complete({"t": 0.0, "event": "run"}))
+    (tmp_path / "trace.jsonl").write_text(run + '\n[1, 2]\n')
     assert cli_main(["explain", str(tmp_path), "--agent", "d1"]) == 2
     assert "trace.jsonl:2: not a JSON object: [1, 2]" in capsys.readouterr().err
     for at in ("nan", "inf", "-1"):
@@ -176,5 +179,5 @@ def test_repeated_decisions_are_folded() -> None:
     decision = {"event": "decision", "algorithm": "alg2", "dac": "d2", "exeDA": "d1", "rule": "cost", "switch": False}
     events = [{"t": float(t), **decision} for t in range(5)] + [{"t": 5.0, "event": "command", "agent": "d1",
                                                                   "flag": "susp"}]
-    lines = explain._event_lines(events)
+    lines = explain._event_lines([parse(complete(e)) for e in events])
     assert len(lines) == 4 and "3 more decisions like it" in lines[1] and "command susp" in lines[3]

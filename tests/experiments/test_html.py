@@ -18,7 +18,8 @@ from experiments.run.runner import run_scenario
 from robot.spec import load_world
 
 DEMO = Path(__file__).resolve().parents[2] / "experiments" / "inputs" / "scenarios" / "synthetic_demo.toml"
-HAZARD = {"event": "hazard", "agent": "d1", "hazard": "device_on", "args": ["cooker"], "budget_s": 30.0}
+HAZARD = {"event": "hazard", "agent": "d1", "hazard": "device_on", "args": ["cooker"], "fact": ["device_on", "cooker"],
+          "budget_s": 30.0, "severity": 1.0}
 
 
 @pytest.fixture(scope="module")
@@ -82,7 +83,8 @@ def test_timeline_without_cost_decisions_shows_the_decisions() -> None:
 def test_hazards_fall_back_to_metric_episodes() -> None:
     metrics = {"safety": {"episodes": [{"agent": "d1", "hazard": "cooker_on", "subject": "cooker", "start": 2.0,
                                         "end": 5.0}]}}
-    assert report_html.hazards_of([{"t": 6.0, "event": "run"}], metrics) == [("d1", "cooker_on cooker", 2.0, 5.0)]
+    trace = [{"t": 6.0, "event": "mode", "mode": "IT"}]
+    assert report_html.hazards_of(trace, metrics) == [("d1", "cooker_on cooker", 2.0, 5.0)]
 
 
 def test_gantt_names_every_stage(events: list[dict[str, Any]]) -> None:

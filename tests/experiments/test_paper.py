@@ -42,7 +42,7 @@ def checked(paper_run: Path) -> dict[float, list[dict[str, Any]]]:
     return {0.9: as_dicts, 1.0: run_one((1.0, None, "paper"))["steps"]}
 
 
-def _events(change: Callable[[scenarios.RobotScenario], scenarios.RobotScenario]) -> list[appendix_b.Event]:
+def _events(change: Callable[[scenarios.RobotScenario], scenarios.RobotScenario]) -> list[dict[str, Any]]:
     scn = change(scenarios.load(scenarios.resolve("paper")))
     return list(run_scenario(scn, seed=scn.seed, pictures=False).trace.events)
 

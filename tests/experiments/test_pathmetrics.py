@@ -6,6 +6,7 @@ import pytest
 
 from experiments.metrics.paths import abandonments, path_metrics, travel_m
 from robot.recording import PersonState, Sample
+from tests.experiments.events import completed
 
 # The robot on the x axis, one sample a second; Ann lies at the origin from t = 0; Bob stands at (0, 5).
 XS = [5.0, 3.0, 1.5, 1.0, 2.5, 1.0, 1.0, 1.0, 3.0, 3.0, 3.0]
@@ -18,11 +19,11 @@ def samples(ann_up_at: float = 99.0) -> list[Sample]:
             for t, x in enumerate(XS)]
 
 
-EVENTS = [
+EVENTS = completed([
     {"t": 1.0, "event": "request", "agent": "d1", "task_type": "help", "args": {"person": "ann", "deadline": 9.0}},
     {"t": 1.0, "event": "request", "agent": "d2", "task_type": "escort", "args": {"person": "bob", "to": "hall"}},
     {"t": 7.5, "event": "end", "agent": "d1", "task_type": "help", "cause": "finished"},
-]
+])
 
 
 def test_travel_is_the_length_of_the_sampled_path() -> None:
@@ -54,7 +55,7 @@ def test_a_smaller_circle_changes_the_count() -> None:
 
 
 def _roles(*changes: tuple[float, str | None]) -> list[dict[str, object]]:
-    return [{"t": t, "event": "roles", "exeDA": a, "irrDA": None, "idleDA": []} for t, a in changes]
+    return completed({"t": t, "event": "roles", "exeDA": a, "irrDA": None, "idleDA": []} for t, a in changes)
 
 
 def test_leaving_while_driving_to_the_person_is_not_for_another_task() -> None:
@@ -72,11 +73,11 @@ def test_leaving_while_driving_to_the_person_is_not_for_another_task() -> None:
 def test_a_fall_requested_again_is_watched_until_its_last_task_ends() -> None:
     # d1's help failed at t=2 and was asked again as d3 at t=5, which finished at 7.5: the robot
     # leaving at t=4 (between them) left Ann lying, and it counts once, for the need d1
-    renewed = [EVENTS[0], EVENTS[1],
-               {"t": 2.0, "event": "end", "agent": "d1", "task_type": "help", "cause": "failed"},
-               {"t": 5.0, "event": "request", "agent": "d3", "task_type": "help", "args": EVENTS[0]["args"],
-                "renews": "d1"},
-               {"t": 7.5, "event": "end", "agent": "d3", "task_type": "help", "cause": "finished"}]
+    renewed = completed([EVENTS[0], EVENTS[1],
+                         {"t": 2.0, "event": "end", "agent": "d1", "task_type": "help", "cause": "failed"},
+                         {"t": 5.0, "event": "request", "agent": "d3", "task_type": "help",
+                          "args": EVENTS[0]["args"], "renews": "d1"},
+                         {"t": 7.5, "event": "end", "agent": "d3", "task_type": "help", "cause": "finished"}])
     assert abandonments(renewed, samples()) == {"d1": 1}
     # the renewal executing counts as the fall's own task, not another's
     theirs = sorted(renewed + _roles((1.0, "d2"), (3.5, "d3")), key=lambda e: e["t"])

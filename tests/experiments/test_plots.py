@@ -10,6 +10,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from experiments.inputs import synthetic
 from experiments.report import plots
+from experiments.trace.timeline import Timeline
+from tests.experiments.events import completed
 
 DEMO = Path(__file__).resolve().parents[2] / "experiments" / "inputs" / "scenarios" / "synthetic_demo.toml"
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -25,10 +27,10 @@ def is_png(path: Path, min_bytes: int = 2000) -> bool:
     return data[:8] == PNG and len(data) >= min_bytes
 
 
-TINY = [
+TINY = completed([
     {"t": 0.0, "event": "run", "seed": 1},
     {"t": 0.0, "event": "request", "agent": "d1", "task_type": "cook", "args": {}, "requester": "x"},
-]
+])
 
 
 @pytest.mark.parametrize("plot", [plots.timeline, plots.gantt])
@@ -59,7 +61,7 @@ def test_timeline_with_infinite_costs_and_priority_decisions(tmp_path: Path) -> 
         {"t": 2.0, "event": "roles", "exeDA": "d1", "irrDA": "d2", "idleDA": []},
         {"t": 2.0, "event": "command", "agent": "d1", "flag": "susp"},
     ]
-    assert is_png(plots.timeline(trace, tmp_path / "t.png"))
+    assert is_png(plots.timeline(completed(trace), tmp_path / "t.png"))
 
 
 def test_role_spans_follow_roles_events() -> None:
@@ -68,13 +70,15 @@ def test_role_spans_follow_roles_events() -> None:
         {"t": 1.0, "event": "roles", "exeDA": "d1", "irrDA": None, "idleDA": ["d2"]},
         {"t": 4.0, "event": "roles", "exeDA": "d1", "irrDA": "d2", "idleDA": []},
     ]
-    assert plots._role_spans(roles, 6.0) == [
+    requests = [{"t": 0.0, "event": "request", "agent": a} for a in ("d1", "d2")]
+    roles.append({"t": 6.0, "event": "mode", "mode": "IT"})  # the trace goes on to t = 6
+    assert plots.role_spans(Timeline.of(completed(requests + roles))) == [
         ("d1", "idleDA", 0.0, 1.0), ("d2", "idleDA", 1.0, 4.0), ("d1", "exeDA", 1.0, 6.0), ("d2", "irrDA", 4.0, 6.0),
     ]
 
 
 def test_state_spans_from_transitions(events: list[dict[str, Any]]) -> None:
-    spans = plots._state_spans(events, 100.0)
+    spans = plots.state_spans(Timeline.of(events))
     assert [s[0] for s in spans["d1"]] == ["initComm", "compSP", "upTsk", "exeTsk", "genSusp", "exeSusp", "wait",
                                            "upTsk", "exeTsk"]
     assert spans["d1"][-1][2] == 69.5  # ends at its end transition, not at the given end
@@ -97,11 +101,11 @@ def test_world_path_with_trace_and_recording(tmp_path: Path) -> None:
     for k in range(40):
         rec.record(k * 0.5, (6.0, 1.0 + 0.1 * k, 1.57), [PersonState("sara", 5.4, 3.2, 0.0, "fallen")])
     rec.mark(10.0, "pan", "put_down", 6.0, 3.0)
-    events = [{"t": 0.0, "event": "request", "agent": "d1", "task_type": "cook"},
-              {"t": 0.0, "event": "roles", "exeDA": "d1"},
-              {"t": 8.0, "event": "command", "agent": "d1", "flag": "susp"},
-              {"t": 9.0, "event": "roles", "exeDA": None},
-              {"t": 19.0, "event": "end", "agent": "d1", "reason": "finished"}]
+    events = completed([{"t": 0.0, "event": "request", "agent": "d1", "task_type": "cook"},
+                        {"t": 0.0, "event": "roles", "exeDA": "d1"},
+                        {"t": 8.0, "event": "command", "agent": "d1", "flag": "susp"},
+                        {"t": 9.0, "event": "roles", "exeDA": None},
+                        {"t": 19.0, "event": "end", "agent": "d1", "reason": "finished"}])
     traj = [(s.t, *s.robot) for s in rec.samples]
     assert is_png(plots.world_path("paper", traj, tmp_path / "w.png", events=events, recording=rec), 10_000)
 
@@ -124,7 +128,7 @@ def test_timeline_keeps_its_time_axis_with_only_priority_decisions(tmp_path: Pat
          "rule": "priority", "switch": t == 3}
         for t in range(1, 6)
     ] + [{"t": 1.0, "event": "roles", "exeDA": "d1", "irrDA": None, "idleDA": ["d2"]}]
-    fig = plots.timeline_figure(trace)
+    fig = plots.timeline_figure(completed(trace))
     FigureCanvasAgg(fig).draw()  # tick labels exist only once drawn
     bottom = fig.axes[1]
     labels = [t.get_text() for t in bottom.get_xticklabels() if t.get_visible() and t.get_text()]
@@ -134,8 +138,9 @@ def test_timeline_keeps_its_time_axis_with_only_priority_decisions(tmp_path: Pat
 
 def test_hazard_spans_pair_on_and_off() -> None:
     hz = {"event": "hazard", "agent": "d1", "hazard": "device_on", "args": ["cooker"], "budget_s": 30.0}
-    trace = [{"t": 1.0, **hz, "status": "on"}, {"t": 4.0, **hz, "status": "off"}, {"t": 6.0, **hz, "status": "on"}]
-    assert plots.hazard_spans(trace, 9.0) == [("d1", "device_on cooker", 1.0, 4.0),
+    trace = [{"t": 1.0, **hz, "status": "on"}, {"t": 4.0, **hz, "status": "off"}, {"t": 6.0, **hz, "status": "on"},
+             {"t": 9.0, "event": "mode", "mode": "IT"}]
+    assert plots.hazard_spans(Timeline.of(completed(trace))) == [("d1", "device_on cooker", 1.0, 4.0),
                                               ("d1", "device_on cooker", 6.0, 9.0)]
 
 
@@ -147,6 +152,7 @@ def test_gantt_stage_names_do_not_overlap(tmp_path: Path) -> None:
         trace.append({"t": 1.0 + 2.0 * i, "event": "stage", "agent": "d1", "fsm": "exeTsk", "index": i,
                       "action": name, "args": [], "kind": "suspendable", "status": "begin"})
     trace.append({"t": 300.0, "event": "transition", "agent": "d1", "from": "exeTsk", "to": "end"})
+    trace = completed(trace)
     fig = plots.gantt_figure(trace)
     canvas = FigureCanvasAgg(fig)
     canvas.draw()

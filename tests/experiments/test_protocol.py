@@ -14,6 +14,7 @@ from experiments.days import table as day_table
 from experiments.metrics import day as day_metrics_mod
 from tasker import schedulers
 from tasker.support.reader import InputError
+from tests.experiments.events import complete
 
 TABSA = Path(__file__).resolve().parents[2] / "experiments" / "days" / "protocols" / "tabsa.toml"
 
@@ -167,7 +168,7 @@ def test_a_robot_backends_tasks_are_checked_against_the_task_types(tmp_path: Pat
 # -- metrics on a hand-made day -----------------------------------------------------------------------
 
 def ev(t: float, event: str, **f: object) -> dict[str, object]:
-    return {"t": t, "event": event, **f}
+    return complete({"t": t, "event": event, **f})
 
 
 HAND = [
@@ -197,7 +198,8 @@ def test_metrics_agree_with_hand_computed_values() -> None:
     m = day_metrics_mod.day_metrics(HAND, day_end=2000.0)
     assert m["requested"] == 3 and m["completed"] == 2
     assert m["dead_falls"] == 1 and m["first_death_t"] == 1000.0  # d3 never finished
-    assert m["interruptions"] == 2 and m["suspensions"] == 1
+    # every entry into genSusp is a suspension (docs/metrics.md), one of which ran stages
+    assert m["interruptions"] == 2 and m["suspensions"] == 2 and m["suspensions_with_stages"] == 1
     assert m["suspension_time_s"] == pytest.approx(5.0)  # 10 -> 15, then 90 -> 90
     assert m["switches"] == 5
     assert m["oscillation_t"] == 95.0 and m["ending"] == "oscillation"  # before the death at 1000

@@ -40,13 +40,13 @@ def rows() -> list[RunRow]:
     out = []
     for seed in range(5):
         out += [
-            _row("a", seed, STATIC, totals={"duration_s": {"mean": 10.0 + seed}, "failed": 0}, x_s=10.0 + seed,
-                 people={"people_waiting_s": 20.0 + seed}),
-            _row("a", seed, PLANNED, totals={"duration_s": {"mean": 8.0 + seed}, "failed": 0}, x_s=8.0 + seed,
-                 people={"people_waiting_s": 20.0 + seed}),
-            _row("b", seed, STATIC, totals={"duration_s": {"mean": 5.0}, "failed": 0}, x_s=5.0),
+            _row("a", seed, STATIC, totals={"duration_s": {"mean": 10.0 + seed}, "failed": 0},
+                 safety={"unattended_s": 10.0 + seed}, people={"people_waiting_s": 20.0 + seed}),
+            _row("a", seed, PLANNED, totals={"duration_s": {"mean": 8.0 + seed}, "failed": 0},
+                 safety={"unattended_s": 8.0 + seed}, people={"people_waiting_s": 20.0 + seed}),
+            _row("b", seed, STATIC, totals={"duration_s": {"mean": 5.0}, "failed": 0}, safety={"unattended_s": 5.0}),
             _row("b", seed, PLANNED, totals={"duration_s": {"mean": 6.0 + 0.1 * seed}, "failed": 0},
-                 x_s=6.0 + 0.1 * seed),
+                 safety={"unattended_s": 6.0 + 0.1 * seed}),
         ]
     return out
 
@@ -59,11 +59,26 @@ def test_numeric_metrics_flatten_and_skip_what_is_not_a_number() -> None:
 
 def test_summaries_per_strategy_pooled_and_per_scenario(rows: list[RunRow]) -> None:
     by = {(s.scenario, s.strategy, s.metric): s.estimate for s in summarise(rows)}
-    assert by[(ALL, STATIC, "x_s")].n == 10  # pooled rows are descriptive only, never compared
-    assert by[("a", PLANNED, "x_s")].mean == pytest.approx(10.0)
-    assert by[("b", STATIC, "x_s")].half == 0.0
+    assert by[(ALL, STATIC, "safety.unattended_s")].n == 10  # pooled rows are descriptive only, never compared
+    assert by[("a", PLANNED, "safety.unattended_s")].mean == pytest.approx(10.0)
+    assert by[("b", STATIC, "safety.unattended_s")].half == 0.0
     assert (ALL, STATIC, "people.people_waiting_s") in by and ("b", STATIC, "people.people_waiting_s") not in by
     assert by[(ALL, STATIC, "people.people_waiting_s")].n == 5  # missing in b: left out, not zero
+
+
+def test_verdicts_come_from_the_registry_never_from_a_name() -> None:
+    """Before: a regular expression on names called the longer mean duration of finished tasks better
+    ('finished' matched), so a sweep said static was better where planned was 8.1 s shorter."""
+    shorter = [_row("a", s, st, tasks={"d1": {"cause": "finished", "duration_s": d + s}})
+               for s in range(5) for st, d in ((STATIC, 30.0), (PLANNED, 22.0))]
+    p = {q.metric: q for q in paired(shorter)}["derived.finished_duration_s.mean"]
+    assert p.diff.mean == pytest.approx(-8.0) and (p.wins, p.losses) == (5, 0)
+    assert report_tables._verdict(p) == "suspension=planned better"
+    unregistered = [_row("a", s, st, made_up_s=float(s + (st == PLANNED)))
+                    for s in range(5) for st in (STATIC, PLANNED)]
+    q = {r.metric: r for r in paired(unregistered)}["made_up_s"]
+    assert (q.wins, q.ties, q.losses, q.better) == (0, 0, 0, "–")
+    assert report_tables._verdict(q) == "not registered: no verdict"
 
 
 def test_direction_of_better() -> None:
@@ -91,10 +106,10 @@ def test_paired_is_per_scenario_never_pooled_and_holm_corrected(rows: list[RunRo
     pairs = {(p.scenario, p.metric): p for p in paired(rows)}
     assert not any(sc == ALL for sc, _ in pairs)  # opposite effects in a and b are never pooled
     assert ("a", "totals.duration_s.mean") not in pairs  # replaced by the finished-only duration
-    a = pairs[("a", "x_s")]
+    a = pairs[("a", "safety.unattended_s")]
     assert (a.wins, a.ties, a.losses, a.diff.mean, a.diff.n) == (5, 0, 0, pytest.approx(-2.0), 5)
     assert report_tables._verdict(a) == "suspension=planned better"
-    b = pairs[("b", "x_s")]
+    b = pairs[("b", "safety.unattended_s")]
     assert (b.wins, b.ties, b.losses) == (0, 0, 5) and report_tables._verdict(b) == "suspension=static better"
     tests = [p for p in pairs.values() if not math.isnan(p.p)]
     assert [p.p_holm for p in tests] == pytest.approx(holm([p.p for p in tests]))
@@ -115,12 +130,12 @@ def test_constant_metrics_are_dropped_with_a_note(tmp_path: Path, rows: list[Run
 
 def test_non_finite_values_are_counted_and_shown(rows: list[RunRow]) -> None:
     bad = [RunRow(r.scenario, r.seed, r.strategy, r.status, r.record,
-                  {**r.metrics, "y_s": "inf" if (r.seed, r.strategy) == (0, PLANNED) else float(r.seed)})
+                  {**r.metrics, "wall_time_s": "inf" if (r.seed, r.strategy) == (0, PLANNED) else float(r.seed)})
            for r in rows]
     by = {(s.scenario, s.strategy, s.metric): s for s in summarise(bad)}
-    assert (by[("a", PLANNED, "y_s")].nonfinite, by[("a", PLANNED, "y_s")].estimate.n) == (1, 4)
+    assert (by[("a", PLANNED, "wall_time_s")].nonfinite, by[("a", PLANNED, "wall_time_s")].estimate.n) == (1, 4)
     pairs = {(p.scenario, p.metric): p for p in paired(bad)}
-    assert (pairs[("a", "y_s")].nonfinite, pairs[("a", "y_s")].diff.n) == (1, 4)
+    assert (pairs[("a", "wall_time_s")].nonfinite, pairs[("a", "wall_time_s")].diff.n) == (1, 4)
     assert "1 non-finite" in report_tables.markdown(analyse(bad))
 
 
@@ -151,7 +166,7 @@ def test_primary_outcome_reads_configured_paths(tmp_path: Path) -> None:
 def test_errors_and_unpaired_runs_are_left_out_of_the_comparison(rows: list[RunRow]) -> None:
     extra = [RunRow("a", 9, PLANNED, Status.ERROR, {}, {}, error="Boom: no plan"), _row("a", 8, STATIC, x=1.0)]
     pairs = {(p.scenario, p.metric): p for p in paired(rows + extra)}
-    assert pairs[("a", "x_s")].diff.n == 5
+    assert pairs[("a", "safety.unattended_s")].diff.n == 5
     assert ("a", "x") not in pairs
 
 
@@ -196,7 +211,7 @@ def test_host_dependent_metrics_are_reported_without_a_verdict(tmp_path: Path, r
     files = build_report(db, tmp_path / "out")
     with files.paired_csv.open() as f:
         flags = {r["metric"]: r["host_dependent"] for r in csv.DictReader(f)}
-    assert flags["wall_time_s"] == "1" and flags["real_time_factor"] == "1" and flags["x_s"] == "0"
+    assert flags["wall_time_s"] == "1" and flags["real_time_factor"] == "1" and flags["safety.unattended_s"] == "0"
     assert files.html is not None
     page = files.html.read_text()
     assert "<table>" in page and "host-dependent: no verdict" in page and 'id="metric-0"' in page

@@ -1,0 +1,472 @@
+"""The one reading of a trace: typed events become a timeline of intervals and episodes.
+
+Everything that measures a run — run, day and path metrics, calibration, plots, the HTML
+pages, the Appendix B check, ``tasker explain`` — reads a :class:`Timeline`, never raw
+trace dicts.  So what a state, a suspension or a hazard episode *is* is decided here, once:
+
+* **state spans** per agent: each FSM leaf state from the moment the agent entered it to
+  the moment it left (``initComm`` from the request), with the triggers in and out;
+* **harmoniser role spans** per agent (``exeDA``, ``irrDA``, ``idleDA``, from the ``roles``
+  events) and **person role spans** (the task folders' declared roles, ``role`` events);
+* **stage runs**: each stage from ``begin`` to its closing event;
+* **suspension episodes**: from entering ``genSusp`` (by ``suspend``, ``stage_failed`` or
+  ``secure``) to entering ``wait`` or ``end``, with the ``exeSusp`` plan and the stages run;
+* **interruptions**: from a ``susp`` command to the agent's next ``start`` (a ``start`` with
+  ``secure`` does not end one), with the expected and realised lengths;
+* **hazard episodes** with their owner (``null``: nobody's), from ``on`` to ``off``.
+
+A span still open when the trace ends is closed at the trace's last time with
+``closed=False``.  Times are the trace's simulated seconds.  The names of states and
+triggers come from :mod:`tasker.fsm` (a renamed state breaks here, loudly, not silently in a
+metric).
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from collections.abc import Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from tasker import events as ev
+from tasker.fsm import FsmState
+from tasker.trace import read_events, typed
+
+S = FsmState
+CMD = frozenset(s.value for s in FsmState if s.in_cmd)
+"""Leaves of ``cmd`` (Fig. 5): an agent in one of them owns the robot."""
+SUSPENDING = frozenset({S.GEN_SUSP.value, S.EXE_SUSP.value})
+
+
+@dataclass(frozen=True, slots=True)
+class Span:
+    """``[start, end]``; ``closed`` is False when the trace ended first (``end`` is then its last time)."""
+
+    start: float
+    end: float
+    closed: bool = True
+
+    @property
+    def duration(self) -> float:
+        return self.end - self.start
+
+    def overlap(self, start: float, end: float) -> float:
+        """Seconds of this span within ``[start, end]``."""
+        return max(0.0, min(self.end, end) - max(self.start, start))
+
+
+@dataclass(frozen=True, slots=True)
+class StateSpan(Span):
+    """An agent in one FSM leaf state; ``entered_by`` / ``left_by`` are the FSM events (triggers)."""
+
+    state: str = ""
+    entered_by: str = ""
+    left_by: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class RoleSpan(Span):
+    """A harmoniser role (``exeDA``, ``irrDA``, ``idleDA``) held by one agent."""
+
+    agent: str = ""
+    role: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class PersonRoleSpan(Span):
+    """A person's declared role (``waiting``, ``following``, ...) while an agent's task holds it."""
+
+    agent: str = ""
+    role: str = ""
+    person: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class StageRun:
+    """One stage from ``begin`` to its closing event (``status`` ``running`` if the trace ended first)."""
+
+    agent: str
+    fsm: str
+    index: int
+    action: str
+    args: tuple[Any, ...]
+    kind: str
+    begin: float
+    end: float | None
+    status: str
+    reason: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class Suspension:
+    """One episode of making a task safe: ``genSusp`` (and ``exeSusp``) until ``wait`` or ``end``.
+
+    ``trigger``: ``suspend`` (a ``susp`` or ``term`` command, or the task's own ``ic_term``),
+    ``stage_failed`` (a failed stage, before the task ends) or ``secure`` (hazard-aware
+    waiting, from ``wait``).  ``outcome``: ``wait``, ``end`` or ``open`` (the trace ended).
+    ``ready`` is when ``exeSusp`` began (its plan was ready), if it did."""
+
+    agent: str
+    start: float
+    trigger: str
+    plan: ev.PlanMade | None
+    stages: tuple[StageRun, ...]
+    ready: float | None
+    end: float
+    outcome: str
+
+    @property
+    def duration(self) -> float:
+        return self.end - self.start
+
+
+@dataclass(frozen=True, slots=True)
+class Interruption:
+    """A ``susp`` command and what became of it (``docs/metrics.md``, calibration)."""
+
+    agent: str
+    task_type: str
+    by: str | None
+    susp_t: float
+    expected_s: float | None
+    wait_t: float | None
+    resume_t: float | None
+    outcome: str  # resumed, not suspended, ended, open at the end of the run
+
+
+@dataclass(frozen=True, slots=True)
+class HazardEpisode:
+    """A declared hazard from ``on`` to ``off`` (``end`` None: still on when the trace ended)."""
+
+    owner: str | None
+    hazard: str
+    args: tuple[str, ...]
+    fact: tuple[str, ...]
+    budget_s: float
+    severity: float
+    start: float
+    end: float | None
+
+    @property
+    def label(self) -> str:
+        return " ".join([self.hazard, *self.args])
+
+
+@dataclass
+class AgentTimeline:
+    """Everything the trace says about one agent."""
+
+    id: str
+    task_type: str
+    args: Mapping[str, Any]
+    requester: str
+    renews: str | None
+    request_t: float
+    states: list[StateSpan] = field(default_factory=list)
+    roles: list[RoleSpan] = field(default_factory=list)
+    person_roles: list[PersonRoleSpan] = field(default_factory=list)
+    plans: list[ev.PlanMade] = field(default_factory=list)
+    stages: list[StageRun] = field(default_factory=list)
+    commands: list[ev.CommandSent] = field(default_factory=list)
+    transitions: list[ev.Transition] = field(default_factory=list)
+    suspensions: list[Suspension] = field(default_factory=list)
+    interruptions: list[Interruption] = field(default_factory=list)
+    resumptions: list[Span] = field(default_factory=list)
+    """From each ``wait --start--> upTsk`` to the first stage that then began (none if none did)."""
+    end: ev.TaskEnded | None = None
+
+    @property
+    def ended(self) -> bool:
+        return self.end is not None
+
+    @property
+    def cause(self) -> str | None:
+        return self.end.cause if self.end is not None else None
+
+    @property
+    def first_start(self) -> ev.CommandSent | None:
+        """The first ``start`` that gave it the robot to run its task (not one to secure a hazard)."""
+        return next((c for c in self.commands if c.flag == "start" and not c.secure), None)
+
+    def state_at(self, t: float) -> str | None:
+        """Its state at ``t`` (after every event of that instant); None before its request."""
+        state = None
+        for s in self.states:
+            if s.start <= t:
+                state = s.state
+            else:
+                break
+        if self.end is not None and t >= self.end.t:
+            return S.END.value
+        return state
+
+    def in_cmd(self) -> list[StateSpan]:
+        return [s for s in self.states if s.state in CMD]
+
+    def person_role_at(self, role: str, t: float) -> bool:
+        """Whether its person held ``role`` at ``t`` (the last edge at or before ``t``)."""
+        on = False
+        for s in self.person_roles:
+            if s.role != role:
+                continue
+            if s.start <= t:
+                on = not (s.closed and s.end <= t)
+        return on
+
+
+class Timeline:
+    """A run's trace read once (see the module docstring).  Build it with :meth:`of` (typed
+    events or records), :meth:`read` (a ``trace.jsonl``) or :meth:`from_events`."""
+
+    def __init__(self, events: Sequence[ev.Event]) -> None:
+        self.events: list[ev.Event] = list(events)
+        self.t_end = max((e.t for e in self.events), default=0.0)
+        self.started: ev.RunStarted | None = None
+        self.stopped: ev.RunStopped | None = None
+        self.agents: dict[str, AgentTimeline] = {}
+        self.decisions: list[ev.Decision] = []
+        self.roles: list[ev.RolesChanged] = []
+        self.world: list[ev.WorldChanged] = []
+        self.modes: list[ev.ModeChanged] = []
+        self.changes: list[ev.ArgsChanged] = []
+        self.secures: list[ev.SecureChanged] = []
+        self.commands: list[ev.CommandSent] = []
+        self.hazards: list[HazardEpisode] = []
+        self.needs: dict[str, str] = {}
+        self._role_times: list[float] | None = None
+        self.people_order: list[str] = []
+        """Agents in the order their first person-role edge came (the order of ``people`` metrics)."""
+        self._build()
+
+    # -- construction ---------------------------------------------------------------------------
+
+    @classmethod
+    def from_events(cls, events: Iterable[ev.Event]) -> Timeline:
+        return cls(list(events))
+
+    @classmethod
+    def of(cls, events: Iterable[ev.Event | Mapping[str, Any]] | Timeline) -> Timeline:
+        """A timeline of typed events, of records (a live trace's ``events`` or
+        :func:`tasker.trace.read`'s), or the timeline itself."""
+        if isinstance(events, Timeline):
+            return events
+        items = list(events)
+        if items and not isinstance(items[0], ev.Event):
+            return cls(typed(items))  # type: ignore[arg-type]
+        return cls(items)  # type: ignore[arg-type]
+
+    @classmethod
+    def read(cls, path: str | Path) -> Timeline:
+        """The timeline of a saved ``trace.jsonl`` (a damaged one is a ``ValueError`` naming its line)."""
+        return cls(read_events(path))
+
+    def _build(self) -> None:
+        state: dict[str, tuple[str, float, str]] = {}  # agent -> (state, since, entered_by)
+        stage_open: dict[str, tuple[ev.StageChanged, int]] = {}  # agent -> (its begin, index in stages)
+        susp_open: dict[str, dict[str, Any]] = {}
+        inter_open: dict[str, dict[str, Any]] = {}
+        roles_now: dict[str, tuple[str, float]] = {}
+        person_open: dict[tuple[str, str], tuple[float, str]] = {}
+        hazard_open: dict[tuple[str | None, str, tuple[str, ...]], ev.HazardChanged] = {}
+        resuming: dict[str, float] = {}
+        for e in self.events:
+            if isinstance(e, ev.TaskRequested):
+                self.agents[e.agent] = AgentTimeline(e.agent, e.task_type, e.args, e.requester, e.renews, e.t)
+                state[e.agent] = (S.INIT_COMM.value, e.t, "request")
+                self.needs[e.agent] = (self.needs.get(e.renews, e.renews) if e.renews is not None else e.agent)
+            elif isinstance(e, ev.Transition):
+                a = self.agents.get(e.agent)
+                if a is None:
+                    continue
+                a.transitions.append(e)
+                was, since, by = state.pop(e.agent, (e.source, e.t, ""))
+                a.states.append(StateSpan(since, e.t, True, was, by, e.trigger))
+                if e.target != S.END.value:
+                    state[e.agent] = (e.target, e.t, e.trigger)
+                if e.source == S.WAIT.value and e.target == S.UP_TSK.value:
+                    resuming[e.agent] = e.t
+                self._on_transition(a, e, susp_open, inter_open)
+            elif isinstance(e, ev.StageChanged):
+                a = self.agents.get(e.agent)
+                if a is None:
+                    continue
+                if e.status == "begin":
+                    if e.agent in resuming:
+                        a.resumptions.append(Span(resuming.pop(e.agent), e.t))
+                    a.stages.append(StageRun(e.agent, e.fsm, e.index, e.action, tuple(e.args), e.kind, e.t, None,
+                                             "running"))
+                    stage_open[e.agent] = (e, len(a.stages) - 1)
+                    if e.fsm == S.EXE_SUSP.value and e.agent in susp_open and susp_open[e.agent]["ready"] is None:
+                        susp_open[e.agent]["ready"] = e.t
+                elif e.agent in stage_open:
+                    begin, k = stage_open.pop(e.agent)
+                    run = a.stages[k]
+                    a.stages[k] = StageRun(run.agent, run.fsm, run.index, run.action, run.args, run.kind, run.begin,
+                                           e.t, e.status, e.reason)
+                    if run.fsm == S.EXE_SUSP.value and e.agent in susp_open:
+                        susp_open[e.agent]["stages"].append(a.stages[k])
+            elif isinstance(e, ev.PlanMade):
+                a = self.agents.get(e.agent)
+                if a is None:
+                    continue
+                a.plans.append(e)
+                if e.purpose == S.GEN_SUSP.value and e.agent in susp_open:
+                    susp_open[e.agent]["plan"] = e
+            elif isinstance(e, ev.CommandSent):
+                self.commands.append(e)
+                a = self.agents.get(e.agent)
+                if a is None:
+                    continue
+                a.commands.append(e)
+                self._on_command(a, e, inter_open)
+            elif isinstance(e, ev.TaskEnded):
+                a = self.agents.get(e.agent)
+                if a is None:
+                    continue
+                a.end = e
+                opened = inter_open.pop(e.agent, None)
+                if opened is not None:
+                    a.interruptions.append(Interruption(**opened, resume_t=None, outcome="ended"))
+            elif isinstance(e, ev.RolesChanged):
+                self.roles.append(e)
+                now = {x: "idleDA" for x in e.idle_da}
+                if e.exe_da:
+                    now[e.exe_da] = "exeDA"
+                if e.irr_da:
+                    now[e.irr_da] = "irrDA"
+                for agent in [x for x in roles_now if now.get(x) != roles_now[x][0]]:
+                    role, t0 = roles_now.pop(agent)
+                    if e.t > t0 and agent in self.agents:
+                        self.agents[agent].roles.append(RoleSpan(t0, e.t, True, agent, role))
+                for agent, role in now.items():
+                    roles_now.setdefault(agent, (role, e.t))
+            elif isinstance(e, ev.RoleChanged):
+                if e.agent in self.agents and e.agent not in self.people_order:
+                    self.people_order.append(e.agent)
+                key = (e.agent, e.role)
+                if e.status == "on":
+                    person_open.setdefault(key, (e.t, e.person))
+                elif key in person_open and e.agent in self.agents:
+                    t0, person = person_open.pop(key)
+                    self.agents[e.agent].person_roles.append(PersonRoleSpan(t0, e.t, True, e.agent, e.role, person))
+            elif isinstance(e, ev.HazardChanged):
+                hkey = (e.agent, e.hazard, tuple(str(x) for x in e.args))
+                if e.status == "on" and hkey not in hazard_open:
+                    hazard_open[hkey] = e
+                elif e.status == "off" and hkey in hazard_open:
+                    on = hazard_open.pop(hkey)
+                    self.hazards.append(_episode(on, e.t))
+            elif isinstance(e, ev.Decision):
+                self.decisions.append(e)
+            elif isinstance(e, ev.WorldChanged):
+                self.world.append(e)
+            elif isinstance(e, ev.ModeChanged):
+                self.modes.append(e)
+            elif isinstance(e, ev.ArgsChanged):
+                self.changes.append(e)
+            elif isinstance(e, ev.SecureChanged):
+                self.secures.append(e)
+            elif isinstance(e, ev.RunStarted):
+                self.started = self.started or e
+            elif isinstance(e, ev.RunStopped):
+                self.stopped = e
+        t_end = self.t_end
+        for agent, (st, since, by) in state.items():
+            self.agents[agent].states.append(StateSpan(since, t_end, False, st, by, None))
+        for agent, (_, k) in stage_open.items():
+            run = self.agents[agent].stages[k]
+            if run.fsm == S.EXE_SUSP.value and agent in susp_open:
+                susp_open[agent]["stages"].append(run)
+        for agent, opened in susp_open.items():
+            opened["stages"] = tuple(opened["stages"])
+            self.agents[agent].suspensions.append(Suspension(**opened, end=t_end, outcome="open"))
+        for agent, opened in inter_open.items():
+            self.agents[agent].interruptions.append(Interruption(**opened, resume_t=None,
+                                                                 outcome="open at the end of the run"))
+        for agent, (role, t0) in roles_now.items():
+            if agent in self.agents:
+                self.agents[agent].roles.append(RoleSpan(t0, t_end, False, agent, role))
+        for (agent, role), (t0, person) in person_open.items():
+            if agent in self.agents:
+                self.agents[agent].person_roles.append(PersonRoleSpan(t0, t_end, False, agent, role, person))
+        self.hazards += [_episode(on, None) for on in hazard_open.values()]
+        self.hazards.sort(key=lambda h: (h.start, h.hazard, h.args, str(h.owner)))
+        for a in self.agents.values():
+            a.roles.sort(key=lambda s: s.start)
+            a.person_roles.sort(key=lambda s: (s.start, s.role))
+
+    def _on_transition(self, a: AgentTimeline, e: ev.Transition, susp_open: dict[str, dict[str, Any]],
+                       inter_open: dict[str, dict[str, Any]]) -> None:
+        if e.target == S.GEN_SUSP.value:
+            susp_open[a.id] = {"agent": a.id, "start": e.t, "trigger": e.trigger, "plan": None, "stages": [],
+                               "ready": None}
+        elif e.source in SUSPENDING and e.target not in SUSPENDING and a.id in susp_open:
+            opened = susp_open.pop(a.id)
+            opened["stages"] = tuple(opened["stages"])
+            a.suspensions.append(Suspension(**opened, end=e.t, outcome=e.target))
+        if e.target == S.WAIT.value and a.id in inter_open and inter_open[a.id]["wait_t"] is None:
+            inter_open[a.id]["wait_t"] = e.t
+
+    def _on_command(self, a: AgentTimeline, e: ev.CommandSent, inter_open: dict[str, dict[str, Any]]) -> None:
+        if e.flag == "start" and not e.secure:
+            opened = inter_open.pop(a.id, None)
+            if opened is not None:
+                outcome = "resumed" if opened["wait_t"] is not None else "not suspended"
+                a.interruptions.append(Interruption(**opened, resume_t=e.t if outcome == "resumed" else None,
+                                                    outcome=outcome))
+        elif e.flag == "susp":
+            inter_open[a.id] = {"agent": a.id, "task_type": a.task_type, "by": e.by, "susp_t": e.t,
+                                "expected_s": e.expected_s, "wait_t": None}
+
+    # -- queries --------------------------------------------------------------------------------
+
+    def __iter__(self) -> Iterator[ev.Event]:
+        return iter(self.events)
+
+    def of_kind(self, kind: type[ev.Event]) -> list[Any]:
+        """Every event of one type, in order."""
+        return [e for e in self.events if isinstance(e, kind)]
+
+    def exe_changes(self) -> list[tuple[float, str | None]]:
+        """``(t, exeDA)`` at every change of the executing agent."""
+        out: list[tuple[float, str | None]] = []
+        for r in self.roles:
+            if not out or out[-1][1] != r.exe_da:
+                out.append((r.t, r.exe_da))
+        return out
+
+    def exe_at(self, t: float) -> str | None:
+        """``exeDA`` at ``t``: the last ``roles`` event at or before it."""
+        if self._role_times is None or len(self._role_times) != len(self.roles):
+            self._role_times = [r.t for r in self.roles]
+        k = bisect.bisect_right(self._role_times, t) - 1
+        return self.roles[k].exe_da if k >= 0 else None
+
+    def decisions_by(self, *, rule: str | None = None, dac: str | None = None, exe: str | None = None,
+                     switched: bool | None = None, after: float = -math.inf) -> list[ev.Decision]:
+        """Decisions at or after ``after`` matching what is given."""
+        return [d for d in self.decisions if d.t >= after and (rule is None or d.rule == rule)
+                and (dac is None or d.dac == dac) and (exe is None or d.exe_da == exe)
+                and (switched is None or d.switch == switched)]
+
+    def commands_to(self, agent: str, flag: str | None = None, after: float = -math.inf) -> list[ev.CommandSent]:
+        a = self.agents.get(agent)
+        return [c for c in (a.commands if a else []) if c.t >= after and (flag is None or c.flag == flag)]
+
+    def first_needs(self) -> list[str]:
+        """The agents that first asked for a need (a renewal is the same need: ``renews``)."""
+        return [a for a in self.agents if self.needs.get(a) == a]
+
+
+def _episode(on: ev.HazardChanged, end: float | None) -> HazardEpisode:
+    return HazardEpisode(on.agent, on.hazard, tuple(str(x) for x in on.args), tuple(str(x) for x in on.fact),
+                         float(on.budget_s), float(on.severity), on.t, end)
+
+
+def timeline(source: Timeline | Iterable[ev.Event | Mapping[str, Any]] | str | Path) -> Timeline:
+    """A :class:`Timeline` of whatever a reader has: a timeline, events, records or a trace file."""
+    if isinstance(source, str | Path):
+        return Timeline.read(source)
+    return Timeline.of(source)
