@@ -14,7 +14,7 @@ apartment, over random reachable pose pairs:
   start already searched in this scene state, as in travel tables, approach poses and
   the robot waiting: only the goal is linked);
 * **before**: the planner as it was before its queries were made fast
-  (``tests/robot/plain_planner.py``, the slow reference the tests hold it to), same
+  (``robot/reference_planner.py``, the slow reference the tests hold it to), same
   queries, same run, same table;
 * a travel table of the apartment's 8 places (56 pairs) in one pass;
 * the real-time factor of a navigation in MuJoCo (TIAGo, 50 Hz controller).
@@ -105,7 +105,7 @@ def _time(fn: Any, cold: bool = False) -> float:
 def bench_queries(n: int = 60) -> None:
     from ompl import util as ou
 
-    from tests.robot.plain_planner import PlainPlanner
+    from robot.reference_planner import PlainPlanner
 
     ou.setLogLevel(ou.LOG_WARN)
     spec = load_world("paper")

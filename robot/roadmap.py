@@ -25,9 +25,9 @@ Shortest paths are searched per source and scene state by :mod:`robot.motion`
 (Dijkstra, scipy).  Roadmaps are cached in-process by (world, radius, seed, size), and
 on disk (:mod:`tasker.support.diskcache`, kind ``roadmap``, an ``.npz`` of the nodes, edges,
 lengths, corner nodes and stats) under the SHA-256 of the world's ``repr``, the robot's
-radius, the seed, the size, the OMPL and numpy versions and the source of this module and
-of :mod:`robot.scene` (whose exact tests complete the roadmap): a process that finds it
-there grows nothing and loads the same arrays, bit for bit.  An entry that cannot be read
+radius, the seed, the size, the OMPL and numpy versions and the source of this module, of
+:mod:`robot.scene` and of :mod:`robot.spec` (whose exact tests complete the roadmap): a process
+that finds it there grows nothing and loads the same arrays, bit for bit.  An entry that cannot be read
 (truncated, corrupt, inconsistent) is grown again and rewritten.
 """
 
@@ -44,12 +44,12 @@ from typing import Any
 import numpy as np
 from scipy.sparse import csr_matrix
 
-from robot import scene as scene_module
 from robot.scene import Scene
 from robot.spec import DEFAULT_DENSITY, WorldSpec
 from tasker.support.diskcache import content_key, installed_version, remembered
 
 DISK_KIND = "roadmap"  # the on-disk cache's kind (tasker.support.diskcache)
+_GEOMETRY = ("scene.py", "spec.py")  # the exact tests that complete the roadmap (disc_clear is spec's)
 _CACHE: dict[tuple[object, ...], Roadmap] = {}
 log = logging.getLogger(__name__)
 
@@ -160,7 +160,7 @@ def disk_key(spec: WorldSpec, scene: Scene, seed: int, milestones: int | None) -
     """The on-disk cache key of the roadmap :meth:`Roadmap.for_world` returns: everything it is grown from."""
     return content_key(DISK_KIND, [repr(spec), repr(float(scene.radius)), str(seed), repr(milestones),
                                    installed_version("ompl"), f"numpy {np.__version__}", Path(__file__).read_bytes(),
-                                   Path(scene_module.__file__).read_bytes()])
+                                   *(Path(__file__).with_name(m).read_bytes() for m in _GEOMETRY)])
 
 
 class Roadmap:

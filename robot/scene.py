@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robot.spec import Box, WorldSpec
+from robot.spec import Box, WorldSpec, disc_clear, in_bounds
 
 PERSON_RADIUS = {"standing": 0.25, "sitting": 0.35, "fallen": 0.6}
 PEOPLE_TOLERANCE = 1e-3  # metres of slack: planned paths are rounded to 0.1 mm, the skill checks from the true pose
@@ -223,6 +223,7 @@ class Scene:
     def __init__(self, spec: WorldSpec, radius: float) -> None:
         self.radius = float(radius)
         (self.xmin, self.ymin), (self.xmax, self.ymax) = spec.bounds
+        self._bounds = spec.bounds
         self.static = np.array([o.box for o in spec.obstacles], dtype=float).reshape(-1, 4)
         self.walls = np.array([o.box for o in spec.obstacles if o.kind == "wall"], dtype=float).reshape(-1, 4)
         self._static_list: list[Box] = [o.box for o in spec.obstacles]
@@ -306,20 +307,12 @@ class Scene:
 
     # ---- queries ---------------------------------------------------------------------
     def in_bounds(self, x: float, y: float) -> bool:
-        r = self.radius
-        return self.xmin + r <= x <= self.xmax - r and self.ymin + r <= y <= self.ymax - r
+        return in_bounds(self._bounds, x, y, self.radius)
 
     def static_free(self, x: float, y: float) -> bool:
-        """Is the disc at ``(x, y)`` clear of walls and furniture?  Plain Python: OMPL calls it."""
-        if not self.in_bounds(x, y):
-            return False
-        r2 = self.radius * self.radius
-        for x0, y0, x1, y1 in self._static_list:
-            dx = x0 - x if x < x0 else (x - x1 if x > x1 else 0.0)
-            dy = y0 - y if y < y0 else (y - y1 if y > y1 else 0.0)
-            if dx * dx + dy * dy < r2:
-                return False
-        return True
+        """Is the disc at ``(x, y)`` clear of walls and furniture (:func:`robot.spec.disc_clear`)?
+        OMPL's validity checker calls it."""
+        return disc_clear(self._static_list, self._bounds, self.radius, x, y)
 
     def sees(self, a: tuple[float, float], b: tuple[float, float]) -> bool:
         """Is there a line from ``a`` to ``b`` that crosses no wall and no closed door?  (Furniture

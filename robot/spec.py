@@ -14,22 +14,20 @@ Boxes are axis-aligned rectangles ``[xmin, ymin, xmax, ymax]`` in metres; poses 
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from tasker.support import reader
 from tasker.support.reader import InputError, Table, check_name, check_number, check_numbers, suggest
 from tasker.world import Pose
 
-if TYPE_CHECKING:
-    from robot.scene import Scene
-
 WORLDS_DIR = Path(__file__).with_name("worlds")
 POSTURES = ("standing", "sitting", "fallen")
 
 Box = tuple[float, float, float, float]
+Bounds = tuple[tuple[float, float], tuple[float, float]]
 
 
 class WorldFileError(InputError):
@@ -98,7 +96,7 @@ class WorldSpec:
 
     name: str
     source: str
-    bounds: tuple[tuple[float, float], tuple[float, float]]
+    bounds: Bounds
     rooms: Mapping[str, Box]
     obstacles: tuple[Obstacle, ...]
     doors: Mapping[str, Door]
@@ -269,12 +267,34 @@ def room_of(spec: WorldSpec, x: float, y: float) -> str | None:
     return min(inside)[1] if inside else None
 
 
+def in_bounds(bounds: Bounds, x: float, y: float, radius: float = 0.0) -> bool:
+    """Is a disc of ``radius`` at ``(x, y)`` inside ``bounds`` (touching them allowed)?"""
+    (x0, y0), (x1, y1) = bounds
+    return x0 + radius <= x <= x1 - radius and y0 + radius <= y <= y1 - radius
+
+
+def disc_clear(boxes: Sequence[Box], bounds: Bounds, radius: float, x: float, y: float) -> bool:
+    """Is a disc of ``radius`` at ``(x, y)`` inside ``bounds`` and at least ``radius`` from every
+    box (touching allowed)?  **The** rule for where the robot may stand among walls and furniture:
+    :func:`robot_problem` checks a world file's places with it, and the 2-D scene's
+    ``static_free`` answers OMPL's validity checker with it (plain Python: called millions of
+    times).  It lives here, not in the scene, so that the scene depends on the world file's
+    module and never the reverse."""
+    if not in_bounds(bounds, x, y, radius):
+        return False
+    r2 = radius * radius
+    for x0, y0, x1, y1 in boxes:
+        dx = x0 - x if x < x0 else (x - x1 if x > x1 else 0.0)
+        dy = y0 - y if y < y0 else (y - y1 if y > y1 else 0.0)
+        if dx * dx + dy * dy < r2:
+            return False
+    return True
+
+
 def point_problem(spec: WorldSpec, x: float, y: float) -> str | None:
     """Why ``(x, y)`` is not a point in the world's free space (outside the bounds, inside a
     wall or furniture), or ``None``."""
-    from robot.scene import Scene
-
-    if not Scene(spec, 0.0).in_bounds(x, y):
+    if not in_bounds(spec.bounds, x, y):
         (x0, y0), (x1, y1) = spec.bounds
         return f"outside the world's bounds [[{x0:g}, {y0:g}], [{x1:g}, {y1:g}]]"
     for o in spec.obstacles:
@@ -320,31 +340,29 @@ def _check_geometry(spec: WorldSpec, top: Table) -> None:
     robot_t = top.table("robot")
     x, y, _ = spec.robot.pose
     check(robot_t, "pose", x, y)
-    from robot.scene import Scene
     from robot.tiago import robot_dimensions
 
-    scene = Scene(spec, robot_dimensions()[2])  # one for the robot's pose and every place
-    bad = robot_problem(spec, x, y, scene)
+    radius = robot_dimensions()[2]
+    bad = robot_problem(spec, x, y, radius)
     if bad:
         raise robot_t.error("pose", f"{bad}; expected free space")
     for n, (x, y, _) in spec.places.items():  # the robot drives to every place: a goal it never reaches
-        bad = robot_problem(spec, x, y, scene)
+        bad = robot_problem(spec, x, y, radius)
         if bad:
             raise places_t.error(n, f"{bad}, and a place is where the robot stands (it could never get there); "
                                     "expected a point with room for the robot")
 
 
-def robot_problem(spec: WorldSpec, x: float, y: float, scene: Scene | None = None) -> str | None:
+def robot_problem(spec: WorldSpec, x: float, y: float, radius: float | None = None) -> str | None:
     """Why the robot cannot stand at ``(x, y)`` (its disc overlaps a wall, furniture or the bounds), or
-    ``None``; ``scene``: the world's, at the robot's radius, when the caller asks of many points."""
-    if scene is None:
-        from robot.scene import Scene
+    ``None``; ``radius``: the robot's planning radius (looked up when not given)."""
+    if radius is None:
         from robot.tiago import robot_dimensions
 
-        scene = Scene(spec, robot_dimensions()[2])
-    if scene.static_free(x, y):
+        radius = robot_dimensions()[2]
+    if disc_clear([o.box for o in spec.obstacles], spec.bounds, radius, x, y):
         return None
-    return (f"the robot (radius {scene.radius:g} m) at ({x:g}, {y:g}) overlaps a wall, furniture or the "
+    return (f"the robot (radius {radius:g} m) at ({x:g}, {y:g}) overlaps a wall, furniture or the "
             "world's bounds")
 
 

@@ -145,6 +145,9 @@ def test_roadmap_key_has_every_input(paper: WorldSpec, scene: Scene, monkeypatch
     with monkeypatch.context() as m:  # the roadmap module's source
         m.setattr(roadmap_module, "__file__", str(ROOT / "robot" / "spec.py"))
         others.append(disk_key(paper, scene, 1, SMALL))
+    with monkeypatch.context() as m:  # the sources of the exact tests (scene's, spec's disc_clear)
+        m.setattr(roadmap_module, "_GEOMETRY", ("scene.py",))
+        others.append(disk_key(paper, scene, 1, SMALL))
     assert len({key, *others}) == len(others) + 1
 
 

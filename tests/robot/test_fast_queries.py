@@ -2,7 +2,7 @@
 
 :class:`robot.motion.BasePlanner` keeps visibility memos, reads the door layer off the
 all-pairs table, tests segments with :func:`robot.scene.pairs_near` and runs its shortcut in
-plain floats.  :class:`tests.robot.plain_planner.PlainPlanner` is the planner as it was before
+plain floats.  :class:`robot.reference_planner.PlainPlanner` is the planner as it was before
 (every segment tested by its exact distance each time, a Dijkstra per start).  Over random
 start and goal pairs in every shipped world — with people standing in doorways and sitting
 in rooms, one door closed, starts asked for several goals, and the scene changed under the
@@ -15,12 +15,12 @@ import numpy as np
 import pytest
 
 from robot.motion import BasePlanner
+from robot.reference_planner import PlainPlanner
+from robot.reference_planner import segments_clear as segments_clear_by_distance
 from robot.roadmap import path_length
 from robot.scene import Scene, pair_distance, pairs_near, segments_clear
 from robot.spec import load_world, shipped_worlds
 from robot.tiago import robot_dimensions
-from tests.robot.plain_planner import PlainPlanner
-from tests.robot.plain_planner import segments_clear as segments_clear_by_distance
 
 PAIRS = 30
 

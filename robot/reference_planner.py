@@ -4,8 +4,12 @@
 were made fast (issue 11, item 6), kept verbatim apart from its name: every segment tested
 each time it is needed, by its exact distance (``pair_distance``; no visibility memo), a
 scipy Dijkstra for every start, the shortcut's dynamic programme in numpy.
-``tests/robot/test_fast_queries.py`` holds the fast planner to its answers;
-``benchmarks/bench_robot.py`` measures it as the "before" of the same run.
+
+Nothing in a run uses it.  It is kept, slow on purpose, for two readers that must agree on
+what "before" means: ``tests/robot/test_fast_queries.py`` holds the fast planner to its
+answers, and ``benchmarks/bench_robot.py`` measures it as the "before" of the same run.  It
+lives in the package, not under ``tests/``, so that the benchmarks import nothing from the
+tests.
 """
 
 from __future__ import annotations
