@@ -53,12 +53,10 @@ def main(argv: list[str]) -> int:
 
     from planners.bundled import task_types
     from planners.examples import example_context
-    from tests.planners.conftest import DOMAIN, problem_text
-
     with tempfile.TemporaryDirectory(prefix="tasker-bench-startup-") as tmp:
-        d, p = Path(tmp) / "domain.pddl", Path(tmp) / "problem.pddl"
-        d.write_text(DOMAIN)
-        p.write_text(problem_text())
+        # a small delivery problem (the cheap route a-b-c beats the direct a-c)
+        data = ROOT / "benchmarks" / "data"
+        d, p = data / "delivery_domain.pddl", data / "delivery_problem.pddl"
         cook = next(t for t in task_types() if t.name == "cook")
         ctx = example_context(cook)  # type: ignore[arg-type]
         assert ctx is not None

@@ -97,3 +97,13 @@ def test_no_two_modules_import_each_other() -> None:
              for n in MODULES}
     pairs = sorted({tuple(sorted((a, b))) for a in graph for b in graph[a] if a in graph.get(b, ())})
     assert not pairs, pairs
+
+
+def test_benchmarks_import_nothing_from_tests() -> None:
+    wrong = []
+    for path in sorted((ROOT / "benchmarks").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else (
+                [node.module] if isinstance(node, ast.ImportFrom) and node.module else [])
+            wrong += [f"{path.name} imports {n}" for n in names if n.split(".")[0] == "tests"]
+    assert not wrong, wrong
