@@ -103,3 +103,11 @@ class AgentEnded(TaskerError):
         self.agent = agent
         self.reason = reason
         super().__init__(f"agent {agent} ended: {reason}")
+
+
+class UsageError(TaskerError, ValueError):
+    """A command-line argument is invalid; the message starts with the argument's name."""
+
+    def __init__(self, argument: str, message: str) -> None:
+        self.argument = argument
+        super().__init__(f"argument {argument}: {message}")

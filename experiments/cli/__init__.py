@@ -19,15 +19,15 @@ import logging
 import sys
 from collections.abc import Sequence
 
+from experiments.cli.args import EXIT_EPILOG, EXIT_USAGE, Parser, run_handler
 from tasker import __version__
-from tasker.support.cliargs import EXIT_EPILOG, EXIT_USAGE, Parser, run_handler
 
 SUBCOMMAND_MODULES = (
     "experiments.cli.run",    # run
     "experiments.cli.sweep",  # sweep, report
     "experiments.cli.check",  # check
-    "planners.cli",           # plan, domains, fsm, new
-    "robot.cli",              # world, cost
+    "experiments.cli.plan",   # plan, domains, fsm, new
+    "experiments.cli.world",  # world, cost
     "experiments.cli.explain",  # explain
     "experiments.cli.day",    # day
     # Add a subcommand here: a module with ``register(subparsers)`` (e.g. explain, an HTML report).

@@ -20,8 +20,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from experiments.cli.args import EXIT_FAILED, EXIT_OK, error_text
 from experiments.cli.run import add_path_option, task_paths
-from tasker.support.cliargs import EXIT_FAILED, EXIT_OK, error_text
 from tasker.support.reader import InputWarning
 
 EXAMPLES = """\
@@ -159,7 +159,7 @@ class Checker:
         from robot.spec import load_world
 
         if self.attempt(p, f"world {scn.world}", lambda: world.append(load_world(scn.world))):
-            from tasker.support.cliargs import did_you_mean
+            from experiments.cli.args import did_you_mean
 
             for name in scn.people:
                 if name not in world[0].people:

@@ -12,9 +12,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from experiments.days import pipeline as days
-from tasker.errors import ConfigError
-from tasker.support.cliargs import (
+from experiments.cli.args import (
     EXIT_INTERRUPTED,
     SEED_LIMIT,
     UsageError,
@@ -23,6 +21,8 @@ from tasker.support.cliargs import (
     writable_dir,
     writable_file,
 )
+from experiments.days import pipeline as days
+from tasker.errors import ConfigError
 from tasker.support.reader import suggest
 
 EXAMPLES = """\
@@ -65,7 +65,7 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
 def _days(a: argparse.Namespace) -> int:
     """Run the days into ``OUT/days.db``; write ``days.jsonl`` and ``table.md``; print the table.
 
-    Bad input raises :class:`tasker.support.cliargs.UsageError` (or the protocol's
+    Bad input raises :class:`experiments.cli.args.UsageError` (or the protocol's
     :class:`tasker.support.reader.InputError`) before the first day runs.  Returns 1 if a day failed
     to run (it is listed under the table), else 0."""
     import json

@@ -9,9 +9,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from experiments.cli.args import UsageError, non_negative_seconds
 from experiments.report.explain import explain, load_index, write
 from tasker.errors import TaskerError
-from tasker.support.cliargs import UsageError, non_negative_seconds
 
 
 def _planned_in(run_dir: str) -> str:

@@ -12,8 +12,7 @@ import sys
 import warnings
 from pathlib import Path
 
-from tasker.errors import RunInterrupted
-from tasker.support.cliargs import (
+from experiments.cli.args import (
     EXIT_FAILED,
     EXIT_INTERRUPTED,
     EXIT_OK,
@@ -24,6 +23,7 @@ from tasker.support.cliargs import (
     show_progress,
     writable_dir,
 )
+from tasker.errors import RunInterrupted
 from tasker.support.reader import InputWarning
 from tasker.trace import FAILED
 

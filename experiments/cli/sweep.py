@@ -17,8 +17,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from urllib.parse import urlsplit
 
-from experiments.cli.run import add_path_option, task_paths
-from tasker.support.cliargs import (
+from experiments.cli.args import (
     EXIT_FAILED,
     EXIT_OK,
     UsageError,
@@ -28,6 +27,7 @@ from tasker.support.cliargs import (
     writable_dir,
     writable_file,
 )
+from experiments.cli.run import add_path_option, task_paths
 
 SWEEP_EXAMPLES = """\
 examples:

@@ -28,10 +28,10 @@ from typing import TYPE_CHECKING, Any
 
 from experiments.inputs import fields
 from experiments.inputs.actions import NO_REQUESTS, TimedAction, located
+from experiments.inputs.fields import TASKS_HINT
 from experiments.inputs.request_fields import FIELD_NAMES, asked_for, with_request_fields
 from experiments.inputs.robot_scenario import RobotScenario
 from tasker.errors import TaskerError
-from tasker.support.cliargs import TASKS_HINT
 from tasker.support.reader import Table, check_name, suggest
 
 if TYPE_CHECKING:

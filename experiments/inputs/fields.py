@@ -10,8 +10,10 @@ from __future__ import annotations
 from typing import Any
 
 from tasker import schedulers
-from tasker.support.cliargs import TASKS_HINT
 from tasker.support.reader import InputError, Table
+
+TASKS_HINT = "to add a task type, add its folder with --path DIR or TASKER_TASKS (see 'tasker new')"
+"""What an unknown task type's error adds: how to add one."""
 
 MODES = ("IT", "CT")
 STRATEGIES = ("planned", "static")

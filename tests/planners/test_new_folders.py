@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 
 from planners.checks import DefinitionError
-from planners.cli import scaffold
 from planners.loader import load_task
+from planners.scaffold import scaffold
 from tasker.stage import Purpose
 from tasker.support.reader import InputWarning
 

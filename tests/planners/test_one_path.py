@@ -134,7 +134,7 @@ def test_concurrent_writers_leave_whole_markers(cache_dir: Path) -> None:
 def test_task_folder_example_is_solved_once_per_content(cache_dir: Path, tmp_path: Path,
                                                         monkeypatch: pytest.MonkeyPatch) -> None:
     import planners.loader as loader
-    from planners.cli import scaffold
+    from planners.scaffold import scaffold
 
     folder = tmp_path / "t"
     scaffold("t", folder)  # loads it once: the example solved and recorded

@@ -2,8 +2,8 @@
 
 :func:`register` adds the subcommands to an ``argparse`` sub-parser set; each sets
 ``func`` to a handler ``(args) -> int`` returning the exit status (0 success, 1 no
-plan, 2 bad input; :mod:`tasker.support.cliargs`).  Handlers raise on bad input and the caller
-(:func:`tasker.support.cliargs.run_handler`) prints one line, never a traceback.
+plan, 2 bad input; :mod:`experiments.cli.args`).  Handlers raise on bad input and the caller
+(:func:`experiments.cli.args.run_handler`) prints one line, never a traceback.
 
 Heavy modules are imported inside the handlers.  ``tasker plan`` with the default
 engine goes to Fast Downward without unified-planning's engine framework, and skips
@@ -22,8 +22,9 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from experiments.cli.args import EXIT_FAILED, EXIT_OK, UsageError, non_negative_int, note, positive_seconds
+from planners.scaffold import scaffold
 from tasker.support import reader
-from tasker.support.cliargs import EXIT_FAILED, EXIT_OK, UsageError, non_negative_int, note, positive_seconds
 
 if TYPE_CHECKING:
     from planners.pddl_task import PddlTaskType
@@ -33,7 +34,6 @@ if TYPE_CHECKING:
 
 ENV_VAR = "TASKER_TASKS"  # as planners.bundled.ENV_VAR, which would import the loader (and UP's reader)
 
-TEMPLATE = Path(__file__).resolve().parent / "template"
 """The folder ``tasker new`` copies: ``domain.pddl``, ``task.toml``, ``scenario.toml``."""
 
 _DOMAIN_NAME = re.compile(r"\(\s*domain\s+([^\s()]+)\s*\)", re.IGNORECASE)
@@ -225,46 +225,6 @@ def fsm_command(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def scaffold(name: str, folder: Path) -> list[Path]:
-    """Write a task folder for ``name`` from :data:`TEMPLATE` into ``folder``; return the files.
-
-    Besides the template's files it writes ``problem.pddl``, the ``[example]``'s problem,
-    for ``tasker plan``.  The folder must not exist or be empty."""
-    if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
-        raise UsageError("TASK", f"expected a lower-case identifier such as fetch_cup, got {name!r}")
-    if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
-        raise UsageError("DIR", f"{folder} exists and is not empty; choose a new folder")
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise UsageError("DIR", f"cannot create {folder}: {exc.strerror or exc}") from None
-    written = []
-    for src in sorted(TEMPLATE.iterdir()):
-        if src.is_file() and src.suffix in (".pddl", ".toml"):
-            dst = folder / src.name
-            dst.write_text(src.read_text(encoding="utf-8").replace("__TASK__", name).replace("__DIR__", str(folder)),
-                           encoding="utf-8")
-            written.append(dst)
-    written.append(_write_example_problem(folder))
-    return written
-
-
-def _write_example_problem(folder: Path) -> Path:
-    from planners.examples import example_context
-    from planners.loader import load_task
-    from planners.stages import Bindings
-
-    task = load_task(folder)  # the scaffold is checked like any task folder: it loads and plans
-    ctx = example_context(task)
-    assert ctx is not None
-    b = Bindings(ctx.args, ctx.world)
-    text, _, _ = task.problem_text(ctx, ctx.world, b.literals(task.spec.goal), b.literals(task.spec.facts))
-    out = folder / "problem.pddl"
-    out.write_text(f"; the [example] of task.toml as a PDDL problem (written by 'tasker new')\n{text.problem}",
-                   encoding="utf-8")
-    return out
-
-
 def new_command(args: argparse.Namespace) -> int:
     """Scaffold a task folder that loads, plans and runs at once."""
     folder = Path(args.dir if args.dir else args.task)
@@ -344,14 +304,3 @@ def register(subparsers: Any) -> None:
     n.add_argument("task", metavar="TASK", help="the task type's name (a lower-case identifier)")
     n.add_argument("dir", metavar="DIR", nargs="?", default=None, help="folder to create (default: ./TASK)")
     n.set_defaults(func=new_command)
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Stand-alone entry: these subcommands without the rest of ``tasker``."""
-    from tasker.support.cliargs import standalone
-
-    return standalone(register, argv)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -5,7 +5,7 @@
 ``register(subparsers)`` adds them to an :mod:`argparse` parser; each handler returns
 the exit status.  ``cost`` answers the travel-time matrix of every given place or
 point in one process; it exits 0 when every pair is reachable, 1 when one is not and
-2 on bad input (:mod:`tasker.support.cliargs`; one line on stderr, never a traceback).
+2 on bad input (:mod:`experiments.cli.args`; one line on stderr, never a traceback).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from tasker.support.cliargs import EXIT_FAILED, EXIT_OK, UsageError, did_you_mean, seed, show_progress, writable_file
+from experiments.cli.args import EXIT_FAILED, EXIT_OK, UsageError, did_you_mean, seed, show_progress, writable_file
 from tasker.world import MotionEstimate, MotionModel, Pose
 
 if TYPE_CHECKING:
@@ -174,14 +174,3 @@ def register(subparsers: Any) -> None:
     c.add_argument("--json", action="store_true", help="print the matrices as JSON")
     c.add_argument("--seed", type=seed, default=1, help="roadmap seed, 0 <= N < 2**32 (default 1)")
     c.set_defaults(func=_cost)
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Run the subcommands on their own (the ``tasker`` command wires them in normally)."""
-    from tasker.support.cliargs import standalone
-
-    return standalone(register, argv)
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

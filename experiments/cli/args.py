@@ -25,7 +25,8 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any, NoReturn
 
-from tasker.errors import TaskerError, UnknownName
+from experiments.inputs.fields import TASKS_HINT
+from tasker.errors import TaskerError, UnknownName, UsageError
 from tasker.support.reader import InputWarning
 
 EXIT_OK = 0
@@ -51,14 +52,6 @@ exit status:
 
 SEED_LIMIT = 2**32
 """Seeds are ``0 <= seed < 2**32``: what NumPy, OMPL and MuJoCo all accept."""
-
-
-class UsageError(TaskerError, ValueError):
-    """A command-line argument is invalid; the message starts with the argument's name."""
-
-    def __init__(self, argument: str, message: str) -> None:
-        self.argument = argument
-        super().__init__(f"argument {argument}: {message}")
 
 
 def did_you_mean(name: str, known: Iterable[str]) -> str:
@@ -161,7 +154,6 @@ def writable_file(path: str | Path, argument: str) -> Path:
     return p
 
 
-TASKS_HINT = "to add a task type, add its folder with --path DIR or TASKER_TASKS (see 'tasker new')"
 
 
 _NEGATIVE_POINT = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?,")
@@ -246,14 +238,3 @@ def note(args: argparse.Namespace, text: str) -> None:
     """An informational line on stderr (``--quiet`` drops it)."""
     if not getattr(args, "quiet", False):
         print(text, file=sys.stderr)
-
-
-def standalone(register: Callable[[Any], None], argv: list[str] | None = None) -> int:
-    """Run one module's subcommands without the rest of ``tasker`` (``python -m robot.cli …``)."""
-    parser = Parser(prog="tasker")
-    register(parser.add_subparsers(dest="command", required=True))
-    try:
-        args = parser.parse_args(argv)
-    except SystemExit as exc:
-        return exc.code if isinstance(exc.code, int) else EXIT_USAGE
-    return run_handler(args.func, args)

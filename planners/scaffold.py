@@ -1,0 +1,51 @@
+"""``tasker new``'s work: a task folder written from :data:`TEMPLATE` that loads, plans and runs at once."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from tasker.errors import UsageError
+
+TEMPLATE = Path(__file__).resolve().parent / "template"
+"""The template task folder (``__TASK__`` and ``__DIR__`` are replaced)."""
+
+
+def scaffold(name: str, folder: Path) -> list[Path]:
+    """Write a task folder for ``name`` from :data:`TEMPLATE` into ``folder``; return the files.
+
+    Besides the template's files it writes ``problem.pddl``, the ``[example]``'s problem,
+    for ``tasker plan``.  The folder must not exist or be empty."""
+    if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
+        raise UsageError("TASK", f"expected a lower-case identifier such as fetch_cup, got {name!r}")
+    if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
+        raise UsageError("DIR", f"{folder} exists and is not empty; choose a new folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UsageError("DIR", f"cannot create {folder}: {exc.strerror or exc}") from None
+    written = []
+    for src in sorted(TEMPLATE.iterdir()):
+        if src.is_file() and src.suffix in (".pddl", ".toml"):
+            dst = folder / src.name
+            dst.write_text(src.read_text(encoding="utf-8").replace("__TASK__", name).replace("__DIR__", str(folder)),
+                           encoding="utf-8")
+            written.append(dst)
+    written.append(_write_example_problem(folder))
+    return written
+
+
+def _write_example_problem(folder: Path) -> Path:
+    from planners.examples import example_context
+    from planners.loader import load_task
+    from planners.stages import Bindings
+
+    task = load_task(folder)  # the scaffold is checked like any task folder: it loads and plans
+    ctx = example_context(task)
+    assert ctx is not None
+    b = Bindings(ctx.args, ctx.world)
+    text, _, _ = task.problem_text(ctx, ctx.world, b.literals(task.spec.goal), b.literals(task.spec.facts))
+    out = folder / "problem.pddl"
+    out.write_text(f"; the [example] of task.toml as a PDDL problem (written by 'tasker new')\n{text.problem}",
+                   encoding="utf-8")
+    return out
