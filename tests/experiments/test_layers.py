@@ -107,3 +107,19 @@ def test_benchmarks_import_nothing_from_tests() -> None:
                 [node.module] if isinstance(node, ast.ImportFrom) and node.module else [])
             wrong += [f"{path.name} imports {n}" for n in names if n.split(".")[0] == "tests"]
     assert not wrong, wrong
+
+
+def test_the_generated_docs_are_up_to_date() -> None:
+    """docs/trace.md's event fields and docs/metrics.md's registry are generated (`tasker docs`)."""
+    from experiments.report.reference import update
+
+    stale = update(ROOT, check=True)
+    assert not stale, f"out of date: {stale}; run 'tasker docs'"
+
+
+def test_argparse_lives_only_in_cli() -> None:
+    users = sorted(n for n, p in MODULES.items() if not n.startswith("experiments.cli")
+                   and any(isinstance(x, ast.Import | ast.ImportFrom) and "argparse" in
+                           ([a.name for a in x.names] if isinstance(x, ast.Import) else [x.module or ""])
+                           for x in ast.walk(ast.parse(p.read_text(encoding="utf-8")))))
+    assert users == ["experiments.paper.report", "experiments.sweep.factorial"], users  # issues 26-27 replace them

@@ -1,0 +1,78 @@
+"""The parts of ``docs/`` generated from the definitions they describe, never typed.
+
+* ``docs/trace.md``: every event's fields, from the types of :mod:`tasker.events`;
+* ``docs/metrics.md``: every metric's unit, direction and meaning, from
+  :mod:`experiments.metrics.registry`.
+
+Each generated part sits between two markers (``<!-- generated: NAME ... -->`` and
+``<!-- end generated: NAME -->``) in its document; :func:`update` rewrites them and
+``tasker docs --check`` (a test runs it) fails when one is out of date.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from pathlib import Path
+
+from experiments.metrics.registry import markdown_table
+from tasker import events as ev
+
+
+def events_markdown() -> str:
+    """One table per event type: its JSON fields in written order, their types, and what they mean."""
+    out = []
+    for cls in ev.TYPES:
+        out += [f"#### `{cls.KIND}`: {cls.__name__}", "", (cls.__doc__ or "").strip().split("\n\n")[0], "",
+                "| field | type | meaning |", "|---|---|---|", "| `t` | float | simulated seconds since the start |"]
+        if cls is ev.Decision:
+            out.append("| (the record's own fields) | – | `algorithm`, `switch`, usually `rule`, `dac`, `exeDA`, and "
+                       "what the algorithm compared |")
+        else:
+            fields = {f.name: f for f in dataclasses.fields(cls)}
+            for attr, name, optional in cls.spec():
+                f = fields[attr]
+                kind = str(f.type).replace(" | None", "") + (" (optional)" if optional else "")
+                out.append(f"| `{name}` | {kind.replace('|', '∣')} | {f.metadata.get('doc', '')} |")
+        out.append("")
+    return "\n".join(out)
+
+
+GENERATED: dict[str, dict[str, Callable[[], str]]] = {
+    "docs/trace.md": {"events": events_markdown},
+    "docs/metrics.md": {"registry": markdown_table},
+}
+"""Per document, its generated parts and what makes each."""
+
+
+def _markers(name: str) -> tuple[str, str]:
+    return (f"<!-- generated: {name} (run 'tasker docs' to update; do not edit by hand) -->",
+            f"<!-- end generated: {name} -->")
+
+
+def splice(text: str, name: str, block: str) -> str:
+    """``text`` with its part ``name`` replaced by ``block`` (appended at the end if it has none)."""
+    begin, end = _markers(name)
+    body = f"{begin}\n{block.rstrip()}\n{end}"
+    if begin in text and end in text:
+        head, _, rest = text.partition(begin)
+        _, _, tail = rest.partition(end)
+        return head + body + tail
+    return text.rstrip() + "\n\n" + body + "\n"
+
+
+def update(root: Path, *, check: bool = False) -> list[Path]:
+    """Rewrite every generated part under ``root``; return the documents that changed (with
+    ``check``, those that would, writing nothing)."""
+    stale = []
+    for doc, parts in GENERATED.items():
+        path = root / doc
+        text = path.read_text(encoding="utf-8") if path.is_file() else ""
+        new = text
+        for name, make in parts.items():
+            new = splice(new, name, make())
+        if new != text:
+            stale.append(path)
+            if not check:
+                path.write_text(new, encoding="utf-8")
+    return stale
