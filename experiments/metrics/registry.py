@@ -303,12 +303,3 @@ def lookup(metrics: Mapping[str, float], paths: Sequence[str]) -> tuple[str, flo
         if p in metrics:
             return p, metrics[p]
     return None
-
-
-def markdown_table() -> str:
-    """The registry as the Markdown table of ``docs/metrics.md`` (generated, never typed)."""
-    rows = ["| metric | unit | better | meaning |", "|---|---|---|---|"]
-    for m in METRICS:
-        better = "– (host)" if m.host else ("–" if m.direction is N else m.direction.value)
-        rows.append(f"| `{m.name}` | {m.unit} | {better} | {m.meaning} |")
-    return "\n".join(rows) + "\n"

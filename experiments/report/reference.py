@@ -15,7 +15,8 @@ import dataclasses
 from collections.abc import Callable
 from pathlib import Path
 
-from experiments.metrics.registry import markdown_table
+from experiments.analysis.tables import markdown_table
+from experiments.metrics.registry import METRICS, Direction
 from tasker import events as ev
 
 
@@ -23,24 +24,32 @@ def events_markdown() -> str:
     """One table per event type: its JSON fields in written order, their types, and what they mean."""
     out = []
     for cls in ev.TYPES:
-        out += [f"#### `{cls.KIND}`: {cls.__name__}", "", (cls.__doc__ or "").strip().split("\n\n")[0], "",
-                "| field | type | meaning |", "|---|---|---|", "| `t` | float | simulated seconds since the start |"]
+        rows: list[tuple[str, str, str]] = [("`t`", "float", "simulated seconds since the start")]
         if cls is ev.Decision:
-            out.append("| (the record's own fields) | – | `algorithm`, `switch`, usually `rule`, `dac`, `exeDA`, and "
-                       "what the algorithm compared |")
+            rows.append(("(the record's own fields)", "–", "`algorithm`, `switch`, usually `rule`, `dac`, `exeDA`, "
+                                                           "and what the algorithm compared"))
         else:
             fields = {f.name: f for f in dataclasses.fields(cls)}
             for attr, name, optional in cls.spec():
                 f = fields[attr]
                 kind = str(f.type).replace(" | None", "") + (" (optional)" if optional else "")
-                out.append(f"| `{name}` | {kind.replace('|', '∣')} | {f.metadata.get('doc', '')} |")
-        out.append("")
+                rows.append((f"`{name}`", kind.replace("|", "∣"), f.metadata.get("doc", "")))
+        out += [f"#### `{cls.KIND}`: {cls.__name__}", "", (cls.__doc__ or "").strip().split("\n\n")[0], "",
+                *markdown_table(["field", "type", "meaning"], rows), ""]
     return "\n".join(out)
+
+
+def metrics_markdown() -> str:
+    """The registry as a table: every metric's name, unit, direction and meaning."""
+    rows = [(f"`{m.name}`", m.unit,
+             "– (host)" if m.host else ("–" if m.direction is Direction.NEITHER else m.direction.value), m.meaning)
+            for m in METRICS]
+    return "\n".join(markdown_table(["metric", "unit", "better", "meaning"], rows)) + "\n"
 
 
 GENERATED: dict[str, dict[str, Callable[[], str]]] = {
     "docs/trace.md": {"events": events_markdown},
-    "docs/metrics.md": {"registry": markdown_table},
+    "docs/metrics.md": {"registry": metrics_markdown},
 }
 """Per document, its generated parts and what makes each."""
 

@@ -14,6 +14,7 @@ from pathlib import Path
 
 from experiments.analysis.compare import INFEASIBLE, Analysis, MetricSummary, Paired, PrimaryOutcome, primary_cells
 from experiments.analysis.stats import ALPHA, Estimate
+from experiments.analysis.tables import markdown_table
 from experiments.inputs.strategy import Strategy
 from experiments.metrics.registry import (
     has_verdict,
@@ -40,9 +41,7 @@ def _cell(e: Estimate, nonfinite: int = 0) -> str:
 
 
 def _table(header: Sequence[str], body: Iterable[Sequence[str]]) -> list[str]:
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    lines += ["| " + " | ".join(c.replace("|", "\\|") for c in row) + " |" for row in body]
-    return lines
+    return markdown_table(header, body)
 
 
 def _strategy_table(summaries: Sequence[MetricSummary], scenario: str) -> list[str]:

@@ -24,6 +24,7 @@ from pathlib import Path
 
 from experiments.analysis.compare import INFEASIBLE, Paired, PrimaryOutcome, constant_metrics, paired
 from experiments.analysis.stats import ALPHA, Estimate, estimate, holm
+from experiments.analysis.tables import markdown_table
 from experiments.inputs.strategy import Strategy
 from experiments.metrics.registry import host_dependent, numeric_metrics
 from experiments.metrics.store import ResultStore, RunRow, Status
@@ -131,9 +132,7 @@ def _ci(e: Estimate) -> str:
 
 
 def _table(header: Sequence[str], body: Iterable[Sequence[str]]) -> list[str]:
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    lines += ["| " + " | ".join(c.replace("|", "\\|") for c in row) + " |" for row in body]
-    return lines + [""]
+    return [*markdown_table(header, body), ""]
 
 
 def _name(scenario: str) -> str:
