@@ -304,6 +304,37 @@ TASK_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b", "#e377c2"
 IDLE_COLOUR = "#9a9a9a"
 
 
+class _Labels:
+    """Places short labels next to their points so that no two overlap (a greedy search over
+    offsets round the point, nearest first; a thin leader line when the label had to move away)."""
+
+    OFFSETS = ((0.1, 0.1), (0.1, -0.3), (-1.0, 0.1), (-1.0, -0.3), (0.1, 0.4), (0.1, -0.6), (-1.0, 0.4),
+               (-1.0, -0.6), (0.1, 0.7), (0.1, -0.9), (-1.0, 0.7), (-1.0, -0.9), (0.6, 0.1), (-1.5, 0.1))
+    """(dx, dy) in metres; a dx of -1 means 'the label's width to the left'."""
+
+    def __init__(self, metres_per_point: float) -> None:
+        self.per_pt = metres_per_point
+        self.boxes: list[tuple[float, float, float, float]] = []
+
+    def place(self, ax: Axes, x: float, y: float, text: str, *, fontsize: float, color: str = "#222") -> None:
+        w, h = len(text) * 0.55 * fontsize * self.per_pt, 1.2 * fontsize * self.per_pt
+        best = None
+        for dx, dy in self.OFFSETS:
+            bx = x + (dx if dx >= 0 else dx * w - 0.1)
+            box = (bx, y + dy, bx + w, y + dy + h)
+            if not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3] for b in self.boxes):
+                best = box
+                break
+        if best is None:  # crowded everywhere: the first place, as before
+            dx, dy = self.OFFSETS[0]
+            best = (x + dx, y + dy, x + dx + w, y + dy + h)
+        self.boxes.append(best)
+        ax.text(best[0], best[1], text, fontsize=fontsize, color=color, va="bottom", ha="left", zorder=6,
+                bbox={"boxstyle": "square,pad=0.05", "facecolor": "white", "edgecolor": "none", "alpha": 0.6})
+        if math.hypot(best[0] - x, best[1] - y) > 0.45:
+            ax.plot([x, best[0]], [y, best[1] + h / 2], "-", color="#999", lw=0.4, zorder=5)
+
+
 def _pose_at(samples: Sequence[tuple[float, ...]], t: float) -> tuple[float, float] | None:
     """The robot's position at ``t``: the last sample at or before it."""
     best = None
@@ -344,34 +375,41 @@ def world_path(world_name_or_path: Any, trajectory: Iterable[Sequence[float]], o
     agents = _agents(tl)
     colour = {a: TASK_COLOURS[k % len(TASK_COLOURS)] for k, a in enumerate(agents)}
 
+    (x0, _), (x1, _) = spec.bounds
+    labels = _Labels(metres_per_point=(x1 - x0) / (0.85 * max(4.0, (x1 - x0) * 0.8) * 72))
+
     def decorate(ax: Axes) -> None:
         changes = tl.exe_changes() or [(0.0, None)]
         handles: dict[str, Any] = {}
-        for k, (t0, agent) in enumerate(changes):
+        drawn = [k for k, (t0, _) in enumerate(changes)]
+        for n, k in enumerate(drawn):  # later stretches on top and thinner: an earlier path under a later one shows
+            t0, agent = changes[k]
             t1 = changes[k + 1][0] if k + 1 < len(changes) else math.inf
             seg = [(s[1], s[2]) for s in samples if t0 - 1e-9 <= s[0] <= t1 + 1e-9]
             if len(seg) < 2:
                 continue
             c = colour.get(agent, IDLE_COLOUR) if agent else IDLE_COLOUR
             label = f"{agent} {agents.get(agent, '')}" if agent else "no task"
-            (line,) = ax.plot(*zip(*seg, strict=True), "-", color=c, lw=1.8, label=label)
+            width = 3.4 - 2.0 * n / max(1, len(drawn) - 1)
+            (line,) = ax.plot(*zip(*seg, strict=True), "-", color=c, lw=width, alpha=0.9, label=label,
+                              zorder=2 + n / max(1, len(drawn)), solid_capstyle="round")
             handles.setdefault(label, line)
         for s in samples[:: max(1, int(round(30.0 / max(samples[1][0] - samples[0][0], 1e-9))))]\
                 if len(samples) > 1 else []:
-            ax.plot(s[1], s[2], ".", color="#333", ms=3)
-            ax.text(s[1] + 0.08, s[2] + 0.08, f"{s[0]:.0f}s", fontsize=5, color="#333")
+            ax.plot(s[1], s[2], ".", color="#333", ms=3, zorder=4)
+            labels.place(ax, s[1], s[2], f"{s[0]:.0f}s", fontsize=5, color="#333")
         for e in tl.events:
             if isinstance(e, ev.CommandSent) and e.flag == "susp" and (at := _pose_at(samples, e.t)) is not None:
-                h = ax.plot(*at, "x", color=colour.get(e.agent, "k"), ms=9, mew=2.2)[0]
-                ax.text(at[0] + 0.1, at[1] - 0.25, f"susp {e.agent} {e.t:.0f}s", fontsize=6)
+                h = ax.plot(*at, "x", color=colour.get(e.agent, "k"), ms=9, mew=2.2, zorder=5)[0]
+                labels.place(ax, at[0], at[1], f"susp {e.agent} {e.t:.0f}s", fontsize=6)
                 handles.setdefault("suspension", h)
             elif isinstance(e, ev.TaskEnded) and (at := _pose_at(samples, e.t)) is not None:
-                h = ax.plot(*at, "o", mfc="none", color=colour.get(e.agent, "k"), ms=10, mew=1.5)[0]
-                ax.text(at[0] + 0.1, at[1] + 0.15, f"{e.agent} {e.reason} {e.t:.0f}s", fontsize=6)
+                h = ax.plot(*at, "o", mfc="none", color=colour.get(e.agent, "k"), ms=10, mew=1.5, zorder=5)[0]
+                labels.place(ax, at[0], at[1], f"{e.agent} {e.reason} {e.t:.0f}s", fontsize=6)
                 handles.setdefault("task ends", h)
         for m in getattr(recording, "marks", []):
-            h = ax.plot(m.x, m.y, "s", color="#6a3d9a", ms=6)[0]
-            ax.text(m.x + 0.12, m.y - 0.3, f"{m.action} {m.item} {m.t:.0f}s", fontsize=5, color="#6a3d9a")
+            h = ax.plot(m.x, m.y, "s", color="#6a3d9a", ms=6, zorder=5)[0]
+            labels.place(ax, m.x, m.y, f"{m.action} {m.item} {m.t:.0f}s", fontsize=5, color="#6a3d9a")
             handles.setdefault("object handled", h)
         if handles:
             ax.legend(list(handles.values()), list(handles), fontsize=6, loc="upper right", framealpha=0.8)

@@ -17,6 +17,7 @@ import plotly.graph_objects as go
 
 from experiments.analysis.compare import ALL
 from experiments.metrics.registry import headline, host_dependent
+from experiments.metrics.registry import label as metric_label
 from experiments.report.page import Raw, figure_div, page, table
 
 
@@ -85,7 +86,7 @@ def sweep_page(markdown_text: str, summaries: Sequence[Any], pairs: Sequence[Any
                 hovertemplate=f"{st}<br>%{{x}}: %{{y:.4g}} ± %{{error_y.array:.3g}} (n=%{{customdata}})"
                               "<extra></extra>"))
         note = " (host-dependent: reported, no verdict)" if host_dependent(metric) else ""
-        fig.update_layout(title=metric + note, barmode="group", template="plotly_white", height=380,
+        fig.update_layout(title=metric_label(metric) + note, barmode="group", template="plotly_white", height=380,
                           yaxis_title="mean, 95 % CI", legend={"orientation": "h", "y": -0.2},
                           margin={"t": 50, "r": 10})
         sections.append(figure_div(fig, f"metric-{n}"))
@@ -97,7 +98,7 @@ def sweep_page(markdown_text: str, summaries: Sequence[Any], pairs: Sequence[Any
                       key=lambda p: (p.scenario, shown.index(p.metric)))
         if not mine:
             continue
-        labels = [f"{Path(p.scenario).stem}: {p.metric}" for p in mine]
+        labels = [f"{Path(p.scenario).stem}: {metric_label(p.metric)}" for p in mine]
         fig = go.Figure()
         for label, attr, colour in (("treatment better", "wins", "#2ca02c"), ("tie", "ties", "#999"),
                                     ("baseline better", "losses", "#d62728")):

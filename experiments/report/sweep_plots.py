@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from experiments.analysis.compare import ALL, MetricSummary, Paired, PrimaryOutcome, primary_cells
-from experiments.metrics.registry import headline, host_dependent
+from experiments.metrics.registry import headline, host_dependent, label
 from experiments.metrics.store import RunRow
 
 
@@ -46,7 +46,8 @@ def plot(summaries: Sequence[MetricSummary], pairs: Sequence[Paired], out: Path)
             ax.bar(xs, means, width, yerr=errs, capsize=3, label=st)
         ax.set_xticks(range(len(groups)), ["all scenarios" if g == ALL else Path(g).stem for g in groups])
         ax.set_ylabel("mean, 95 % CI")
-        ax.set_title(metric + (" (host-dependent: no verdict)" if host_dependent(metric) else ""), fontsize="medium")
+        ax.set_title(label(metric) + (" (host-dependent: no verdict)" if host_dependent(metric) else ""),
+                     fontsize="medium")
         # below the axes, never over a bar
         fig.legend(fontsize="x-small", loc="outside lower center", ncol=min(2, len(strategies)))
         path = out / f"{_slug(metric)}.png"

@@ -21,6 +21,7 @@ from experiments.metrics.registry import (
     headline,
     higher_is_better,
     host_dependent,
+    label,
     lookup,
     metric,
     numeric_metrics,
@@ -51,7 +52,7 @@ def _strategy_table(summaries: Sequence[MetricSummary], scenario: str) -> list[s
     cells = {(s.strategy, s.metric): s for s in mine}
     body = [[st, *(_cell(c.estimate, c.nonfinite) if (c := cells.get((st, m))) else "–" for m in metrics)]
             for st in strategies]
-    return _table(["strategy", *metrics], body)
+    return _table(["strategy", *(label(m) for m in metrics)], body)
 
 
 def _primary_names(rows: Sequence[RunRow], primary: PrimaryOutcome) -> tuple[str, str]:
@@ -138,7 +139,7 @@ def markdown(analysis: Analysis, title: str = "Sweep report") -> str:
                 out += [f"{sc}:", ""]
                 out += _table(["metric", "better", "treatment − baseline", "wins/ties/losses", "p", "p (Holm)",
                                "verdict"],
-                              [[p.metric, p.better, _cell(p.diff, p.nonfinite), _counts(p), _fmt(p.p),
+                              [[label(p.metric), p.better, _cell(p.diff, p.nonfinite), _counts(p), _fmt(p.p),
                                 _fmt(p.p_holm), _verdict(p)] for p in mine])
                 out.append("")
     elif len({r.strategy for r in ok}) > 1:

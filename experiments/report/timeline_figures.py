@@ -46,15 +46,20 @@ def _roles_bars(fig: go.Figure, tl: Timeline, hazards: Sequence[tuple[str, str, 
             orientation="h", base=[s[2] for s in mine], x=[s[3] - s[2] for s in mine], y=[s[0] for s in mine],
             name=role, marker_color=colour, legendgroup="roles", legendgrouptitle_text="roles",
             hovertemplate=f"%{{y}} {role}<br>%{{base:.1f}} s – +%{{x:.1f}} s<extra></extra>"), row=row, col=1)
-    hazard_rows = {h[:2]: f"{h[0]} hazard: {h[1]}" for h in hazards}  # one row per hazard: never overlapping
+    # one row per owned hazard (never overlapping); every hazard nobody owns (a door open in the world
+    # file, say) on one row of its own, named in the hover: they are not any task's to attend to
+    hazard_rows = {h[:2]: f"{h[0]} hazard: {h[1]}" if h[0] != "unowned" else "unowned hazards" for h in hazards}
     if hazards:
         fig.add_trace(go.Bar(
             orientation="h", base=[h[2] for h in hazards], x=[max(h[3] - h[2], 1e-3) for h in hazards],
             y=[hazard_rows[h[:2]] for h in hazards], name="hazard on", marker_color=HAZARD_COLOUR,
-            legendgroup="roles", hovertemplate="%{y}<br>on %{base:.1f} s – +%{x:.1f} s<extra></extra>"),
+            customdata=[h[1] for h in hazards], legendgroup="roles",
+            hovertemplate="%{y}: %{customdata}<br>on %{base:.1f} s – +%{x:.1f} s<extra></extra>"),
             row=row, col=1)
     rows = [a for a in order] + sorted({s[0] for s in spans} - set(order))
     cats = [c for a in rows for c in [a, *sorted({v for k, v in hazard_rows.items() if k[0] == a})]]
+    if any(h[0] == "unowned" for h in hazards):
+        cats.append("unowned hazards")
     fig.update_yaxes(categoryorder="array", categoryarray=cats[::-1], row=row, col=1)
 
 

@@ -218,7 +218,11 @@ def _world_title(t: float, hazards: Sequence[tuple[str, str, float, float]],
                  t_end: float) -> str:
     """The world's title at ``t``; a stretch still open at ``t_end`` (the end of the run) includes it."""
     exe = next((a for tt, a in reversed(roles) if tt <= t), None)
-    on = [f"{h[1]} ({h[0]})" for h in hazards if h[2] <= t and (t < h[3] or h[3] >= t_end)]
+    now = [h for h in hazards if h[2] <= t and (t < h[3] or h[3] >= t_end)]
+    on = [f"{h[1]} ({h[0]})" for h in now if h[0] != "unowned"]
+    unowned = sum(1 for h in now if h[0] == "unowned")  # e.g. doors open in the world file: nobody's to attend
+    if unowned:
+        on.append(f"{unowned} nobody owns")
     susp = sorted({a for a, t0, t1 in suspended if t0 <= t and (t < t1 or t1 >= t_end)})
     parts = [f"t = {t:.1f} s", f"exeDA: {exe or '–'}"]
     parts.append("suspended: " + (", ".join(susp) if susp else "–"))

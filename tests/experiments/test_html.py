@@ -148,3 +148,13 @@ def test_unknown_trajectory_format_falls_back(tmp_path: Path) -> None:
     assert html_world.read_trajectory(tmp_path) is None
     (tmp_path / "trajectory.jsonl").write_text('{"time": 1}\n')
     assert html_world.read_trajectory(tmp_path) is None
+
+
+def test_hazards_nobody_owns_share_one_row(events: list[dict[str, Any]]) -> None:
+    """Before: each door open in the world file had a row of its own, always on."""
+    doors = [{"t": 0.0, "event": "hazard", "agent": None, "hazard": "door_open", "args": [d], "fact": ["door_open", d],
+              "status": "on", "budget_s": 60.0, "severity": 1.0} for d in ("a", "b", "c", "d", "e")]
+    trace = [*events, *doors]
+    fig = html_timeline.timeline_figure(trace, report_html.hazards_of(trace, None))
+    bar = next(t for t in fig.data if t.name == "hazard on")
+    assert set(bar.y) == {"unowned hazards"} and len(bar.y) == 5

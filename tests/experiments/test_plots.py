@@ -7,6 +7,7 @@ from typing import Any
 
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
 from experiments.inputs import synthetic
 from experiments.report import plots
@@ -163,3 +164,17 @@ def test_gantt_stage_names_do_not_overlap(tmp_path: Path) -> None:
         for b in boxes[i + 1:]:
             assert not a.overlaps(b), (a, b)
     assert is_png(plots.gantt(trace, tmp_path / "g.png"))
+
+
+def test_world_labels_at_one_point_do_not_pile_up() -> None:
+    """Before: a suspension, two ends and a time mark at one spot were drawn on top of each other."""
+    fig = Figure()
+    ax = fig.subplots()
+    labels = plots._Labels(metres_per_point=0.02)
+    for text in ("susp d1 62s", "susp d3 69s", "d3 peter is fine 78s", "d4 finished 88s", "60s", "90s"):
+        labels.place(ax, 6.3, 3.9, text, fontsize=6)
+    boxes = labels.boxes
+    assert len(boxes) == 6
+    for i, a in enumerate(boxes):
+        for b in boxes[i + 1:]:
+            assert not (a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]), (a, b)
