@@ -71,6 +71,7 @@ class Problem:
         self.weight, self.deadline, self.budget = list(weight), list(deadline), list(budget)
         self.lateness_weight, self.hazard_weight = lateness_weight, hazard_weight
         self.left_on = [tuple(x) for x in left_on] if left_on is not None else [()] * n
+        self.hazards_left_on = any(self.left_on)  # without any, the search skips the term (its hot loop)
         self.dmin = [min([self.first[j], *(self.after[i][j] for i in range(n) if i != j)]) for j in range(n)]
 
     def cost(self, j: int, c: float) -> float:
@@ -92,7 +93,8 @@ class Problem:
     def evaluate(self, order: Sequence[int]) -> float:
         t, total, prev = self.now, 0.0, -1
         for j in order:
-            total += self.wait_cost(j, t)
+            if self.hazards_left_on:
+                total += self.wait_cost(j, t)
             t += self.first[j] if prev < 0 else self.after[prev][j]
             total += self.cost(j, t)
             prev = j
@@ -164,7 +166,9 @@ def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
     placed = [False] * n
 
     def bound(t: float, acc: float) -> float:
-        return acc + sum(p.cost(j, t + p.dmin[j]) + p.wait_cost(j, t) for j in range(n) if not placed[j])
+        if p.hazards_left_on:
+            return acc + sum(p.cost(j, t + p.dmin[j]) + p.wait_cost(j, t) for j in range(n) if not placed[j])
+        return acc + sum(p.cost(j, t + p.dmin[j]) for j in range(n) if not placed[j])
 
     def dfs(prev: int, t: float, acc: float) -> None:
         nonlocal best, best_order, nodes, exhausted
@@ -184,7 +188,7 @@ def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
                 exhausted = True
                 return
             nodes += 1
-            acc_j = acc + p.cost(j, c) + p.wait_cost(j, t)
+            acc_j = acc + p.cost(j, c) + (p.wait_cost(j, t) if p.hazards_left_on else 0.0)
             placed[j] = True
             order.append(j)
             if bound(c, acc_j) < best:
@@ -319,7 +323,7 @@ class LookAhead(Scheduler):
         }
         if view.exe is not None and view.suspension is not None:  # the plan-based switch penalty
             record["suspend_s"] = {c.id: self._penalty[c.id] for c in view.candidates}
-        if any(prob.left_on):
+        if prob.hazards_left_on:
             record["left_on"] = [{"agent": hz.agent, "hazard": hz.name, "due": hz.since + hz.budget_s}
                                  for hz in view.hazards if hz.agent in {c.id for c in jobs}]
         return Decision(first if switch else None, record)
