@@ -13,6 +13,11 @@
    ``lookahead-cpsat`` (:mod:`planners.cpsat`, OR-Tools CP-SAT) at its default time
    limit, over the best order known (the better of CP-SAT with 10x its limit and the
    branch and bound with 100x its budget), and the wall time of one search of each.
+4. The other schedulers' decision on the views of part 1, against Alg. 2's, measured in the
+   same run (ratio = scheduler / alg2): ``wspt``, ``atc`` and TaBSA's agents.  TaBSA's
+   agents keep state (estimates read at events, the request table), so each timed
+   decision is a fresh scheduler's first: every estimate read and, for
+   ``tabsa-scheduler``, the table of slots built — their dearest decision.
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ from tasker.schedulers.lookahead import LookAhead, solve
 
 SPEED = 0.5
 SIZES = (1, 2, 4, 8, 12, 16, 32, 64)
+OTHERS = ("wspt", "atc", "tabsa-simple", "tabsa-simple2", "tabsa-distance", "tabsa-scheduler")
 
 
 def make_view(n: int, seed: int = 0) -> ScheduleView:
@@ -64,6 +70,32 @@ def decision_time(s: Scheduler, view: ScheduleView, repeats: int) -> float:
         s.schedule(view)
         samples.append(time.perf_counter() - t0)
     return statistics.median(samples)
+
+
+def first_decision_time(name: str, view: ScheduleView, repeats: int) -> float:
+    """Median seconds of a fresh scheduler's first decision (made outside the timing)."""
+    samples = []
+    for _ in range(repeats):
+        s = schedulers.create(name)
+        t0 = time.perf_counter()
+        s.schedule(view)
+        samples.append(time.perf_counter() - t0)
+    return statistics.median(samples)
+
+
+def others() -> None:
+    alg2 = schedulers.create("alg2")
+    print("4. other schedulers: decision time (median ms) and ratio to alg2 on the same view")
+    print(f"{'queue':>6} {'alg2 ms':>9} " + " ".join(f"{n:>22}" for n in OTHERS))
+    for n in SIZES:
+        view = make_view(n)
+        repeats = 200 if n <= 16 else 50
+        t_alg2 = decision_time(alg2, view, repeats)
+        cells = []
+        for name in OTHERS:
+            t = first_decision_time(name, view, repeats)
+            cells.append(f"{t * 1e3:>12.3f} ({t / t_alg2:>6.1f})")
+        print(f"{n:>6} {t_alg2 * 1e3:>9.3f} " + " ".join(f"{c:>22}" for c in cells))
 
 
 def main() -> None:
@@ -111,6 +143,7 @@ def main() -> None:
             t_cp.append(t2 - t1)
         print(f"{n:>6} {statistics.mean(bb):>8.3f} ({max(bb):.3f}) {statistics.median(t_bb) * 1e3:>7.1f} "
               f"{statistics.mean(cp):>8.3f} ({max(cp):.3f}) {statistics.median(t_cp) * 1e3:>7.1f}")
+    others()
 
 
 if __name__ == "__main__":

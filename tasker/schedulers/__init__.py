@@ -7,22 +7,29 @@ True
 
 Each algorithm is a module of this package with a class; a third-party algorithm
 registers with :func:`register` (or the entry-point group ``tasker.schedulers``).
-An unknown name is an error that lists the known ones.
+An unknown name is an error that lists the known ones.  Options are checked when the
+scheduler is made: an unknown one, or a value of the wrong type or out of range, is a
+:class:`~tasker.errors.ConfigError` naming the option and what it expects.
+:func:`sweep` gives the option values an experiment sweeps for an algorithm (TaBSA's
+grid for its agents' hesitance and ratio):
+
+>>> schedulers.sweep("tabsa-simple")
+{'hesitance': (0.0, 0.25, 0.5, 0.75, 1.0)}
 """
 
 from __future__ import annotations
 
 import importlib
 import inspect
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from tasker.errors import ConfigError, UnknownName
-from tasker.schedulers.base import Candidate, Decision, Scheduler, ScheduleView
+from tasker.schedulers.base import Candidate, Decision, Scheduler, ScheduleView, UnattendedHazard
 from tasker.support.reader import suggest
 
-__all__ = ["Candidate", "Decision", "Scheduler", "ScheduleView", "create", "names", "options", "register",
-           "unknown_option"]
+__all__ = ["Candidate", "Decision", "Scheduler", "ScheduleView", "UnattendedHazard", "create", "names", "options",
+           "register", "sweep", "unknown_option"]
 
 _BUILTIN = {
     "alg2": "tasker.schedulers.alg2:Alg2",
@@ -35,6 +42,12 @@ _BUILTIN = {
     "simple2": "tasker.schedulers.simple2:ShortestFirst",
     "distance": "tasker.schedulers.distance:DistanceOverDuration",
     "lookahead": "tasker.schedulers.lookahead:LookAhead",
+    "tabsa-simple": "tasker.schedulers.tabsa:TabsaSimple",
+    "tabsa-simple2": "tasker.schedulers.tabsa:TabsaSimple2",
+    "tabsa-distance": "tasker.schedulers.tabsa:TabsaDistance",
+    "tabsa-scheduler": "tasker.schedulers.tabsa_slots:TabsaScheduler",
+    "wspt": "tasker.schedulers.wspt:WeightedShortestFirst",
+    "atc": "tasker.schedulers.atc:ApparentTardinessCost",
 }
 _registry: dict[str, str | Callable[..., Scheduler]] = dict(_BUILTIN)
 _entry_points_loaded = False
@@ -84,6 +97,13 @@ def options(name: str) -> tuple[str, ...] | None:
     if any(p.kind is p.VAR_KEYWORD for p in params):
         return None
     return tuple(p.name for p in params if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY))
+
+
+def sweep(name: str) -> dict[str, tuple[Any, ...]]:
+    """The option values scheduler ``name`` is swept over (its class's ``SWEEP``; empty if none),
+    read without making one."""
+    grid = getattr(_factory(name), "SWEEP", None)
+    return {str(k): tuple(v) for k, v in grid.items()} if isinstance(grid, Mapping) else {}
 
 
 def unknown_option(name: str, option: str) -> str | None:

@@ -28,6 +28,20 @@ class Candidate:
 
 
 @dataclass(frozen=True, slots=True)
+class UnattendedHazard:
+    """A hazard that holds now while its agent is out of ``cmd`` (a cooker left on by a
+    suspended task): it overruns its budget unless the agent is back in ``cmd`` by
+    ``since + budget_s``.  ``since`` is when the unattended stretch began: when the hazard
+    went on or when its agent last left ``cmd``, whichever is later
+    (:meth:`tasker.securing.HazardWatch.due` counts the same way)."""
+
+    agent: str
+    name: str
+    budget_s: float
+    since: float
+
+
+@dataclass(frozen=True, slots=True)
 class ScheduleView:
     """Read-only input of ``pf_schedule``.
 
@@ -42,6 +56,16 @@ class ScheduleView:
     candidate with the lowest :meth:`Scheduler.select_key`, found without a scan.
     Such a scheduler asks for it through :meth:`best` and need not read
     ``candidates`` at all (the harmoniser then passes a sequence built only if read).
+
+    ``suspension`` and ``hazards`` are what a whole-queue scheduler needs of the
+    harmoniser beyond the reports (both optional; a unit test's view leaves them out):
+
+    * ``suspension(by)``: seconds ``exe`` needs, from ``now``, to report ``wait`` if it is
+      sent ``susp`` now with ``by`` (a candidate's id) as its replacement — what is left
+      of its blocking stages and its own suspension plan, for the interruption the
+      harmoniser would announce in that ``susp`` (``expected_s``); ``inf`` if it cannot
+      be planned.  May raise :class:`~tasker.errors.AgentEnded` like ``req_sp``;
+    * ``hazards``: the hazards that hold now and are unattended (:class:`UnattendedHazard`).
     """
 
     now: float
@@ -50,6 +74,8 @@ class ScheduleView:
     req_sp: Callable[[str, SPRequest], Any]
     fresh: Callable[[str], ScheduleParams | None] | None = None
     lowest: Candidate | None = None
+    suspension: Callable[[str], float] | None = None
+    hazards: Sequence[UnattendedHazard] = ()
 
     def best(self, key: Callable[[Candidate], Any]) -> Candidate | None:
         """The candidate with the lowest ``key`` (None if there is none).
@@ -96,6 +122,11 @@ class Scheduler:
 
     name: ClassVar[str] = ""
     preemptive: ClassVar[bool] = True
+    work_conserving: ClassVar[bool] = True
+    """False for a scheduler that may leave the robot idle while candidates wait (a
+    time-table one: a task waits for its slot)."""
+    SWEEP: ClassVar[Mapping[str, tuple[Any, ...]]] = {}
+    """Option values an experiment sweeps, as the algorithm's authors swept them (empty: none)."""
     indexed: ClassVar[bool] = False
     """True when :meth:`schedule` picks its candidate as the lowest :meth:`select_key`
     (through :meth:`ScheduleView.best`) and reads nothing else of the other candidates:

@@ -1,4 +1,8 @@
-"""TaBSA's ``distance`` agent, re-implemented from its description: distance against duration.
+"""Ours: a priority-first variant of TaBSA's ``distance`` agent (distance against duration).
+
+Not TaBSA's agent (that is ``tabsa-distance``, :mod:`tasker.schedulers.tabsa`): TaBSA's
+ignores priority and *maximises* ``distance − ratio × duration``, so with ``ratio = 0`` it
+goes to the farthest task first; this one minimises ``distance / cTime`` within priority.
 
 A candidate's score is the distance from where the robot will be (the executing
 task's ``endPose``, or the ``endPose`` of the last task it ran) to the candidate's

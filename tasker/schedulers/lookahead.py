@@ -9,13 +9,19 @@ Each decision solves a single-machine sequencing problem over the executing task
   ``cost`` differ only by the cps-weighted extra time).  For the executing task asked
   from another pose, that answer is what resuming it costs (travel back, the resume
   stages, planning): the switch cost comes from the task's own plans and motion;
-* **preempting** ``exeDA`` adds ``switch_penalty_s`` (its suspension) before the first
-  task, and makes ``exeDA`` a later job resumed from its predecessor's end pose;
-* the **objective** of an order with completion times ``C_j`` is
+* **preempting** ``exeDA`` puts its suspension before the first task — the seconds the
+  executing task's own suspension plan takes (what is left of its blocking stages, then
+  its ``exeSusp``), from ``ScheduleView.suspension`` when the harmoniser gives it, else
+  the constant ``switch_penalty_s`` — and makes ``exeDA`` a later job resumed from its
+  predecessor's end pose (travel back and resume stages: its ``reqSP`` answer, above);
+* the **objective** of an order with start times ``S_j`` and completion times ``C_j`` is
 
       sum_j  cps_j * (C_j - now)                                (cost: harm grows with delay)
            + lateness_weight * cps_j * max(0, C_j - deadline_j)  (deadlines)
-           + hazard_weight * max(0, C_j - deadline_j - budget_j) (hazard budgets, per task type)
+           + hazard_weight * max(0, C_j - deadline_j - budget_j) (hazard budgets, per task type:
+                                                                  a fall's death time)
+           + hazard_weight * sum_h max(0, S_j - since_h - budget_h) (hazards left on: a cooker
+                                      left on by suspended task j, from ``ScheduleView.hazards``)
 
 * the **search** starts from a greedy order improved by insertion moves, then runs a
   depth-first branch and bound over orders, children tried best first, pruned by the
@@ -30,7 +36,9 @@ Each decision solves a single-machine sequencing problem over the executing task
 The executing task keeps the robot unless the best order that starts with another
 task beats the best order that continues it by the factor ``hysteresis``.
 Every decision leaves a ``decision`` record: ``rule`` (``exact`` or ``anytime``),
-``order``, ``objective``, ``objective_continue``, ``nodes``.
+``order``, ``objective``, ``objective_continue``, ``nodes``; ``suspend_s`` (each
+candidate's plan-based switch penalty) when the view gives suspension estimates, and
+``left_on`` (agent, hazard, due) when hazards are left on.
 """
 
 from __future__ import annotations
@@ -48,17 +56,22 @@ class Problem:
     """The sequencing instance of one decision.  Job 0 is ``exeDA`` when ``has_exe``.
 
     ``first[j]`` is job *j*'s duration when it goes first, ``after[i][j]`` when it follows
-    job *i*; ``weight``, ``deadline``, ``budget`` per job; ``now`` the clock.
+    job *i*; ``weight``, ``deadline``, ``budget`` per job; ``now`` the clock.  ``left_on[j]``
+    (optional): for each hazard job *j* left unattended, the time by which *j* must be
+    running again (``since + budget``); every second it starts later costs ``hazard_weight``.
     """
 
     def __init__(self, now: float, first: Sequence[float], after: Sequence[Sequence[float]],
                  weight: Sequence[float], deadline: Sequence[float], budget: Sequence[float], *,
-                 has_exe: bool = False, lateness_weight: float = 1.0, hazard_weight: float = 1e4) -> None:
+                 has_exe: bool = False, lateness_weight: float = 1.0, hazard_weight: float = 1e4,
+                 left_on: Sequence[Sequence[float]] | None = None) -> None:
         n = len(first)
         self.n, self.now, self.has_exe = n, now, has_exe
         self.first, self.after = list(first), [list(r) for r in after]
         self.weight, self.deadline, self.budget = list(weight), list(deadline), list(budget)
         self.lateness_weight, self.hazard_weight = lateness_weight, hazard_weight
+        self.left_on = [tuple(x) for x in left_on] if left_on is not None else [()] * n
+        self.hazards_left_on = any(self.left_on)  # without any, the search skips the term (its hot loop)
         self.dmin = [min([self.first[j], *(self.after[i][j] for i in range(n) if i != j)]) for j in range(n)]
 
     def cost(self, j: int, c: float) -> float:
@@ -72,9 +85,16 @@ class Problem:
                 out += self.hazard_weight * (late - self.budget[j])
         return out
 
+    def wait_cost(self, j: int, s: float) -> float:
+        """Objective term of job ``j`` starting at ``s``: its hazards' overruns (0 without hazards)."""
+        due = self.left_on[j]
+        return self.hazard_weight * sum(s - d for d in due if s > d) if due else 0.0
+
     def evaluate(self, order: Sequence[int]) -> float:
         t, total, prev = self.now, 0.0, -1
         for j in order:
+            if self.hazards_left_on:
+                total += self.wait_cost(j, t)
             t += self.first[j] if prev < 0 else self.after[prev][j]
             total += self.cost(j, t)
             prev = j
@@ -146,6 +166,8 @@ def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
     placed = [False] * n
 
     def bound(t: float, acc: float) -> float:
+        if p.hazards_left_on:
+            return acc + sum(p.cost(j, t + p.dmin[j]) + p.wait_cost(j, t) for j in range(n) if not placed[j])
         return acc + sum(p.cost(j, t + p.dmin[j]) for j in range(n) if not placed[j])
 
     def dfs(prev: int, t: float, acc: float) -> None:
@@ -166,7 +188,7 @@ def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
                 exhausted = True
                 return
             nodes += 1
-            acc_j = acc + p.cost(j, c)
+            acc_j = acc + p.cost(j, c) + (p.wait_cost(j, t) if p.hazards_left_on else 0.0)
             placed[j] = True
             order.append(j)
             if bound(c, acc_j) < best:
@@ -225,6 +247,7 @@ class LookAhead(Scheduler):
                                   f"got {value!r}")
         self.budgets = {str(k): float(v) for k, v in (budgets or {}).items()}
         self.hysteresis = float(hysteresis)
+        self._penalty: dict[str, float] = {}  # the last problem's switch penalty per candidate
 
     def _duration(self, view: ScheduleView, c: Candidate, p: CostParams, pose: Any, after: str) -> float:
         """Seconds ``c`` takes if started at ``pose`` once ``after`` is complete: its reqSP
@@ -238,17 +261,37 @@ class LookAhead(Scheduler):
         extra = (answer.cc - p.cost) / p.cps
         return max(0.0, p.c_time + extra) if math.isfinite(extra) else math.inf
 
+    def switch_penalty(self, view: ScheduleView, c: Candidate) -> float:
+        """Seconds before ``c`` can start if it preempts ``exeDA`` now: the executing task's own
+        suspension estimate when the view has one (``ScheduleView.suspension``), else
+        ``switch_penalty_s``.  Travel and the resumption are in ``exeDA``'s ``reqSP`` answers."""
+        if view.suspension is None:
+            return self.switch_penalty_s
+        s = float(view.suspension(c.id))
+        if s != s or s < 0:
+            raise ConfigError(f"lookahead: the suspension estimate of {view.exe.id if view.exe else None} "
+                              f"for {c.id} is {s!r}, expected seconds >= 0")
+        return s
+
     def problem(self, view: ScheduleView) -> tuple[Problem, list[Candidate]]:
         jobs = ([view.exe] if view.exe is not None else []) + list(view.candidates)
         params = [self.cost_params(c, self.name) for c in jobs]
         has_exe = view.exe is not None
-        first = [p.c_time + (self.switch_penalty_s if has_exe and k > 0 else 0.0) for k, p in enumerate(params)]
+        self._penalty = {c.id: self.switch_penalty(view, c) for c in jobs[1:]} if has_exe else {}
+        first = [p.c_time + (self._penalty[jobs[k].id] if has_exe and k > 0 else 0.0) for k, p in enumerate(params)]
         after = [[0.0 if i == j else self._duration(view, jobs[j], params[j], params[i].end_pose, jobs[i].id)
                   for j in range(len(jobs))] for i in range(len(jobs))]
         deadline = [math.inf if p.deadline is None else p.deadline for p in params]
         budget = [self.budgets.get(c.task_type, math.inf) for c in jobs]
+        at = {c.id: k for k, c in enumerate(jobs)}
+        left_on: list[list[float]] = [[] for _ in jobs]
+        for hz in view.hazards:  # a hazard left on: its agent must be back in cmd by since + budget
+            k = at.get(hz.agent)
+            if k is not None and math.isfinite(hz.since + hz.budget_s):
+                left_on[k].append(hz.since + hz.budget_s)
         return Problem(view.now, first, after, [p.cps for p in params], deadline, budget, has_exe=has_exe,
-                       lateness_weight=self.lateness_weight, hazard_weight=self.hazard_weight), jobs
+                       lateness_weight=self.lateness_weight, hazard_weight=self.hazard_weight,
+                       left_on=left_on), jobs
 
     def solve(self, prob: Problem, budget: int, *, fixed_first: int | None = None,
               exclude_first: int | None = None) -> tuple[list[int], float, int, bool]:
@@ -278,4 +321,9 @@ class LookAhead(Scheduler):
             "order": [jobs[k].id for k in order], "objective": obj, "objective_continue": keep_obj,
             "nodes": nodes, "switch": switch,
         }
+        if view.exe is not None and view.suspension is not None:  # the plan-based switch penalty
+            record["suspend_s"] = {c.id: self._penalty[c.id] for c in view.candidates}
+        if prob.hazards_left_on:
+            record["left_on"] = [{"agent": hz.agent, "hazard": hz.name, "due": hz.since + hz.budget_s}
+                                 for hz in view.hazards if hz.agent in {c.id for c in jobs}]
         return Decision(first if switch else None, record)

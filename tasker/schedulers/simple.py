@@ -1,4 +1,8 @@
-"""TaBSA's ``simple`` agent, re-implemented from its description: longest task first.
+"""Ours: a priority-first variant of TaBSA's ``simple`` agent (longest task first).
+
+Not TaBSA's agent (that is ``tabsa-simple``, :mod:`tasker.schedulers.tabsa`): TaBSA's
+ignores priority and keeps a preemptive executing task with probability ``hesitance``;
+this one ranks by priority first and turns hesitance into a deterministic margin.
 
 Candidates are ranked by static priority (``CostParams.priority``, higher first; none
 counts as 0), then by ``cTime``, longest first, then by request order.  An executing

@@ -1,4 +1,7 @@
-"""TaBSA's ``simple2`` agent, re-implemented from its description: shortest task first.
+"""Ours: a priority-first variant of TaBSA's ``simple2`` agent (shortest task first).
+
+Not TaBSA's agent (that is ``tabsa-simple2``, :mod:`tasker.schedulers.tabsa`): TaBSA's
+ignores priority and keeps a preemptive executing task with probability ``hesitance``.
 
 The mirror of :mod:`tasker.schedulers.simple`: priority first (higher first), then
 ``cTime`` shortest first; at equal priority the executing task is preempted when

@@ -23,6 +23,10 @@ from tasker.task import TaskContext
 from .helpers import make_loop, st
 
 WINDOW = 180.0
+UNMOVED = {"tabsa-simple", "tabsa-simple2", "tabsa-distance", "tabsa-scheduler"}
+"""TaBSA's own agents read no priority, cost or deadline of a report, and re-read cTime only
+when a request arrives or the executing task changes (``tasker.schedulers.tabsa``): the
+flip of :class:`ThrashTask` does not move them, so they do not thrash here."""
 
 
 class ThrashTask(SyntheticTask):
@@ -65,16 +69,20 @@ def thrash_loop(scheduler: str, guard: OscillationGuard | None) -> Any:
 @pytest.mark.parametrize("scheduler", schedulers.names())
 def test_no_task_becomes_exe_da_a_third_time_within_the_window(scheduler: str) -> None:
     loop = thrash_loop(scheduler, OscillationGuard(window_s=WINDOW, count=2))
+    if not loop.harmoniser.scheduler.work_conserving:  # a time table: these tasks' slots (deadline now) never come
+        assert oscillations(loop.run(until=600.0).events) == []
+        return
     tr = loop.run()
     assert oscillations(tr.events) == []
     assert sorted(e["cause"] for e in tr.of("end")) == ["finished", "finished"]
-    if loop.harmoniser.scheduler.preemptive:  # the guard is what stopped it, and it says so
+    if loop.harmoniser.scheduler.preemptive and scheduler not in UNMOVED:  # the guard stopped it, and says so
         held = [e for e in tr.events if e["event"] == "decision" and "held" in e]
         assert held and all(e["switch"] is False and e["held"]["guard"] == "oscillation" for e in held)
         assert held[0]["held"]["count"] == 2 and held[0]["held"]["window_s"] == WINDOW
 
 
-@pytest.mark.parametrize("scheduler", [n for n in schedulers.names() if schedulers.create(n).preemptive])
+@pytest.mark.parametrize("scheduler", [n for n in schedulers.names()
+                                       if schedulers.create(n).preemptive and n not in UNMOVED])
 def test_the_scenario_thrashes_without_the_guard(scheduler: str) -> None:
     """The scenario is built to thrash: without the guard every preemptive scheduler oscillates."""
     loop = thrash_loop(scheduler, None)

@@ -30,11 +30,26 @@ def test_contract(name: str) -> None:
     assert s.schedule(v(None, [])) == Decision()
     cands = [cand("d2", 1, cost=3, c_time=3, deadline=9), cand("d3", 2, cost=2, c_time=2, deadline=8)]
     d = s.schedule(v(None, cands))
-    assert d.irr_da in {"d2", "d3"}  # with no agent executing, something is started
+    if s.work_conserving:
+        assert d.irr_da in {"d2", "d3"}  # with no agent executing, something is started
+    else:  # a time table may leave the robot idle, and says why
+        assert d.irr_da in {None, "d2", "d3"} and d.record is not None and d.record["switch"] is (d.irr_da is not None)
     d = s.schedule(v(cand("d1", 0, cost=9, c_time=9, deadline=99), cands))
     assert d.irr_da is None or d.irr_da in {"d2", "d3"}
     if not s.preemptive:
         assert d.irr_da is None
+
+
+def test_the_sweep_grids_are_tabsas() -> None:
+    grid = (0.0, 0.25, 0.5, 0.75, 1.0)  # Smit-Sim run_all_agents_100_days.sh
+    assert schedulers.sweep("tabsa-simple") == {"hesitance": grid}
+    assert schedulers.sweep("tabsa-simple2") == {"hesitance": grid}
+    assert schedulers.sweep("tabsa-distance") == {"ratio": grid}
+    assert schedulers.sweep("alg2") == {} and schedulers.sweep("tabsa-scheduler") == {}
+    for name in schedulers.names():  # every value of a grid is a valid option
+        for option, values in schedulers.sweep(name).items():
+            for value in values:
+                schedulers.create(name, **{option: value})
 
 
 def test_unknown_name_lists_known_ones() -> None:
@@ -101,6 +116,19 @@ def test_registering_a_scheduler() -> None:
     ("priority", {"default": float("nan")}, "priority: default must be a number"),
     ("lookahead", {"budgets": 5}, "lookahead: budgets must be a table"),
     ("lookahead", {"budgets": {"a": -1}}, "lookahead: budgets['a'] must be a finite number of seconds >= 0"),
+    ("tabsa-simple", {"hesitance": 1.5}, "tabsa-simple: hesitance must be a number in [0, 1], got 1.5"),
+    ("tabsa-simple2", {"hesitance": "high"}, "tabsa-simple2: hesitance must be a number in [0, 1], got 'high'"),
+    ("tabsa-simple", {"hesitance": True}, "tabsa-simple: hesitance must be a number in [0, 1], got True"),
+    ("tabsa-simple", {"seed": 1.5}, "tabsa-simple: seed must be an integer, got 1.5"),
+    ("tabsa-distance", {"ratio": -0.25}, "tabsa-distance: ratio must be a number in [0, 1], got -0.25"),
+    ("tabsa-distance", {"ratio": float("nan")}, "tabsa-distance: ratio must be a number in [0, 1], got nan"),
+    ("tabsa-distance", {"hesitance": 0.5}, "scheduler 'tabsa-distance' has no option 'hesitance'"),
+    ("tabsa-scheduler", {"non_preemptive": "fall"}, "tabsa-scheduler: non_preemptive must be a list of task type"),
+    ("tabsa-simple", {"estimates": "event"}, "tabsa-simple: estimates must be one of 'events', 'reports', "
+                                             "got 'event'; did you mean 'events'?"),
+    ("wspt", {"weight": "cost"}, "wspt: weight must be one of 'priority', 'cps', got 'cost'"),
+    ("atc", {"k": 0}, "atc: k must be a number in (0, inf), got 0"),
+    ("atc", {"k": float("inf")}, "atc: k must be a number in (0, inf), got inf"),
 ])
 def test_bad_options_are_config_errors_naming_the_option(name: str, options: dict[str, object],
                                                          fragment: str) -> None:
