@@ -122,7 +122,10 @@ def test_every_scheduler_runs_every_task_type_synthetic(name: str) -> None:
 @pytest.mark.parametrize("name", schedulers.names())
 def test_every_scheduler_runs_every_task_type_robot(tiny_protocol: protocol.Protocol, name: str) -> None:
     m = day_runner.run_day(tiny_protocol.source, 1, name, "robot")
-    assert {t: v["completed"] for t, v in m["per_type"].items()} == {"transport": 1, "fall": 1, "pick_place": 1}
+    if schedulers.create(name).work_conserving:
+        assert {t: v["completed"] for t, v in m["per_type"].items()} == {"transport": 1, "fall": 1, "pick_place": 1}
+    else:  # a time-table (TaBSA's scheduler agent) runs a task in its slot before the deadline: after this short day
+        assert m["per_type"]["fall"]["completed"] == 1
     assert m["dead_falls"] == 0 and m["travel_m"] > 0
 
 
