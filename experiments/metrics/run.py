@@ -23,7 +23,7 @@ from experiments.metrics.calibration import calibration
 from experiments.trace.timeline import CMD, AgentTimeline, HazardEpisode, Timeline, timeline
 from tasker import events as ev
 from tasker.fsm import FsmState
-from tasker.trace import FAILED
+from tasker.trace import FAILED, INAPPLICABLE
 
 S = FsmState
 Source = Timeline | Iterable[ev.Event | Mapping[str, Any]]
@@ -236,7 +236,38 @@ def safety(tl: Timeline) -> dict[str, Any]:
         "overrun_s": math.fsum(r["overrun_s"] for r in owned),
         "after_end_s": math.fsum(r["after_end_s"] for r in owned),
         "unowned_hazards": len(rows) - len(owned),
+        # within the owner's lifetime (what a suspension or hazard-aware waiting could attend to); the
+        # rest, after the owner ended, is a task-design defect reported apart (after_end_s)
+        "unattended_alive_s": math.fsum(r["unattended_s"] - r["after_end_s"] for r in owned),
+        "severity_unattended_s": math.fsum(float(r["severity"]) * (r["unattended_s"] - r["after_end_s"])
+                                           for r in owned),
+        "unowned_s": math.fsum(r["active_s"] for r in rows if r["agent"] is None),
     }
+
+
+def suspensions(tl: Timeline) -> dict[str, Any]:
+    """Each suspension episode (entering ``genSusp`` until ``wait`` or ``end``): was it *safe* — when
+    it closed, no hazard its agent owns was on, and every stage it executed was applicable
+    (``tasker.trace.INAPPLICABLE``) — and how long it took to get there."""
+    rows: list[dict[str, Any]] = []
+    for a in tl.agents.values():
+        for s in a.suspensions:
+            if s.outcome == "open":
+                continue
+            left_on = [f"{h.hazard}({', '.join(h.args)})" for h in _active_at(tl.hazards, s.end) if h.owner == a.id]
+            inapplicable = [r.action for r in s.stages if r.status == "failed" and (r.reason or "").startswith(
+                INAPPLICABLE)]
+            rows.append({"agent": a.id, "task_type": a.task_type, "start": s.start, "end": s.end,
+                         "trigger": s.trigger, "outcome": s.outcome,
+                         "strategy": s.plan.strategy if s.plan is not None else None,
+                         "stages": len(s.stages), "left_on": left_on, "inapplicable": inapplicable,
+                         "safe": not left_on and not inapplicable, "duration_s": s.duration})
+    rows.sort(key=lambda r: (r["start"], r["agent"]))
+    safe = [r for r in rows if r["safe"]]
+    return {"episodes": rows, "count": len(rows), "safe": len(safe), "unsafe": len(rows) - len(safe),
+            "all_safe": not rows or len(safe) == len(rows),
+            "inapplicable_stages": sum(len(r["inapplicable"]) for r in rows),
+            "time_to_safe_s": _stats([r["duration_s"] for r in safe])}
 
 
 # -- people -------------------------------------------------------------------------------------
@@ -292,7 +323,8 @@ def compute(events: Source) -> dict[str, Any]:
     tl = timeline(events)
     per, totals = tasks(tl)
     out = {"run": run_info(tl), "totals": totals, "switching": switching(tl), "decisions": decisions(tl),
-           "safety": safety(tl), "people": people(tl), "calibration": calibration(tl), "tasks": per}
+           "safety": safety(tl), "suspensions": suspensions(tl), "people": people(tl),
+           "calibration": calibration(tl), "tasks": per}
     return _clean(out)
 
 
