@@ -25,9 +25,11 @@ from typing import Any
 import numpy as np
 
 from experiments.inputs import fields
+from experiments.inputs import perturbation as perturbations
 from experiments.inputs.actions import TABLES, TimedAction, read_actions
 from experiments.inputs.fields import MODES, POLICIES, STRATEGIES, ScenarioError
 from experiments.inputs.filekinds import expect
+from experiments.inputs.perturbation import Perturbation
 from experiments.inputs.robot_scenario import RobotScenario
 from tasker.support import reader
 
@@ -206,7 +208,8 @@ class InterruptionGrid:
 
 
 def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, pose_jitter: float = 0.5,
-              interruption: InterruptionGrid | None = None) -> RobotScenario:
+              interruption: InterruptionGrid | None = None,
+              perturbation: Perturbation | None = None) -> RobotScenario:
     """A variant of ``scenario`` drawn from ``seed``.
 
     * Request and event times are scaled by up to ``±time_jitter`` (what happens together
@@ -218,6 +221,9 @@ def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, 
       and walk times scaled like the rest, keeping each point in free space (the person's disc
       clear of walls and furniture, :class:`robot.scene.Scene`) and each leg clear of walls;
       a draw that fails 20 times keeps the original point.
+    * With a ``perturbation`` (and an ``interruption`` grid), exogenous world events are drawn
+      around the placed interruption (:mod:`experiments.inputs.perturbation`); everything else
+      is drawn exactly as without it, so the control arm is the same variant unperturbed.
 
     The same seed gives the same variant."""
     from robot.scene import PERSON_RADIUS, Scene
@@ -275,5 +281,12 @@ def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, 
             new_walk.sort()
             e["walk"] = [w for i, w in enumerate(new_walk) if i == 0 or w[0] > new_walk[i - 1][0]]
         people[name] = e
+    if perturbation is not None:
+        if placed is None:
+            raise ScenarioError(scenario.source, "perturbation: needs an interruption grid ([variants.NAME]) to "
+                                                 "place its window around")
+        offer = perturbations.candidates(spec, scenario.objects, actions, people)
+        drawn_events = perturbations.events(perturbation, f"{scenario.name}:{seed}", placed, **offer)
+        actions += [dataclasses.replace(a, origin=("perturbation", k)) for k, a in enumerate(drawn_events)]
     return dataclasses.replace(scenario, actions=tuple(sorted(actions, key=lambda a: a.t)), people=people,
                                seed=seed, name=f"{scenario.name}~{seed}")
