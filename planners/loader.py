@@ -219,6 +219,8 @@ def _check_meaning(spec: TaskSpec, dm: DomainModel) -> tuple[Binding, ...]:
         for role, lits in spec.people.roles.items():
             for lit in lits:
                 _check_pattern(spec, dm, f"people.{role}", lit, variables=True)
+    for lit in spec.invariants:
+        _check_pattern(spec, dm, "derived.invariants", lit, variables=False)
     out = []
     for k, b in enumerate(spec.bindings):
         _check_pattern(spec, dm, f"bindings[{k}].fact", b.fact, variables=True)

@@ -6,11 +6,16 @@ Hooks, and what they do here:
   (R6: what the robot or a person already did is not redone), solved optimally;
   ``static``: the template ``exeTsk`` of ``[static] update`` (Alg. 3).
 * ``generate_suspension`` (genSusp) — one decision list ``[[suspension]]`` (eq. 47) for
-  both strategies: the first branch whose ``when`` holds in the state at interruption
-  (see :meth:`PddlTaskType.branch`) gives the suspension goal; ``planned`` plans to it
-  from that state, ``static`` runs the branch's ``stages`` (checked at load to reach the
-  same goal).  Strategies differ only in method; ``ctx.strategy.policy`` decides whether
-  branches that trade safety for time are eligible, for both alike.
+  the tree's two strategies: the first branch whose ``when`` holds in the state at
+  interruption (see :meth:`PddlTaskType.branch`) gives the suspension goal; ``planned``
+  plans to it from that state, ``static`` runs the branch's ``stages`` (checked at load to
+  reach the same goal).  ``derived`` plans to a goal the folder's declarations give instead
+  of the tree's (:meth:`PddlTaskType.derived_goal`): every hazard the task owns off, its
+  person in a ``safe`` role of ``[people]``, its ``[derived] invariants``.  The method
+  (plan or run the stages) and the goal's source (tree or declarations) are separate
+  factors; ``ctx.strategy.policy`` decides, for all three alike, whether safety may be
+  traded for time (a ``conditional`` branch; a hazard whose budget covers the expected
+  interruption).
 * ``compute_params`` / ``request_sp`` — ``cost = cps * (age + cTime)``: the discomfort
   accumulated by completion, with ``cTime`` and ``endPose`` from the plan upTsk would make
   from the state asked about (:mod:`planners.estimates`), timed with ``ctx.motion``;
@@ -40,6 +45,8 @@ from planners.results import PlanResult, PlanStatus
 from planners.stages import Bindings, StageBuilder, place_of, robot_name
 from planners.taskspec import Branch, Literal, TaskSpec
 from tasker.errors import BadRequest, PlanningFailed, UnknownName
+from tasker.meaning import Hazard, bind, matches
+from tasker.meaning import holds as holds_literal
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
 from tasker.stage import Purpose, Stage, StagePlan
 from tasker.task import Effects, Leaving, TaskContext, TaskType
@@ -163,7 +170,7 @@ class PddlTaskType(TaskType):
     def generate_suspension(self, ctx: TaskContext) -> StagePlan:
         if ctx.strategy.suspension == "static":
             return self.static_suspension(ctx)
-        world, goal, branch = self.suspension_inputs(ctx)
+        world, goal, branch = self.suspension_inputs(ctx)  # the tree's branch, or the derived goal
         extra = self.suspension_facts(ctx, world)
         ready = self._preplanned(ctx, world, goal, extra, branch.label)
         if ready is not None:
@@ -207,10 +214,90 @@ class PddlTaskType(TaskType):
         return world, b.literals(self.spec.goal), extra + self._hook_facts(ctx, world)
 
     def suspension_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], Branch]:
-        """genSusp: the world at interruption, the suspension goal and the branch that chose it."""
+        """genSusp: the world at interruption, the suspension goal and the branch that chose it
+        (for ``derived``, a branch made of the derived goal and its label, with no stages)."""
         world = self._world(ctx)
+        if ctx.strategy.suspension == "derived":
+            goal, label = self.derived_goal(ctx, world)
+            return world, goal, Branch(goal=tuple(goal), label=label)
         branch, b = self.branch(ctx, world)
         return world, b.literals(branch.goal), branch
+
+    def owned_hazards(self, ctx: TaskContext, world: WorldState) -> list[tuple[Hazard, Literal]]:
+        """The declared hazards that hold now and are this task's, as the hazard monitor owns them
+        (:class:`tasker.meaning.Monitor`): a pattern with ``$args`` through the request's arguments; one
+        without, when the monitor gives it to this agent (``ctx.hazards``) or a stage of this task made it
+        true (its ``add`` effects) and it still holds."""
+        robot = robot_name(world)
+        mine = {(name, tuple(f)) for name, f in (ctx.hazards() if ctx.hazards is not None else ())}
+        made = {tuple(f) for s in ctx.done for f in s.data.get("add", ())}
+        out: list[tuple[Hazard, Literal]] = []
+        for hz in self.spec.hazards:
+            atom = bind(hz.fact, ctx.args, robot)
+            if atom is None:
+                continue
+            by_args = any(tok.startswith("$") and tok != "$robot" for tok in hz.fact)
+            for f in matches(atom, world.facts):
+                if by_args or (hz.name, f) in mine or f in made:
+                    out.append((hz, f))
+        return out
+
+    def derived_goal(self, ctx: TaskContext, world: WorldState) -> tuple[list[Literal], str]:
+        """The ``derived`` suspension goal and a label saying what it asks for.
+
+        * every hazard this task owns (:meth:`owned_hazards`) off — under the ``conditional``
+          policy, a hazard whose ``budget_s`` is at least the expected interruption
+          (``ctx.memory["interruption_s"]``; unknown means long) may stay on;
+        * the task's person in one of the ``safe`` roles of ``[people]``: if none holds, the
+          role literal the planner reaches most cheaply (each is planned as the estimates plan);
+        * the ``[derived] invariants``."""
+        expected = ctx.memory.get(INTERRUPTION_KEY)
+        length = math.inf if expected is None else float(expected)
+        goal: list[Literal] = []
+        said: list[str] = []
+        for hz, fact in self.owned_hazards(ctx, world):
+            if ctx.strategy.policy == "conditional" and length <= hz.budget_s:
+                said.append(f"{hz.name}({', '.join(fact[1:])}) left on")
+                continue
+            goal.append(("not", *fact))
+            said.append(f"{hz.name}({', '.join(fact[1:])}) off")
+        b = Bindings(ctx.args, world)
+        goal += [lit for lit in b.literals(self.spec.invariants) if lit not in goal]
+        if self.spec.invariants:
+            said.append("invariants")
+        people = self.spec.people
+        if people is not None and people.safe:
+            robot = robot_name(world)
+            options = [lit for role in people.safe for pat in people.roles[role]
+                       if (lit := bind(pat, ctx.args, robot)) is not None]
+            if options and not any(holds_literal(lit, world.facts) for lit in options):
+                chosen = self._cheapest(ctx, world, goal, options)
+                if chosen is not None:
+                    goal.append(chosen)
+                    said.append(f"{ctx.args.get(people.person)} {' '.join(chosen)}")
+            else:
+                said.append(f"{ctx.args.get(people.person)} safe")
+        return goal, "derived: " + (", ".join(said) if said else "nothing to make safe")
+
+    def _cheapest(self, ctx: TaskContext, world: WorldState, goal: list[Literal],
+                  options: list[Literal]) -> Literal | None:
+        """Of ``options`` (a safe role's literals), the one added to ``goal`` the planner reaches at
+        the lowest cost (planned as the estimates plan: cached, travel with nobody in the way); the
+        first one if it reaches none (genSusp will then say it is unsolvable)."""
+        extra = self.suspension_facts(ctx, world)
+        travel = estimator_for(self).reference_table(world, ctx.motion)
+        best: tuple[float, int] | None = None
+        for k, lit in enumerate(options):
+            steps, status, _ = estimator_for(self).plan(ctx, world, [*goal, lit], extra)
+            if status is not PlanStatus.SOLVED:
+                continue
+            try:
+                cost = sum(s.duration for s in self.builder.from_steps(steps, travel, ctx.args))
+            except PlanningFailed:  # a leg the robot cannot drive now
+                continue
+            if best is None or (cost, k) < best:
+                best = (cost, k)
+        return options[best[1] if best is not None else 0]
 
     def suspension_facts(self, ctx: TaskContext, world: WorldState) -> list[Literal]:
         """genSusp's extra init facts: the request's and ``task.py``'s (e.g. carry_object's

@@ -106,6 +106,8 @@ class TaskSpec:
     hazards: tuple[Hazard, ...] = ()
     people: People | None = None
     bindings: tuple[RawBinding, ...] = ()
+    invariants: tuple[Literal, ...] = ()
+    """``[derived] invariants``: facts that must hold whenever the task is suspended (derived strategy)."""
     lines: Mapping[str, int | None] = field(default_factory=dict)
     """Where each checked field is written (``"hazards[0].fact"`` -> line), for later checks."""
 
@@ -339,8 +341,25 @@ def _people(r: _Reader, top: reader.Table) -> People | None:
     person = p.string("person")
     r.note(p, "person")
     roles = {role: r.literals(p, role) for role in ROLES if role in p}
+    safe = tuple(str(s) for s in p.array("safe", []))
+    r.note(p, "safe")
+    for k, role in enumerate(safe):
+        if role not in roles:
+            raise r.fail(p.at("safe", {}), k, f"{role!r} is not a role this [people] declares "
+                                                f"({', '.join(sorted(roles)) or 'none'}){reader.suggest(role, roles)}")
     p.done()
-    return People(person, roles)
+    return People(person, roles, safe)
+
+
+def _derived(r: _Reader, top: reader.Table) -> tuple[Literal, ...]:
+    """``[derived] invariants``: what must hold whenever the task is suspended (besides its hazards
+    off and its person in a safe role), for the ``derived`` suspension strategy."""
+    if "derived" not in top:
+        return ()
+    d = top.table("derived")
+    invariants = r.literals(d, "invariants")
+    d.done()
+    return tuple(invariants)
 
 
 def _bindings(r: _Reader, top: reader.Table) -> tuple[RawBinding, ...]:
@@ -407,7 +426,8 @@ def read_task_toml(path: Path) -> TaskSpec:
             suspension=r.branches(top, "suspension"), actions=actions, static_update=static_update,
             cps=float(cps), travel_s=float(travel_s), planning_time_s=float(planning_time_s),
             static_time_s=float(static_time_s), timeout_s=float(timeout_s), example=_example(r, top),
-            hazards=_hazards(r, top), people=_people(r, top), bindings=_bindings(r, top), lines=r.lines,
+            hazards=_hazards(r, top), people=_people(r, top), bindings=_bindings(r, top),
+            invariants=_derived(r, top), lines=r.lines,
         )
         top.done()
     return spec

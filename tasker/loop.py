@@ -145,6 +145,7 @@ class SimulationLoop:
             core=self.core,
             motion=self.motion,
             handover=functools.partial(self.harmoniser.handover, agent_id),
+            hazards=functools.partial(self._owned_hazards, agent_id),
         )
         world = self._snapshot if self.world is not None else None
         agent = DynamicAgent(agent_id, task, ctx, trace=self.trace, rates=self.rates, core=self.core,
@@ -152,6 +153,14 @@ class SimulationLoop:
         self._wake(agent, self._tick + 1)
         self.all_agents.append(agent)
         return agent
+
+    def _owned_hazards(self, agent_id: str) -> tuple[tuple[str, tuple[str, ...]], ...]:
+        """The hazards ``agent_id`` owns that hold now (from the harmoniser's hazard source, e.g.
+        :meth:`tasker.meaning.Monitor.active`; none without one)."""
+        source = self.harmoniser.hazards
+        if source is None:
+            return ()
+        return tuple((str(h.name), tuple(h.fact)) for h in source() if h.agent == agent_id)
 
     def _snapshot(self) -> Any:
         """The world's snapshot for a hook; a world that raises stops the run (:class:`WorldError`)."""

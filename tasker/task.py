@@ -31,7 +31,7 @@ the declared :class:`ArgSpec` tuple; task types add checks in ``check_args``.
 from __future__ import annotations
 
 import random
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -68,6 +68,11 @@ class Effects:
 
 
 POLICIES = ("strict", "conditional")
+UPDATES = ("planned", "static")
+"""How upTsk builds exeTsk: plan from the world as it is, or the template (Alg. 3)."""
+SUSPENSIONS = ("planned", "static", "derived")
+"""How genSusp builds exeSusp: plan to the decision tree's goal, run its stages, or plan to the goal
+derived from the task's declarations."""
 """Suspension policies (:attr:`Strategy.policy`)."""
 
 _ARG_TYPES: dict[str, type] = {"str": str, "float": float, "int": int, "bool": bool, "pose": tuple}
@@ -121,8 +126,10 @@ class Strategy:
     """How a task builds its FSMs: ``update`` in upTsk, ``suspension`` in genSusp.
 
     Each is ``"planned"`` (call a planner on the world as it is) or ``"static"``
-    (the task's template ``exeTsk``, Alg. 3, and decision-tree ``exeSusp``, eq. 47).
-    Both pursue the same suspension goal.  ``policy`` is a separate factor applied to
+    (the task's template ``exeTsk``, Alg. 3, and decision-tree ``exeSusp``, eq. 47); both
+    pursue the goal of the decision tree's branch.  ``suspension`` may also be ``"derived"``:
+    plan to a goal derived from what the task declares (every hazard it owns off, every
+    person it affects in a safe role, its invariants), not from the tree.  ``policy`` is a separate factor applied to
     both: ``"strict"`` always reaches the safe state; ``"conditional"`` also allows the
     branches a task declares as trading safety for time (e.g. leave the cooker on for a
     short interruption).
@@ -133,9 +140,10 @@ class Strategy:
     policy: str = "strict"
 
     def __post_init__(self) -> None:
-        for name in ("update", "suspension"):
-            if getattr(self, name) not in ("planned", "static"):
-                raise ConfigError(f"Strategy.{name} must be 'planned' or 'static', got {getattr(self, name)!r}")
+        if self.update not in UPDATES:
+            raise ConfigError(f"Strategy.update must be one of {list(UPDATES)}, got {self.update!r}")
+        if self.suspension not in SUSPENSIONS:
+            raise ConfigError(f"Strategy.suspension must be one of {list(SUSPENSIONS)}, got {self.suspension!r}")
         if self.policy not in POLICIES:
             raise ConfigError(f"Strategy.policy must be one of {list(POLICIES)}, got {self.policy!r}")
 
@@ -178,6 +186,9 @@ class TaskContext:
     suspended: bool = False
     terminating: bool = False
     handover: Callable[[str | None], Effects | None] | None = None
+    hazards: Callable[[], Sequence[tuple[str, tuple[str, ...]]]] | None = None
+    """The hazards this agent owns that hold now, as ``(hazard name, ground fact)`` (set by the loop
+    from the harmoniser's hazard source; None without one): what a derived suspension turns off."""
 
     @property
     def current(self) -> Stage | None:

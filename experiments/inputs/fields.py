@@ -17,6 +17,7 @@ TASKS_HINT = "to add a task type, add its folder with --path DIR or TASKER_TASKS
 
 MODES = ("IT", "CT")
 STRATEGIES = ("planned", "static")
+SUSPENSIONS = ("planned", "static", "derived")
 POLICIES = ("strict", "conditional")
 
 

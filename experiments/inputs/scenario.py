@@ -27,7 +27,7 @@ import numpy as np
 from experiments.inputs import fields
 from experiments.inputs import perturbation as perturbations
 from experiments.inputs.actions import TABLES, TimedAction, read_actions
-from experiments.inputs.fields import MODES, POLICIES, STRATEGIES, ScenarioError
+from experiments.inputs.fields import MODES, POLICIES, STRATEGIES, SUSPENSIONS, ScenarioError
 from experiments.inputs.filekinds import expect
 from experiments.inputs.perturbation import Perturbation
 from experiments.inputs.robot_scenario import RobotScenario
@@ -110,7 +110,8 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
     sched = fields.scheduler(s)
     strategies: dict[str, dict[str, str]] = {}
     for task, t in s.named("strategies"):
-        strategies[task] = {k: str(t.string(k, choices=STRATEGIES)) for k in ("update", "suspension") if k in t}
+        strategies[task] = {k: str(t.string(k, choices=SUSPENSIONS if k == "suspension" else STRATEGIES))
+                            for k in ("update", "suspension") if k in t}
         t.done()
     actions = read_actions(top, world_events=True)
     people: dict[str, dict[str, Any]] = {}
@@ -148,7 +149,7 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
         s_freq=fields.rate(s, "s_freq", 1.0), rep_rate=fields.rate(s, "rep_rate", 1.0),
         task_exe_rate=fields.rate(s, "task_exe_rate", 10.0), sp_up_rate=fields.rate(s, "sp_up_rate", 1.0),
         update=str(s.string("update", "planned", choices=STRATEGIES)),
-        suspension=str(s.string("suspension", "planned", choices=STRATEGIES)), strategies=strategies,
+        suspension=str(s.string("suspension", "planned", choices=SUSPENSIONS)), strategies=strategies,
         seed=int(top.number("seed", 1, integer=True, min=0, max=reader.MAX_SEED)),
         horizon=float(s.number("horizon", 1800.0, positive=True)),
         people=people, objects=objects, policy=str(s.string("policy", "strict", choices=POLICIES)),
