@@ -46,9 +46,9 @@ from tasker.task import Effects, Leaving, TaskContext, TaskType
 from tasker.world import Pose, WorldState
 
 INTERRUPTION_KEY = "interruption_s"
-PREPLAN_KEY = "_suspension_planned_ahead"
-"""``ctx.memory`` key: (symbolic suspension problem, its PlanResult or None if the goal held)."""
 """``ctx.memory`` key: expected length of an interruption (s); unknown means long."""
+PREPLAN_KEY = "_suspension_planned_ahead"
+"""``ctx.memory`` key: (symbolic suspension problem, its plan's steps, empty if the goal held), or None: no plan."""
 
 _shared_planner: Planner | None = None
 

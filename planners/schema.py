@@ -24,7 +24,6 @@ import contextlib
 import functools
 import io
 from dataclasses import dataclass
-from pathlib import Path
 
 from planners.fd import TRANSLATE_LOCK
 
@@ -126,7 +125,3 @@ def _read(text: str) -> DomainSchema:
         constants=tuple((c.name, type_of(c.type_name)) for c in constants),
     )
 
-
-def read_schema_file(path: str | Path) -> DomainSchema:
-    """:func:`read_schema` of a file (for tools and tests)."""
-    return read_schema(Path(path).read_text(encoding="utf-8-sig"))
