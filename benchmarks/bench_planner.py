@@ -28,10 +28,10 @@ from unified_planning.shortcuts import OneshotPlanner  # noqa: E402
 
 from planners.bundled import task_types  # noqa: E402
 from planners.checks import load_problem_text  # noqa: E402
-from planners.engine import register_engine  # noqa: E402
 from planners.examples import StraightLineMotion, example_context  # noqa: E402
 from planners.pddl_task import PddlTaskType  # noqa: E402
 from planners.planner import PddlText, Planner, plan_cost  # noqa: E402
+from planners.registration import register_engine  # noqa: E402
 from tasker.stage import Purpose  # noqa: E402
 
 TARGET_SPEEDUP = 5.0

@@ -408,17 +408,6 @@ class PddlTaskType(TaskType):
         return StagePlan(plan.stages, plan.purpose, strategy="static", sim_time=plan.sim_time,
                          note=f"fallback to static: {why}", info=plan.info)
 
-    def _declared_template_time(self) -> float:
-        """Without a world: the static template's declared durations, travel at ``travel_s``."""
-        total = 0.0
-        for t in self.spec.static_update:
-            a, model = self.spec.actions[t.action], self.domain.actions[t.action]
-            if a.travel is not None:
-                total += self.spec.travel_s
-            else:
-                total += a.duration if a.duration is not None else (model.constant_cost or 0.0)
-        return total
-
     def estimate(self, ctx: TaskContext, start: Pose | None, after: str | None = None) -> tuple[float, Pose | None]:
         """Seconds to complete the task from ``start`` (the robot's pose if None) and the end pose.
 

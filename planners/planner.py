@@ -25,14 +25,12 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 from planners.fd import OPTIMAL_SEARCH, run_fast_downward
+from planners.registration import ENGINE_NAME, oneshot_planners, register_engine
 from planners.results import PlanResult, PlanStatus, from_fd_outcome
 from tasker.errors import UnknownName
 
 if TYPE_CHECKING:
     import unified_planning as up
-
-ENGINE_NAME = "tasker-fd"
-"""The name of the in-process Fast Downward engine (:mod:`planners.engine` registers it)."""
 
 DEFAULT_PLANNER = ENGINE_NAME
 """The engine a :class:`Planner` uses unless told otherwise."""
@@ -44,24 +42,6 @@ class PddlText:
 
     domain: str
     problem: str
-
-
-def oneshot_planners() -> list[str]:
-    """Names of the one-shot planning engines installed in UP's factory."""
-    from unified_planning.environment import get_environment
-
-    from planners.engine import register_engine
-
-    register_engine()
-    factory = get_environment().factory
-    return sorted(n for n in factory.engines if _is_oneshot(factory.engine(n)))
-
-
-def _is_oneshot(cls: type) -> bool:
-    try:
-        return bool(getattr(cls, "is_oneshot_planner")())  # noqa: B009 - engines are duck-typed
-    except Exception:  # noqa: BLE001 - meta-engine wrappers may refuse the question
-        return False
 
 
 def plan_steps(plan: Any) -> tuple[tuple[str, ...], ...]:
@@ -162,8 +142,6 @@ class Planner:
 
     def _solve_up(self, problem: up.model.Problem, timeout: float | None, start: float) -> PlanResult:
         from unified_planning.shortcuts import OneshotPlanner
-
-        from planners.engine import register_engine
 
         register_engine()  # also silences the credits banner
         with warnings.catch_warnings(record=True) as caught:
