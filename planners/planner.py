@@ -5,8 +5,8 @@
 :class:`~planners.results.PlanResult`.  The default engine is ``tasker-fd``
 (:mod:`planners.engine`); given PDDL text it goes straight to Fast Downward without
 building a UP model at all.  Results are cached on the PDDL text (domain + problem),
-so a repeated identical problem is answered from memory; time-outs and errors are
-never cached.
+so a repeated identical problem is answered from memory (its ``wall_time_s`` is that
+answer's, not the original solve's); time-outs and errors are never cached.
 
 With the default engine nothing of unified-planning is imported (the command line's
 path to Fast Downward stays fast); another engine imports UP's factory when first used,
@@ -82,17 +82,20 @@ class Planner:
 
     def solve(self, problem: up.model.Problem | PddlText, timeout: float | None = None) -> PlanResult:
         """Solve ``problem``; never raises for an unsolvable or failing problem (see the status)."""
+        asked = time.perf_counter()
         timeout = self.timeout if timeout is None else timeout
         text = problem if isinstance(problem, PddlText) else self._text_of(problem)
         key = (self.name, text.domain, text.problem)
         if self.cache_size:
             with self._lock:
                 hit = self._cache.get(key)
-                if hit is not None:
+                if hit is None:
+                    self.misses += 1
+                else:
                     self._cache.move_to_end(key)
                     self.hits += 1
-                    return replace(hit, cached=True)
-                self.misses += 1
+            if hit is not None:  # this call's time: the original solve's was counted when it ran
+                return replace(hit, cached=True, wall_time_s=time.perf_counter() - asked)
         start = time.perf_counter()
         if self.name == ENGINE_NAME:
             result = self._solve_fd(text, timeout, start)
