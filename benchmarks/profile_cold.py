@@ -117,7 +117,7 @@ def report(r: Profile, title: str) -> None:
     wall, cpu, sim = float(r["wall"]), float(r["cpu"]), float(r["sim"])
     print(f"{title}: {sim:.1f} s simulated in {wall:.2f} s = {sim / wall:.0f}x, CPU {cpu:.2f} s "
           f"(imports before run_scenario: {float(r['imports']):.2f} s, not counted)")
-    print(f"  {'':26s} {'wall':>7s} {'':6s} {'CPU':>7s} {'':6s}")
+    print(f"  {'':26s} {'wall':>7s} {'':6s} {'CPU':>7s}")
     top_wall = top_cpu = 0.0
     for label in r["order"]:
         if not label.startswith("  "):
