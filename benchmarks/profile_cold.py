@@ -92,10 +92,30 @@ print(json.dumps({{"order": order, "imports": imported, "wall": wall, "cpu": use
 
 Profile = dict[str, Any]
 
+_LAYOUTS = r"""
+import importlib, importlib.util, sys, types
+sys.path.insert(0, {root!r})
+# experiments/ moved into layers (experiments.run.runner, experiments.inputs.scenario): with
+# --baseline, one side may name a module by the other layout; each name then finds it
+def _has(name):
+    try:
+        return importlib.util.find_spec(name) is not None
+    except ModuleNotFoundError:
+        return False
+for a, b in (("experiments.runner", "experiments.run.runner"), ("experiments.scenario", "experiments.inputs.scenario")):
+    for want, have in ((a, b), (b, a)):
+        if not _has(want) and _has(have):
+            parent = want.rpartition(".")[0]
+            if parent not in sys.modules and not _has(parent):
+                sys.modules[parent] = types.ModuleType(parent)
+            sys.modules[want] = importlib.import_module(have)
+"""
+
 
 def run(scenario: str, cache: Path, root: Path = ROOT) -> Profile:
     env = {**os.environ, "TASKER_CACHE": str(cache)}
-    out = subprocess.run([sys.executable, "-c", _CHILD.format(root=str(root), scenario=scenario)],
+    code = _LAYOUTS.format(root=str(root)) + _CHILD.format(root=str(root), scenario=scenario)
+    out = subprocess.run([sys.executable, "-c", code],
                          capture_output=True, text=True, check=True, env=env, cwd=root)
     result: Profile = json.loads(out.stdout.strip().splitlines()[-1])
     return result
