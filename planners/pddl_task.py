@@ -53,9 +53,9 @@ from tasker.task import Effects, Leaving, TaskContext, TaskType
 from tasker.world import Pose, WorldState
 
 INTERRUPTION_KEY = "interruption_s"
-PREPLAN_KEY = "_suspension_planned_ahead"
-"""``ctx.memory`` key: (symbolic suspension problem, its PlanResult or None if the goal held)."""
 """``ctx.memory`` key: expected length of an interruption (s); unknown means long."""
+PREPLAN_KEY = "_suspension_planned_ahead"
+"""``ctx.memory`` key: (symbolic suspension problem, its plan's steps, empty if the goal held), or None: no plan."""
 
 _shared_planner: Planner | None = None
 
@@ -494,17 +494,6 @@ class PddlTaskType(TaskType):
     def _fallback(plan: StagePlan, why: str) -> StagePlan:
         return StagePlan(plan.stages, plan.purpose, strategy="static", sim_time=plan.sim_time,
                          note=f"fallback to static: {why}", info=plan.info)
-
-    def _declared_template_time(self) -> float:
-        """Without a world: the static template's declared durations, travel at ``travel_s``."""
-        total = 0.0
-        for t in self.spec.static_update:
-            a, model = self.spec.actions[t.action], self.domain.actions[t.action]
-            if a.travel is not None:
-                total += self.spec.travel_s
-            else:
-                total += a.duration if a.duration is not None else (model.constant_cost or 0.0)
-        return total
 
     def estimate(self, ctx: TaskContext, start: Pose | None, after: str | None = None) -> tuple[float, Pose | None]:
         """Seconds to complete the task from ``start`` (the robot's pose if None) and the end pose.

@@ -15,7 +15,7 @@ is always read this way, checked or remembered, so the two paths cannot disagree
 
 The translator's parser consults its module-global options (``--keep-no-ops``: an
 action without effects is kept, as PDDL and unified-planning keep it), so a read
-holds :data:`planners.fd.TRANSLATE_LOCK` like a translation does.
+holds :data:`planners.translate.TRANSLATE_LOCK` like a translation does.
 """
 
 from __future__ import annotations
@@ -24,9 +24,8 @@ import contextlib
 import functools
 import io
 from dataclasses import dataclass
-from pathlib import Path
 
-from planners.fd import TRANSLATE_LOCK
+from planners.translate import TRANSLATE_LOCK, domain_sexp
 
 OBJECT_TYPE = "object"
 """PDDL's root type; a type of the schema only in domains that use it (see :func:`read_schema`)."""
@@ -82,13 +81,13 @@ def read_schema(text: str) -> DomainSchema:
 def _read(text: str) -> DomainSchema:
     from fast_downward.translate import options as fd_options
     from fast_downward.translate import pddl
-    from fast_downward.translate.pddl_parser import lisp_parser, parsing_functions
+    from fast_downward.translate.pddl_parser import parsing_functions
     from fast_downward.translate.pddl_parser.parse_error import ParseError
 
     with TRANSLATE_LOCK, contextlib.redirect_stdout(io.StringIO()):
         fd_options.set_options(["domain.pddl", "problem.pddl", "--keep-no-ops"])
         try:
-            nested = lisp_parser.parse_nested_list(io.StringIO(text))
+            nested = domain_sexp(text)  # read once per process, shared with the translator
             (name, _req, types, _type_dict, constants, predicates, _pred_dict, functions, actions,
              _axioms) = parsing_functions.parse_domain_pddl(parsing_functions.Context(), nested)
         except (ParseError, SystemExit) as exc:  # the translator reports bad input both ways
@@ -126,7 +125,3 @@ def _read(text: str) -> DomainSchema:
         constants=tuple((c.name, type_of(c.type_name)) for c in constants),
     )
 
-
-def read_schema_file(path: str | Path) -> DomainSchema:
-    """:func:`read_schema` of a file (for tools and tests)."""
-    return read_schema(Path(path).read_text(encoding="utf-8-sig"))

@@ -17,7 +17,16 @@ import pytest
 
 import domains
 from planners.bundled import task_types
-from planners.estimates import Estimate, Estimator, Source, estimator_for, moved_robot, nearest_place, walk
+from planners.estimates import (
+    Estimate,
+    Estimator,
+    Source,
+    declared_template_time,
+    estimator_for,
+    moved_robot,
+    nearest_place,
+    walk,
+)
 from planners.examples import StraightLineMotion
 from planners.pddl_task import PddlTaskType
 from planners.results import PlanResult, PlanStatus
@@ -256,7 +265,7 @@ def test_estimate_checks_fire() -> None:
 def test_without_world_the_declared_template_time(task: PddlTaskType) -> None:
     ctx = replace(make_ctx(task), world=None)
     est = estimator_for(task).estimate(ctx)
-    assert est.source is Source.DECLARED and est.c_time == task._declared_template_time() > 0
+    assert est.source is Source.DECLARED and est.c_time == declared_template_time(task.spec, task.domain) > 0
 
 
 class _ClosedDoors:
