@@ -29,6 +29,7 @@ suspension or a planner time-out falls back to the static strategy, said in the 
 from __future__ import annotations
 
 import contextlib
+import itertools
 import math
 import traceback
 from collections.abc import Callable, Iterator
@@ -40,7 +41,16 @@ from typing import Any
 from planners.checks import DefinitionError
 from planners.estimates import estimator_for, executing
 from planners.planner import PddlText, Planner
-from planners.problem import PLACE_TYPE, DomainModel, PortablePddl, holds, portable, render_problem, travel_table
+from planners.problem import (
+    CONNECTED,
+    PLACE_TYPE,
+    DomainModel,
+    PortablePddl,
+    holds,
+    portable,
+    render_problem,
+    travel_table,
+)
 from planners.results import PlanResult, PlanStatus
 from planners.stages import Bindings, StageBuilder, place_of, robot_name
 from planners.taskspec import Branch, Literal, TaskSpec
@@ -50,9 +60,12 @@ from tasker.meaning import holds as holds_literal
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
 from tasker.stage import Purpose, Stage, StagePlan
 from tasker.task import Effects, Leaving, TaskContext, TaskType
+from tasker.trace import INAPPLICABLE
 from tasker.world import Pose, WorldState
 
 INTERRUPTION_KEY = "interruption_s"
+RESTORE_KEY = "_restore_baseline"
+"""``ctx.memory`` key: the facts of ``[problem] restore``'s patterns that held when the task first planned."""
 """``ctx.memory`` key: expected length of an interruption (s); unknown means long."""
 PREPLAN_KEY = "_suspension_planned_ahead"
 """``ctx.memory`` key: (symbolic suspension problem, its plan's steps, empty if the goal held), or None: no plan."""
@@ -182,6 +195,33 @@ class PddlTaskType(TaskType):
         return self._fallback(self.static_suspension(ctx),
                               f"{why.get(outcome.status, 'planner error')} for {goal}")
 
+    def inapplicable(self, ctx: TaskContext, stage: Stage) -> str | None:
+        """Why ``stage`` cannot run now: the literals of its action's precondition that do not
+        hold in the state the planner would see (the world, the request's and ``task.py``'s facts,
+        Alg. 3's while suspended).  ``connected`` is left out: the planner derives it from the
+        motion model, and an unreachable leg fails when the stage is built.  None when it can
+        run, when it would change nothing, or when the precondition is not a conjunction of
+        literals."""
+        world = ctx.world
+        if not isinstance(world, WorldState) or stage.action not in self.domain.actions:
+            return None
+        try:
+            b = Bindings(ctx.args, world)
+            extra = b.literals(self.spec.facts) + (b.literals(self.spec.suspended_facts) if ctx.suspended else [])
+            extra += self._hook_facts(ctx, world)
+        except PlanningFailed:
+            return None
+        facts = world.facts | frozenset(extra)
+        add, delete = [tuple(f) for f in stage.data.get("add", ())], [tuple(f) for f in stage.data.get("delete", ())]
+        if add and all(f in facts for f in add) and not any(f in facts for f in delete):
+            return None  # it would change nothing (driving to where the robot stands): nothing to refuse
+        unmet = self.domain.unmet(stage.action, stage.args, facts)
+        unmet = [lit for lit in unmet or () if (lit[1] if lit[0] == "not" else lit[0]) != CONNECTED]
+        if not unmet:
+            return None
+        said = ", ".join(f"({' '.join(lit)})" for lit in unmet)
+        return f"{INAPPLICABLE} {stage.action}({' '.join(stage.args)}) needs {said}, which does not hold"
+
     def compute_params(self, ctx: TaskContext) -> CostParams:
         """``cost = cps * (age + cTime)``; cTime and endPose from :meth:`estimate` of the state now.
 
@@ -207,11 +247,38 @@ class PddlTaskType(TaskType):
     # -- planning inputs (public for tests and tools) -----------------------------------
 
     def update_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], list[Literal]]:
-        """upTsk: the world, the goal and the extra init facts (request, Alg. 3, task.py)."""
+        """upTsk: the world, the goal (with what ``[problem] restore`` asks back) and the extra init
+        facts (request, Alg. 3, task.py)."""
         world = self._world(ctx)
         b = Bindings(ctx.args, world)
         extra = b.literals(self.spec.facts) + (b.literals(self.spec.suspended_facts) if ctx.suspended else [])
-        return world, b.literals(self.spec.goal), extra + self._hook_facts(ctx, world)
+        goal = b.literals(self.spec.goal)
+        goal += [lit for lit in self.restored(ctx, world) if lit not in goal]
+        return world, goal, extra + self._hook_facts(ctx, world)
+
+    def restored(self, ctx: TaskContext, world: WorldState) -> list[Literal]:
+        """``[problem] restore``: ``("not", fact)`` for every ground instance of a pattern (over the
+        world's objects of the predicate's types) that did not hold when this task first planned
+        (remembered in ``ctx.memory``), so it leaves them as it found them."""
+        if not self.spec.restore:
+            return []
+        robot = robot_name(world)
+        patterns = [p for pat in self.spec.restore if (p := bind(pat, ctx.args, robot)) is not None]
+        baseline = ctx.memory.setdefault(RESTORE_KEY, frozenset(f for p in patterns for f in matches(p, world.facts)))
+        out: list[Literal] = []
+        for pat in patterns:
+            signature = self.domain.predicates.get(pat[0], ())
+            choices = []
+            for tok, typ in zip(pat[1:], signature, strict=False):
+                if tok.startswith("?"):
+                    choices.append(sorted(n for n, t in world.objects.items() if self.domain.has_type(t, typ)))
+                else:
+                    choices.append([tok])
+            for inst in itertools.product(*choices):
+                fact = (pat[0], *inst)
+                if fact not in baseline and ("not", *fact) not in out:
+                    out.append(("not", *fact))
+        return out
 
     def suspension_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], Branch]:
         """genSusp: the world at interruption, the suspension goal and the branch that chose it

@@ -53,6 +53,10 @@ class ActionModel:
     effects: tuple[EffectTemplate, ...]
     constant_cost: float | None
     param_types: tuple[str, ...] = ()
+    precondition: tuple[EffectTemplate, ...] | None = ()
+    """The precondition as a conjunction of literals (``positive`` False: a negated one; ``=`` may
+    appear as a fluent), or None when it is more than that (a disjunction, a quantifier): then
+    applicability is not decided from it (:meth:`planners.problem.DomainModel.unmet`)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -104,6 +108,21 @@ def _read(text: str) -> DomainSchema:
     def type_of(t: str) -> str:
         return "" if t == OBJECT_TYPE and not rooted else t
 
+    def conjunction(c: pddl.Condition) -> tuple[EffectTemplate, ...] | None:
+        if isinstance(c, pddl.Truth):
+            return ()
+        if isinstance(c, pddl.Literal):
+            return (EffectTemplate(c.predicate, tuple(str(x) for x in c.args), not c.negated),)
+        if isinstance(c, pddl.Conjunction):
+            out: list[EffectTemplate] = []
+            for part in c.parts:
+                lits = conjunction(part)
+                if lits is None:
+                    return None
+                out += lits
+            return tuple(out)
+        return None  # a disjunction or a quantifier: not a plain conjunction of literals
+
     def action(a: pddl.Action) -> ActionModel:
         effects = tuple(
             EffectTemplate(e.literal.predicate, tuple(e.literal.args), not e.literal.negated)
@@ -112,7 +131,8 @@ def _read(text: str) -> DomainSchema:
         cost = a.cost.expression.value if isinstance(getattr(a.cost, "expression", None),
                                                      pddl.NumericConstant) else None
         return ActionModel(a.name, tuple(p.name.lstrip("?") for p in a.parameters), effects,
-                           None if cost is None else float(cost), tuple(type_of(p.type_name) for p in a.parameters))
+                           None if cost is None else float(cost), tuple(type_of(p.type_name) for p in a.parameters),
+                           conjunction(a.precondition))
 
     return DomainSchema(
         name=name,

@@ -108,6 +108,10 @@ class TaskSpec:
     bindings: tuple[RawBinding, ...] = ()
     invariants: tuple[Literal, ...] = ()
     """``[derived] invariants``: facts that must hold whenever the task is suspended (derived strategy)."""
+    restore: tuple[Literal, ...] = ()
+    """``[problem] restore``: patterns of facts the task leaves as it found them — a ground instance
+    that did not hold when the task first planned must not hold at its goal (a door it opened is
+    closed again)."""
     lines: Mapping[str, int | None] = field(default_factory=dict)
     """Where each checked field is written (``"hazards[0].fact"`` -> line), for later checks."""
 
@@ -402,6 +406,7 @@ def read_task_toml(path: Path) -> TaskSpec:
         goal = r.literals(problem, "goal")
         facts = r.literals(problem, "facts")
         suspended_facts = r.literals(problem, "suspended_facts")
+        restore = r.literals(problem, "restore")
         problem.done()
         actions_t = top.table("actions")
         actions = {}
@@ -427,7 +432,7 @@ def read_task_toml(path: Path) -> TaskSpec:
             cps=float(cps), travel_s=float(travel_s), planning_time_s=float(planning_time_s),
             static_time_s=float(static_time_s), timeout_s=float(timeout_s), example=_example(r, top),
             hazards=_hazards(r, top), people=_people(r, top), bindings=_bindings(r, top),
-            invariants=_derived(r, top), lines=r.lines,
+            invariants=_derived(r, top), restore=tuple(restore), lines=r.lines,
         )
         top.done()
     return spec

@@ -284,6 +284,16 @@ class TaskType:
         """``ic_term`` set by the agent itself: a reason to end, or None to go on."""
         return None
 
+    def inapplicable(self, ctx: TaskContext, stage: Stage) -> str | None:
+        """Why ``stage`` cannot run in the world as it is now (``ctx.world``), or None if it can.
+
+        Asked before every stage begins, static and planned alike, as a robot would find out:
+        a stage whose action's precondition does not hold fails without running (its reason
+        starts with :data:`tasker.trace.INAPPLICABLE`) and applies no effect.  Override it for
+        a task type that knows its actions' preconditions (a PDDL task folder does); the
+        default knows none."""
+        return None
+
     def on_stage_done(self, ctx: TaskContext, stage: Stage) -> None:
         """Called after a stage of ``exeTsk`` or ``exeSusp`` completes."""
 

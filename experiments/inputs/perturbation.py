@@ -6,8 +6,8 @@ draw world events from the world's own vocabulary, in a window around the time t
 placed its interruption (:class:`~experiments.inputs.scenario.InterruptionGrid`):
 
 * ``door`` — a door is opened or closed (whichever it is not, as the earlier events left it);
-* ``move`` — an object a request names is moved to another place (a ``surface`` place if the
-  world has surfaces); nothing happens if the robot holds it then;
+* ``move`` — an object a request names is moved to another of the world's places; nothing
+  happens if the robot holds it then;
 * ``device`` — a device is switched (on if it is off, as the earlier events left it, else off);
 * ``bystander`` — a person no request names walks into a doorway, stands there a while, and
   walks back to where the scenario starts them.
@@ -135,8 +135,6 @@ def candidates(spec: Any, scenario_objects: Mapping[str, Mapping[str, Any]], act
                people: Mapping[str, Mapping[str, Any]]) -> dict[str, Any]:
     """What a world (a :class:`robot.spec.WorldSpec`) and a scenario offer :func:`events`."""
     named = _named(actions)
-    facts = {tuple(f) for f in spec.facts} | {tuple(f) for o in scenario_objects.values() for f in o.get("facts", [])}
-    surfaces = sorted(f[1] for f in facts if len(f) == 2 and f[0] == "surface")
     things = sorted((set(spec.objects) | set(scenario_objects)) & named)
     doors = {n: ((d.box[0] + d.box[2]) / 2, (d.box[1] + d.box[3]) / 2, bool(d.open)) for n, d in spec.doors.items()}
     bystanders = {}
@@ -144,5 +142,5 @@ def candidates(spec: Any, scenario_objects: Mapping[str, Mapping[str, Any]], act
         pose = people.get(name, {}).get("pose") or (list(spec.people[name].pose) if name in spec.people else None)
         if pose is not None:
             bystanders[name] = (round(float(pose[0]), 3), round(float(pose[1]), 3))
-    return {"doors": doors, "objects": things, "places": surfaces or sorted(spec.places),
+    return {"doors": doors, "objects": things, "places": sorted(spec.places),
             "devices": {n: d.state for n, d in spec.devices.items()}, "bystanders": bystanders}

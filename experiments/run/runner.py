@@ -213,7 +213,7 @@ def _action(loop: SimulationLoop, sim: Any, made: _Made, a: TimedAction, sid: st
         elif what == "device":
             sim.set_device(value[0], value[1])
         elif what == "move":  # an object someone moved: wherever it was (not if the robot holds it)
-            if not any(f[0] == "holding" and f[-1] == value[0] for f in sim.facts):
+            if value[0] not in sim.held:
                 sim.apply(delete=[f for f in sim.facts if f[0] == "at" and len(f) == 3 and f[1] == value[0]],
                           add=[("at", value[0], value[1])])
         elif what == "add":
