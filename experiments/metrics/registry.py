@@ -108,6 +108,10 @@ METRICS: tuple[Metric, ...] = (
     Metric("decisions.decisions", "count", N, "scheduling decisions"),
     Metric("decisions.switch_decisions", "count", N, "decisions that chose to switch"),
     Metric("decisions.decisions_by.*", "count", N, "decisions by algorithm/rule"),
+    Metric("decisions.cost_compared", "count", N, "Alg. 2 decisions that compared finite costs"),
+    Metric("decisions.margins.*", "count", N, "cost decisions by margin 1 − c_switch/c_wait (bins of 0.1)"),
+    Metric("decisions.hysteresis_flips.*", "count", N, "cost decisions that would have gone the other way "
+           "at this hysteresis"),
     Metric("safety.unattended_s", "s", L, "hazard time on while its owner was not in cmd, over owned hazards",
            label="hazard time unattended (s)"),
     Metric("safety.longest_unattended_s", "s", L, "the longest unbroken unattended stretch of an owned hazard"),

@@ -123,11 +123,39 @@ def switching(tl: Timeline) -> dict[str, Any]:
             "changes": sum(1 for c in tl.changes if c.ignored is None)}
 
 
+HYSTERESES = (0.85, 0.9, 0.95, 1.0)
+"""The hysteresis values a run's cost decisions are re-read under (how many would have gone the other way)."""
+MARGIN_BINS = 0.1
+"""Width of the bins of the cost decisions' margins ``1 − c_switch / c_wait`` (clipped to [−1, 1])."""
+
+
 def decisions(tl: Timeline) -> dict[str, Any]:
-    """Scheduling decisions: how many, by algorithm and rule, and how many chose to switch."""
+    """Scheduling decisions: how many, by algorithm and rule, and how many chose to switch; for Alg. 2's
+    finite cost comparisons, a histogram of their margins ``1 − c_switch / c_wait`` and, per hysteresis
+    of :data:`HYSTERESES`, how many would have decided the other way (a sensitivity check, decision by
+    decision: what would have happened after is not re-run)."""
     by = Counter(f"{d.algorithm}/{d.rule if d.rule is not None else '-'}" for d in tl.decisions)
+    margins: Counter[str] = Counter()
+    flips = dict.fromkeys((f"{h:g}" for h in HYSTERESES), 0)
+    compared = 0
+    for d in tl.decisions:
+        if d.rule != "cost":
+            continue
+        try:
+            cs, cw, h = float(d.get("c_switch")), float(d.get("c_wait")), float(d.get("hysteresis", 1.0))
+        except (TypeError, ValueError):
+            continue
+        if not (math.isfinite(cs) and math.isfinite(cw) and cw > 0 and math.isfinite(h)):
+            continue
+        compared += 1
+        margin = max(-1.0, min(1.0, 1.0 - cs / cw))
+        margins[f"{math.floor(margin / MARGIN_BINS + 1e-9) * MARGIN_BINS:+.1f}"] += 1
+        for other in HYSTERESES:
+            if (cs < other * cw) != (cs < h * cw):
+                flips[f"{other:g}"] += 1
     return {"decisions": len(tl.decisions), "switch_decisions": sum(d.switch for d in tl.decisions),
-            "decisions_by": dict(sorted(by.items()))}
+            "decisions_by": dict(sorted(by.items())), "cost_compared": compared,
+            "margins": dict(sorted(margins.items(), key=lambda kv: float(kv[0]))), "hysteresis_flips": flips}
 
 
 # -- safety: hazards -------------------------------------------------------------------------------
