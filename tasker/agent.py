@@ -396,7 +396,7 @@ class DynamicAgent:
         self.ctx.suspended = True
         self.ctx.terminating = self._latched.term is not None
         self._fire(event, now)
-        self.refresh(now)  # the stage that just ended may have changed the world (a pan put on the cooker)
+        self.refresh(now)  # the stage that just ended may have changed the world
         try:
             plan = self.task.generate_suspension(self.ctx)
         except PlanningFailed as exc:

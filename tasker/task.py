@@ -124,7 +124,7 @@ class Strategy:
     (the task's template ``exeTsk``, Alg. 3, and decision-tree ``exeSusp``, eq. 47).
     Both pursue the same suspension goal.  ``policy`` is a separate factor applied to
     both: ``"strict"`` always reaches the safe state; ``"conditional"`` also allows the
-    branches a task declares as trading safety for time (e.g. leave the cooker on for a
+    branches a task declares as trading safety for time (e.g. leave a device on for a
     short interruption).
     """
 
@@ -207,12 +207,17 @@ class TaskType:
     belongs in ``ctx.memory``, never on ``self``.  :attr:`meaning` declares what the
     task means for safety and people (hazards, roles, physical bindings; see
     :mod:`tasker.meaning`): the trace and the metrics read it, never the task's name.
+    :attr:`priority` declares how urgent the type is against others, for schedulers that
+    rank task types in classes.
     """
 
     name: str = ""
     description: str = ""
     arg_specs: tuple[ArgSpec, ...] = ()
     meaning: Meaning = NO_MEANING
+    priority: int | None = None
+    """The type's priority class, higher is more urgent; None: the lowest.  Alg. 2's classes
+    come from it when a scenario names none (a task folder declares it as ``[schedule] priority``)."""
 
     # -- framework-owned ------------------------------------------------------------
 
