@@ -454,10 +454,10 @@ class DynamicAgent:
 
     def _guard(self, name: str) -> bool:
         """Evaluate a guard named in :data:`tasker.fsm.TRANSITIONS` (meanings: :data:`tasker.fsm.GUARD_MEANING`)."""
-        try:
-            return _GUARDS[name](self)
-        except KeyError:
-            raise ConfigError(f"agent {self.id}: the FSM names a guard {name!r} the agent does not know") from None
+        evaluate = _GUARDS.get(name)
+        if evaluate is None:
+            raise ConfigError(f"agent {self.id}: the FSM names a guard {name!r} the agent does not know")
+        return evaluate(self)
 
     def _fire(self, event: str, now: float) -> None:
         """Fire ``event`` through the FSM table: the table picks the target; traced and reported."""
@@ -555,10 +555,11 @@ _COMMANDS: dict[str, Callable[[DynamicAgent, float], None]] = {
 }
 """What the command rows that leave ``compSP`` and ``wait`` do (``suspend`` leaves ``exeTsk``)."""
 
-if set(_GUARDS) != set(fsm.GUARDS) or not {t.event for t in fsm.TRANSITIONS if t.auto and t.source in (
-        S.COMP_SP, S.WAIT)} <= set(_COMMANDS):
-    raise FSMError(f"the agent evaluates the guards {sorted(_GUARDS)} and does the commands {sorted(_COMMANDS)}; "
-                   f"the FSM table names the guards {list(fsm.GUARDS)}")
+_TAKEN_BY_COMP_SP = {t.event for t in fsm.TRANSITIONS if t.auto and t.source in (S.COMP_SP, S.WAIT)}
+if set(_GUARDS) != set(fsm.GUARDS) or not _TAKEN_BY_COMP_SP <= set(_COMMANDS):  # the table and its runner agree
+    raise FSMError(f"the agent evaluates the guards {sorted(_GUARDS)} and takes the commands {sorted(_COMMANDS)} "
+                   f"in compSP and wait; the FSM table names the guards {list(fsm.GUARDS)} and the commands "
+                   f"{sorted(_TAKEN_BY_COMP_SP)}")
 
 _HANDLERS: dict[FsmState, Callable[[DynamicAgent, float], None]] = {
     S.INIT_COMM: DynamicAgent._init_comm,
