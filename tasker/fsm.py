@@ -339,8 +339,8 @@ def to_mermaid(*, errors: bool = False) -> str:
         if PARENT[c] is None:
             block(c, "    ")
     for child in PARENT:
-        if PARENT[child] is None and child not in COMPOSITES:
-            leaf(str(child), "    ")
+        if PARENT[child] is None and child not in COMPOSITES and _holding(str(child)):
+            leaf(str(child), "    ")  # a top-level leaf appears with its transitions; named here for what it holds
     for t in TRANSITIONS:
         if errors or t.event != "error":
             lines.append(f"    {t.source.value} --> {t.target.value} : {_label(t)}")
