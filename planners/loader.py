@@ -305,6 +305,7 @@ def load_task(folder: str | Path, *, use_cache: bool = True) -> PddlTaskType:
     bindings = _check_meaning(spec, dm)
     task = PddlTaskType(spec, dm, hooks=_load_hooks(spec))
     task.meaning = meaning_of(spec, bindings)
+    task.priority = spec.priority
     if not remembered:
         _check_example(task)
         cache.record("task-folder", key, {"folder": str(folder.resolve()), "name": spec.name})

@@ -101,6 +101,8 @@ class TaskSpec:
     planning_time_s: float
     static_time_s: float
     timeout_s: float = 10.0
+    priority: int | None = None
+    """``[schedule] priority``: the type's priority class, higher is more urgent (None: the lowest)."""
     example: ExampleWorld | None = None
     hooks: Mapping[str, Any] = field(default_factory=dict)
     hazards: tuple[Hazard, ...] = ()
@@ -424,6 +426,7 @@ def read_task_toml(path: Path) -> TaskSpec:
         schedule = top.table("schedule", {})
         cps = schedule.number("cps", 1.0, min=0)
         travel_s = schedule.number("travel_s", 10.0, min=0)
+        priority = schedule.number("priority", None, integer=True)
         schedule.done()
         spec = TaskSpec(
             folder=path.parent, name=name, description=description, domain_file=path.parent / domain,
@@ -431,6 +434,7 @@ def read_task_toml(path: Path) -> TaskSpec:
             suspension=r.branches(top, "suspension"), actions=actions, static_update=static_update,
             cps=float(cps), travel_s=float(travel_s), planning_time_s=float(planning_time_s),
             static_time_s=float(static_time_s), timeout_s=float(timeout_s), example=_example(r, top),
+            priority=None if priority is None else int(priority),
             hazards=_hazards(r, top), people=_people(r, top), bindings=_bindings(r, top),
             invariants=_derived(r, top), restore=tuple(restore), lines=r.lines,
         )

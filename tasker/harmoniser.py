@@ -39,7 +39,7 @@ import math
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
-from typing import Any, overload
+from typing import Any, final, overload
 
 from tasker import events as ev
 from tasker.agent import DynamicAgent
@@ -246,8 +246,13 @@ class TaskHarmoniser:
 
     # -- f^harm ------------------------------------------------------------------------------
 
+    @final
     def step(self, now: float, timer: bool = False) -> None:
-        """One iteration of ``f^harm`` (eq. 36) at simulated time ``now``."""
+        """One iteration of ``f^harm`` (eq. 36) at simulated time ``now``.
+
+        The framework's loop: a subclass must not override it (``typing.final``); a
+        scheduling algorithm plugs in as a :class:`~tasker.schedulers.Scheduler`.
+        """
         self.now = now
         if self._requests:
             self._pf_init_da(now)

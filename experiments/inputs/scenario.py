@@ -162,7 +162,12 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
     from experiments.inputs import crossref
     from planners.bundled import task_types
 
-    return crossref.check_robot(scenario, top, task_types(list(task_paths)))
+    types = task_types(list(task_paths))
+    scenario = crossref.check_robot(scenario, top, types)
+    # what the scheduler is not told, the task folders may declare (alg2's classes from their priorities)
+    options = fields.scheduler_defaults(scenario.scheduler, scenario.scheduler_options, types)
+    return scenario if options == scenario.scheduler_options else dataclasses.replace(scenario,
+                                                                                      scheduler_options=options)
 
 
 @dataclass(frozen=True)
