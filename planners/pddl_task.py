@@ -63,6 +63,12 @@ from tasker.task import Effects, Leaving, TaskContext, TaskType
 from tasker.trace import INAPPLICABLE
 from tasker.world import Pose, WorldState
 
+PLANNED_FROM_KEY = "_planned_from"
+"""``ctx.memory`` key: the last plans' stages, each with the facts it was made from."""
+PLANS_REMEMBERED = 8
+LOCATION = "at"
+MOVERS = frozenset({"robot", "person"})
+"""Object types whose ``at`` fact the world grounds from a pose (:meth:`PddlTaskType._assumed`)."""
 INTERRUPTION_KEY = "interruption_s"
 RESTORE_KEY = "_restore_baseline"
 """``ctx.memory`` key: the facts of ``[problem] restore``'s patterns that held when the task first planned."""
@@ -163,6 +169,21 @@ class PddlTaskType(TaskType):
         return str(why) if why else None
 
     def update_task(self, ctx: TaskContext) -> StagePlan:
+        return self._planned_from(ctx, self._update_task(ctx))
+
+    def generate_suspension(self, ctx: TaskContext) -> StagePlan:
+        return self._planned_from(ctx, self._generate_suspension(ctx))
+
+    def _planned_from(self, ctx: TaskContext, plan: StagePlan) -> StagePlan:
+        """Remember the state ``plan`` was made from (``ctx.memory``, the last few plans: an estimate may
+        plan a suspension on a copy of the context meanwhile), for :meth:`inapplicable`."""
+        if isinstance(ctx.world, WorldState) and plan.stages:
+            made = ctx.memory.setdefault(PLANNED_FROM_KEY, [])
+            made.append((plan.stages, ctx.world.facts))
+            del made[:-PLANS_REMEMBERED]
+        return plan
+
+    def _update_task(self, ctx: TaskContext) -> StagePlan:
         if ctx.strategy.update == "static":
             return self.static_update(ctx)
         world, goal, extra = self.update_inputs(ctx)
@@ -180,7 +201,7 @@ class PddlTaskType(TaskType):
             return self._fallback(self.static_update(ctx), "planner timed out for upTsk")
         raise PlanningFailed("error", f"{self.name}: planner error: {outcome.message}")
 
-    def generate_suspension(self, ctx: TaskContext) -> StagePlan:
+    def _generate_suspension(self, ctx: TaskContext) -> StagePlan:
         if ctx.strategy.suspension == "static":
             return self.static_suspension(ctx)
         world, goal, branch = self.suspension_inputs(ctx)  # the tree's branch, or the derived goal
@@ -196,12 +217,15 @@ class PddlTaskType(TaskType):
                               f"{why.get(outcome.status, 'planner error')} for {goal}")
 
     def inapplicable(self, ctx: TaskContext, stage: Stage) -> str | None:
-        """Why ``stage`` cannot run now: the literals of its action's precondition that do not
-        hold in the state the planner would see (the world, the request's and ``task.py``'s facts,
-        Alg. 3's while suspended).  ``connected`` is left out: the planner derives it from the
-        motion model, and an unreachable leg fails when the stage is built.  None when it can
-        run, when it would change nothing, or when the precondition is not a conjunction of
-        literals."""
+        """Why ``stage`` cannot run now: the literals of its action's precondition that do not hold.
+
+        Checked in the state the planner would see — the world, the request's and ``task.py``'s
+        facts, Alg. 3's while suspended — except for what the stage's own plan is entitled to
+        assume: facts no world holds (an apology due) and where the robot and people are (the
+        world grounds those from poses, a metre from the place a plan means) are read from the
+        state the plan was made from, as its stages executed so far left it.  ``connected`` is
+        left out (the planner derives it from the motion model).  None when the stage can run,
+        when it would change nothing, or when the precondition is not a conjunction of literals."""
         world = ctx.world
         if not isinstance(world, WorldState) or stage.action not in self.domain.actions:
             return None
@@ -215,12 +239,43 @@ class PddlTaskType(TaskType):
         add, delete = [tuple(f) for f in stage.data.get("add", ())], [tuple(f) for f in stage.data.get("delete", ())]
         if add and all(f in facts for f in add) and not any(f in facts for f in delete):
             return None  # it would change nothing (driving to where the robot stands): nothing to refuse
-        unmet = self.domain.unmet(stage.action, stage.args, facts)
-        unmet = [lit for lit in unmet or () if (lit[1] if lit[0] == "not" else lit[0]) != CONNECTED]
+        projected = self._projection(ctx, stage, frozenset(extra) - world.facts)
+        if projected is not None:
+            assumed, kinds = projected
+            facts = frozenset(f for f in facts if not self._assumed(f, kinds, world)) | assumed
+        unmet = [lit for lit in self.domain.unmet(stage.action, stage.args, facts) or ()
+                 if (lit[1] if lit[0] == "not" else lit[0]) != CONNECTED]
         if not unmet:
             return None
         said = ", ".join(f"({' '.join(lit)})" for lit in unmet)
         return f"{INAPPLICABLE} {stage.action}({' '.join(stage.args)}) needs {said}, which does not hold"
+
+    def _projection(self, ctx: TaskContext, stage: Stage,
+                    extra: frozenset[Literal]) -> tuple[frozenset[Literal], frozenset[str]] | None:
+        """What ``stage``'s plan may assume: the facts it was made from of the kinds :meth:`_assumed` names,
+        updated by the effects of the plan's stages before ``stage``; None for a stage of no plan made here."""
+        world = ctx.world
+        assert isinstance(world, WorldState)
+        kinds = frozenset(f[0] for f in extra)
+        for stages, planned_facts in reversed(ctx.memory.get(PLANNED_FROM_KEY, ())):
+            k = next((i for i, s in enumerate(stages) if s is stage), None)
+            if k is None:
+                continue
+            state = {f for f in planned_facts | extra if self._assumed(f, kinds, world)}
+            for done in stages[:k]:
+                state -= {tuple(f) for f in done.data.get("delete", ()) if self._assumed(tuple(f), kinds, world)}
+                state |= {tuple(f) for f in done.data.get("add", ()) if self._assumed(tuple(f), kinds, world)}
+            return frozenset(state), kinds
+        return None
+
+    @staticmethod
+    def _assumed(fact: Literal, extra_kinds: frozenset[str], world: WorldState) -> bool:
+        """A fact a plan reads from its own projection, not from the world now: one of a kind no world
+        holds (``extra_kinds``: the request's, ``task.py``'s, Alg. 3's), or where the robot or a person is
+        (an abstraction of a pose that the stage which drove there has met)."""
+        if fact[0] in extra_kinds:
+            return True
+        return fact[0] == LOCATION and len(fact) == 3 and world.objects.get(fact[1]) in MOVERS
 
     def compute_params(self, ctx: TaskContext) -> CostParams:
         """``cost = cps * (age + cTime)``; cTime and endPose from :meth:`estimate` of the state now.

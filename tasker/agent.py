@@ -325,6 +325,12 @@ class DynamicAgent:
             return
         if self.core is None:
             raise ConfigError(f"agent {self.id}: a stage must run but no core agent was given")
+        self.refresh(now)  # the stage before may just have changed the world
+        why = self.task.inapplicable(self.ctx, stage)
+        if why is not None:  # as on a robot: an action that cannot run fails, and changes nothing
+            runner.event(now, self.state, "begin")
+            self._stage_failed(now, stage, why)
+            return
         if in_task:
             self.ctx.stage_started = now
         runner.begin(self.core, self.state, now)
@@ -341,15 +347,7 @@ class DynamicAgent:
             return
         status = self.core.poll(self.id, stage, now)
         if status.state is SkillState.FAILED:
-            runner.close(now, self.state, "failed", reason=status.reason)
-            failure = f"stage {stage.label} failed: {status.reason}"
-            if fsm.resolve(self.state, "stage_failed", self._guard).target is S.END:
-                # a suspension's own stage: nothing safer to fall back on
-                self._end(now, self._after_failure(failure), cause="failed", event="stage_failed")
-                return
-            # the task cannot go on, but what it leaves must be safe: genSusp, exeSusp, then end
-            self._latched.terminate(failure, "failed")
-            self._suspend_now(now, stage, event="stage_failed")  # the stage is closed: nothing to stop
+            self._stage_failed(now, stage, status.reason or "no reason given")
             return
         if status.state is SkillState.SUCCEEDED:
             runner.close(now, self.state, "done")
@@ -376,6 +374,21 @@ class DynamicAgent:
             self._next_sp = _next_tick_of(now, self.rates.sp_up_rate)
         if runner.running:
             self.next_wake = _next_tick_of(now, self.rates.task_exe_rate)
+
+    def _stage_failed(self, now: float, stage: Stage, reason: str) -> None:
+        """The running stage failed (its skill said so, or it could not run): close it ``failed``; in
+        ``exeSusp`` the task ends, in ``exeTsk`` it is first made safe (genSusp, exeSusp), then ends."""
+        runner = self._runner
+        assert runner is not None
+        runner.close(now, self.state, "failed", reason=reason)
+        failure = f"stage {stage.label} failed: {reason}"
+        if fsm.resolve(self.state, "stage_failed", self._guard).target is S.END:
+            # a suspension's own stage: nothing safer to fall back on
+            self._end(now, self._after_failure(failure), cause="failed", event="stage_failed")
+            return
+        # the task cannot go on, but what it leaves must be safe: genSusp, exeSusp, then end
+        self._latched.terminate(failure, "failed")
+        self._suspend_now(now, stage, event="stage_failed")  # the stage is closed: nothing to stop
 
     def _suspend_now(self, now: float, stage: Stage, event: str = "suspend") -> None:
         """A suspendable stage of exeTsk ends at once for a pending susp or term (eq. 26), or a
