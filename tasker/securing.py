@@ -104,8 +104,9 @@ class HazardWatch:
         return secure_s + suspend_s + self.period_s + self.margin_s
 
     def due(self, now: float, hazards: Iterable[Any], waiting: Mapping[str, WatchedAgent],
-            exe: WatchedAgent | None, order: Mapping[str, int]) -> Due | None:
-        """The waiting agent that must secure now, if any (its episodes are then marked secured).
+            exe: WatchedAgent | None, order: Mapping[str, int], *, mark: bool = True) -> Due | None:
+        """The waiting agent that must secure now, if any (with ``mark``, its episodes are then
+        marked secured: they will not be secured twice).
 
         ``waiting`` are the idle agents whose report is ``wait``; ``exe`` the executing
         agent.  A hazard's unattended stretch began when it went on or when its agent
@@ -149,8 +150,9 @@ class HazardWatch:
             return None
         agent = best[2]
         remaining, hz = watched[agent]
-        _, _, secure_s, suspend_s = self._estimates.pop(agent)
-        self.secured.update(episodes[agent])
+        _, _, secure_s, suspend_s = self._estimates.pop(agent) if mark else self._estimates[agent]
+        if mark:
+            self.secured.update(episodes[agent])
         return Due(agent, hz, remaining, secure_s, suspend_s, tuple(episodes[agent]))
 
 

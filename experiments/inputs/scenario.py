@@ -153,6 +153,7 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
         seed=int(top.number("seed", 1, integer=True, min=0, max=reader.MAX_SEED)),
         horizon=float(s.number("horizon", 1800.0, positive=True)),
         people=people, objects=objects, policy=str(s.string("policy", "strict", choices=POLICIES)),
+        secure_over_higher=bool(s.boolean("secure_over_higher", False)),
     )
     s.done()
     top.done(SCENARIO_KEYS)

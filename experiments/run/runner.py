@@ -26,8 +26,8 @@ from pathlib import Path
 from typing import Any
 
 import tasker
+from experiments.inputs import fields, synthetic
 from experiments.inputs import scenario as scenarios
-from experiments.inputs import synthetic
 from experiments.inputs.actions import TimedAction
 from experiments.inputs.perturbation import Perturbation
 from experiments.inputs.request_fields import asked_for
@@ -103,12 +103,14 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
     per_type = {t: Strategy(update or s.get("update", default.update),
                             suspension or s.get("suspension", default.suspension), default.policy)
                 for t, s in scn.strategies.items()}
-    options = scn.scheduler_options if scheduler in (None, scn.scheduler) else {}
+    # another scheduler than the scenario's gets no options of its, but what the folders declare (alg2's classes)
+    options = scn.scheduler_options if scheduler in (None, scn.scheduler) else \
+        fields.scheduler_defaults(str(scheduler), {}, types)
     loop = SimulationLoop(
         store, schedulers.create(scheduler or scn.scheduler, **options), seed=seed, trace=trace,
         mode=Mode(scn.mode), s_freq=scn.s_freq, rates=Rates(scn.rep_rate, scn.task_exe_rate, scn.sp_up_rate),
         strategy=default, strategies=per_type, core=sim, world=sim, motion=sim.motion, horizon=scn.horizon,
-        hazard_waiting=hazard_waiting,
+        hazard_waiting=hazard_waiting, secure_over_higher=scn.secure_over_higher,
     )
     monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning,
                       lambda: sim.snapshot().facts, task_types=store.names(),

@@ -80,6 +80,10 @@ class Alg2(Scheduler):
         self._rank = rank
         self._lowest = len(self.classes)
 
+    def outranks(self, a: Candidate, b: Candidate) -> bool:
+        """``a``'s class is more urgent than ``b``'s (``classes`` is highest first)."""
+        return self.rank(a.task_type) < self.rank(b.task_type)
+
     def rank(self, task_type: str) -> int:
         """Priority class of a task type: 0 is the highest."""
         return self._rank.get(task_type, self._lowest)
