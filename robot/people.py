@@ -157,8 +157,9 @@ class Person:
             self._walk_to(nx, ny, budget / self.spec.speed)
             break
 
-    def step(self, t: float, dt: float, facts: frozenset[Fact] | set[Fact], robot: tuple[float, float]) -> None:
-        """Move the person from ``t - dt`` to ``t`` (``facts`` is not read: reactions are flags)."""
+    def step(self, t: float, dt: float, robot: tuple[float, float]) -> None:
+        """Move the person from ``t - dt`` to ``t``: reactions are the flags the world sets from
+        the task folders' bindings, never a task's predicates."""
         events = self.spec.events
         while self._event < len(events) and events[self._event][0] <= t:
             self.posture = events[self._event][1]
@@ -244,9 +245,9 @@ class People:
     def __iter__(self):  # type: ignore[no-untyped-def]
         return iter(self.by_name.values())
 
-    def step(self, t: float, dt: float, facts: frozenset[Fact] | set[Fact], robot: tuple[float, float]) -> None:
+    def step(self, t: float, dt: float, robot: tuple[float, float]) -> None:
         for p in self.by_name.values():
-            p.step(t, dt, facts, robot)
+            p.step(t, dt, robot)
 
     def facts(self) -> set[Fact]:
         return {("posture", p.name, p.posture) for p in self.by_name.values()}

@@ -150,11 +150,11 @@ class Simulation:
         """Until when person ``p`` certainly stays as they are (``self.time``: they may move now)."""
         events = p.spec.events
         nxt = events[p._event][0] if p._event < len(events) else math.inf
-        if ("following", p.name) in self.facts or p.stepping_aside():
+        if p.following or p.stepping_aside():
             return self.time
         if p.giving_room is not None and p.giving_room[1] is not None:
             return nxt  # standing clear of someone fallen until a posture changes
-        if p.posture == "fallen" or ("told_to_wait", p.name) in self.facts or not p.walk:
+        if p.posture == "fallen" or p.waiting or not p.walk:
             return nxt
         walk = p.walk
         if self.time < walk[0][0]:
@@ -182,7 +182,7 @@ class Simulation:
         if n < 2:
             return False
         for p in self.people:
-            if ("following", p.name) not in self.facts:
+            if not p.following:
                 p._trail = []  # what Person.step does for someone not following
         end = self._ticks + n
         while self._ticks < end:
@@ -197,7 +197,7 @@ class Simulation:
         self._ticks += 1
         t = round(self._ticks * CONTROL_DT, 9)
         x, y, _ = self.mj.pose()
-        self.people.step(t, CONTROL_DT, self.facts, (x, y))
+        self.people.step(t, CONTROL_DT, (x, y))
         self._give_room()
         self._sync_people()
         cmd = self.skill.control(t, CONTROL_DT) if self.skill is not None else STOP
