@@ -73,20 +73,27 @@ class MjApartment:
         for name, d in spec.doors.items():
             self.set_door(name, d.open)
         mujoco.mj_forward(self.model, self.data)
+        # the base's pose and velocity change only in :meth:`step` (nothing else writes
+        # qpos/qvel): read once per step, not once per question (a tick asks several times)
+        self._pose: tuple[float, float, float] | None = None
+        self._velocity: tuple[float, float] | None = None
 
     @property
     def time(self) -> float:
         return float(self.data.time)
 
     def pose(self) -> tuple[float, float, float]:
-        qw, qx, qy, qz = self.data.qpos[3:7]
-        yaw = math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
-        return float(self.data.qpos[0]), float(self.data.qpos[1]), yaw
+        if self._pose is None:
+            x, y, _, qw, qx, qy, qz = self.data.qpos[0:7].tolist()
+            self._pose = (x, y, math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz)))
+        return self._pose
 
     def velocity(self) -> tuple[float, float]:
         """Planar speed (m/s) and yaw rate (rad/s) of the base."""
-        v = self.data.qvel
-        return float(math.hypot(v[0], v[1])), float(v[5])
+        if self._velocity is None:
+            v = self.data.qvel[0:6].tolist()
+            self._velocity = (math.hypot(v[0], v[1]), v[5])
+        return self._velocity
 
     def at_rest(self, tolerance: float = 1e-4) -> bool:
         """Is the base still (planar speed below ``tolerance`` m/s, turn rate below ``tolerance`` rad/s)?"""
@@ -100,6 +107,7 @@ class MjApartment:
 
     def step(self, n: int) -> None:
         self._mj.mj_step(self.model, self.data, nstep=n)
+        self._pose = self._velocity = None
 
     def set_door(self, name: str, is_open: bool) -> None:
         g = self._doors[name]
