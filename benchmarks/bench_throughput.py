@@ -1,6 +1,7 @@
 """Benchmark: simulation throughput in CPU seconds, against a pinned baseline commit.
 
     python benchmarks/bench_throughput.py [--baseline COMMIT] [--seeds N] [--no-baseline]
+    python benchmarks/bench_throughput.py --profile      # where the day's CPU time goes (docs/robot.md)
 
 Two measurements, each taken on this code and on ``--baseline`` (default ``4b70084``,
 the commit before the throughput work) in the same run: the baseline is checked out with
@@ -84,12 +85,98 @@ def day(code_root: Path, cache: Path, out: Path) -> tuple[float, float]:
     return float(json.loads(last)["t"]), cpu
 
 
+# where the time goes: a function's own CPU time is booked to the first group whose file
+# (and, for robot/sim.py, name) it matches; a library or built-in function's time is booked
+# to the groups of its callers, in proportion to the time it spent for each
+_SNAPSHOT = {"snapshot", "_facts_now", "_bound_facts", "facts_key", "person_place", "nearest_place",
+             "_memo_place", "place_of", "room_of", "objects"}
+GROUPS = (
+    ("MuJoCo physics (mj_step)", lambda f, n: n.startswith("<built-in method mujoco._functions.mj_step")),
+    ("snapshots and facts (Simulation.snapshot, tasker.meaning)",
+     lambda f, n: (f.endswith("robot/sim.py") and n in _SNAPSHOT) or f.endswith("tasker/meaning.py")),
+    ("simulation ticks (people, skills, control, sync, recording)",
+     lambda f, n: any(f.endswith(f"robot/{m}.py") for m in ("sim", "people", "skills", "control", "mjworld",
+                                                              "recording", "drive"))),
+    ("motion estimates and paths (robot.estimator, motion, scene, visibility, roadmap)",
+     lambda f, n: any(f.endswith(f"robot/{m}.py") for m in ("estimator", "motion", "scene", "visibility",
+                                                              "roadmap", "spec", "tiago"))),
+    ("task planning (planners/, Fast Downward's translator)",
+     lambda f, n: "/planners/" in f or "/fast_downward/" in f or "/domains/" in f),
+    ("harmoniser, agents, trace (tasker/)", lambda f, n: "/tasker/" in f and "/site-packages/" not in f),
+    ("scenario, metrics, output files (experiments/)", lambda f, n: "/experiments/" in f),
+)
+
+
+def _group(func: tuple[str, int, str], stats: dict, memo: dict, depth: int = 0) -> dict[str, float]:
+    """Shares of ``func``'s own time per group (see :data:`GROUPS`)."""
+    if func in memo:
+        return memo[func]
+    f, _, n = func
+    for label, match in GROUPS:
+        if match(f, n):
+            memo[func] = {label: 1.0}
+            return memo[func]
+    callers = stats[func][4]
+    total = sum(c[2] + 1e-12 for c in callers.values())
+    out: dict[str, float] = {}
+    if depth < 30 and callers:
+        memo[func] = {"other": 1.0}  # a cycle back here counts as other
+        for caller, c in callers.items():
+            for label, share in _group(caller, stats, memo, depth + 1).items():
+                out[label] = out.get(label, 0.0) + share * (c[2] + 1e-12) / total
+    memo[func] = out or {"other": 1.0}
+    return memo[func]
+
+
+def profile() -> int:
+    """Print a Markdown table of where the time of the hour's day goes (cProfile, in this
+    process, as ``tasker run`` runs it).  cProfile's own clock is kept: timing it with
+    ``time.process_time`` costs a system call per Python call and swamps what it measures;
+    the shares are those of a profiled run (the profiler slows Python calls, not C)."""
+    import cProfile
+    import pstats
+    import time
+    import warnings
+
+    warnings.simplefilter("ignore")
+    sys.path.insert(0, str(ROOT))
+    from experiments.runner import run_scenario
+
+    with tempfile.TemporaryDirectory() as tmp:
+        run_scenario("household", seed=1, randomize=True, pictures=False)  # imports, disk cache
+        prof = cProfile.Profile()
+        cpu = time.process_time()
+        child = _children_cpu()
+        prof.enable()
+        run_scenario(DAY, out=Path(tmp) / "day", pictures=False)
+        prof.disable()
+        child, cpu = _children_cpu() - child, time.process_time() - cpu
+    stats = pstats.Stats(prof).stats  # type: ignore[attr-defined]
+    memo: dict = {}
+    totals: dict[str, float] = {}
+    for func, (_, _, tt, _, _) in stats.items():
+        for label, share in _group(func, stats, memo).items():
+            totals[label] = totals.get(label, 0.0) + tt * share
+    whole = sum(totals.values())
+    steps = next((v[1] for k, v in stats.items() if k[2].startswith("<built-in method mujoco._functions.mj_step")), 0)
+    print(f"| where the time goes ({DAY.name}, 1 hour) | s | share |\n|---|---:|---:|")
+    for label, t in sorted(totals.items(), key=lambda kv: -kv[1]):
+        print(f"| {label} | {t:.2f} | {t / whole:.0%} |")
+    print(f"| **all** (profiled) | {whole:.2f} | 100% |")
+    print(f"\nprofiled run: {cpu:.1f} CPU-s in this process, {child:.2f} CPU-s in child processes (Fast Downward's "
+          f"search); mj_step calls: {steps}")
+    return 0
+
+
 def main(argv: list[str]) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--baseline", default=BASELINE, help=f"commit to compare with (default {BASELINE})")
     ap.add_argument("--seeds", type=int, default=3, help="household seeds 1..N (default 3)")
     ap.add_argument("--no-baseline", action="store_true", help="measure this code only")
+    ap.add_argument("--profile", action="store_true", help="print where the day's CPU time goes (a table), only")
     args = ap.parse_args(argv)
+    if args.profile:
+        return profile()
     head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout
     with tempfile.TemporaryDirectory() as tmp:
         roots = {"this": ROOT}
