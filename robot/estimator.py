@@ -48,13 +48,14 @@ class MotionEstimator:
         self._memo: dict[tuple[object, ...], object] = {}
 
     def _state(self) -> tuple[object, ...]:
-        """What every answer of this estimator depends on besides its arguments: the scene's
-        version (bumped by every change of doors, people and who makes way; never reused,
-        so :meth:`Scene.as_expected <robot.scene.Scene.as_expected>` moving people and back
-        is a new state) and where people step aside to, which bumps no version."""
+        """What every answer of this estimator depends on besides its arguments and the person
+        it is about: the doors, the people in the robot's way (:meth:`Scene.discs
+        <robot.scene.Scene.discs>`: everyone but those making way for it, whose walking
+        behind the robot changes no path) and where people step aside to.  The planner
+        answers from exactly these (its walls and roadmap never change)."""
         scene = self.planner.scene
-        extra = () if self.open_planner is None else (self.open_planner.scene.version,)
-        return (scene.version, tuple(sorted(scene.stepping_to.items())), *extra)
+        return (tuple(sorted(scene.door_open.items())), tuple(scene.discs()),
+                tuple(sorted(scene.stepping_to.items())))
 
     def _remembered(self, key: tuple[object, ...]) -> tuple[bool, object]:
         if not self.memo:
@@ -75,12 +76,13 @@ class MotionEstimator:
 
         Answers are remembered per scene state (:meth:`_state`): the same question in the
         same scene gets the same answer without planning again."""
-        key = ("estimate", tuple(start), tuple(goal))
+        scene = self.planner.scene
+        person = scene.person_at(goal[0], goal[1])
+        key = ("estimate", tuple(start), tuple(goal), person and scene.people[person])
         known, value = self._remembered(key)
         if known:
             assert isinstance(value, MotionEstimate)
             return value
-        person = self.planner.scene.person_at(goal[0], goal[1])
         if person is not None:
             est = self.approach(start, person)[1]
         else:
@@ -119,7 +121,7 @@ class MotionEstimator:
         stepping aside count where they are going, as in :meth:`estimate`; the ``navigate``
         skill drives to this pose once the way there is clear.
         """
-        key = ("approach", tuple(start), person)
+        key = ("approach", tuple(start), person, self.planner.scene.people[person])
         known, value = self._remembered(key)
         if known:
             return value  # type: ignore[return-value]
@@ -137,7 +139,7 @@ class MotionEstimator:
         """The poses of ``person``'s ring of ``radius`` the robot may help them from (free,
         no wall between): they depend on the scene, not on where the robot starts, so they
         are computed once per scene state (and in it, per person and ring)."""
-        key = ("ring", person, radius)
+        key = ("ring", person, radius, self.planner.scene.people[person])
         known, value = self._remembered(key)
         if known:
             return value  # type: ignore[return-value]

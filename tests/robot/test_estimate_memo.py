@@ -53,8 +53,10 @@ def test_remembered_estimates_equal_fresh_ones_as_the_scene_changes(paper: World
         elif step == 4:
             scene.set_stepping_to(sorted(scene.stepping_to)[0], None)
             scene.set_making_way("john", True)
-        else:
+        else:  # John makes way (no path changes) but is still whom the robot goes to
             scene.set_person(name, d.x + 0.3, d.y, "standing")
+            john = scene.people["john"]
+            scene.set_person("john", john.x - 0.4, john.y + 0.2, "standing")
         ask(queries)
         ask(queries)
         hits += len(cached._memo)
