@@ -84,6 +84,8 @@ class Person:
             return None
         if t <= walk[0][0]:
             return None  # before the first waypoint the person stays where they are
+        if t > walk[-1][0]:
+            return walk[-1][1], walk[-1][2]  # after the script (what the loop below ends with)
         for (t0, x0, y0), (t1, x1, y1) in zip(walk, walk[1:], strict=False):
             if t <= t1:
                 f = (t - t0) / (t1 - t0)
@@ -164,7 +166,7 @@ class Person:
         while self._event < len(events) and events[self._event][0] <= t:
             self.posture = events[self._event][1]
             self._event += 1
-        if not self.following:
+        if not self.following and self._trail:
             self._trail = []
         target = self.scripted(t)
         if self.posture == "fallen" or self.giving_room is not None and self.giving_room[1] is not None \

@@ -166,7 +166,7 @@ class Simulation:
         walk = p.walk
         if self.time < walk[0][0]:
             return min(nxt, walk[0][0])
-        if self.time >= walk[-1][0] and math.hypot(p.x - walk[-1][1], p.y - walk[-1][2]) <= 1e-9:
+        if self.time >= walk[-1][0] and math.hypot(p.x - walk[-1][1], p.y - walk[-1][2]) <= 1e-9 and not p._detour:
             return nxt
         return self.time
 
@@ -211,7 +211,7 @@ class Simulation:
         self._last_cmd = cmd
         self.mj.command(cmd.v, cmd.w)
         # People are mocap bodies that touch nothing, so with no command and the base at
-        # rest a physics step changes nothing worth 25 MuJoCo steps: skip it
+        # rest a physics step changes nothing worth its MuJoCo steps: skip it
         if cmd != STOP or not self.mj.at_rest():
             self.mj.step(round(CONTROL_DT / TIMESTEP))
             self.physics_ticks += 1
