@@ -35,7 +35,9 @@ import resource
 import subprocess
 import sys
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 DAY = ROOT / "benchmarks" / "day_hour.toml"
@@ -85,56 +87,69 @@ def day(code_root: Path, cache: Path, out: Path) -> tuple[float, float]:
     return float(json.loads(last)["t"]), cpu
 
 
-# where the time goes: a function's own CPU time is booked to the first group whose file
-# (and, for robot/sim.py, name) it matches; a library or built-in function's time is booked
-# to the groups of its callers, in proportion to the time it spent for each
-_SNAPSHOT = {"snapshot", "_facts_now", "_bound_facts", "facts_key", "person_place", "nearest_place",
-             "_memo_place", "place_of", "room_of", "objects"}
-GROUPS = (
-    ("MuJoCo physics (mj_step)", lambda f, n: n.startswith("<built-in method mujoco._functions.mj_step")),
-    ("snapshots and facts (Simulation.snapshot, tasker.meaning)",
-     lambda f, n: (f.endswith("robot/sim.py") and n in _SNAPSHOT) or f.endswith("tasker/meaning.py")),
-    ("simulation ticks (people, skills, control, sync, recording)",
-     lambda f, n: any(f.endswith(f"robot/{m}.py") for m in ("sim", "people", "skills", "control", "mjworld",
-                                                              "recording", "drive"))),
-    ("motion estimates and paths (robot.estimator, motion, scene, visibility, roadmap)",
-     lambda f, n: any(f.endswith(f"robot/{m}.py") for m in ("estimator", "motion", "scene", "visibility",
-                                                              "roadmap", "spec", "tiago"))),
-    ("task planning (planners/, Fast Downward's translator)",
-     lambda f, n: "/planners/" in f or "/fast_downward/" in f or "/domains/" in f),
-    ("harmoniser, agents, trace (tasker/)", lambda f, n: "/tasker/" in f and "/site-packages/" not in f),
-    ("scenario, metrics, output files (experiments/)", lambda f, n: "/experiments/" in f),
+# where the time goes: CPU seconds of calls to these entry points, each call's own time
+# less that of the entry points it calls (so the rows add up); the rest is the loop,
+# the harmoniser and the agents.  Looked up by name: one that is missing is skipped.
+ENTRY_POINTS = (
+    ("MuJoCo physics (mj_step)", "robot.mjworld", "MjApartment.step"),
+    ("simulation ticks: people, skills, control, sync, recording", "robot.sim", "Simulation.advance"),
+    ("simulation ticks: people, skills, control, sync, recording", "robot.sim", "Simulation.begin"),
+    ("snapshots of the world (Simulation.snapshot)", "robot.sim", "Simulation.snapshot"),
+    ("facts and roles observed (tasker.meaning.Monitor.observe)", "tasker.meaning", "Monitor.observe"),
+    ("motion estimates and paths (robot.estimator, robot.motion)", "robot.estimator", "MotionEstimator.estimate"),
+    ("motion estimates and paths (robot.estimator, robot.motion)", "robot.estimator", "MotionEstimator.approach"),
+    ("motion estimates and paths (robot.estimator, robot.motion)", "robot.estimator",
+     "MotionEstimator.estimate_ignoring_doors"),
+    ("motion estimates and paths (robot.estimator, robot.motion)", "robot.estimator",
+     "MotionEstimator.estimate_ignoring_people"),
+    ("motion estimates and paths (robot.estimator, robot.motion)", "robot.motion", "BasePlanner.plan"),
+    ("motion estimates and paths (robot.estimator, robot.motion)", "robot.motion", "BasePlanner.plan_ignoring_people"),
+    ("task plans (planners.planner.Planner.solve: Fast Downward's translator in-process)", "planners.planner",
+     "Planner.solve"),
+    ("schedule-parameter estimates, less plans and motion (planners.estimates)", "planners.estimates",
+     "Estimator.estimate"),
+    ("writing the run's files (trajectory, trace, problems)", "experiments.runner", "_save"),
 )
 
 
-def _group(func: tuple[str, int, str], stats: dict, memo: dict, depth: int = 0) -> dict[str, float]:
-    """Shares of ``func``'s own time per group (see :data:`GROUPS`)."""
-    if func in memo:
-        return memo[func]
-    f, _, n = func
-    for label, match in GROUPS:
-        if match(f, n):
-            memo[func] = {label: 1.0}
-            return memo[func]
-    callers = stats[func][4]
-    total = sum(c[2] + 1e-12 for c in callers.values())
-    out: dict[str, float] = {}
-    if depth < 30 and callers:
-        memo[func] = {"other": 1.0}  # a cycle back here counts as other
-        for caller, c in callers.items():
-            for label, share in _group(caller, stats, memo, depth + 1).items():
-                out[label] = out.get(label, 0.0) + share * (c[2] + 1e-12) / total
-    memo[func] = out or {"other": 1.0}
-    return memo[func]
+def _instrument(totals: dict[str, float], calls: dict[str, int]) -> None:
+    import functools
+    import importlib
+    import time
+
+    stack: list[float] = []  # CPU seconds of entry points called inside the current one
+
+    def wrap(label: str, fn: Callable[..., Any]) -> Callable[..., Any]:
+        @functools.wraps(fn)
+        def timed(*args: Any, **kwargs: Any) -> Any:
+            t = time.process_time()
+            stack.append(0.0)
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                spent = time.process_time() - t
+                inner = stack.pop()
+                totals[label] = totals.get(label, 0.0) + spent - inner
+                calls[label] = calls.get(label, 0) + 1
+                if stack:
+                    stack[-1] += spent
+        return timed
+
+    for label, module, name in ENTRY_POINTS:
+        try:
+            owner: Any = importlib.import_module(module)
+        except ImportError:
+            continue
+        *path, attr = name.split(".")
+        for part in path:
+            owner = getattr(owner, part, None)
+        if owner is not None and callable(getattr(owner, attr, None)):
+            setattr(owner, attr, wrap(label, getattr(owner, attr)))
 
 
 def profile() -> int:
-    """Print a Markdown table of where the time of the hour's day goes (cProfile, in this
-    process, as ``tasker run`` runs it).  cProfile's own clock is kept: timing it with
-    ``time.process_time`` costs a system call per Python call and swamps what it measures;
-    the shares are those of a profiled run (the profiler slows Python calls, not C)."""
-    import cProfile
-    import pstats
+    """Print a Markdown table of where the CPU time of the hour's day goes, run in this
+    process as ``tasker run`` runs it (see :data:`ENTRY_POINTS`)."""
     import time
     import warnings
 
@@ -142,29 +157,26 @@ def profile() -> int:
     sys.path.insert(0, str(ROOT))
     from experiments.runner import run_scenario
 
+    totals: dict[str, float] = {}
+    calls: dict[str, int] = {}
     with tempfile.TemporaryDirectory() as tmp:
         run_scenario("household", seed=1, randomize=True, pictures=False)  # imports, disk cache
-        prof = cProfile.Profile()
-        cpu = time.process_time()
-        child = _children_cpu()
-        prof.enable()
+        _instrument(totals, calls)
+        child, cpu = _children_cpu(), time.process_time()
         run_scenario(DAY, out=Path(tmp) / "day", pictures=False)
-        prof.disable()
         child, cpu = _children_cpu() - child, time.process_time() - cpu
-    stats = pstats.Stats(prof).stats  # type: ignore[attr-defined]
-    memo: dict = {}
-    totals: dict[str, float] = {}
-    for func, (_, _, tt, _, _) in stats.items():
-        for label, share in _group(func, stats, memo).items():
-            totals[label] = totals.get(label, 0.0) + tt * share
-    whole = sum(totals.values())
-    steps = next((v[1] for k, v in stats.items() if k[2].startswith("<built-in method mujoco._functions.mj_step")), 0)
-    print(f"| where the time goes ({DAY.name}, 1 hour) | s | share |\n|---|---:|---:|")
+    totals["the loop, harmoniser, agents and the rest"] = cpu - sum(totals.values())
+    totals["Fast Downward's search (child processes)"] = child
+    whole = cpu + child
+    print(f"| where the CPU time goes ({DAY.name}, 1 hour) | CPU s | share |\n|---|---:|---:|")
     for label, t in sorted(totals.items(), key=lambda kv: -kv[1]):
         print(f"| {label} | {t:.2f} | {t / whole:.0%} |")
-    print(f"| **all** (profiled) | {whole:.2f} | 100% |")
-    print(f"\nprofiled run: {cpu:.1f} CPU-s in this process, {child:.2f} CPU-s in child processes (Fast Downward's "
-          f"search); mj_step calls: {steps}")
+    print(f"| **all** | {whole:.2f} | 100% |")
+    from robot.mjworld import TIMESTEP
+    from robot.sim import CONTROL_DT
+
+    print(f"\nphysics ticks: {calls.get(ENTRY_POINTS[0][0], 0)}, each {round(CONTROL_DT / TIMESTEP)} MuJoCo steps "
+          f"of {TIMESTEP * 1000:g} ms; CPU s of this process {cpu:.2f}, of child processes {child:.2f}")
     return 0
 
 
