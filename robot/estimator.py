@@ -25,6 +25,7 @@ from tasker.world import UNREACHABLE, MotionEstimate, Pose
 APPROACH = 0.9  # metres from a person's centre when the robot goes "to" them
 APPROACH_DIRECTIONS = 16
 APPROACH_RINGS = (APPROACH, 1.1, 1.3)  # tried in turn: a farther ring only when no pose of the nearer is reachable
+_ESTIMATE, _APPROACH, _RING = range(3)  # what a remembered answer answers (MotionEstimator._memo keys)
 
 
 class MotionEstimator:
@@ -78,7 +79,7 @@ class MotionEstimator:
         same scene gets the same answer without planning again."""
         scene = self.planner.scene
         person = scene.person_at(goal[0], goal[1])
-        key = ("estimate", tuple(start), tuple(goal), person and scene.people[person])
+        key = (_ESTIMATE, tuple(start), tuple(goal), person and scene.people[person])
         known, value = self._remembered(key)
         if known:
             assert isinstance(value, MotionEstimate)
@@ -121,7 +122,7 @@ class MotionEstimator:
         stepping aside count where they are going, as in :meth:`estimate`; the ``navigate``
         skill drives to this pose once the way there is clear.
         """
-        key = ("approach", tuple(start), person, self.planner.scene.people[person])
+        key = (_APPROACH, tuple(start), person, self.planner.scene.people[person])
         known, value = self._remembered(key)
         if known:
             return value  # type: ignore[return-value]
@@ -139,7 +140,7 @@ class MotionEstimator:
         """The poses of ``person``'s ring of ``radius`` the robot may help them from (free,
         no wall between): they depend on the scene, not on where the robot starts, so they
         are computed once per scene state (and in it, per person and ring)."""
-        key = ("ring", person, radius, self.planner.scene.people[person])
+        key = (_RING, person, radius, self.planner.scene.people[person])
         known, value = self._remembered(key)
         if known:
             return value  # type: ignore[return-value]
