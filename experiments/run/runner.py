@@ -142,7 +142,9 @@ def _world_file_events(spec: Any, world: str) -> tuple[Any, list[TimedAction]]:
 
 def _with_objects(scn: scenarios.RobotScenario, spec: Any) -> Any:
     """The world with the scenario's ``[objects]``: each gets its type, ``("at", name, place)``
-    and its facts (its pose is its place's, see :meth:`robot.sim.Simulation.snapshot`)."""
+    and its facts (its pose is its place's, see :meth:`robot.sim.Simulation.snapshot`); and with
+    its ``[devices]``, as if the world file listed them."""
+    spec = scenarios.with_devices(scn, spec)
     if not scn.objects:
         return spec
     objects = dict(spec.objects)
