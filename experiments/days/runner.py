@@ -30,9 +30,10 @@ from experiments.trace.timeline import Timeline
 from tasker.errors import ConfigError
 
 
-def scheduler_options(proto: protocols.Protocol, name: str, backend: str = "synthetic") -> dict[str, Any]:
+def scheduler_options(proto: protocols.Protocol, name: str, backend: str = "synthetic", seed: int = 0,
+                      ) -> dict[str, Any]:
     """Options each scheduler gets from the protocol (:func:`experiments.days.pipeline.scheduler_options`)."""
-    return day_pipeline.scheduler_options(proto, name, backend)
+    return day_pipeline.scheduler_options(proto, name, backend, seed)
 
 
 def run_day(protocol: str, seed: int, scheduler: str, backend: str = "synthetic",
