@@ -48,9 +48,13 @@ class DayTask(SyntheticTask):
     up again on return.  The pick and place take the request's ``pick`` and ``place``
     seconds when it gives them (drawn per request), else the protocol's.
 
-    A stopped motion stage restarts from its origin (the synthetic executor does not
-    track partial motion), after the robot has travelled back there: progress lost to
-    an interruption is a real cost here, as is the travel.
+    A motion with a load (an escort, a carry) stopped by a suspension resumes from where it
+    was stopped: the person waits there, the object is set down there, and on resumption the
+    robot goes back to that point, apologises or picks the object up again, and goes on
+    (TaBSA keeps a transport's progress too).  The point is the origin moved toward the
+    target by the share of the stage's time that had run, as the task last saw it (its
+    schedule parameters are computed every step).  The timed executor knows a robot's
+    position only at the end of a completed motion, so the robot travels back from there.
     """
 
     def __init__(self, spec: TaskSpec, robot_speed: float, planning_time: float) -> None:
@@ -97,6 +101,11 @@ class DayTask(SyntheticTask):
         out: list[Stage] = []
         pose = start
         first = rest[0] if rest else None
+        reached = ctx.memory.get("reached")
+        if first is not None and reached is not None and reached[0] == first.action:  # goes on from there
+            first = Stage(first.action, kind=first.kind, duration=first.duration, skill=first.skill,
+                          data={**first.data, "from": tuple(reached[1])})
+            rest[0] = first
         if resume and first is not None and first.data.get("from") is not None:
             origin = first.data["from"]
             out.append(Stage("go_back", kind=SUSP, duration=_dist(pose, origin) / self.speed, skill="timed",
@@ -117,11 +126,19 @@ class DayTask(SyntheticTask):
     def update_task(self, ctx: TaskContext) -> StagePlan:
         ctx.memory["waiting"] = False
         stages = self._build(ctx, self._robot_pose(ctx), resume=ctx.suspended)
+        ctx.memory.pop("reached", None)  # the plan's motion starts there now
         return StagePlan(tuple(stages), Purpose.UP_TSK, strategy="static", sim_time=self.planning_time)
 
     def generate_suspension(self, ctx: TaskContext) -> StagePlan:
         ctx.memory["waiting"] = True
         stopped = ctx.interrupted
+        moving = ctx.memory.pop("moving", None)
+        if stopped is not None and stopped.data.get("from") is not None and moving is not None \
+                and moving[0] == ctx.stage_index and stopped.duration > 0:
+            share = min(1.0, max(0.0, (ctx.now - moving[1]) / stopped.duration))
+            a, b = stopped.data["from"], stopped.data["site"]
+            ctx.memory["reached"] = (stopped.action, tuple(round(x + share * (y - x), 3) for x, y in zip(a, b,
+                                                                                                          strict=True)))
         stages: tuple[Stage, ...] = ()
         if stopped is not None and stopped.data.get("from") is not None and self.spec.suspend_s:
             action = "ask_to_stay" if self.spec.kind == "transport" else "set_down"
@@ -141,6 +158,9 @@ class DayTask(SyntheticTask):
         return ctx.args["dest"] if ctx.args["dest"] is not None else ctx.args["site"]
 
     def compute_params(self, ctx: TaskContext) -> CostParams:
+        current = ctx.current
+        if ctx.stage_started is not None and current is not None and current.data.get("from") is not None:
+            ctx.memory["moving"] = (ctx.stage_index, ctx.stage_started)  # a suspension knows how far it got
         c_time = self._c_time(ctx, None if ctx.plan is not None and not ctx.memory.get("waiting")
                               else self._robot_pose(ctx))
         w = ctx.args["weight"]

@@ -119,6 +119,6 @@ def expand(texts: Sequence[str]) -> list[SchedulerSpec]:
     labels = [s.label for s in out]
     twice = sorted({x for x in labels if labels.count(x) > 1})
     if twice:
-        raise ConfigError(f"scheduler {twice[0]!r} is given twice")
+        raise ConfigError(f"{twice[0]!r} is given twice")
     return out
 

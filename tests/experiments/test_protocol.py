@@ -228,8 +228,9 @@ def test_holm_adjustment() -> None:
 def test_table_has_every_scheduler_and_the_paired_tests(tabsa: protocol.Protocol) -> None:
     results = day_runner.run_days(TABSA, 3, ["lookahead", "simple2"], workers=1)
     text = day_table.table(results)
-    assert "| metric | lookahead | simple2 |" in text
-    assert "| dead falls | simple2 |" in text and "Holm" in text
+    assert "| metric | lookahead | simple2 (ours) |" in text  # our priority-first reading of TaBSA's agent
+    assert "| dead falls | simple2 (ours) | 3 |" in text and "Holm" in text
+    assert "too few days (< 8)" in text  # 8 tests: 2^(1-n) * 8 < 0.05 needs n >= 8
 
 
 def test_a_failed_tasks_own_safe_suspension_is_not_an_interruption() -> None:
