@@ -36,6 +36,15 @@ def _move(action: str, target: Pose, speed: float, origin: Pose | None = None, k
                  skill="timed", data={"site": target, "from": origin, "speed": speed})
 
 
+def _seconds(drawn: Any, fixed: float | tuple[float, float]) -> float:
+    """A stage's seconds: the request's drawn value, else the protocol's fixed one."""
+    if drawn is not None:
+        return float(drawn)
+    if isinstance(fixed, tuple):
+        raise ValueError("a duration the protocol draws per request is missing from the request")
+    return float(fixed)
+
+
 class DayTask(SyntheticTask):
     """A protocol task type; its stages come from the request (site, dest, work, walk speed).
 
@@ -88,12 +97,10 @@ class DayTask(SyntheticTask):
                     Stage("goodbye", kind=BLOCK, duration=s.goodbye_s)]
         if s.kind == "fall":
             return [go, Stage("help", kind=BLOCK, duration=args["work"])]
-        pick = args.get("pick")
-        place = args.get("place")
         carry = args.get("carry_speed") or self.speed
-        return [go, Stage("pick_up", kind=BLOCK, duration=float(pick if pick is not None else s.pick_s)),
+        return [go, Stage("pick_up", kind=BLOCK, duration=_seconds(args.get("pick"), s.pick_s)),
                 _move("carry", dest, carry, site, move),
-                Stage("place", kind=BLOCK, duration=float(place if place is not None else s.place_s))]
+                Stage("place", kind=BLOCK, duration=_seconds(args.get("place"), s.place_s))]
 
     def _build(self, ctx: TaskContext, start: Pose | None, resume: bool) -> list[Stage]:
         rest = list(ctx.remaining) if ctx.plan is not None else self._template(ctx.args)

@@ -37,6 +37,7 @@ from experiments.days import draw as draws
 from experiments.days import protocol as protocols
 from experiments.days.draw import DayRequest
 from experiments.days.protocol import Protocol
+from experiments.days.robot_work import SUFFIX, wrapper_for
 from experiments.days.specs import SchedulerSpec, parse
 from experiments.inputs.actions import TimedAction
 from experiments.inputs.strategy import FACTORS
@@ -79,6 +80,7 @@ register("tabsa", PROTOCOLS_DIR / "tabsa.toml")
 register("tabsa-short", PROTOCOLS_DIR / "tabsa_short.toml")
 register("tabsa-rush", PROTOCOLS_DIR / "tabsa_rush.toml")
 register("tabsa-original", PROTOCOLS_DIR / "tabsa_original.toml")
+register("tabsa-anywhere", PROTOCOLS_DIR / "tabsa_anywhere.toml")
 
 
 def resolve(name_or_path: str | Path) -> Path:
@@ -191,6 +193,8 @@ def _robot(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) 
             objects[obj] = {"type": rt.object_type, "place": backend.places[r.site], "facts": []}
         args: dict[str, Any] = {k: values.get(v, v) for k, v in rt.args.items()}
         args |= {"deadline": r.deadline, "priority": r.priority}
+        drawn = {"$work": r.work, "$pick": r.pick, "$place": r.place}
+        args |= {action + SUFFIX: drawn[v] for action, v in rt.durations.items() if drawn[v] is not None}
         if r.death_at is not None:
             args["death_at"] = r.death_at
         renew = {} if rt.renew_after_s is None else {"renew": {
@@ -258,6 +262,14 @@ def _script(home: tuple[float, ...], spot: tuple[float, ...], r: DayRequest, lea
     return entry
 
 
+def robot_work(proto: Protocol) -> dict[str, tuple[tuple[str, ...], bool]]:
+    """Per task folder the robot day runs: the actions given drawn durations, and whether it is preemptive
+    (:func:`experiments.days.robot_work.wrapper_for`)."""
+    if proto.robot is None:
+        return {}
+    return {rt.task: (tuple(rt.durations), proto.tasks[kind].preemptive) for kind, rt in proto.robot.tasks.items()}
+
+
 _BACKENDS: dict[str, Callable[[Protocol, int, str, dict[str, Any]], Any]] = {
     "synthetic": _synthetic, "robot": _robot}
 
@@ -307,7 +319,7 @@ class Day:
         with tempfile.TemporaryDirectory(prefix="tasker-day-") as tmp:
             where = Path(out) if out is not None else Path(tmp)
             result = run_scenario(self.scenario, seed=self.seed, out=where, pictures=False, request_fields=True,
-                                  **settings)
+                                  task_wrapper=wrapper_for(robot_work(self.protocol)), **settings)
             _, samples, _ = read_trajectory(where / "trajectory.jsonl")
         return DayRun(list(result.trace.events), tuple(samples), result.record)
 

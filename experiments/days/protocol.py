@@ -82,8 +82,9 @@ class TaskSpec:
     carry_speed: Range | None = None
 
 
-_ADDED = {"priorities": (), "preemptive": True, "deadline_draws": 1, "carry_speed": None,
-          "process": "uniform", "call_lead_s": 0.0, "positions": "sites", "clearance_m": 0.0}
+_ADDED: dict[str, Any] = {"priorities": (), "preemptive": True, "deadline_draws": 1, "carry_speed": None,
+                          "process": "uniform", "call_lead_s": 0.0, "positions": "sites", "clearance_m": 0.0,
+                          "durations": {}}
 """Fields added after days were stored: left out of :meth:`Protocol.digest` while they hold their
 default, so that a protocol written before them keeps its digest (and its stored days resume)."""
 
@@ -100,6 +101,8 @@ class RobotTask:
     ``renew_after_s``: a request of this type whose task fails (a plan, a skill or a hook
     failed) is made again this long after, until its ``death_at`` (or the day's end): the
     need stands until served, as in TaBSA.  ``None``: a failed task stays failed.
+    ``durations``: per action of the folder, the drawn value its stage takes (``$work`` of a
+    fall, ``$pick`` and ``$place`` of a pick-and-place; :mod:`experiments.days.robot_work`).
     """
 
     kind: str
@@ -108,6 +111,7 @@ class RobotTask:
     object_type: str | None = None
     posture: str | None = None
     renew_after_s: float | None = None
+    durations: dict[str, str] = dataclasses.field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -161,7 +165,7 @@ class Protocol:
         comments, layout or place) and, with a robot backend, the bytes of its world file.  Stored
         with each day, so that a resumed run does not mix days of two versions of a protocol."""
         values = _without_defaults(dataclasses.asdict(self))
-        for spec in values["tasks"].values():
+        for spec in [*values["tasks"].values(), *(values["robot"] or {}).get("tasks", {}).values()]:
             _without_defaults(spec)
         values.pop("source")
         h = hashlib.sha256(json.dumps(values, sort_keys=True, default=str).encode())
@@ -388,7 +392,8 @@ def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str
         variables = {"$site": "place", "$dest": "place", "$person": "person", **({"$object": obj} if obj else {})}
         check_template(tt, types[name], args, variables, spec)  # names, required ones, each of its PDDL type
         renew = tt.number("renew_after_s", None, positive=True)
-        out[kind] = RobotTask(kind, name, args, obj, posture, renew)
+        durations = _durations(tt, kind, tasks[kind], types[name])
+        out[kind] = RobotTask(kind, name, args, obj, posture, renew, durations)
         tt.done()
     missing = sorted(set(tasks) - set(out))
     if missing:
@@ -398,6 +403,30 @@ def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str
     t.done()
     return RobotBackend(world=str(world_file.resolve()), places=places, spots=spots, tasks=out, lead_s=lead,
                         task_exe_rate=exe_rate)
+
+
+DRAWN = {"fall": ("$work",), "pick_place": ("$pick", "$place"), "transport": ()}
+"""What each type draws per request that a robot task's ``durations`` may give a stage."""
+
+
+def _durations(t: Table, kind: str, spec: TaskSpec, task: Any) -> dict[str, str]:
+    """``durations = { ACTION = "$work" }``: actions of the task folder, each given a value the type draws."""
+    if "durations" not in t:
+        return {}
+    d = t.table("durations")
+    actions = sorted(getattr(getattr(task, "spec", None), "actions", {}) or {})
+    drawn = [v for v in DRAWN[kind] if v != "$pick" or isinstance(spec.pick_s, tuple)]
+    drawn = [v for v in drawn if v != "$place" or isinstance(spec.place_s, tuple)]
+    out: dict[str, str] = {}
+    for action, _ in d.items():
+        check_name(d, action, action, actions, "action", f"an action of task folder {task.name!r}")
+        value = d.string(action)
+        if value not in drawn:
+            have = f"one of {', '.join(drawn)}" if drawn else "nothing: this protocol's type draws no duration"
+            raise d.error(action, f"expected a value the {kind} requests draw ({have}), got {value!r}")
+        out[action] = value
+    d.done()
+    return out
 
 
 def _not_standable(spec: Any, xy: Pose) -> str:

@@ -13,8 +13,8 @@ from typing import Any
 
 import pytest
 
-from experiments.days import pipeline as days
 from experiments.days import draw as day_draw
+from experiments.days import pipeline as days
 from experiments.days import protocol
 from experiments.days import runner as day_runner
 from experiments.metrics import day as day_metrics_mod

@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 
 from experiments.analysis import stats
-from experiments.days import pipeline as day_pipeline
 from experiments.days import draw as day_draw
+from experiments.days import pipeline as day_pipeline
 from experiments.days import protocol
 from experiments.days import runner as day_runner
 from experiments.days import table as day_table
