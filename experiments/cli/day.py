@@ -31,6 +31,9 @@ DEFAULT_SCHEDULERS = ("lookahead", "alg2", "edf", "wspt", "atc", "tabsa-simple",
 EXAMPLES = """\
 examples:
   tasker day --protocol tabsa --days 100 --out out/day
+  tasker day --protocol tabsa-original --days 20 --schedulers tabsa-simple tabsa-simple2 tabsa-distance \
+      tabsa-scheduler edf lookahead --out out/day-original
+  tasker day --protocol tabsa-original --days 100 --schedulers lookahead tabsa-simple:hesitance=* --out out/sweep
   tasker day --protocol tabsa-short --backend robot --days 20 --out out/day-robot --resume
   tasker day --protocol tabsa-short --backend robot --days 10 --schedulers lookahead alg2 \\
       --strategies suspension=static suspension=planned --out out/day-susp"""
