@@ -29,16 +29,22 @@ def day_page(markdown_text: str, results: Sequence[Mapping[str, Any]], *, plotly
     f = figures(results)
     sections = [markdown_html(markdown_text), "<h2>Charts</h2>"]
     if f.schedulers:
-        fig = go.Figure()
-        for t in f.types:
-            est = [f.completed[n, t] for n in f.schedulers]
-            fig.add_trace(go.Bar(name=t, x=list(f.schedulers), y=[e.mean for e in est],
-                                 error_y={"type": "data",
-                                          "array": [0.0 if math.isnan(e.half) else e.half for e in est]},
-                                 hovertemplate=f"{t}<br>%{{x}}: %{{y:.2f}} ± %{{error_y.array:.2f}}<extra></extra>"))
-        fig.update_layout(title="Completions per type (mean a day, 95 % CI)", barmode="group", height=400,
-                          template="plotly_white", legend={"orientation": "h", "y": -0.3}, margin={"t": 50, "r": 10})
-        sections.append(figure_div(fig, "completions"))
+        panels = [("over the whole day", f.completed)]
+        if f.completed_by_stop:
+            panels.append(("by the time TaBSA's day would stop", f.completed_by_stop))
+        for k, (what, cells) in enumerate(panels):
+            fig = go.Figure()
+            for t in f.types:
+                est = [cells.get((n, t)) for n in f.schedulers]
+                fig.add_trace(go.Bar(
+                    name=t, x=list(f.schedulers), y=[e.mean if e else None for e in est],
+                    error_y={"type": "data", "array": [0.0 if e is None or math.isnan(e.half) else e.half
+                                                       for e in est]},
+                    hovertemplate=f"{t}<br>%{{x}}: %{{y:.2f}} ± %{{error_y.array:.2f}}<extra></extra>"))
+            fig.update_layout(title=f"Completions per type, {what} (mean a day, 95 % CI)", barmode="group",
+                              height=400, template="plotly_white", legend={"orientation": "h", "y": -0.3},
+                              margin={"t": 50, "r": 10})
+            sections.append(figure_div(fig, f"completions-{k}"))
         for k, (rule, counts) in enumerate(f.endings.items()):
             fig = go.Figure()
             for ending in next(iter(counts.values())):

@@ -28,6 +28,9 @@ class DayFigures:
     types: tuple[str, ...]
     completed: Mapping[tuple[str, str], Estimate]
     """(scheduler, type) -> tasks of that type completed a day."""
+    completed_by_stop: Mapping[tuple[str, str], Estimate]
+    """(scheduler, type) -> those completed by the time TaBSA's day would stop (empty for days stored
+    before TaBSA's rule was read)."""
     endings: Mapping[str, Mapping[str, Mapping[str, int]]]
     """rule ("TaBSA", "ours") -> scheduler -> ending -> days."""
     gaps: Mapping[tuple[str, str], tuple[float, ...]]
@@ -42,6 +45,9 @@ def figures(results: Sequence[Mapping[str, Any]]) -> DayFigures:
     by = {n: [r for r in ok if r["scheduler"] == n] for n in names}
     completed = {(n, t): estimate([float(r["per_type"].get(t, {}).get("completed", 0)) for r in by[n]])
                  for n in names for t in types}
+    by_stop = {(n, t): estimate([float(r["per_type"][t]["tabsa_completed"]) for r in by[n]
+                                 if "tabsa_completed" in r["per_type"].get(t, {})]) for n in names for t in types}
+    by_stop = {k: e for k, e in by_stop.items() if e.n}
     endings = {"TaBSA": {n: {e: sum(1 for r in by[n] if r.get("tabsa_ending") == e) for e in TABSA_ENDINGS}
                          for n in names},
                "ours": {n: {e: sum(1 for r in by[n] if r.get("ending") == e) for e in ENDINGS} for n in names}}
@@ -49,7 +55,7 @@ def figures(results: Sequence[Mapping[str, Any]]) -> DayFigures:
         del endings["TaBSA"]
     gaps = {(n, t): tuple(float(g) for r in by[n] for g in r["per_type"].get(t, {}).get("gaps_s", []) or [])
             for n in names for t in types}
-    return DayFigures(names, types, completed, endings, gaps)
+    return DayFigures(names, types, completed, by_stop, endings, gaps)
 
 
 def _slug(text: str) -> str:
@@ -74,15 +80,21 @@ def plot(results: Sequence[Mapping[str, Any]], out: Path) -> list[Path]:
         return files
     width = 0.8 / max(1, len(f.types))
     wide = max(6.0, 1.0 + 0.9 * len(f.schedulers))
-    fig, ax = plt.subplots(figsize=(wide, 4.5), layout="constrained")
-    for i, t in enumerate(f.types):
-        est = [f.completed[n, t] for n in f.schedulers]
-        xs = [k + (i - (len(f.types) - 1) / 2) * width for k in range(len(f.schedulers))]
-        ax.bar(xs, [e.mean for e in est], width, yerr=[0.0 if math.isnan(e.half) else e.half for e in est],
-               capsize=3, label=t)
-    ax.set_xticks(range(len(f.schedulers)), f.schedulers, rotation=30, ha="right", fontsize="small")
-    ax.set_ylabel("tasks completed a day (mean, 95 % CI)")
-    ax.set_title("Completions per type", fontsize="medium")
+    panels = [("over the whole day", f.completed)]
+    if f.completed_by_stop:
+        panels.append(("by the time TaBSA's day would stop", f.completed_by_stop))
+    fig, axes = plt.subplots(len(panels), 1, figsize=(wide, 0.6 + 3.4 * len(panels)), layout="constrained",
+                             squeeze=False, sharey=True)
+    for ax, (title, cells) in zip(axes[:, 0], panels, strict=True):
+        for i, t in enumerate(f.types):
+            est = [cells.get((n, t)) for n in f.schedulers]
+            xs = [k + (i - (len(f.types) - 1) / 2) * width for k in range(len(f.schedulers))]
+            ax.bar(xs, [e.mean if e else math.nan for e in est], width,
+                   yerr=[0.0 if e is None or math.isnan(e.half) else e.half for e in est], capsize=3,
+                   label=t if ax is axes[0, 0] else None)
+        ax.set_xticks(range(len(f.schedulers)), f.schedulers, rotation=30, ha="right", fontsize="small")
+        ax.set_ylabel("tasks a day (mean, 95 % CI)")
+        ax.set_title(f"Completions per type, {title}", fontsize="medium")
     fig.legend(fontsize="small", loc="outside lower center", ncol=len(f.types))
     files.append(_save(fig, out / "completions_per_type.png"))
     plt.close(fig)
