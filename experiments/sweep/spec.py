@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 from experiments.inputs.filekinds import expect
+from experiments.inputs.perturbation import KINDS as perturbation_kinds
+from experiments.inputs.perturbation import Perturbation
 from experiments.inputs.scenario import InterruptionGrid
 from experiments.inputs.strategy import FACTOR_LEVELS, FACTORS, Strategy, expand
 from experiments.metrics.store import JobKey
@@ -39,6 +41,7 @@ class Job:
     strategy: Strategy
     task_paths: tuple[str, ...] = ()  # absolute task folders (--path), so a Dask worker elsewhere loads the same
     interruption: InterruptionGrid | None = None  # where variants place the interruption ([variants.NAME])
+    perturbation: Perturbation | None = None  # exogenous world events around it ([perturbation])
 
     @property
     def key(self) -> JobKey:
@@ -56,6 +59,8 @@ class SweepSpec:
     sources: Mapping[str, str] = field(default_factory=dict)
     task_paths: tuple[str, ...] = ()
     variants: Mapping[str, InterruptionGrid] = field(default_factory=dict)
+    perturbation: Perturbation | None = None
+    """Exogenous world events drawn around each variant's interruption (:mod:`experiments.inputs.perturbation`)."""
 
     def __post_init__(self) -> None:
         if not self.scenarios:
@@ -77,7 +82,8 @@ class SweepSpec:
 
     def jobs(self) -> list[Job]:
         """Every job, scenario-major then seed then strategy (so paired runs finish close together)."""
-        return [Job(sc, self.sources.get(sc, sc), seed, st, self.task_paths, self.variants.get(sc))
+        return [Job(sc, self.sources.get(sc, sc), seed, st, self.task_paths, self.variants.get(sc),
+                    self.perturbation if sc in self.variants else None)
                 for sc in self.scenarios for seed in self.seeds for st in self.strategies]
 
     def to_json(self) -> dict[str, Any]:
@@ -85,6 +91,8 @@ class SweepSpec:
                                "strategies": [s.label for s in self.strategies], "sources": dict(self.sources)}
         if self.variants:
             out["variants"] = {sc: g.to_json() for sc, g in sorted(self.variants.items())}
+        if self.perturbation is not None:
+            out["perturbation"] = self.perturbation.to_json()
         return out
 
 
@@ -93,7 +101,7 @@ def looks_like_path(text: str) -> bool:
     return "/" in text or os.sep in text or text.endswith((".toml", ".json"))
 
 
-SPEC_KEYS = ("name", "scenarios", "seeds", "seed_start", "strategies", "factors", "variants")
+SPEC_KEYS = ("name", "scenarios", "seeds", "seed_start", "strategies", "factors", "variants", "perturbation", "paths")
 
 
 def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
@@ -132,6 +140,7 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
                 scenarios.resolve(sc)
             except reader.InputError as exc:
                 raise at.error(i, exc.message) from None
+    paths = _paths(top, p.parent)
     start = int(top.number("seed_start", 0, integer=True, min=0, max=reader.MAX_SEED))
     seeds_raw = top.raw("seeds")
     if isinstance(seeds_raw, int) and not isinstance(seeds_raw, bool):
@@ -191,8 +200,68 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
         raise top.error("seeds", f"the spec expands to {len(scenario_list)} scenarios x {len(seeds)} seeds x "
                                  f"{len(strategies)} strategies = {n} jobs, more than the {limit} a sweep may have")
     variants = _variants(top.table("variants", {}), scenario_list, sources)
+    perturbation = _perturbation(top, variants) if "perturbation" in top else None
     _warn_ignored_factors(top, scenario_list, sources, strategies)
-    return SweepSpec(tuple(scenario_list), seeds, tuple(strategies), name=name, sources=sources, variants=variants)
+    return SweepSpec(tuple(scenario_list), seeds, tuple(strategies), name=name, sources=sources, variants=variants,
+                     perturbation=perturbation, task_paths=paths)
+
+
+def _paths(top: reader.Table, here: Path) -> tuple[str, ...]:
+    """``paths``: task folders (or folders of them) the scenarios need besides the bundled ones,
+    relative to the spec file; they come back absolute (``--path`` on the command line adds more)."""
+    at = top.at("paths", {})
+    out: list[str] = []
+    for i, entry in enumerate(top.array("paths", [])):
+        if not isinstance(entry, str) or not entry:
+            raise at.error(i, f"expected a task folder (a path relative to the spec), got {entry!r}")
+        folder = (here / entry).resolve()
+        if not folder.is_dir():
+            raise at.error(i, f"no such folder: {folder} (paths are relative to the spec file)")
+        out.append(str(folder))
+    return tuple(dict.fromkeys(out))
+
+
+def select_seeds(spec: SweepSpec, text: str) -> SweepSpec:
+    """``spec`` with only the seeds ``text`` names: ``A-B`` (inclusive), ``A,B,C`` or a mix
+    (``1-20,40``); each must be a seed of the spec.  Raises ValueError saying what was expected."""
+    chosen: list[int] = []
+    for part in (x.strip() for x in text.split(",")):
+        lo, dash, hi = part.partition("-")
+        try:
+            first, last = int(lo), int(hi if dash else lo)
+        except ValueError:
+            raise ValueError(f"expected seeds as A-B or A,B,C (e.g. 1-20), got {text!r}") from None
+        if last < first:
+            raise ValueError(f"{part!r}: expected a range low-high, got high < low")
+        chosen += [s for s in range(first, last + 1) if s not in chosen]
+    absent = [s for s in chosen if s not in spec.seeds]
+    if absent:
+        lo_s, hi_s = min(spec.seeds), max(spec.seeds)
+        raise ValueError(f"seed {absent[0]} is not a seed of the spec (its seeds: {len(spec.seeds)} from {lo_s} to "
+                         f"{hi_s})")
+    return replace(spec, seeds=tuple(s for s in spec.seeds if s in chosen))
+
+
+def _perturbation(top: reader.Table, variants: Mapping[str, InterruptionGrid]) -> Perturbation:
+    """``[perturbation]``: the pre-registered rates of exogenous world events (drawn only for the
+    scenarios with ``[variants.NAME]``: the window is placed around their interruption)."""
+    t = top.table("perturbation")
+    if not variants:
+        raise top.error("perturbation", "needs [variants.NAME]: the events are drawn around each variant's "
+                                        "interruption")
+    kinds = t.array("kinds", list(perturbation_kinds))
+    stand = t.array("stand_s", [10.0, 40.0])
+    try:
+        p = Perturbation(rate_per_min=float(t.number("rate_per_min", 3.0, min=0)),
+                         before_s=float(t.number("before_s", 20.0, min=0)),
+                         after_s=float(t.number("after_s", 60.0, min=0)),
+                         kinds=tuple(str(k) for k in kinds),
+                         stand_s=(float(stand[0]), float(stand[1])) if len(stand) == 2 and all(
+                             isinstance(v, int | float) and not isinstance(v, bool) for v in stand) else (-1.0, -1.0))
+    except ValueError as exc:
+        raise t.error(str(exc).partition(":")[0].split(",")[0], str(exc).partition(": ")[2]) from None
+    t.done()
+    return p
 
 
 def _warn_ignored_factors(top: reader.Table, scenario_list: Sequence[str], sources: Mapping[str, str],
