@@ -43,7 +43,7 @@ from tasker.loop import SimulationLoop
 from tasker.meaning import Monitor
 from tasker.requester import Requester
 from tasker.store import TaskStore
-from tasker.task import Strategy
+from tasker.task import Strategy, TaskType
 from tasker.trace import FAILED, Trace
 
 
@@ -60,14 +60,16 @@ class RunResult:
 def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None = None,
                 suspension: str | None = None, scheduler: str | None = None,
                 trace: Trace | None = None, task_paths: tuple[str, ...] = (), policy: str | None = None,
-                hazard_waiting: bool = False, request_fields: bool = False) -> tuple[SimulationLoop, Any]:
+                hazard_waiting: bool = False, request_fields: bool = False,
+                task_wrapper: Callable[[TaskType], TaskType] | None = None) -> tuple[SimulationLoop, Any]:
     """The loop and the simulation for a robot scenario, with every request and event scheduled.
 
     ``task_paths`` are task folders loaded besides the bundled ones and ``$TASKER_TASKS``.
     ``policy`` (default: the scenario's) reaches every task's :class:`Strategy`;
     ``hazard_waiting`` is passed to the loop; ``request_fields`` lets every task type take
     the requests' ``deadline`` and ``priority`` (:mod:`experiments.inputs.request_fields`); it is on
-    whenever the scenario's requests give one.
+    whenever the scenario's requests give one.  ``task_wrapper`` is applied to every task type
+    after that (a day's drawn work: :mod:`experiments.days.robot_work`).
     A ``people`` entry may set a person's ``pose``, ``walk`` and walking ``speed``."""
     from planners.bundled import task_types
     from robot.sim import Simulation
@@ -97,6 +99,8 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
         from experiments.inputs.request_fields import with_request_fields
 
         loaded = [with_request_fields(t) for t in loaded]
+    if task_wrapper is not None:
+        loaded = [task_wrapper(t) for t in loaded]
     store = TaskStore(loaded)
     types = [store.get(n) for n in store.names()]
     sim.bind(b for t in types for b in t.meaning.bindings)  # the world reads the folders' bindings
@@ -273,7 +277,8 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
                  progress: bool = False, pictures: bool = True, task_paths: tuple[str, ...] = (),
                  policy: str | None = None, hazard_waiting: bool | None = None,
                  interruption: scenarios.InterruptionGrid | None = None,
-                 perturbation: Perturbation | None = None, request_fields: bool = False) -> RunResult:
+                 perturbation: Perturbation | None = None, request_fields: bool = False,
+                 task_wrapper: Callable[[TaskType], TaskType] | None = None) -> RunResult:
     """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced.
 
     ``task_paths``: task folders to load besides the bundled ones (``tasker run --path``).
@@ -281,7 +286,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
     hazard-aware waiting on; ``interruption`` (with ``randomize``) places the interrupting request
     in the seed's stratum (:class:`experiments.inputs.scenario.InterruptionGrid`) and ``perturbation``
     draws exogenous world events around it (:mod:`experiments.inputs.perturbation`);
-    ``request_fields``: see :func:`build_robot`."""
+    ``request_fields`` and ``task_wrapper``: see :func:`build_robot`."""
     if isinstance(source, scenarios.RobotScenario):
         kind, scn_path = "robot", Path(source.source)
     else:
@@ -304,7 +309,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
             scn = dataclasses.replace(scn, mode=mode)
         loop, sim = build_robot(scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler,
                                 task_paths=task_paths, policy=policy, hazard_waiting=bool(hazard_waiting),
-                                request_fields=request_fields)
+                                request_fields=request_fields, task_wrapper=task_wrapper)
         spec_json = {"kind": "robot", **scn.to_json()}
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")

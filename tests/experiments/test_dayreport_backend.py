@@ -179,8 +179,8 @@ def test_strategies_are_compared_under_each_scheduler() -> None:
          for s in (1, 2, 3)]
     text = day_table.report(a + b, title="t")
     assert "## t, strategy `suspension=static`" in text and "## t, strategy `suspension=planned`" in text
-    assert "| travel distance (m) | `suspension=planned`, lookahead | 1.00 ± 0.00 |" in text
-    assert "| travel distance (m) | `suspension=planned`, alg2 | 1.00 ± 0.00 |" in text
+    assert "| travel distance (m) | `suspension=planned`, lookahead | 3 | 1.00 ± 0.00 | 0 / 0 / 3 |" in text
+    assert "| travel distance (m) | `suspension=planned`, alg2 | 3 | 1.00 ± 0.00 | 0 / 0 / 3 |" in text
     assert "| time suspending (s, ours) | `suspension=planned`, alg2 |" in text  # what strategies differ in
 
 
