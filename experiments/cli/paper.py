@@ -1,6 +1,7 @@
 """``tasker paper``: reproduce Appendix B in both scenarios under both cost models, into ``docs/paper.md``.
 
-The runs and the tables are :mod:`experiments.paper.report`'s; this module holds the options,
+The runs and the tables are :mod:`experiments.paper.report`'s (and the recorded comparisons,
+:mod:`experiments.paper.recorded`'s); this module holds the options,
 names the commit in the generated text and writes it (``--out``: the block between the
 report's markers; otherwise stdout).
 """
@@ -55,7 +56,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 
 def _command(args: argparse.Namespace) -> int:
-    from experiments.paper import report
+    from experiments.paper import recorded, report
 
     out = Path(args.out) if args.out else None
     if out is not None and not out.is_file():
@@ -72,7 +73,7 @@ def _command(args: argparse.Namespace) -> int:
         print(file=sys.stderr)
     command = "tasker paper --variants {}{}{}".format(
         args.variants, "".join(f" --scenario {s}" for s in args.scenario or ()), f" --out {args.out}" if out else "")
-    block = report.render(results, scenarios, args.variants, command, made_at)
+    block = report.render(results, scenarios, args.variants, command, made_at, recorded.rows())
     if js is not None:
         runs = [{"scenario": s, "model": c.model, "hysteresis": c.hysteresis, "variant": v, **r}
                 for (s, c, v), r in results.items()]

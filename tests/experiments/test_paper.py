@@ -228,3 +228,4 @@ def test_tasker_paper_writes_the_block_with_its_command_and_commit(tmp_path: Pat
     assert "`tasker paper --variants 2 --scenario paper-2019 --out " in text and "at commit `" in text
     assert "| 2 | s | yes +50.0 %; 1/2 |" in text  # the shipped run holds; variant 1 of 2 misses
     assert "taskER-2019, h = 0.9" in text and "`paper-2019`" in text and "`paper`:" not in text
+    assert "| 2521.1 | taskER-2019 | 2.248 | 2.861 | +21.4 % | yes | yes | 2.248 | 2.861 |" in text
