@@ -42,7 +42,7 @@ def geometry(t: float) -> Any:
              "alice_destination": (*lay.alice_dest, 0.0), "john_destination": (*lay.john_dest, 0.0)}
     places = ("alice_destination", "john_destination", "robot_spot", "john_spot", "alice_spot")
     objects = {"robot": "robot", "john": "person", "alice": "person", **{p: "place" for p in places}}
-    facts = frozenset({("at", "robot", "robot_spot"), ("hand_empty", "robot"), ("at", "john", "john_spot"),
+    facts = frozenset({("at", "robot", "robot_spot"), ("at", "john", "john_spot"),
                        ("at", "alice", "alice_spot")})
     return WorldState(facts, poses, objects, t)
 
