@@ -28,6 +28,14 @@ from tasker.task import POLICIES, ArgSpec
 SKILLS = ("navigate", "say", "manipulate", "wait")
 """Skills the core agent offers (the contract with ``robot/``)."""
 
+COST_MODEL_ARG = "cost_model"
+"""The request argument that chooses a task's cost model, when its folder offers a choice."""
+COST_MODELS = ("seconds", "taskER-2019")
+"""Cost models (``docs/model.md``): ``seconds``, ours and the default (costs that add, in
+seconds); ``taskER-2019``, the original TaskER code's (path metres weighted per person),
+offered by a folder that declares ``[schedule.taskER-2019]``."""
+ORIGINAL = COST_MODELS[1]
+
 Literal = tuple[str, ...]
 
 
@@ -69,6 +77,31 @@ class Branch:
     label: str = ""
     policy: str = "strict"
     max_interruption_s: float | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class OriginalCosts:
+    """``[schedule.taskER-2019]``: what the original TaskER code's cost model measures for this task.
+
+    ``person`` is whom the robot goes to (leg *a*, the robot's path to them); ``destination``,
+    if any, where it then takes them (leg *g*, their path there; the task ends there, else
+    at the person).  ``walk``: literals that hold while the person walks with the robot;
+    ``sit``: literals that hold once the person was greeted (the 2019 code asked them to sit
+    and wait).  ``factors``: the request arguments giving the cost per metre while walking,
+    standing (not yet greeted) and sitting; without them every factor is 1.
+    ``planners.pddl_task`` computes the parameters; ``docs/model.md`` gives the formulas.
+    """
+
+    person: str
+    destination: str | None = None
+    walk: tuple[Literal, ...] = ()
+    sit: tuple[Literal, ...] = ()
+    factors: tuple[str, str, str] | None = None
+
+    @property
+    def args(self) -> tuple[str, ...]:
+        """The request arguments of the model: the choice and the factors."""
+        return (COST_MODEL_ARG, *(f[1:] for f in self.factors or ()))
 
 
 @dataclass(frozen=True, slots=True)
@@ -114,6 +147,8 @@ class TaskSpec:
     """``[problem] restore``: patterns of facts the task leaves as it found them — a ground instance
     that did not hold when the task first planned must not hold at its goal (a door it opened is
     closed again)."""
+    original_costs: OriginalCosts | None = None
+    """``[schedule.taskER-2019]``: the folder offers the original TaskER cost model."""
     lines: Mapping[str, int | None] = field(default_factory=dict)
     """Where each checked field is written (``"hazards[0].fact"`` -> line), for later checks."""
 
@@ -297,6 +332,50 @@ def _args(r: _Reader, top: reader.Table) -> tuple[ArgSpec, ...]:
     return tuple(out)
 
 
+def _original_costs(r: _Reader, schedule: reader.Table, top: reader.Table,
+                    args: tuple[ArgSpec, ...]) -> OriginalCosts | None:
+    """``[schedule.taskER-2019]``, checked against the declared request arguments: a folder that
+    offers the model declares ``cost_model`` (choices: the models), and one that does not, does not."""
+    by_name = {a.name: a for a in args}
+    choice = by_name.get(COST_MODEL_ARG)
+    if ORIGINAL not in schedule:
+        if choice is not None:
+            raise r.fail(top, "args", f"argument {COST_MODEL_ARG!r} chooses a cost model, and only a folder "
+                                      f"with [schedule.{ORIGINAL}] offers another than {COST_MODELS[0]!r}")
+        return None
+    t = schedule.table(ORIGINAL)
+    r.note(t)
+    if choice is None or choice.required or choice.choices is None or set(choice.choices) != set(COST_MODELS):
+        raise r.fail(t, None, f"a folder that offers the {ORIGINAL} cost model declares the optional argument "
+                              f"{COST_MODEL_ARG!r} with choices = {list(COST_MODELS)}")
+
+    def arg_token(key: str, kind: str) -> str:
+        tok = t.string(key)
+        if not tok.startswith("$") or tok[1:] not in by_name or by_name[tok[1:]].type != kind:
+            raise r.fail(t, key, f"expected $name of a request argument of type {kind!r} "
+                                 f"(declared: {', '.join('$' + a for a in by_name)}), got {tok!r}")
+        return tok
+
+    person = arg_token("person", "str")
+    destination = arg_token("destination", "str") if "destination" in t else None
+    factors: tuple[str, str, str] | None = None
+    if "factors" in t:
+        raw = t.raw("factors")
+        if not isinstance(raw, list) or len(raw) != 3:
+            raise r.fail(t, "factors", f"expected [\"$walk\", \"$stand\", \"$sit\"] (three request arguments), "
+                                       f"got {raw!r}")
+        names = []
+        for k, tok in enumerate(raw):
+            arg = by_name.get(tok[1:]) if isinstance(tok, str) and tok.startswith("$") else None
+            if arg is None or arg.type != "float" or arg.required:
+                raise r.fail(t, "factors", f"factors[{k}]: expected $name of an optional float argument, got {tok!r}")
+            names.append(tok)
+        factors = (names[0], names[1], names[2])
+    out = OriginalCosts(person, destination, r.literals(t, "walk"), r.literals(t, "sit"), factors)
+    t.done()
+    return out
+
+
 def _example(r: _Reader, top: reader.Table) -> ExampleWorld | None:
     if "example" not in top:
         return None
@@ -427,16 +506,18 @@ def read_task_toml(path: Path) -> TaskSpec:
         cps = schedule.number("cps", 1.0, min=0)
         travel_s = schedule.number("travel_s", 10.0, min=0)
         priority = schedule.number("priority", None, integer=True)
+        args = _args(r, top)
+        original = _original_costs(r, schedule, top, args)
         schedule.done()
         spec = TaskSpec(
             folder=path.parent, name=name, description=description, domain_file=path.parent / domain,
-            args=_args(r, top), goal=goal, facts=facts, suspended_facts=suspended_facts,
+            args=args, goal=goal, facts=facts, suspended_facts=suspended_facts,
             suspension=r.branches(top, "suspension"), actions=actions, static_update=static_update,
             cps=float(cps), travel_s=float(travel_s), planning_time_s=float(planning_time_s),
             static_time_s=float(static_time_s), timeout_s=float(timeout_s), example=_example(r, top),
             priority=None if priority is None else int(priority),
             hazards=_hazards(r, top), people=_people(r, top), bindings=_bindings(r, top),
-            invariants=_derived(r, top), restore=tuple(restore), lines=r.lines,
+            invariants=_derived(r, top), restore=tuple(restore), original_costs=original, lines=r.lines,
         )
         top.done()
     return spec
