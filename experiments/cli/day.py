@@ -28,7 +28,8 @@ from tasker.support.reader import suggest
 EXAMPLES = """\
 examples:
   tasker day --protocol tabsa --days 100 --out out/day
-  tasker day --protocol tabsa-short --backend robot --days 20 --out out/day-robot --resume
+  tasker day --protocol tabsa-short --backend robot --days 20 --out out/day-robot   # again: goes on
+  tasker day --protocol tabsa-short --days 20 --out out/day --overwrite             # afresh
   tasker day --protocol tabsa-short --backend robot --days 10 --schedulers lookahead alg2 \\
       --strategies suspension=static suspension=planned --out out/day-susp"""
 
@@ -53,8 +54,13 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="run the days on this Dask scheduler (e.g. tcp://host:8786) instead of local processes, "
                          "as tasker sweep does")
     ap.add_argument("--resume", action="store_true",
-                    help="keep OUT/days.db and run only the days it lacks (an older OUT/days.jsonl is read in)")
-    ap.add_argument("--retry-errors", action="store_true", help="with --resume: run again the days stored as errors")
+                    help="the default, kept for older scripts: OUT/days.db is kept and only the days it lacks run "
+                         "(an older OUT/days.jsonl is read in)")
+    ap.add_argument("--overwrite", action="store_true",
+                    help="delete OUT/days.db and OUT/days.jsonl first and run every day afresh (nothing stored is "
+                         "ever deleted without it)")
+    ap.add_argument("--retry-errors", action="store_true",
+                    help="run again the days stored as errors (the days stored as ok are kept)")
     ap.add_argument("--keep-runs", action="store_true",
                     help="keep each day's files in OUT/runs/[STRATEGY/]SCHEDULER/SEED")
     ap.add_argument("--out", required=True, type=Path,
@@ -75,6 +81,8 @@ def _days(a: argparse.Namespace) -> int:
     from experiments.days.runner import run_days
     from experiments.days.table import report
     from experiments.inputs.strategy import Strategy
+    from experiments.metrics.store import holds_results
+    from experiments.metrics.store import remove as remove_store
     from experiments.sweep.driver import lease
     from experiments.sweep.spec import MAX_JOBS
     from tasker import schedulers
@@ -127,18 +135,20 @@ def _days(a: argparse.Namespace) -> int:
     db, log = a.out / "days.db", a.out / "days.jsonl"
     for written in (db, log, a.out / "table.md"):  # now, not after hours of days: their table would be lost
         writable_file(written, "--out")
-    if not a.resume:
+    if a.overwrite and a.resume:
+        raise UsageError("--overwrite", "and --resume contradict each other: --overwrite deletes the stored days, "
+                                        "--resume (the default) keeps them")
+    if a.overwrite:
         with lease(db):  # a run still writing into OUT keeps its days: this one stops instead
-            for old in (db, log):
-                old.unlink(missing_ok=True)
-    elif not db.exists() and log.is_file():
-        import_log(log, db, a.protocol, a.backend)
-    else:
-        try:
-            check_resumable(db, scenario_key(a.protocol, a.backend), proto)
-        except ConfigError as exc:
-            raise UsageError("--resume", f"{exc}; run without --resume to start afresh, or give another --out") \
-                from None
+            remove_store(db)
+            log.unlink(missing_ok=True)
+    if not holds_results(db) and log.is_file():
+        import_log(log, db, a.protocol, a.backend)  # days of a tasker before days.db: kept, as any stored day
+    try:
+        check_resumable(db, scenario_key(a.protocol, a.backend), proto)
+    except ConfigError as exc:
+        raise UsageError("--out", f"{exc}; give --overwrite to delete them and start afresh, or another --out") \
+            from None
     with dask_scheduler(a.scheduler_address):
         results = run_days(a.protocol, a.days, a.schedulers, first_seed=a.first_seed, workers=workers,
                            backend=a.backend, db=db, keep=a.out / "runs" if a.keep_runs else None,
@@ -162,8 +172,8 @@ def _run(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:  # every day that ended is already in days.db
         db = Path(args.out) / "days.db"
         if db.is_file():
-            print(f"tasker day: interrupted; the days that ended are in {db}: run the same command with --resume "
-                  "to go on", file=sys.stderr)
+            print(f"tasker day: interrupted; the days that ended are in {db}: run the same command again to go on "
+                  "(without --overwrite)", file=sys.stderr)
             return EXIT_INTERRUPTED
         raise
 
@@ -172,7 +182,8 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("day", help="run a day protocol: N days x schedulers on a backend, and its table",
                        description="Run N seeded days of a protocol under each scheduler on the synthetic or the "
                                    "robot backend (and, there, each strategy), on local processes or Dask; store each "
-                                   "day in OUT/days.db as it ends (--resume goes on), write OUT/days.jsonl and "
+                                   "day in OUT/days.db as it ends (run again, it goes on: days.db is never "
+                                   "emptied without --overwrite), write OUT/days.jsonl and "
                                    "OUT/table.md (95 % CIs, paired comparisons of lookahead against each baseline, "
                                    "and of strategies under each scheduler).",
                        epilog=EXAMPLES)

@@ -27,9 +27,9 @@ def check_resumable(db: Path, scenario: str, proto: protocols.Protocol) -> None:
     """A :class:`ConfigError` when ``db`` holds days of ``scenario`` (``PROTOCOL@BACKEND``) drawn from
     another version of ``proto``: resumed, they would be compared with days of this one as if alike.
     Days stored without a digest (by an older tasker, or imported from a ``days.jsonl``) are kept."""
-    from experiments.metrics.store import ResultStore
+    from experiments.metrics.store import ResultStore, holds_results
 
-    if not db.is_file():
+    if not holds_results(db):  # nothing stored (or what a failed first write left): nothing to compare
         return
     with ResultStore(db, readonly=True) as store:
         stored = {r.record.get("protocol_digest") for r in store.rows() if r.scenario == scenario}

@@ -60,30 +60,46 @@ class SweepSummary:
 def lease(db_path: str | Path) -> Iterator[None]:
     """Hold the sweep lease of a results database: one driver at a time, or a clear :class:`SweepError`.
 
-    An exclusive ``flock`` on ``<db>.lock``, which says who holds it.  The kernel drops
-    the lock when the holder dies, even by ``kill -9``, so a stale lease never blocks a
-    resumption.  Readers (``tasker report``) take no lease.
+    An exclusive ``flock`` on ``<db>.lock``, which says who holds it, removed when the lease
+    ends.  The kernel drops the lock when the holder dies, even by ``kill -9``, so a stale
+    lease (a file left by a killed driver) never blocks a resumption.  Readers (``tasker
+    report``) take no lease.
     """
     lock = Path(f"{db_path}.lock")
     try:
         lock.parent.mkdir(parents=True, exist_ok=True)
-        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
     except OSError as exc:
         raise SweepError(f"{db_path}: cannot take the sweep lease ({lock}: {exc.strerror or exc})") from None
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        holder = os.pread(fd, 512, 0).decode("utf-8", "replace").strip() or "another process"
+    while True:
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise SweepError(f"{db_path}: cannot take the sweep lease ({lock}: {exc.strerror or exc})") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.pread(fd, 512, 0).decode("utf-8", "replace").strip() or "another process"
+            os.close(fd)
+            raise SweepError(f"{db_path}: another sweep is running on this database ({holder}); two drivers "
+                             "would run the same jobs. Wait for it to end (then run again to resume), or use "
+                             "another database") from None
+        try:  # the holder before us deletes the file as it ends: a lock on a deleted file holds nothing
+            same = os.fstat(fd).st_ino == os.stat(lock).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            break
         os.close(fd)
-        raise SweepError(f"{db_path}: another sweep is running on this database ({holder}); two drivers would "
-                         "run the same jobs. Wait for it to end (then run again to resume), or use another "
-                         "database") from None
     try:
         os.ftruncate(fd, 0)
         os.pwrite(fd, f"pid {os.getpid()} on {socket.gethostname()}, since "
                       f"{datetime.now(UTC).isoformat(timespec='seconds')}".encode(), 0)
         yield
     finally:
+        try:  # removed while still held, so no one can take a lock on the file being removed
+            lock.unlink()
+        except OSError:
+            pass
         fcntl.flock(fd, fcntl.LOCK_UN)
         os.close(fd)
 
