@@ -373,6 +373,10 @@ MAX_DEPTH = 64
 """Arrays and tables (JSON objects) within each other at most this deep: no file of tasker's
 needs a tenth of it, and readers of deeper ones would run out of Python's recursion."""
 
+MAX_SECONDS = 7 * 24 * 3600.0
+"""The longest simulated time an input may name (a week): a horizon, a request's time, a duration,
+a budget.  A run steps its clock up to the times it is given, so ``t = 1e300`` never ended."""
+
 MAX_INT = 2**63 - 1
 """Integers are 64-bit (TOML's rule, and SQLite's): a longer one is refused where it is read,
 never turned into an ``OverflowError`` by the first ``float()`` downstream."""
