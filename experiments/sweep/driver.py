@@ -115,18 +115,36 @@ def absolute_source(source: str) -> str:
 
 
 def precheck(jobs: Iterable[Job]) -> None:
-    """Load every distinct scenario of ``jobs`` once, so a bad one fails before any job runs."""
+    """Every check a job would fail, before any job runs: each distinct scenario is loaded once, and
+    for each of its strategies the first job's run is built — its randomised variant drawn (with the
+    spec's interruption grid), its world, task types and scheduler made — without running it.  A
+    fault is a :class:`SweepError` naming the scenario and the strategy (the file's own errors keep
+    their file and line): values that pass the spec's checks and then fail every job stop here."""
     from experiments.inputs import scenario as scenarios
     from experiments.inputs import synthetic
+    from experiments.run.runner import build_robot
 
-    jobs = list(jobs)
-    paths = {j.source: j.task_paths for j in jobs}
-    for source in sorted({j.source for j in jobs}):
+    first: dict[tuple[str, str], Job] = {}
+    for j in jobs:
+        first.setdefault((j.source, j.strategy.label), j)
+    loaded: dict[str, Any] = {}
+    for (source, label), job in sorted(first.items()):
         path = scenarios.resolve(source)
-        if scenarios.kind_of(path) == "robot":
-            scenarios.load(path, task_paths=paths.get(source, ()))
-        else:
-            synthetic.load(path)
+        if source not in loaded:  # its own faults: the scenario's error, with its file and line
+            robot = scenarios.kind_of(path) == "robot"
+            loaded[source] = (scenarios.load(path, task_paths=job.task_paths) if robot else synthetic.load(path))
+        scn, st = loaded[source], job.strategy
+        try:
+            if isinstance(scn, scenarios.RobotScenario):
+                variant = scenarios.randomize(scn, job.seed, interruption=job.interruption)
+                build_robot(variant, seed=job.seed, update=st.update, suspension=st.suspension,
+                            scheduler=st.scheduler, task_paths=job.task_paths, policy=st.policy,
+                            hazard_waiting=bool(st.hazard_waiting))
+            else:
+                synthetic.build(scn, seed=job.seed, scheduler=st.scheduler)
+        except Exception as exc:  # noqa: BLE001 - whatever it is, every job like it would fail
+            raise SweepError(f"scenario {job.scenario!r} with strategy {label!r} (seed {job.seed}) cannot run, so no "
+                             f"job of it would: {type(exc).__name__}: {exc}") from None
 
 
 def _setup(workers: int, address: str | None) -> dict[str, Any]:
