@@ -39,6 +39,7 @@ class Checker:
         self.paths = paths
         self.problems: list[tuple[str, str]] = []
         self.passed: list[tuple[str, str]] = []
+        self.loaded: dict[Path, bool] = {}  # task folder -> it passed its checks
         self._store: Any = None
         self._store_error: str | None = None
 
@@ -92,6 +93,7 @@ class Checker:
             warnings.simplefilter("always", InputWarning)
             ok = self.attempt(p, "task folder: PDDL, task.toml and the [example] solved",
                               lambda: load_task(p, use_cache=False))
+        self.loaded[p.resolve()] = ok
         for w in caught:  # shown as any other warning; they only change what "ok" claims
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         if ok and any(issubclass(w.category, InputWarning) for w in caught):
@@ -202,10 +204,32 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p.set_defaults(func=_check)
 
 
+def _task_folders(targets: list[str]) -> list[Path]:
+    """The targets that are task folders (or folders of them), resolved."""
+    out = []
+    for t in targets:
+        p = Path(t)
+        try:
+            if (p / "task.toml").is_file() or (p.is_dir() and any((q / "task.toml").is_file() for q in p.iterdir())):
+                out.append(p.resolve())
+        except (OSError, ValueError):  # unreadable, or no file name: its own check says so
+            continue
+    return out
+
+
 def _check(args: argparse.Namespace) -> int:
     checker = Checker(task_paths(args))
-    for t in args.targets:
+    folders = _task_folders(args.targets)
+    first = [t for t in args.targets if "\x00" not in t and Path(t).resolve() in folders]
+    for t in first:  # task folders first: a scenario checked with them requests their task types, as with --path
         checker.check(t)
+    for f in folders:  # those that loaded (a broken one has said so already, once)
+        subs = [f] if (f / "task.toml").is_file() else [q.resolve() for q in f.iterdir() if (q / "task.toml").is_file()]
+        if all(checker.loaded.get(q) for q in subs) and str(f) not in checker.paths:
+            checker.paths.append(str(f))
+    for t in args.targets:
+        if t not in first:
+            checker.check(t)
     if not args.quiet:
         for where, what in checker.passed:
             print(f"ok     {where}: {what}")

@@ -16,8 +16,11 @@ from experiments.cli.args import (
     EXIT_INTERRUPTED,
     SEED_LIMIT,
     UsageError,
+    positive_int,
     seed,
     show_progress,
+    shown,
+    workers,
     writable_dir,
     writable_file,
 )
@@ -39,12 +42,12 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help=f"a registered protocol ({', '.join(days.names())}) or a protocol file (.toml); default tabsa")
     ap.add_argument("--backend", default="synthetic", choices=days.BACKENDS,
                     help="timed stages or TIAGo in MuJoCo (default synthetic)")
-    ap.add_argument("--days", type=int, default=100,
+    ap.add_argument("--days", type=positive_int, default=100,
                     help="days per scheduler (seeds first-seed, first-seed + 1, ...; default 100)")
     ap.add_argument("--first-seed", type=seed, default=1, help="seed of the first day (default 1)")
     ap.add_argument("--schedulers", nargs="+", default=["lookahead", "alg2", "simple", "simple2", "distance"],
                     help="registered schedulers to compare (default: lookahead alg2 simple simple2 distance)")
-    ap.add_argument("--workers", type=int, default=None,
+    ap.add_argument("--workers", type=workers, default=None,
                     help="local processes (default: 2 synthetic, 1 robot: a robot day is long, keep it in one)")
     ap.add_argument("--strategies", nargs="+", default=None, metavar="STRATEGY",
                     help="robot backend: strategies to compare under every scheduler, e.g. 'suspension=static' "
@@ -94,12 +97,9 @@ def _days(a: argparse.Namespace) -> int:
     twice = sorted({n for n in a.schedulers if a.schedulers.count(n) > 1})
     if twice:
         raise UsageError("--schedulers", f"{twice[0]!r} is given twice")
-    if a.days < 1:
-        raise UsageError("--days", f"expected >= 1, got {a.days}")
     if a.first_seed + a.days > SEED_LIMIT:
-        raise UsageError("--days", f"the last day's seed would be {a.first_seed + a.days - 1}: seeds are < 2**32")
-    if a.workers is not None and a.workers < 1:
-        raise UsageError("--workers", f"expected >= 1, got {a.workers}")
+        raise UsageError("--days", f"the last day's seed would be {shown(a.first_seed + a.days - 1)}: seeds are "
+                                   "< 2**32")
     strategies = []
     for text in a.strategies or ["default"]:
         try:
@@ -113,8 +113,8 @@ def _days(a: argparse.Namespace) -> int:
         raise UsageError("--strategies", "a strategy is given twice")
     n_jobs = a.days * len(a.schedulers) * len(strategies)
     if n_jobs > MAX_JOBS:  # as a sweep refuses: a typo such as --days 1000000 would fill memory before any day
-        raise UsageError("--days", f"{a.days} days x {len(a.schedulers)} schedulers x {len(strategies)} strategies "
-                                   f"= {n_jobs} days to run, more than the {MAX_JOBS} a run may have")
+        raise UsageError("--days", f"{shown(a.days)} days x {len(a.schedulers)} schedulers x {len(strategies)} "
+                                   f"strategies = {shown(n_jobs)} days to run, more than the {MAX_JOBS} a run may have")
     for st in strategies:
         try:
             days.check_settings(a.backend, dict(st.items()))
@@ -130,7 +130,7 @@ def _days(a: argparse.Namespace) -> int:
         days.make(a.protocol, a.first_seed, backend=a.backend, scheduler=a.schedulers[0])
     except ConfigError as exc:
         raise UsageError("--protocol", str(exc)) from exc
-    workers = a.workers if a.workers is not None else (2 if a.backend == "synthetic" else 1)
+    n_workers = a.workers if a.workers is not None else (2 if a.backend == "synthetic" else 1)
     writable_dir(a.out, "--out")
     db, log = a.out / "days.db", a.out / "days.jsonl"
     for written in (db, log, a.out / "table.md"):  # now, not after hours of days: their table would be lost
@@ -150,7 +150,7 @@ def _days(a: argparse.Namespace) -> int:
         raise UsageError("--out", f"{exc}; give --overwrite to delete them and start afresh, or another --out") \
             from None
     with dask_scheduler(a.scheduler_address):
-        results = run_days(a.protocol, a.days, a.schedulers, first_seed=a.first_seed, workers=workers,
+        results = run_days(a.protocol, a.days, a.schedulers, first_seed=a.first_seed, workers=n_workers,
                            backend=a.backend, db=db, keep=a.out / "runs" if a.keep_runs else None,
                            strategies=strategies, address=a.scheduler_address, progress=show_progress(a),
                            retry_errors=a.retry_errors)

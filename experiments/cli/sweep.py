@@ -22,8 +22,8 @@ from experiments.cli.args import (
     EXIT_OK,
     UsageError,
     note,
-    positive_int,
     show_progress,
+    workers,
     writable_dir,
     writable_file,
 )
@@ -54,7 +54,8 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
                        epilog=SWEEP_EXAMPLES)
     p.add_argument("spec", help="sweep spec (.toml): scenarios, seeds, strategies")
     p.add_argument("--db", required=True, help="results database (SQLite; created if missing)")
-    p.add_argument("--workers", type=positive_int, default=None, help="local worker processes (default: CPU count)")
+    p.add_argument("--workers", type=workers, default=None,
+                   help="local worker processes, at most 1024 (default: CPU count)")
     p.add_argument("--scheduler-address", default=None, metavar="ADDRESS",
                    help="run on this Dask scheduler (e.g. tcp://host:8786) instead of local processes")
     p.add_argument("--retry-errors", action="store_true",
