@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import functools
-import tomllib
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -22,6 +21,7 @@ from typing import Any
 
 from experiments.cli.args import EXIT_FAILED, EXIT_OK, error_text
 from experiments.cli.run import add_path_option, task_paths
+from tasker.support import reader
 from tasker.support.reader import InputWarning
 
 EXAMPLES = """\
@@ -30,6 +30,11 @@ examples:
   tasker check ~/my_tasks                            # a folder of task folders
   tasker check experiments/inputs/scenarios experiments/sweep/specs robot/worlds experiments/days/protocols
   tasker check my_scenario.toml --path ~/my_tasks    # a scenario that requests your own task types"""
+
+
+def _local(exc: reader.InputError) -> str:
+    """A reader's error about the file a problem line already names: ``line N: field: what``."""
+    return ": ".join(x for x in (f"line {exc.line}" if exc.line else "", exc.field, exc.message) if x)
 
 
 class Checker:
@@ -48,7 +53,7 @@ class Checker:
 
         try:
             fn()
-        except (TaskerError, OSError, ValueError, tomllib.TOMLDecodeError) as exc:
+        except (TaskerError, OSError, ValueError) as exc:
             self.problems.append((str(where), error_text(exc)))
             return False
         self.passed.append((str(where), what))
@@ -102,17 +107,21 @@ class Checker:
     def _pddl(self, p: Path) -> None:
         from planners.checks import load_domain
 
-        text = p.read_text(encoding="utf-8", errors="replace").lower()
+        try:
+            text = reader.read_text(p).lower()
+        except reader.InputError as exc:
+            self.problems.append((str(p), _local(exc)))
+            return
         if "(:domain" in text:
             self.problems.append((str(p), "a PDDL problem is checked with its domain: tasker plan DOMAIN PROBLEM"))
             return
         self.attempt(p, "PDDL domain", lambda: load_domain(p))
 
     def _toml(self, p: Path, also: list[str] | None = None) -> None:
-        try:
-            raw = tomllib.loads(p.read_text(encoding="utf-8-sig"))  # a byte-order mark as reader.read_text
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-            self.problems.append((str(p), f"not valid TOML: {exc}"))
+        try:  # within the readers' limits, as every loader reads it
+            raw = reader.loads(reader.read_text(p), p).data
+        except reader.InputError as exc:
+            self.problems.append((str(p), _local(exc)))
             return
         if p.name == "task.toml" or "task" in raw and "actions" in raw:
             self._task_folder(p.parent)

@@ -134,9 +134,9 @@ def _stages_for(domain_text: str, result: PlanResult, extra: list[str],
 
 def _read_arg(path: str, argument: str) -> str:
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise UsageError(argument, f"{path}: no such file")
-    try:
+    try:  # a folder, a device, a huge or binary file: named by the reader
         return reader.read_text(p)
     except reader.InputError as exc:
         raise UsageError(argument, str(exc)) from None

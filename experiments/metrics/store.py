@@ -359,7 +359,8 @@ class ResultStore:
             try:  # within the readers' limits: nesting, 64-bit integers
                 value = reader.parse_json(text, "row")
             except reader.InputError as exc:
-                raise bad(column, f"not JSON ({exc.field + ': ' if exc.field else ''}{exc.message})") from None
+                why = exc.message.removeprefix("not valid JSON: ").removeprefix("not readable JSON: ")
+                raise bad(column, f"not JSON ({exc.field + ': ' if exc.field else ''}{why})") from None
             if not isinstance(value, dict):
                 raise bad(column, f"expected a JSON object, got {type(value).__name__}")
             decoded.append(value)
@@ -393,5 +394,6 @@ class ResultStore:
                     raise reader.InputError("row", "expected JSON text")
                 out.append({"started": st, "spec": reader.parse_json(sp, "row"), "setup": reader.parse_json(se, "row")})
             except reader.InputError as exc:
-                raise StoreError(f"{self.path}: sweeps row id={sid}: not JSON ({exc.message})") from None
+                why = exc.message.removeprefix("not valid JSON: ").removeprefix("not readable JSON: ")
+                raise StoreError(f"{self.path}: sweeps row id={sid}: not JSON ({why})") from None
         return out
