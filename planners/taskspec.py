@@ -27,6 +27,15 @@ from tasker.task import POLICIES, ArgSpec
 
 SKILLS = ("navigate", "say", "manipulate", "wait")
 
+RESERVED_ARGS = {
+    "robot": "$robot is the robot",
+    "deadline": "a request field every task type takes (experiments.inputs.request_fields)",
+    "priority": "a request field every task type takes (experiments.inputs.request_fields)",
+    "death_at": "a request field every task type takes (experiments.inputs.request_fields)",
+}
+"""Argument names a task folder may not declare: the request fields would strip them from its own
+arguments (every request would then lack them), and ``$robot`` names the robot."""
+
 MAX_TIMEOUT_S = 24 * 3600.0
 """The longest wall-clock limit of one planner call: a larger one (1e300) overflowed the clock."""
 """Skills the core agent offers (the contract with ``robot/``)."""
@@ -278,6 +287,8 @@ def _args(r: _Reader, top: reader.Table) -> tuple[ArgSpec, ...]:
     first: dict[str, int | None] = {}
     for a in top.tables("args", []):
         name = a.string("name")
+        if name in RESERVED_ARGS:
+            raise r.fail(a, "name", f"{name!r} is reserved: {RESERVED_ARGS[name]}; name the argument otherwise")
         if name in first:  # a request's argument is one value: which declaration would it follow?
             where = f" (first at line {first[name]})" if first[name] else ""
             raise r.fail(a, "name", f"argument {name!r} is declared twice{where}")
@@ -347,6 +358,12 @@ def _hazards(r: _Reader, top: reader.Table) -> tuple[Hazard, ...]:
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise r.fail(top, "hazards", f"duplicate hazard name(s) {dup}")
+    facts = [x.fact for x in out]
+    for k, x in enumerate(out):  # one unsafe condition declared twice would be counted twice by every metric
+        if x.fact in facts[:k]:
+            other = out[facts.index(x.fact)]
+            raise r.fail(top.at("hazards", {}), k, f"hazard {x.name!r} has the fact of hazard {other.name!r} "
+                                                   f"({list(x.fact)}): one condition, counted twice")
     return tuple(out)
 
 

@@ -126,10 +126,11 @@ def _days(a: argparse.Namespace) -> int:
         raise UsageError("--protocol", str(exc)) from exc
     if a.backend == "robot" and proto.robot is None:
         raise UsageError("--backend", f"{proto.source} has no [robot_backend]: it runs on the synthetic backend only")
-    try:  # what only a drawn day shows (e.g. more people than the world has): once, before any day runs
-        days.make(a.protocol, a.first_seed, backend=a.backend, scheduler=a.schedulers[0])
-    except ConfigError as exc:
-        raise UsageError("--protocol", str(exc)) from exc
+    for name in a.schedulers:  # what only a drawn day shows (more people than the world has, a scheduler's
+        try:  # options): for each scheduler, before any day runs
+            days.make(a.protocol, a.first_seed, backend=a.backend, scheduler=name)
+        except ConfigError as exc:
+            raise UsageError("--protocol", str(exc)) from exc
     n_workers = a.workers if a.workers is not None else (2 if a.backend == "synthetic" else 1)
     writable_dir(a.out, "--out")
     db, log = a.out / "days.db", a.out / "days.jsonl"

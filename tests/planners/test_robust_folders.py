@@ -250,3 +250,29 @@ def test_a_hook_that_kills_its_process_is_named_in_the_sweep(folder: Path) -> No
         (row,) = store.rows()
     assert row.error is not None and "exit code 7" in row.error
     assert f"in the task.py hook check_args of {folder / 'task.py'}" in row.error
+
+
+@pytest.mark.parametrize("name", ["robot", "deadline", "priority", "death_at"])
+def test_a_reserved_argument_name_is_refused(folder: Path, name: str) -> None:
+    """Before: an argument named deadline was stripped from the folder's own arguments by the request
+    fields every task type takes, so every request lacked it; robot shadowed $robot."""
+    toml = folder / "task.toml"
+    toml.write_text(toml.read_text() + f'\n[[args]]\nname = "{name}"\ntype = "float"\nrequired = false\n')
+    with pytest.raises(DefinitionError, match=f"args\\[2\\].name: '{name}' is reserved"):
+        load_task(folder, use_cache=False)
+
+
+def test_the_reserved_names_cover_the_request_fields() -> None:
+    from experiments.inputs.request_fields import FIELD_NAMES
+    from planners.taskspec import RESERVED_ARGS
+
+    assert set(FIELD_NAMES) <= set(RESERVED_ARGS)
+
+
+def test_one_condition_declared_as_two_hazards_is_refused(folder: Path) -> None:
+    """Before: accepted; every hazard metric counted the held item twice."""
+    toml = folder / "task.toml"
+    toml.write_text(toml.read_text() + '\n[[hazards]]\nname = "again"\nfact = ["holding", "$robot", "$item"]\n'
+                                       'budget_s = 30\n')
+    with pytest.raises(DefinitionError, match=r"hazards\[1\]: hazard 'again' has the fact of hazard 'item_held'"):
+        load_task(folder, use_cache=False)
