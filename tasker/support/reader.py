@@ -29,6 +29,7 @@ from __future__ import annotations
 import difflib
 import json
 import math
+import os
 import re
 import stat
 import tomllib
@@ -390,7 +391,7 @@ def read_bytes(path: str | Path, error_class: type[InputError] = InputError, *,
                limit: int = MAX_FILE_BYTES) -> bytes:
     """A file's bytes, at most ``limit`` of them: a missing file, a folder, a device (``/dev/zero``
     never ends) or a file larger than ``limit`` is a clean ``error_class`` naming it.  A pipe is
-    read up to the limit."""
+    read up to the limit; one that no program writes to reads as empty (it never blocks)."""
     p = Path(path)
     if "\x00" in str(path):
         raise error_class(repr(str(path)), "is not a valid file name (it holds a NUL character)")
@@ -400,7 +401,10 @@ def read_bytes(path: str | Path, error_class: type[InputError] = InputError, *,
             raise IsADirectoryError
         if not (stat.S_ISREG(mode) or stat.S_ISFIFO(mode)):
             raise error_class(p, "is not a regular file (a device or a socket), expected a file")
-        with p.open("rb") as f:
+        # a pipe is opened without waiting for a writer (none: it reads as empty), then read as a file
+        fd = os.open(p, os.O_RDONLY | os.O_NONBLOCK)
+        os.set_blocking(fd, True)
+        with os.fdopen(fd, "rb") as f:
             data = f.read(limit + 1)
     except FileNotFoundError:
         raise error_class(p, "no such file") from None
