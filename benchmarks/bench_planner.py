@@ -9,7 +9,10 @@ at every interruption point that needs a plan.  Each is solved by
 * ``OneshotPlanner(name="fast-downward-opt")`` on UP's model — the baseline;
 
 the plan costs must be equal (both optimal).  Then a repeated identical problem is
-answered from the cache.  Run: ``python benchmarks/bench_planner.py [--repeat N]``.
+answered from the cache.  Last, the translator alone, in CPU seconds over all the
+problems: the library's own ``main()`` on files (the baseline, what every call ran before
+:mod:`planners.translate`) against the reuse path, rounds interleaved, the SAS output of
+the two compared byte for byte.  Run: ``python benchmarks/bench_planner.py [--repeat N]``.
 """
 
 from __future__ import annotations
@@ -28,14 +31,16 @@ from unified_planning.shortcuts import OneshotPlanner  # noqa: E402
 
 from planners.bundled import task_types  # noqa: E402
 from planners.checks import load_problem_text  # noqa: E402
-from planners.engine import register_engine  # noqa: E402
 from planners.examples import StraightLineMotion, example_context  # noqa: E402
 from planners.pddl_task import PddlTaskType  # noqa: E402
 from planners.planner import PddlText, Planner, plan_cost  # noqa: E402
+from planners.registration import register_engine  # noqa: E402
+from planners.translate import translate  # noqa: E402
 from tasker.stage import Purpose  # noqa: E402
 
 TARGET_SPEEDUP = 5.0
 TARGET_CACHE_S = 1e-3
+TRANSLATE_ROUNDS = 5
 
 
 def problems_of(task: PddlTaskType) -> list[tuple[str, PddlText]]:
@@ -89,12 +94,14 @@ def main(argv: list[str] | None = None) -> int:
     ours = Planner(cache_size=0)
     ratios: list[float] = []
     mismatches = 0
+    translated: list[PddlText] = []
     print(f"{'domain':14s} {'problem':12s} {'Planner ms':>10s} {'tasker-fd ms':>12s} {'fd-opt ms':>10s} "
           f"{'ratio':>6s} {'cost':>6s}")
     for task in task_types():
         assert isinstance(task, PddlTaskType)
         dom_ratios = []
         for label, text in problems_of(task):
+            translated.append(text)
             model = load_problem_text(task.domain.checked, text.problem)
             t_ours, c_ours = timed(lambda text=text: ours.solve(text).cost, args.repeat)
             t_engine, c_engine = timed(up_solver("tasker-fd", model), args.repeat)
@@ -127,7 +134,27 @@ def main(argv: list[str] | None = None) -> int:
     print(f"repeated identical problem from the cache: median {cache_s * 1e6:.1f} us, max {max(hits) * 1e6:.1f} us "
           f"(target <= {TARGET_CACHE_S * 1e3:g} ms) {'OK' if cache_s <= TARGET_CACHE_S else 'MISSED'}")
     print(f"plan costs equal on every problem: {'yes' if mismatches == 0 else f'NO ({mismatches} mismatches)'}")
-    return 0 if mismatches == 0 and overall >= TARGET_SPEEDUP and cache_s <= TARGET_CACHE_S else 1
+    same = translator(translated, max(args.repeat, TRANSLATE_ROUNDS))
+    return 0 if mismatches == 0 and same and overall >= TARGET_SPEEDUP and cache_s <= TARGET_CACHE_S else 1
+
+
+def translator(problems: list[PddlText], rounds: int) -> bool:
+    """CPU seconds of the translator over ``problems``: the library's ``main()`` on files against
+    the reuse path (each domain read once per process), rounds interleaved; True if every SAS
+    output is byte-identical."""
+    same = all(translate(t.domain, t.problem) == translate(t.domain, t.problem, reuse=False) for t in problems)
+    cpu: dict[bool, list[float]] = {False: [], True: []}
+    for _ in range(rounds):
+        for reuse in (False, True):
+            t0 = time.process_time()
+            for t in problems:
+                translate(t.domain, t.problem, reuse=reuse)
+            cpu[reuse].append(time.process_time() - t0)
+    base, now = statistics.median(cpu[False]), statistics.median(cpu[True])
+    print(f"translator, CPU s over {len(problems)} problems (median of {rounds} rounds): library main() on files "
+          f"{base:.3f}, reuse path {now:.3f} = {base / now:.2f}x; SAS identical on every problem: "
+          f"{'yes' if same else 'NO'}")
+    return same
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 """Run every benchmark in this folder, one after the other, each in its own process.
 
-    python benchmarks/run_all.py [NAME ...]     # e.g. core planner estimates robot paper sweep lookahead startup
+    python benchmarks/run_all.py [NAME ...]   # e.g. core planner estimates robot paper sweep throughput
 
 Each benchmark prints ratios against baselines it measures in the same run.
 """

@@ -2,8 +2,8 @@
 
 * :class:`Planner` — solve with any UP one-shot engine by name, cached (:mod:`planners.planner`);
 * ``tasker-fd`` — the fast optimal Fast Downward engine (:mod:`planners.engine`), registered
-  with UP's factory by :func:`register_engine` (a :class:`Planner` does it when it needs UP's
-  factory, and so does asking this package for any engine-related name);
+  with UP's factory by :func:`register_engine` (:mod:`planners.registration`; a :class:`Planner`
+  does it when it needs UP's factory, and so does asking this package for any engine-related name);
 * :func:`load_task_folder` — task folders (``domain.pddl`` + ``task.toml`` [+ ``task.py``])
   to :class:`~tasker.task.TaskType` instances, checked before any run.
 
@@ -18,13 +18,16 @@ import importlib
 from typing import Any
 
 _EXPORTS = {
-    "DEFAULT_PLANNER": "planners.planner", "ENGINE_NAME": "planners.engine", "DefinitionError": "planners.checks",
+    "DEFAULT_PLANNER": "planners.planner", "ENGINE_NAME": "planners.registration", "DefinitionError": "planners.checks",
     "PddlError": "planners.checks", "PddlTaskType": "planners.pddl_task", "PddlText": "planners.planner",
     "PlanResult": "planners.results", "PlanStatus": "planners.results", "Planner": "planners.planner",
     "TaskerFastDownward": "planners.engine", "load_domain": "planners.checks", "load_problem": "planners.checks",
-    "load_task": "planners.loader", "load_task_folder": "planners.loader", "oneshot_planners": "planners.planner",
-    "register_engine": "planners.engine", "store_loader": "planners.loader",
+    "load_task": "planners.loader", "load_task_folder": "planners.loader", "oneshot_planners": "planners.registration",
+    "register_engine": "planners.registration", "store_loader": "planners.loader",
 }
+
+_ENGINE_NAMES = frozenset({"ENGINE_NAME", "TaskerFastDownward", "register_engine"})
+"""Asking for one of these registers ``tasker-fd`` with UP's factory first."""
 
 __all__ = sorted(_EXPORTS)
 
@@ -34,7 +37,7 @@ def __getattr__(name: str) -> Any:
     if module is None:
         raise AttributeError(f"module 'planners' has no attribute {name!r}")
     value = getattr(importlib.import_module(module), name)
-    if module == "planners.engine":
-        importlib.import_module(module).register_engine()
+    if name in _ENGINE_NAMES:
+        importlib.import_module("planners.registration").register_engine()
     globals()[name] = value
     return value

@@ -1,6 +1,7 @@
 """``tasker-fd``: a unified-planning one-shot engine over :mod:`planners.fd`.
 
-Registered with UP's factory under :data:`ENGINE_NAME`, so any UP code can write::
+Registered with UP's factory under :data:`~planners.registration.ENGINE_NAME` (by
+:func:`planners.registration.register_engine`), so any UP code can write::
 
     with OneshotPlanner(name="tasker-fd") as planner:
         result = planner.solve(problem, timeout=5)
@@ -21,13 +22,12 @@ import unified_planning as up
 from unified_planning.engines import Engine, LogLevel, LogMessage, OptimalityGuarantee, PlanGenerationResult
 from unified_planning.engines import PlanGenerationResultStatus as UPStatus
 from unified_planning.engines.mixins import OneshotPlannerMixin
-from unified_planning.environment import get_environment
 from unified_planning.io import PDDLWriter
 from unified_planning.model import ProblemKind
 
 from planners.fd import OPTIMAL_SEARCH, run_fast_downward
 from planners.kind import supported_kind
-from planners.planner import ENGINE_NAME
+from planners.registration import ENGINE_NAME
 from planners.results import PlanStatus, from_fd_outcome
 
 _UP_STATUS = {
@@ -112,12 +112,3 @@ class TaskerFastDownward(Engine, OneshotPlannerMixin):
         logs = [LogMessage(LogLevel.INFO, f"{len(result.plan)} steps, cost {result.cost:g}, search {self._search}")]
         return PlanGenerationResult(status, up.plans.SequentialPlan(actions), self.name, metrics, logs)
 
-
-def register_engine(name: str = ENGINE_NAME) -> None:
-    """Add the engine to UP's factory (idempotent), through UP's documented ``add_engine``;
-    also silence UP's credits banner, which would otherwise go to stdout."""
-    env = get_environment()
-    env.credits_stream = None
-    factory = env.factory
-    if name not in factory.engines:
-        factory.add_engine(name, __name__, TaskerFastDownward.__name__)

@@ -47,20 +47,17 @@ from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from enum import StrEnum
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
-from planners.planner import PddlText
-from planners.problem import PLACE_TYPE, holds, render_problem, travel_table
+from planners.planner import PddlText, Planner
+from planners.problem import PLACE_TYPE, DomainModel, holds, render_problem, travel_table
 from planners.results import PlanStatus, PlanStep
-from planners.stages import Bindings, robot_name
-from planners.taskspec import Literal
+from planners.stages import Bindings, StageBuilder, robot_name
+from planners.taskspec import Branch, Literal, TaskSpec
 from tasker.errors import PlanningFailed
 from tasker.stage import Purpose, Stage
 from tasker.task import TaskContext
 from tasker.world import Pose, WorldState
-
-if TYPE_CHECKING:
-    from planners.pddl_task import PddlTaskType
 
 NAVIGATE = "navigate"
 """The skill whose stages are timed with the motion model (others by their duration)."""
@@ -68,6 +65,33 @@ PERSON_TYPE = "person"
 """The object type of people: a leg to one ends where they stand (see :func:`walk`)."""
 
 Travel = dict[tuple[str, str], float]
+
+
+class EstimatedTask(Protocol):
+    """What an :class:`Estimator` needs of a task type: its folder's definition, its planner,
+    and the planning inputs upTsk and genSusp would use.
+
+    :class:`~planners.pddl_task.PddlTaskType` is the one tasker builds; the estimator names
+    this protocol rather than that class, so the dependency goes one way (the task type
+    uses its estimator).
+    """
+
+    name: str
+    spec: TaskSpec
+    domain: DomainModel
+    builder: StageBuilder
+    timeout: float
+
+    @property
+    def planner(self) -> Planner: ...
+
+    def update_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], list[Literal]]: ...
+
+    def suspension_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], Branch]: ...
+
+    def suspension_facts(self, ctx: TaskContext, world: WorldState) -> list[Literal]: ...
+
+    def branch(self, ctx: TaskContext, world: WorldState) -> tuple[Branch, Bindings]: ...
 
 
 class Source(StrEnum):
@@ -171,6 +195,18 @@ def _same_pose(a: Pose | None, b: Pose | None) -> bool:
     return a is not None and b is not None and all(abs(x - y) < 1e-6 for x, y in zip(a[:3], b[:3], strict=False))
 
 
+def declared_template_time(spec: TaskSpec, domain: DomainModel) -> float:
+    """Without a world: the static template's declared durations, travel at ``travel_s``."""
+    total = 0.0
+    for t in spec.static_update:
+        a, model = spec.actions[t.action], domain.actions[t.action]
+        if a.travel is not None:
+            total += spec.travel_s
+        else:
+            total += a.duration if a.duration is not None else (model.constant_cost or 0.0)
+    return total
+
+
 def executing(ctx: TaskContext) -> bool:
     """True while a stage of ``exeTsk`` runs: the agent's plan is its plan from the state now."""
     return ctx.plan is not None and ctx.plan.purpose is Purpose.UP_TSK and ctx.stage_started is not None
@@ -192,12 +228,12 @@ class EstimatorStats:
 
 
 class Estimator:
-    """Plan-based estimates for one :class:`~planners.pddl_task.PddlTaskType` (shared by its agents).
+    """Plan-based estimates for one task type (:class:`EstimatedTask`; shared by its agents).
 
     ``cache_size`` bounds the LRU of plans by symbolic problem (0 disables it).
     """
 
-    def __init__(self, task: PddlTaskType, cache_size: int = 256) -> None:
+    def __init__(self, task: EstimatedTask, cache_size: int = 256) -> None:
         self.task = task
         self.cache_size = cache_size
         self.stats = EstimatorStats()
@@ -221,7 +257,7 @@ class Estimator:
         task = self.task
         world = ctx.world if isinstance(ctx.world, WorldState) else None
         if world is None:
-            return Estimate(task._declared_template_time(), None, Source.DECLARED)
+            return Estimate(declared_template_time(task.spec, task.domain), None, Source.DECLARED)
         here = world.poses.get(robot_name(world))
         elsewhere = start is not None and not _same_pose(start, here)
         if executing(ctx) and not elsewhere:
@@ -413,7 +449,7 @@ _estimators: weakref.WeakKeyDictionary[Any, Estimator] = weakref.WeakKeyDictiona
 _estimators_lock = threading.Lock()
 
 
-def estimator_for(task: PddlTaskType) -> Estimator:
+def estimator_for(task: EstimatedTask) -> Estimator:
     """The :class:`Estimator` of a task type (one per instance, so its agents share the cache)."""
     with _estimators_lock:
         est = _estimators.get(task)

@@ -6,8 +6,8 @@ the installed ``fast_downward.translate`` package runs in this process and only 
 C++ search binary shipped with ``up_fast_downward`` is started, which brings a small
 problem down to a few tens of milliseconds.
 
-The translator keeps its options in a module global (``options.options``) and prints
-to ``sys.stdout``, so every call holds :data:`TRANSLATE_LOCK` while it runs.
+The translation (:mod:`planners.translate`) reads each domain once per process and
+writes the SAS task to memory; it goes to the search binary on its standard input.
 
 This module works on PDDL *text*: :func:`run_fast_downward` takes a domain and a
 problem and returns an :class:`FDOutcome` with the plan as tuples of strings, exactly
@@ -17,17 +17,16 @@ the :class:`~planners.planner.Planner` facade are built on it.
 
 from __future__ import annotations
 
-import contextlib
 import importlib.util
-import io
 import os
 import subprocess
 import tempfile
-import threading
 import time
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
+
+from planners.translate import translate
 
 
 def _downward_bin() -> Path:
@@ -48,8 +47,6 @@ AXIOM_SEARCH = "astar(blind())"
 """Optimal fallback when the translated task has axioms (ADL conditions), which LM-cut refuses."""
 
 UNSUPPORTED_FEATURE = 34
-
-TRANSLATE_LOCK = threading.Lock()
 
 
 class FDExit(StrEnum):
@@ -114,37 +111,24 @@ def parse_plan_text(text: str) -> tuple[tuple[tuple[str, ...], ...], float | Non
     return tuple(steps), cost
 
 
-def _translate(domain_file: str, problem_file: str, sas_file: str) -> tuple[int, str]:
-    """Run FD's translator in this process; return ``(exit code, message)``."""
-    from fast_downward.translate import main as translate_main
-    from fast_downward.translate import options as translate_options
-
-    out = io.StringIO()
-    with TRANSLATE_LOCK, contextlib.redirect_stdout(out):
-        translate_options.set_options([domain_file, problem_file, "--sas-file", sas_file])
-        try:
-            translate_main.main()
-        except MemoryError:
-            return 20, "translator ran out of memory"
-        except SystemExit as exc:  # the translator reports input errors this way
-            return 30, f"translator: {exc}"
-        except Exception as exc:  # noqa: BLE001 - any translator failure is an input error for us
-            return 30, f"translator: {type(exc).__name__}: {exc}"
-    return 0, ""
+def _translate(domain: str, problem: str) -> tuple[int, str, bytes]:
+    """Translate in this process (:func:`planners.translate.translate`): ``(exit code, message, SAS)``."""
+    out = translate(domain, problem)
+    return out.code, out.message, out.sas.encode()
 
 
-def _search(sas: str, search: str, plan_file: str, timeout: float | None) -> subprocess.CompletedProcess[bytes] | None:
-    """Run the ``downward`` binary on a SAS file; ``None`` if it ran out of time."""
+def _search(sas: bytes, search: str, plan_file: str, timeout: float | None
+            ) -> subprocess.CompletedProcess[bytes] | None:
+    """Run the ``downward`` binary on a SAS task (its standard input); ``None`` if it ran out of time."""
     if timeout is not None and timeout <= 0:
         return None
-    with open(sas, "rb") as sas_in:
-        try:
-            return subprocess.run(
-                [str(DOWNWARD_BIN), "--search", search, "--internal-plan-file", plan_file],
-                stdin=sas_in, capture_output=True, timeout=timeout, check=False,
-            )
-        except subprocess.TimeoutExpired:
-            return None
+    try:
+        return subprocess.run(
+            [str(DOWNWARD_BIN), "--search", search, "--internal-plan-file", plan_file],
+            input=sas, capture_output=True, timeout=timeout, check=False,
+        )
+    except subprocess.TimeoutExpired:
+        return None
 
 
 def run_fast_downward(
@@ -159,17 +143,15 @@ def run_fast_downward(
     interrupted, so an over-long translation is reported as a time-out after it ends.
     """
     start = time.perf_counter()
+    code, message, sas = _translate(domain, problem)
+    t_translate = time.perf_counter() - start
+    if code != 0:
+        return FDOutcome(FDExit.from_code(code), code, None, None, t_translate, 0.0, message)
+    remaining = None if timeout is None else timeout - t_translate
+    if remaining is not None and remaining <= 0:
+        return FDOutcome(FDExit.TIMEOUT, 21, None, None, t_translate, 0.0, "time limit reached while translating")
     with tempfile.TemporaryDirectory(prefix="tasker-fd-") as tmp:
-        dom, prob, sas, plan_file = (os.path.join(tmp, n) for n in ("domain.pddl", "problem.pddl", "out.sas", "plan"))
-        Path(dom).write_text(domain)
-        Path(prob).write_text(problem)
-        code, message = _translate(dom, prob, sas)
-        t_translate = time.perf_counter() - start
-        if code != 0:
-            return FDOutcome(FDExit.from_code(code), code, None, None, t_translate, 0.0, message)
-        remaining = None if timeout is None else timeout - t_translate
-        if remaining is not None and remaining <= 0:
-            return FDOutcome(FDExit.TIMEOUT, 21, None, None, t_translate, 0.0, "time limit reached while translating")
+        plan_file = os.path.join(tmp, "plan")
         t0 = time.perf_counter()
         proc = _search(sas, search, plan_file, remaining)
         if proc is not None and proc.returncode == UNSUPPORTED_FEATURE and search == OPTIMAL_SEARCH:

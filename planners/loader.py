@@ -26,7 +26,7 @@ import warnings
 from pathlib import Path
 from typing import Any
 
-from planners import cache
+from planners import cache, examplecheck
 from planners.checks import DefinitionError, load_domain, load_problem_text, remembered_domain
 from planners.pddl_task import PddlTaskType, hook_line
 from planners.problem import DomainModel
@@ -265,6 +265,12 @@ def _check_meaning(spec: TaskSpec, dm: DomainModel) -> tuple[Binding, ...]:
         for role, lits in spec.people.roles.items():
             for lit in lits:
                 _check_pattern(spec, dm, f"people.{role}", lit, variables=True)
+    for lit in spec.invariants:
+        _check_pattern(spec, dm, "derived.invariants", lit, variables=False)
+    for lit in spec.restore:
+        if lit[0] == "not":
+            raise spec.error("problem.restore", f"a pattern of facts that hold (no 'not'), got {list(lit)}")
+        _check_pattern(spec, dm, "problem.restore", lit, variables=True)
     out = []
     for k, b in enumerate(spec.bindings):
         _check_pattern(spec, dm, f"bindings[{k}].fact", b.fact, variables=True)
@@ -318,6 +324,8 @@ def _check_example(task: PddlTaskType) -> None:
                                   + (f"; left out of the problem (an object or predicate the domain or [example] "
                                      f"objects do not declare): {left_out}" if left_out else "")
                                   + "; a request like it will end 'upTsk unsolvable'")
+    if result.solved and result.plan is not None:  # what the plan shows about the tree and the goal
+        examplecheck.check(task, ctx, examplecheck.example_stages(task, ctx, result.plan))
     if result.status is PlanStatus.TIMEOUT:  # not solved, not proven unsolvable: say so, not "solved"
         task.spec.warn("task.timeout_s", f"the planner did not finish the [example] within timeout_s = "
                                          f"{task.timeout:g} s (raise it, or simplify the domain); a request like it "
@@ -342,6 +350,7 @@ def load_task(folder: str | Path, *, use_cache: bool = True) -> PddlTaskType:
     bindings = _check_meaning(spec, dm)
     task = PddlTaskType(spec, dm, hooks=_load_hooks(spec))
     task.meaning = meaning_of(spec, bindings)
+    task.priority = spec.priority
     if remembered is not None:  # what the checks found doubtful then is as true now: said again
         for w in remembered.get("warnings", []):
             if isinstance(w, dict):

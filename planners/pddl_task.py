@@ -6,11 +6,16 @@ Hooks, and what they do here:
   (R6: what the robot or a person already did is not redone), solved optimally;
   ``static``: the template ``exeTsk`` of ``[static] update`` (Alg. 3).
 * ``generate_suspension`` (genSusp) — one decision list ``[[suspension]]`` (eq. 47) for
-  both strategies: the first branch whose ``when`` holds in the state at interruption
-  (see :meth:`PddlTaskType.branch`) gives the suspension goal; ``planned`` plans to it
-  from that state, ``static`` runs the branch's ``stages`` (checked at load to reach the
-  same goal).  Strategies differ only in method; ``ctx.strategy.policy`` decides whether
-  branches that trade safety for time are eligible, for both alike.
+  the tree's two strategies: the first branch whose ``when`` holds in the state at
+  interruption (see :meth:`PddlTaskType.branch`) gives the suspension goal; ``planned``
+  plans to it from that state, ``static`` runs the branch's ``stages`` (checked at load to
+  reach the same goal).  ``derived`` plans to a goal the folder's declarations give instead
+  of the tree's (:meth:`PddlTaskType.derived_goal`): every hazard the task owns off, its
+  person in a ``safe`` role of ``[people]``, its ``[derived] invariants``.  The method
+  (plan or run the stages) and the goal's source (tree or declarations) are separate
+  factors; ``ctx.strategy.policy`` decides, for all three alike, whether safety may be
+  traded for time (a ``conditional`` branch; a hazard whose budget covers the expected
+  interruption).
 * ``compute_params`` / ``request_sp`` — ``cost = cps * (age + cTime)``: the discomfort
   accumulated by completion, with ``cTime`` and ``endPose`` from the plan upTsk would make
   from the state asked about (:mod:`planners.estimates`), timed with ``ctx.motion``;
@@ -24,6 +29,7 @@ suspension or a planner time-out falls back to the static strategy, said in the 
 from __future__ import annotations
 
 import contextlib
+import itertools
 import math
 import traceback
 from collections.abc import Callable, Iterator
@@ -35,20 +41,40 @@ from typing import Any
 from planners.checks import DefinitionError
 from planners.estimates import estimator_for, executing
 from planners.planner import PddlText, Planner
-from planners.problem import PLACE_TYPE, DomainModel, PortablePddl, holds, portable, render_problem, travel_table
+from planners.problem import (
+    CONNECTED,
+    PLACE_TYPE,
+    DomainModel,
+    PortablePddl,
+    holds,
+    portable,
+    render_problem,
+    travel_table,
+)
 from planners.results import PlanResult, PlanStatus
 from planners.stages import Bindings, StageBuilder, place_of, robot_name
 from planners.taskspec import Branch, Literal, TaskSpec
 from tasker.errors import BadRequest, PlanningFailed, UnknownName
+from tasker.meaning import Hazard, bind, matches
+from tasker.meaning import holds as holds_literal
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
 from tasker.stage import Purpose, Stage, StagePlan
 from tasker.task import Effects, Leaving, TaskContext, TaskType
+from tasker.trace import INAPPLICABLE
 from tasker.world import Pose, WorldState
 
+PLANNED_FROM_KEY = "_planned_from"
+"""``ctx.memory`` key: the last plans' stages, each with the facts it was made from."""
+PLANS_REMEMBERED = 8
+LOCATION = "at"
+MOVERS = frozenset({"robot", "person"})
+"""Object types whose ``at`` fact the world grounds from a pose (:meth:`PddlTaskType._assumed`)."""
 INTERRUPTION_KEY = "interruption_s"
-PREPLAN_KEY = "_suspension_planned_ahead"
-"""``ctx.memory`` key: (symbolic suspension problem, its PlanResult or None if the goal held)."""
+RESTORE_KEY = "_restore_baseline"
+"""``ctx.memory`` key: the facts of ``[problem] restore``'s patterns that held when the task first planned."""
 """``ctx.memory`` key: expected length of an interruption (s); unknown means long."""
+PREPLAN_KEY = "_suspension_planned_ahead"
+"""``ctx.memory`` key: (symbolic suspension problem, its plan's steps, empty if the goal held), or None: no plan."""
 
 _shared_planner: Planner | None = None
 
@@ -143,6 +169,21 @@ class PddlTaskType(TaskType):
         return str(why) if why else None
 
     def update_task(self, ctx: TaskContext) -> StagePlan:
+        return self._planned_from(ctx, self._update_task(ctx))
+
+    def generate_suspension(self, ctx: TaskContext) -> StagePlan:
+        return self._planned_from(ctx, self._generate_suspension(ctx))
+
+    def _planned_from(self, ctx: TaskContext, plan: StagePlan) -> StagePlan:
+        """Remember the state ``plan`` was made from (``ctx.memory``, the last few plans: an estimate may
+        plan a suspension on a copy of the context meanwhile), for :meth:`inapplicable`."""
+        if isinstance(ctx.world, WorldState) and plan.stages:
+            made = ctx.memory.setdefault(PLANNED_FROM_KEY, [])
+            made.append((plan.stages, ctx.world.facts))
+            del made[:-PLANS_REMEMBERED]
+        return plan
+
+    def _update_task(self, ctx: TaskContext) -> StagePlan:
         if ctx.strategy.update == "static":
             return self.static_update(ctx)
         world, goal, extra = self.update_inputs(ctx)
@@ -160,10 +201,10 @@ class PddlTaskType(TaskType):
             return self._fallback(self.static_update(ctx), "planner timed out for upTsk")
         raise PlanningFailed("error", f"{self.name}: planner error: {outcome.message}")
 
-    def generate_suspension(self, ctx: TaskContext) -> StagePlan:
+    def _generate_suspension(self, ctx: TaskContext) -> StagePlan:
         if ctx.strategy.suspension == "static":
             return self.static_suspension(ctx)
-        world, goal, branch = self.suspension_inputs(ctx)
+        world, goal, branch = self.suspension_inputs(ctx)  # the tree's branch, or the derived goal
         extra = self.suspension_facts(ctx, world)
         ready = self._preplanned(ctx, world, goal, extra, branch.label)
         if ready is not None:
@@ -174,6 +215,67 @@ class PddlTaskType(TaskType):
         why = {PlanStatus.UNSOLVABLE: "suspension goal unsolvable", PlanStatus.TIMEOUT: "planner timed out"}
         return self._fallback(self.static_suspension(ctx),
                               f"{why.get(outcome.status, 'planner error')} for {goal}")
+
+    def inapplicable(self, ctx: TaskContext, stage: Stage) -> str | None:
+        """Why ``stage`` cannot run now: the literals of its action's precondition that do not hold.
+
+        Checked in the state the planner would see — the world, the request's and ``task.py``'s
+        facts, Alg. 3's while suspended — except for what the stage's own plan is entitled to
+        assume: facts no world holds (an apology due) and where the robot and people are (the
+        world grounds those from poses, a metre from the place a plan means) are read from the
+        state the plan was made from, as its stages executed so far left it.  ``connected`` is
+        left out (the planner derives it from the motion model).  None when the stage can run,
+        when it would change nothing, or when the precondition is not a conjunction of literals."""
+        world = ctx.world
+        if not isinstance(world, WorldState) or stage.action not in self.domain.actions:
+            return None
+        try:
+            b = Bindings(ctx.args, world)
+            extra = b.literals(self.spec.facts) + (b.literals(self.spec.suspended_facts) if ctx.suspended else [])
+            extra += self._hook_facts(ctx, world)
+        except PlanningFailed:
+            return None
+        facts = world.facts | frozenset(extra)
+        add, delete = [tuple(f) for f in stage.data.get("add", ())], [tuple(f) for f in stage.data.get("delete", ())]
+        if add and all(f in facts for f in add) and not any(f in facts for f in delete):
+            return None  # it would change nothing (driving to where the robot stands): nothing to refuse
+        projected = self._projection(ctx, stage, frozenset(extra) - world.facts)
+        if projected is not None:
+            assumed, kinds = projected
+            facts = frozenset(f for f in facts if not self._assumed(f, kinds, world)) | assumed
+        unmet = [lit for lit in self.domain.unmet(stage.action, stage.args, facts) or ()
+                 if (lit[1] if lit[0] == "not" else lit[0]) != CONNECTED]
+        if not unmet:
+            return None
+        said = ", ".join(f"({' '.join(lit)})" for lit in unmet)
+        return f"{INAPPLICABLE} {stage.action}({' '.join(stage.args)}) needs {said}, which does not hold"
+
+    def _projection(self, ctx: TaskContext, stage: Stage,
+                    extra: frozenset[Literal]) -> tuple[frozenset[Literal], frozenset[str]] | None:
+        """What ``stage``'s plan may assume: the facts it was made from of the kinds :meth:`_assumed` names,
+        updated by the effects of the plan's stages before ``stage``; None for a stage of no plan made here."""
+        world = ctx.world
+        assert isinstance(world, WorldState)
+        kinds = frozenset(f[0] for f in extra)
+        for stages, planned_facts in reversed(ctx.memory.get(PLANNED_FROM_KEY, ())):
+            k = next((i for i, s in enumerate(stages) if s is stage), None)
+            if k is None:
+                continue
+            state = {f for f in planned_facts | extra if self._assumed(f, kinds, world)}
+            for done in stages[:k]:
+                state -= {tuple(f) for f in done.data.get("delete", ()) if self._assumed(tuple(f), kinds, world)}
+                state |= {tuple(f) for f in done.data.get("add", ()) if self._assumed(tuple(f), kinds, world)}
+            return frozenset(state), kinds
+        return None
+
+    @staticmethod
+    def _assumed(fact: Literal, extra_kinds: frozenset[str], world: WorldState) -> bool:
+        """A fact a plan reads from its own projection, not from the world now: one of a kind no world
+        holds (``extra_kinds``: the request's, ``task.py``'s, Alg. 3's), or where the robot or a person is
+        (an abstraction of a pose that the stage which drove there has met)."""
+        if fact[0] in extra_kinds:
+            return True
+        return fact[0] == LOCATION and len(fact) == 3 and world.objects.get(fact[1]) in MOVERS
 
     def compute_params(self, ctx: TaskContext) -> CostParams:
         """``cost = cps * (age + cTime)``; cTime and endPose from :meth:`estimate` of the state now.
@@ -200,17 +302,124 @@ class PddlTaskType(TaskType):
     # -- planning inputs (public for tests and tools) -----------------------------------
 
     def update_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], list[Literal]]:
-        """upTsk: the world, the goal and the extra init facts (request, Alg. 3, task.py)."""
+        """upTsk: the world, the goal (with what ``[problem] restore`` asks back) and the extra init
+        facts (request, Alg. 3, task.py)."""
         world = self._world(ctx)
         b = Bindings(ctx.args, world)
         extra = b.literals(self.spec.facts) + (b.literals(self.spec.suspended_facts) if ctx.suspended else [])
-        return world, b.literals(self.spec.goal), extra + self._hook_facts(ctx, world)
+        goal = b.literals(self.spec.goal)
+        goal += [lit for lit in self.restored(ctx, world) if lit not in goal]
+        return world, goal, extra + self._hook_facts(ctx, world)
+
+    def restored(self, ctx: TaskContext, world: WorldState) -> list[Literal]:
+        """``[problem] restore``: ``("not", fact)`` for every ground instance of a pattern (over the
+        world's objects of the predicate's types) that did not hold when this task first planned
+        (remembered in ``ctx.memory``), so it leaves them as it found them."""
+        if not self.spec.restore:
+            return []
+        robot = robot_name(world)
+        patterns = [p for pat in self.spec.restore if (p := bind(pat, ctx.args, robot)) is not None]
+        baseline = ctx.memory.setdefault(RESTORE_KEY, frozenset(f for p in patterns for f in matches(p, world.facts)))
+        out: list[Literal] = []
+        for pat in patterns:
+            signature = self.domain.predicates.get(pat[0], ())
+            choices = []
+            for tok, typ in zip(pat[1:], signature, strict=False):
+                if tok.startswith("?"):
+                    choices.append(sorted(n for n, t in world.objects.items() if self.domain.has_type(t, typ)))
+                else:
+                    choices.append([tok])
+            for inst in itertools.product(*choices):
+                fact = (pat[0], *inst)
+                if fact not in baseline and ("not", *fact) not in out:
+                    out.append(("not", *fact))
+        return out
 
     def suspension_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], Branch]:
-        """genSusp: the world at interruption, the suspension goal and the branch that chose it."""
+        """genSusp: the world at interruption, the suspension goal and the branch that chose it
+        (for ``derived``, a branch made of the derived goal and its label, with no stages)."""
         world = self._world(ctx)
+        if ctx.strategy.suspension == "derived":
+            goal, label = self.derived_goal(ctx, world)
+            return world, goal, Branch(goal=tuple(goal), label=label)
         branch, b = self.branch(ctx, world)
         return world, b.literals(branch.goal), branch
+
+    def owned_hazards(self, ctx: TaskContext, world: WorldState) -> list[tuple[Hazard, Literal]]:
+        """The declared hazards that hold now and are this task's, as the hazard monitor owns them
+        (:class:`tasker.meaning.Monitor`): a pattern with ``$args`` through the request's arguments; one
+        without, when the monitor gives it to this agent (``ctx.hazards``) or a stage of this task made it
+        true (its ``add`` effects) and it still holds."""
+        robot = robot_name(world)
+        mine = {(name, tuple(f)) for name, f in (ctx.hazards() if ctx.hazards is not None else ())}
+        made = {tuple(f) for s in ctx.done for f in s.data.get("add", ())}
+        out: list[tuple[Hazard, Literal]] = []
+        for hz in self.spec.hazards:
+            atom = bind(hz.fact, ctx.args, robot)
+            if atom is None:
+                continue
+            by_args = any(tok.startswith("$") and tok != "$robot" for tok in hz.fact)
+            for f in matches(atom, world.facts):
+                if by_args or (hz.name, f) in mine or f in made:
+                    out.append((hz, f))
+        return out
+
+    def derived_goal(self, ctx: TaskContext, world: WorldState) -> tuple[list[Literal], str]:
+        """The ``derived`` suspension goal and a label saying what it asks for.
+
+        * every hazard this task owns (:meth:`owned_hazards`) off — under the ``conditional``
+          policy, a hazard whose ``budget_s`` is at least the expected interruption
+          (``ctx.memory["interruption_s"]``; unknown means long) may stay on;
+        * the task's person in one of the ``safe`` roles of ``[people]``: if none holds, the
+          role literal the planner reaches most cheaply (each is planned as the estimates plan);
+        * the ``[derived] invariants``."""
+        expected = ctx.memory.get(INTERRUPTION_KEY)
+        length = math.inf if expected is None else float(expected)
+        goal: list[Literal] = []
+        said: list[str] = []
+        for hz, fact in self.owned_hazards(ctx, world):
+            if ctx.strategy.policy == "conditional" and length <= hz.budget_s:
+                said.append(f"{hz.name}({', '.join(fact[1:])}) left on")
+                continue
+            goal.append(("not", *fact))
+            said.append(f"{hz.name}({', '.join(fact[1:])}) off")
+        b = Bindings(ctx.args, world)
+        goal += [lit for lit in b.literals(self.spec.invariants) if lit not in goal]
+        if self.spec.invariants:
+            said.append("invariants")
+        people = self.spec.people
+        if people is not None and people.safe:
+            robot = robot_name(world)
+            options = [lit for role in people.safe for pat in people.roles[role]
+                       if (lit := bind(pat, ctx.args, robot)) is not None]
+            if options and not any(holds_literal(lit, world.facts) for lit in options):
+                chosen = self._cheapest(ctx, world, goal, options)
+                if chosen is not None:
+                    goal.append(chosen)
+                    said.append(f"{ctx.args.get(people.person)} {' '.join(chosen)}")
+            else:
+                said.append(f"{ctx.args.get(people.person)} safe")
+        return goal, "derived: " + (", ".join(said) if said else "nothing to make safe")
+
+    def _cheapest(self, ctx: TaskContext, world: WorldState, goal: list[Literal],
+                  options: list[Literal]) -> Literal | None:
+        """Of ``options`` (a safe role's literals), the one added to ``goal`` the planner reaches at
+        the lowest cost (planned as the estimates plan: cached, travel with nobody in the way); the
+        first one if it reaches none (genSusp will then say it is unsolvable)."""
+        extra = self.suspension_facts(ctx, world)
+        travel = estimator_for(self).reference_table(world, ctx.motion)
+        best: tuple[float, int] | None = None
+        for k, lit in enumerate(options):
+            steps, status, _ = estimator_for(self).plan(ctx, world, [*goal, lit], extra)
+            if status is not PlanStatus.SOLVED:
+                continue
+            try:
+                cost = sum(s.duration for s in self.builder.from_steps(steps, travel, ctx.args))
+            except PlanningFailed:  # a leg the robot cannot drive now
+                continue
+            if best is None or (cost, k) < best:
+                best = (cost, k)
+        return options[best[1] if best is not None else 0]
 
     def suspension_facts(self, ctx: TaskContext, world: WorldState) -> list[Literal]:
         """genSusp's extra init facts: the request's and ``task.py``'s (e.g. carry_object's
@@ -407,17 +616,6 @@ class PddlTaskType(TaskType):
     def _fallback(plan: StagePlan, why: str) -> StagePlan:
         return StagePlan(plan.stages, plan.purpose, strategy="static", sim_time=plan.sim_time,
                          note=f"fallback to static: {why}", info=plan.info)
-
-    def _declared_template_time(self) -> float:
-        """Without a world: the static template's declared durations, travel at ``travel_s``."""
-        total = 0.0
-        for t in self.spec.static_update:
-            a, model = self.spec.actions[t.action], self.domain.actions[t.action]
-            if a.travel is not None:
-                total += self.spec.travel_s
-            else:
-                total += a.duration if a.duration is not None else (model.constant_cost or 0.0)
-        return total
 
     def estimate(self, ctx: TaskContext, start: Pose | None, after: str | None = None) -> tuple[float, Pose | None]:
         """Seconds to complete the task from ``start`` (the robot's pose if None) and the end pose.

@@ -5,8 +5,8 @@
 :class:`~planners.results.PlanResult`.  The default engine is ``tasker-fd``
 (:mod:`planners.engine`); given PDDL text it goes straight to Fast Downward without
 building a UP model at all.  Results are cached on the PDDL text (domain + problem),
-so a repeated identical problem is answered from memory; time-outs and errors are
-never cached.
+so a repeated identical problem is answered from memory (its ``wall_time_s`` is that
+answer's, not the original solve's); time-outs and errors are never cached.
 
 With the default engine nothing of unified-planning is imported (the command line's
 path to Fast Downward stays fast); another engine imports UP's factory when first used,
@@ -25,14 +25,12 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 from planners.fd import OPTIMAL_SEARCH, run_fast_downward
+from planners.registration import ENGINE_NAME, oneshot_planners, register_engine
 from planners.results import PlanResult, PlanStatus, from_fd_outcome
 from tasker.errors import UnknownName
 
 if TYPE_CHECKING:
     import unified_planning as up
-
-ENGINE_NAME = "tasker-fd"
-"""The name of the in-process Fast Downward engine (:mod:`planners.engine` registers it)."""
 
 DEFAULT_PLANNER = ENGINE_NAME
 """The engine a :class:`Planner` uses unless told otherwise."""
@@ -44,24 +42,6 @@ class PddlText:
 
     domain: str
     problem: str
-
-
-def oneshot_planners() -> list[str]:
-    """Names of the one-shot planning engines installed in UP's factory."""
-    from unified_planning.environment import get_environment
-
-    from planners.engine import register_engine
-
-    register_engine()
-    factory = get_environment().factory
-    return sorted(n for n in factory.engines if _is_oneshot(factory.engine(n)))
-
-
-def _is_oneshot(cls: type) -> bool:
-    try:
-        return bool(getattr(cls, "is_oneshot_planner")())  # noqa: B009 - engines are duck-typed
-    except Exception:  # noqa: BLE001 - meta-engine wrappers may refuse the question
-        return False
 
 
 def plan_steps(plan: Any) -> tuple[tuple[str, ...], ...]:
@@ -102,17 +82,20 @@ class Planner:
 
     def solve(self, problem: up.model.Problem | PddlText, timeout: float | None = None) -> PlanResult:
         """Solve ``problem``; never raises for an unsolvable or failing problem (see the status)."""
+        asked = time.perf_counter()
         timeout = self.timeout if timeout is None else timeout
         text = problem if isinstance(problem, PddlText) else self._text_of(problem)
         key = (self.name, text.domain, text.problem)
         if self.cache_size:
             with self._lock:
                 hit = self._cache.get(key)
-                if hit is not None:
+                if hit is None:
+                    self.misses += 1
+                else:
                     self._cache.move_to_end(key)
                     self.hits += 1
-                    return replace(hit, cached=True)
-                self.misses += 1
+            if hit is not None:  # this call's time: the original solve's was counted when it ran
+                return replace(hit, cached=True, wall_time_s=time.perf_counter() - asked)
         start = time.perf_counter()
         if self.name == ENGINE_NAME:
             result = self._solve_fd(text, timeout, start)
@@ -162,8 +145,6 @@ class Planner:
 
     def _solve_up(self, problem: up.model.Problem, timeout: float | None, start: float) -> PlanResult:
         from unified_planning.shortcuts import OneshotPlanner
-
-        from planners.engine import register_engine
 
         register_engine()  # also silences the credits banner
         with warnings.catch_warnings(record=True) as caught:

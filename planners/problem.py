@@ -59,6 +59,25 @@ class DomainModel:
             raise PddlError(self.checked.path, f"{where}: {atom[0]!r} takes {len(self.predicates[atom[0]])} "
                                                f"argument(s), got {len(atom) - 1}: {list(lit)}")
 
+    def unmet(self, action: str, args: Sequence[str], facts: frozenset[Fact] | set[Fact]) -> list[Fact] | None:
+        """The literals of ``action``'s precondition, grounded with ``args``, that do not hold in
+        ``facts`` (empty: it can run); None when the precondition is not a plain conjunction of
+        literals (it is then not decided here)."""
+        model = self.actions[action]
+        if model.precondition is None:
+            return None
+        binding = {f"?{p}": a for p, a in zip(model.params, args, strict=True)}
+        out: list[Fact] = []
+        for lit in model.precondition:
+            atom = tuple(binding.get(x, x) for x in lit.args)
+            if lit.fluent == "=":
+                ok = (len(set(atom)) == 1) == lit.positive
+            else:
+                ok = ((lit.fluent, *atom) in facts) == lit.positive
+            if not ok:
+                out.append((lit.fluent, *atom) if lit.positive else ("not", lit.fluent, *atom))
+        return out
+
     def ground(self, action: str, args: Sequence[str]) -> tuple[list[Fact], list[Fact]]:
         """``(add, delete)`` of an action applied with ``args`` (PDDL semantics: delete first)."""
         model = self.actions[action]

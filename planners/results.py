@@ -52,8 +52,8 @@ class PlanResult:
     ``plan`` holds the steps (empty for an already-satisfied goal) when ``status`` is
     SOLVED and is ``None`` otherwise; ``cost`` is the plan's metric value (the action
     costs, or the length without a metric); ``wall_time_s`` is the measured time of
-    the call that produced it (a cache hit keeps the original's) and ``cached`` tells
-    whether it came from the cache.  ``message`` explains a failure.
+    the call that returned it (a cache hit's is the look-up's: the original solve's time
+    was counted once, when it ran) and ``cached`` tells whether it came from the cache.  ``message`` explains a failure.
     """
 
     status: PlanStatus

@@ -15,7 +15,7 @@ is always read this way, checked or remembered, so the two paths cannot disagree
 
 The translator's parser consults its module-global options (``--keep-no-ops``: an
 action without effects is kept, as PDDL and unified-planning keep it), so a read
-holds :data:`planners.fd.TRANSLATE_LOCK` like a translation does.
+holds :data:`planners.translate.TRANSLATE_LOCK` like a translation does.
 """
 
 from __future__ import annotations
@@ -24,9 +24,8 @@ import contextlib
 import functools
 import io
 from dataclasses import dataclass
-from pathlib import Path
 
-from planners.fd import TRANSLATE_LOCK
+from planners.translate import TRANSLATE_LOCK, domain_sexp
 
 OBJECT_TYPE = "object"
 """PDDL's root type; a type of the schema only in domains that use it (see :func:`read_schema`)."""
@@ -54,6 +53,10 @@ class ActionModel:
     effects: tuple[EffectTemplate, ...]
     constant_cost: float | None
     param_types: tuple[str, ...] = ()
+    precondition: tuple[EffectTemplate, ...] | None = ()
+    """The precondition as a conjunction of literals (``positive`` False: a negated one; ``=`` may
+    appear as a fluent), or None when it is more than that (a disjunction, a quantifier): then
+    applicability is not decided from it (:meth:`planners.problem.DomainModel.unmet`)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -82,13 +85,13 @@ def read_schema(text: str) -> DomainSchema:
 def _read(text: str) -> DomainSchema:
     from fast_downward.translate import options as fd_options
     from fast_downward.translate import pddl
-    from fast_downward.translate.pddl_parser import lisp_parser, parsing_functions
+    from fast_downward.translate.pddl_parser import parsing_functions
     from fast_downward.translate.pddl_parser.parse_error import ParseError
 
     with TRANSLATE_LOCK, contextlib.redirect_stdout(io.StringIO()):
         fd_options.set_options(["domain.pddl", "problem.pddl", "--keep-no-ops"])
         try:
-            nested = lisp_parser.parse_nested_list(io.StringIO(text))
+            nested = domain_sexp(text)  # read once per process, shared with the translator
             (name, _req, types, _type_dict, constants, predicates, _pred_dict, functions, actions,
              _axioms) = parsing_functions.parse_domain_pddl(parsing_functions.Context(), nested)
         except (ParseError, SystemExit) as exc:  # the translator reports bad input both ways
@@ -105,6 +108,21 @@ def _read(text: str) -> DomainSchema:
     def type_of(t: str) -> str:
         return "" if t == OBJECT_TYPE and not rooted else t
 
+    def conjunction(c: pddl.Condition) -> tuple[EffectTemplate, ...] | None:
+        if isinstance(c, pddl.Truth):
+            return ()
+        if isinstance(c, pddl.Literal):
+            return (EffectTemplate(c.predicate, tuple(str(x) for x in c.args), not c.negated),)
+        if isinstance(c, pddl.Conjunction):
+            out: list[EffectTemplate] = []
+            for part in c.parts:
+                lits = conjunction(part)
+                if lits is None:
+                    return None
+                out += lits
+            return tuple(out)
+        return None  # a disjunction or a quantifier: not a plain conjunction of literals
+
     def action(a: pddl.Action) -> ActionModel:
         effects = tuple(
             EffectTemplate(e.literal.predicate, tuple(e.literal.args), not e.literal.negated)
@@ -113,7 +131,8 @@ def _read(text: str) -> DomainSchema:
         cost = a.cost.expression.value if isinstance(getattr(a.cost, "expression", None),
                                                      pddl.NumericConstant) else None
         return ActionModel(a.name, tuple(p.name.lstrip("?") for p in a.parameters), effects,
-                           None if cost is None else float(cost), tuple(type_of(p.type_name) for p in a.parameters))
+                           None if cost is None else float(cost), tuple(type_of(p.type_name) for p in a.parameters),
+                           conjunction(a.precondition))
 
     return DomainSchema(
         name=name,
@@ -126,7 +145,3 @@ def _read(text: str) -> DomainSchema:
         constants=tuple((c.name, type_of(c.type_name)) for c in constants),
     )
 
-
-def read_schema_file(path: str | Path) -> DomainSchema:
-    """:func:`read_schema` of a file (for tools and tests)."""
-    return read_schema(Path(path).read_text(encoding="utf-8-sig"))

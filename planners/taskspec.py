@@ -113,11 +113,19 @@ class TaskSpec:
     planning_time_s: float
     static_time_s: float
     timeout_s: float = 10.0
+    priority: int | None = None
+    """``[schedule] priority``: the type's priority class, higher is more urgent (None: the lowest)."""
     example: ExampleWorld | None = None
     hooks: Mapping[str, Any] = field(default_factory=dict)
     hazards: tuple[Hazard, ...] = ()
     people: People | None = None
     bindings: tuple[RawBinding, ...] = ()
+    invariants: tuple[Literal, ...] = ()
+    """``[derived] invariants``: facts that must hold whenever the task is suspended (derived strategy)."""
+    restore: tuple[Literal, ...] = ()
+    """``[problem] restore``: patterns of facts the task leaves as it found them — a ground instance
+    that did not hold when the task first planned must not hold at its goal (a door it opened is
+    closed again)."""
     lines: Mapping[str, int | None] = field(default_factory=dict)
     """Where each checked field is written (``"hazards[0].fact"`` -> line), for later checks."""
 
@@ -374,8 +382,25 @@ def _people(r: _Reader, top: reader.Table) -> People | None:
     person = p.string("person")
     r.note(p, "person")
     roles = {role: r.literals(p, role) for role in ROLES if role in p}
+    safe = tuple(str(s) for s in p.array("safe", []))
+    r.note(p, "safe")
+    for k, role in enumerate(safe):
+        if role not in roles:
+            raise r.fail(p.at("safe", {}), k, f"{role!r} is not a role this [people] declares "
+                                                f"({', '.join(sorted(roles)) or 'none'}){reader.suggest(role, roles)}")
     p.done()
-    return People(person, roles)
+    return People(person, roles, safe)
+
+
+def _derived(r: _Reader, top: reader.Table) -> tuple[Literal, ...]:
+    """``[derived] invariants``: what must hold whenever the task is suspended (besides its hazards
+    off and its person in a safe role), for the ``derived`` suspension strategy."""
+    if "derived" not in top:
+        return ()
+    d = top.table("derived")
+    invariants = r.literals(d, "invariants")
+    d.done()
+    return tuple(invariants)
 
 
 def _bindings(r: _Reader, top: reader.Table) -> tuple[RawBinding, ...]:
@@ -435,6 +460,7 @@ def read_task_toml(path: Path) -> TaskSpec:
         goal = r.literals(problem, "goal")
         facts = r.literals(problem, "facts")
         suspended_facts = r.literals(problem, "suspended_facts")
+        restore = r.literals(problem, "restore")
         problem.done()
         actions_t = top.table("actions")
         actions = {}
@@ -452,6 +478,7 @@ def read_task_toml(path: Path) -> TaskSpec:
         schedule = top.table("schedule", {})
         cps = schedule.number("cps", 1.0, min=0)
         travel_s = schedule.number("travel_s", 10.0, min=0, max=reader.MAX_SECONDS)
+        priority = schedule.number("priority", None, integer=True)
         schedule.done()
         spec = TaskSpec(
             folder=path.parent, name=name, description=description, domain_file=path.parent / domain,
@@ -459,7 +486,9 @@ def read_task_toml(path: Path) -> TaskSpec:
             suspension=r.branches(top, "suspension"), actions=actions, static_update=static_update,
             cps=float(cps), travel_s=float(travel_s), planning_time_s=float(planning_time_s),
             static_time_s=float(static_time_s), timeout_s=float(timeout_s), example=_example(r, top),
-            hazards=_hazards(r, top), people=_people(r, top), bindings=_bindings(r, top), lines=r.lines,
+            priority=None if priority is None else int(priority),
+            hazards=_hazards(r, top), people=_people(r, top), bindings=_bindings(r, top),
+            invariants=_derived(r, top), restore=tuple(restore), lines=r.lines,
         )
         top.done()
     return spec

@@ -25,6 +25,7 @@ from tasker.world import UNREACHABLE, MotionEstimate, Pose
 APPROACH = 0.9  # metres from a person's centre when the robot goes "to" them
 APPROACH_DIRECTIONS = 16
 APPROACH_RINGS = (APPROACH, 1.1, 1.3)  # tried in turn: a farther ring only when no pose of the nearer is reachable
+_ESTIMATE, _APPROACH, _RING = range(3)  # what a remembered answer answers (MotionEstimator._memo keys)
 
 
 class MotionEstimator:
@@ -36,20 +37,60 @@ class MotionEstimator:
     very pose the ``navigate`` skill drives to, so estimate and motion agree.
     """
 
-    def __init__(self, planner: BasePlanner, limits: DriveLimits, open_planner: BasePlanner | None = None) -> None:
+    def __init__(self, planner: BasePlanner, limits: DriveLimits, open_planner: BasePlanner | None = None,
+                 memo: bool = True) -> None:
         self.planner = planner
         self.limits = limits
         self.open_planner = open_planner
+        self.memo = memo
+        # answers for the scene state they were computed in (:meth:`_state`); forgotten
+        # all at once when it changes
+        self._memo_state: tuple[object, ...] | None = None
+        self._memo: dict[tuple[object, ...], object] = {}
+
+    def _state(self) -> tuple[object, ...]:
+        """What every answer of this estimator depends on besides its arguments and the person
+        it is about: the doors, the people in the robot's way (:meth:`Scene.discs
+        <robot.scene.Scene.discs>`: everyone but those making way for it, whose walking
+        behind the robot changes no path) and where people step aside to.  The planner
+        answers from exactly these (its walls and roadmap never change)."""
+        scene = self.planner.scene
+        return (tuple(sorted(scene.door_open.items())), tuple(scene.discs()),
+                tuple(sorted(scene.stepping_to.items())))
+
+    def _remembered(self, key: tuple[object, ...]) -> tuple[bool, object]:
+        if not self.memo:
+            return False, None
+        state = self._state()
+        if state != self._memo_state:
+            self._memo_state, self._memo = state, {}
+        return (True, self._memo[key]) if key in self._memo else (False, None)
+
+    def _remember(self, key: tuple[object, ...], value: object) -> None:
+        if self.memo and self._memo_state == self._state():  # unchanged while computing: still true
+            self._memo[key] = value
 
     def estimate(self, start: Pose, goal: Pose) -> MotionEstimate:
         """Time to drive from ``start`` to ``goal`` (to the person there, if any), with everyone
         who is stepping aside already where they are going (:meth:`Scene.as_expected
-        <robot.scene.Scene.as_expected>`): they will be by the time the robot gets there."""
-        person = self.planner.scene.person_at(goal[0], goal[1])
+        <robot.scene.Scene.as_expected>`): they will be by the time the robot gets there.
+
+        Answers are remembered per scene state (:meth:`_state`): the same question in the
+        same scene gets the same answer without planning again."""
+        scene = self.planner.scene
+        person = scene.person_at(goal[0], goal[1])
+        key = (_ESTIMATE, tuple(start), tuple(goal), person and scene.people[person])
+        known, value = self._remembered(key)
+        if known:
+            assert isinstance(value, MotionEstimate)
+            return value
         if person is not None:
-            return self.approach(start, person)[1]
-        with self.planner.scene.as_expected():
-            return self._estimate(self.planner, start, goal)
+            est = self.approach(start, person)[1]
+        else:
+            with self.planner.scene.as_expected():
+                est = self._estimate(self.planner, start, goal)
+        self._remember(key, est)
+        return est
 
     def estimate_ignoring_doors(self, start: Pose, goal: Pose) -> MotionEstimate:
         """As :meth:`estimate` with every door open and nobody in the way.
@@ -81,28 +122,49 @@ class MotionEstimator:
         stepping aside count where they are going, as in :meth:`estimate`; the ``navigate``
         skill drives to this pose once the way there is clear.
         """
+        key = (_APPROACH, tuple(start), person, self.planner.scene.people[person])
+        known, value = self._remembered(key)
+        if known:
+            return value  # type: ignore[return-value]
+        out: tuple[Pose | None, MotionEstimate] = (None, UNREACHABLE)
         with self.planner.scene.as_expected():  # people stepping aside: where they are going
             for radius in APPROACH_RINGS:
                 best = self._approach_ring(start, person, radius)
                 if best[0] is not None:
-                    return best
-        return None, UNREACHABLE
+                    out = best
+                    break
+        self._remember(key, out)
+        return out
 
-    def _approach_ring(self, start: Pose, person: str, radius: float) -> tuple[Pose | None, MotionEstimate]:
+    def _ring(self, person: str, radius: float) -> list[tuple[int, Pose]]:
+        """The poses of ``person``'s ring of ``radius`` the robot may help them from (free,
+        no wall between): they depend on the scene, not on where the robot starts, so they
+        are computed once per scene state (and in it, per person and ring)."""
+        key = (_RING, person, radius, self.planner.scene.people[person])
+        known, value = self._remembered(key)
+        if known:
+            return value  # type: ignore[return-value]
         scene = self.planner.scene
         d = scene.people[person]
-        cands = []
+        out = []
         for k in range(APPROACH_DIRECTIONS):
             a = 2 * math.pi * k / APPROACH_DIRECTIONS
             gx, gy = d.x + radius * math.cos(a), d.y + radius * math.sin(a)
             # a pose the person can be helped from: free, and with no wall between them (a
             # pose 0.9 m away through a wall is the wrong side of it)
             if scene.free(gx, gy, ignore=(person,)) and scene.sees((gx, gy), (d.x, d.y)):
-                # the straight-line drive time bounds the travel time from below (the profile
-                # is concave, turns cost >= 0), so candidates are tried nearest first and
-                # the search stops once no farther one can beat the best
-                bound = self.limits.drive_time(math.hypot(gx - start[0], gy - start[1]))
-                cands.append((bound, k, (gx, gy, math.atan2(d.y - gy, d.x - gx))))
+                out.append((k, (gx, gy, math.atan2(d.y - gy, d.x - gx))))
+        self._remember(key, out)
+        return out
+
+    def _approach_ring(self, start: Pose, person: str, radius: float) -> tuple[Pose | None, MotionEstimate]:
+        cands = []
+        for k, goal in self._ring(person, radius):
+            # the straight-line drive time bounds the travel time from below (the profile
+            # is concave, turns cost >= 0), so candidates are tried nearest first and
+            # the search stops once no farther one can beat the best
+            bound = self.limits.drive_time(math.hypot(goal[0] - start[0], goal[1] - start[1]))
+            cands.append((bound, k, goal))
         best: tuple[float, int, Pose, MotionEstimate] | None = None
         for bound, k, goal in sorted(cands):
             if best is not None and bound > best[0]:

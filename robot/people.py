@@ -84,6 +84,8 @@ class Person:
             return None
         if t <= walk[0][0]:
             return None  # before the first waypoint the person stays where they are
+        if t > walk[-1][0]:
+            return walk[-1][1], walk[-1][2]  # after the script (what the loop below ends with)
         for (t0, x0, y0), (t1, x1, y1) in zip(walk, walk[1:], strict=False):
             if t <= t1:
                 f = (t - t0) / (t1 - t0)
@@ -157,13 +159,14 @@ class Person:
             self._walk_to(nx, ny, budget / self.spec.speed)
             break
 
-    def step(self, t: float, dt: float, facts: frozenset[Fact] | set[Fact], robot: tuple[float, float]) -> None:
-        """Move the person from ``t - dt`` to ``t`` (``facts`` is not read: reactions are flags)."""
+    def step(self, t: float, dt: float, robot: tuple[float, float]) -> None:
+        """Move the person from ``t - dt`` to ``t``: reactions are the flags the world sets from
+        the task folders' bindings, never a task's predicates."""
         events = self.spec.events
         while self._event < len(events) and events[self._event][0] <= t:
             self.posture = events[self._event][1]
             self._event += 1
-        if not self.following:
+        if not self.following and self._trail:
             self._trail = []
         target = self.scripted(t)
         if self.posture == "fallen" or self.giving_room is not None and self.giving_room[1] is not None \
@@ -244,9 +247,9 @@ class People:
     def __iter__(self):  # type: ignore[no-untyped-def]
         return iter(self.by_name.values())
 
-    def step(self, t: float, dt: float, facts: frozenset[Fact] | set[Fact], robot: tuple[float, float]) -> None:
+    def step(self, t: float, dt: float, robot: tuple[float, float]) -> None:
         for p in self.by_name.values():
-            p.step(t, dt, facts, robot)
+            p.step(t, dt, robot)
 
     def facts(self) -> set[Fact]:
         return {("posture", p.name, p.posture) for p in self.by_name.values()}

@@ -44,6 +44,20 @@ class Sample:
         return {"t": round(self.t, 4), "robot": [round(v, 4) for v in self.robot],
                 "people": {p.name: [round(p.x, 4), round(p.y, 4), round(p.yaw, 4), p.posture] for p in self.people}}
 
+    def line(self) -> str:
+        """``json.dumps(self.to_json(), sort_keys=True)``, written out directly: a day has tens
+        of thousands of samples and the general encoder cost a second of it.  Numbers are
+        ``repr`` of the rounded float, as the encoder writes them; strings go through it."""
+        people = sorted(self.people, key=lambda p: p.name)
+        inner = ", ".join(f"{_str(p.name)}: [{round(float(p.x), 4)!r}, {round(float(p.y), 4)!r}, "
+                          f"{round(float(p.yaw), 4)!r}, {_str(p.posture)}]" for p in people)
+        x, y, yaw = (round(float(v), 4) for v in self.robot)
+        return f'{{"people": {{{inner}}}, "robot": [{x!r}, {y!r}, {yaw!r}], "t": {round(float(self.t), 4)!r}}}'
+
+
+def _str(s: str) -> str:
+    return json.dumps(s)
+
 
 @dataclass(frozen=True, slots=True)
 class Mark:
@@ -92,10 +106,12 @@ class Recorder:
         sample of the same time)."""
         head = {"format": FORMAT, "world": self.world, "rate_hz": self.rate_hz,
                 "fields": {"robot": ["x", "y", "yaw"], "people": ["x", "y", "yaw", "posture"]}}
-        rows: list[tuple[float, int, dict[str, object]]] = [(s.t, 0, s.to_json()) for s in self.samples]
-        rows += [(m.t, 1, m.to_json()) for m in self.marks]
+        rows: list[tuple[float, int, int]] = [(s.t, 0, k) for k, s in enumerate(self.samples)]
+        rows += [(m.t, 1, k) for k, m in enumerate(self.marks)]
         rows.sort(key=lambda r: (r[0], r[1]))
-        return [json.dumps(head, sort_keys=True)] + [json.dumps(r[2], sort_keys=True) for r in rows]
+        return [json.dumps(head, sort_keys=True)] + [
+            self.samples[k].line() if kind == 0 else json.dumps(self.marks[k].to_json(), sort_keys=True)
+            for _, kind, k in rows]
 
     def write(self, path: str | Path) -> Path:
         out = Path(path)

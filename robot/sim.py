@@ -75,6 +75,9 @@ class Simulation:
         self.people = People(self.spec.people.values(), route=self.person_route)
         self.mj = MjApartment(self.spec)
         self.time = 0.0
+        self._objects = self._object_types()
+        # the last snapshot's facts, under the facts_key they were made for (snapshot)
+        self._snapped: tuple[tuple[Any, ...], frozenset[Fact], tuple[tuple[str, Pose | None], ...]] | None = None
         self.facts: set[Fact] = set(self.spec.facts)
         # devices are where their place is
         self.facts |= {("at", d.name, d.place) for d in self.spec.devices.values()}
@@ -108,6 +111,10 @@ class Simulation:
         return self.mj.pose()
 
     def objects(self) -> dict[str, str]:
+        return dict(self._objects)
+
+    def _object_types(self) -> dict[str, str]:
+        """Every object's type: fixed by the world file for the whole run."""
         out = {"robot": "robot"}
         out |= {n: "place" for n in self.spec.places}
         out |= {n: "person" for n in self.spec.people}
@@ -150,16 +157,16 @@ class Simulation:
         """Until when person ``p`` certainly stays as they are (``self.time``: they may move now)."""
         events = p.spec.events
         nxt = events[p._event][0] if p._event < len(events) else math.inf
-        if ("following", p.name) in self.facts or p.stepping_aside():
+        if p.following or p.stepping_aside():
             return self.time
         if p.giving_room is not None and p.giving_room[1] is not None:
             return nxt  # standing clear of someone fallen until a posture changes
-        if p.posture == "fallen" or ("told_to_wait", p.name) in self.facts or not p.walk:
+        if p.posture == "fallen" or p.waiting or not p.walk:
             return nxt
         walk = p.walk
         if self.time < walk[0][0]:
             return min(nxt, walk[0][0])
-        if self.time >= walk[-1][0] and math.hypot(p.x - walk[-1][1], p.y - walk[-1][2]) <= 1e-9:
+        if self.time >= walk[-1][0] and math.hypot(p.x - walk[-1][1], p.y - walk[-1][2]) <= 1e-9 and not p._detour:
             return nxt
         return self.time
 
@@ -182,7 +189,7 @@ class Simulation:
         if n < 2:
             return False
         for p in self.people:
-            if ("following", p.name) not in self.facts:
+            if not p.following:
                 p._trail = []  # what Person.step does for someone not following
         end = self._ticks + n
         while self._ticks < end:
@@ -197,14 +204,14 @@ class Simulation:
         self._ticks += 1
         t = round(self._ticks * CONTROL_DT, 9)
         x, y, _ = self.mj.pose()
-        self.people.step(t, CONTROL_DT, self.facts, (x, y))
+        self.people.step(t, CONTROL_DT, (x, y))
         self._give_room()
         self._sync_people()
         cmd = self.skill.control(t, CONTROL_DT) if self.skill is not None else STOP
         self._last_cmd = cmd
         self.mj.command(cmd.v, cmd.w)
         # People are mocap bodies that touch nothing, so with no command and the base at
-        # rest a physics step changes nothing worth 25 MuJoCo steps: skip it
+        # rest a physics step changes nothing worth its MuJoCo steps: skip it
         if cmd != STOP or not self.mj.at_rest():
             self.mj.step(round(CONTROL_DT / TIMESTEP))
             self.physics_ticks += 1
@@ -276,7 +283,7 @@ class Simulation:
         return tuple(dict.fromkeys(out))
 
     def _type(self, name: str) -> str:
-        return self.objects().get(name, "")
+        return self._objects.get(name, "")
 
     def _set_bound(self, fact: Fact, value: bool) -> bool:
         hit = self._binding(fact)
@@ -388,7 +395,7 @@ class Simulation:
 
     def _bound_facts(self) -> set[Fact]:
         out: set[Fact] = set()
-        objects = self.objects()
+        objects = self._objects
         for b in self.bindings:
             if b.kind == "device":
                 things = [n for n, v in self.device_state.items() if v == b.state]
@@ -415,10 +422,21 @@ class Simulation:
         """
         poses: dict[str, Pose] = {"robot": self.robot_pose()}
         poses |= {p.name: p.pose for p in self.people}
-        poses |= dict(self.spec.places)
+        poses |= self.spec.places
+        key = self.facts_key()
+        if self._snapped is None or self._snapped[0] != key:  # facts change only with their key
+            self._snapped = (key, *self._facts_now(poses["robot"]))
+        _, facts, held_or_placed = self._snapped
+        for name, place in held_or_placed:
+            poses[name] = poses["robot"] if place is None else place
+        return WorldState(facts, poses, dict(self._objects), self.time)
+
+    def _facts_now(self, robot: Pose) -> tuple[frozenset[Fact], tuple[tuple[str, Pose | None], ...]]:
+        """The facts of :meth:`snapshot` and where each movable object is posed (None: with
+        the robot, which holds it), computed afresh."""
         names = set(self.spec.people) | {"robot"}
         facts = {f for f in self.facts if not (f[0] == "at" and len(f) == 3 and f[1] in names)}
-        rx, ry, _ = poses["robot"]
+        rx, ry, _ = robot
         robot_place = self.nearest_place(rx, ry)
         facts.add(("at", "robot", robot_place))
         for p in self.people:
@@ -428,13 +446,14 @@ class Simulation:
                 facts.add(("fallen", p.name))
         facts |= {("state", n, v) for n, v in self.device_state.items()}
         facts |= self._bound_facts()
+        objects: list[tuple[str, Pose | None]] = []
         for name in sorted(self.spec.objects):  # an object is posed at its place, or with the robot holding it
             place = next((f[2] for f in facts if f[0] == "at" and len(f) == 3 and f[1] == name), None)
             if name in self.held:
-                poses[name] = poses["robot"]
+                objects.append((name, None))
             elif place is not None and place in self.spec.places:
-                poses[name] = self.spec.places[place]
-        return WorldState(frozenset(facts | self.people.facts()), poses, self.objects(), self.time)
+                objects.append((name, self.spec.places[place]))
+        return frozenset(facts | self.people.facts()), tuple(objects)
 
     def facts_key(self) -> tuple[Any, ...]:
         """What the facts of :meth:`snapshot` are made of, cheaply: equal keys, equal facts.

@@ -10,35 +10,33 @@ hooks.  It is stepped by a clock (:mod:`tasker.loop`) at the times it asks for:
 * in ``upTsk`` and ``genSusp`` once, when the planning hook's simulated time is up;
 * at once, whenever the harmoniser delivers a command.
 
-Suspension follows eqs. 25-26: ``susp`` ends a suspendable stage at once; a
-blocking stage runs to its goal and the pending ``susp`` is honoured when the FSM
-reaches the next suspendable stage.  ``term`` while in ``cmd`` is handled as a safe
-suspension followed by ``end`` (a task is never dropped mid-manoeuvre); so is the
-task's own ``ic_term`` (``check_terminate``) while it executes.
-
-Hazard-aware waiting (``docs/model.md``): a ``start`` whose data has ``secure`` makes a
-waiting agent *secure* its hazard — ``wait --secure--> genSusp``, the suspension of the
-``strict`` policy, ``exeSusp``, then ``wait`` again — instead of resuming its task.
-
-The agent never names a target state: it fires events through the one FSM table of
-:mod:`tasker.fsm`, whose guards it evaluates.  Every call into a task hook or the core
-agent is contained (:meth:`DynamicAgent.step`): an exception ends this task only.
+What a command does is read off the one FSM table of :mod:`tasker.fsm`: the agent
+latches it (:mod:`tasker.conditions`, as :data:`tasker.fsm.LATCHES` says) and takes the
+first command row whose guards hold (:func:`tasker.fsm.enabled`) whenever it steps --
+so a ``susp`` ends a suspendable stage at once and waits out a blocking one (eqs.
+25-26), a ``term`` in ``cmd`` is a safe suspension followed by ``end``, and a ``start``
+with ``secure`` makes a waiting agent secure its hazard (hazard-aware waiting,
+``docs/model.md``).  Hooks' outcomes are fired as events (:func:`tasker.fsm.resolve`).
+The agent never names a target state; it evaluates the table's guards and does what
+each transition means.  Every call into a task hook or the core agent is contained
+(:meth:`DynamicAgent.step`): an exception ends this task only.
 """
 
 from __future__ import annotations
 
 import math
-import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, final
 
 from tasker import events as ev
 from tasker import fsm, securing
-from tasker.errors import AgentEnded, ConfigError, FSMError, InvariantViolation, PlanningFailed, WorldError
+from tasker.conditions import Latched
+from tasker.errors import AgentEnded, ConfigError, FSMError, PlanningFailed
 from tasker.messages import Command, Flag, FsmState, Report, ScheduleParams, SPRequest
 from tasker.protocols import CoreAgent, SkillState
 from tasker.stage import Purpose, Stage, StagePlan
+from tasker.stagerun import UNCONTAINED, StageRunner, describe
 from tasker.task import TaskContext, TaskType
 from tasker.trace import Trace
 
@@ -62,21 +60,6 @@ class Rates:
             v = getattr(self, name)
             if not isinstance(v, int | float) or not math.isfinite(v) or v <= 0:
                 raise ConfigError(f"Rates.{name} must be a positive number of Hz, got {v!r}")
-
-
-class StageRunner:
-    """Runs one stage FSM (``exeTsk`` or ``exeSusp``) on a core agent; pure bookkeeping."""
-
-    __slots__ = ("plan", "index", "running")
-
-    def __init__(self, plan: StagePlan) -> None:
-        self.plan = plan
-        self.index = 0
-        self.running = False
-
-    @property
-    def stage(self) -> Stage | None:
-        return self.plan.stages[self.index] if self.index < len(self.plan.stages) else None
 
 
 class DynamicAgent:
@@ -115,10 +98,7 @@ class DynamicAgent:
         self.next_wake = ctx.request_time
         self._inbox: list[Command] = []
         self._ack = 0
-        self._pending_start = False
-        self._pending_susp = False
-        self._pending_secure = False  # the pending start asks to secure (hazard-aware waiting)
-        self._pending_term: tuple[str, str] | None = None  # (reason, cause: "term" or "self")
+        self._latched = Latched()  # ic_start, ic_susp, ic_term as the FSM's guards read them
         self._runner: StageRunner | None = None
         self._ready_at = 0.0  # end of a planning hook's simulated time
         self._next_sp = 0.0
@@ -153,12 +133,12 @@ class DynamicAgent:
         if self.state is S.END:
             raise AgentEnded(self.id, self.end_reason or "ended")
         try:
-            self._refresh(now)
+            self.refresh(now)
             return self.task.request_sp(self.ctx, request)
-        except _UNCONTAINED:
+        except UNCONTAINED:
             raise
         except Exception as exc:
-            self._fail(now, exc)
+            self.fail(now, exc)
             raise AgentEnded(self.id, self.end_reason or "error") from exc
 
     def fresh_params(self, now: float) -> ScheduleParams | None:
@@ -177,15 +157,25 @@ class DynamicAgent:
         if self._fresh is not None and self._fresh[0] == now:
             return self._fresh[1]
         try:
-            self._refresh(now)
+            self.refresh(now)
             params = self.task.compute_params(self.ctx)
             self._fresh = (now, params)
             return params
-        except _UNCONTAINED:
+        except UNCONTAINED:
             raise
         except Exception as exc:
-            self._fail(now, exc)
+            self.fail(now, exc)
             raise AgentEnded(self.id, self.end_reason or "error") from exc
+
+    @property
+    def ready_at(self) -> float:
+        """When the planning hook's simulated time of ``upTsk`` or ``genSusp`` is (or was) up."""
+        return self._ready_at
+
+    @property
+    def stage_plan(self) -> StagePlan | None:
+        """The ``exeTsk`` or ``exeSusp`` plan the agent runs or is about to, None before the first."""
+        return self._runner.plan if self._runner is not None else None
 
     @property
     def progress(self) -> tuple[FsmState, int]:
@@ -212,8 +202,12 @@ class DynamicAgent:
 
     # -- stepping ---------------------------------------------------------------------------
 
+    @final
     def step(self, now: float) -> None:
         """Run the transition functions due at ``now``; set :attr:`next_wake`.
+
+        The framework's loop (``typing.final``): a task changes what the agent does
+        through the hooks of :class:`~tasker.task.TaskType`, never by overriding this.
 
         This is the containment boundary: an exception from a task hook, the core
         agent or a planner ends this task (``end`` with cause ``error`` and the
@@ -224,15 +218,16 @@ class DynamicAgent:
             return
         self._params_at = self._fresh = None  # stepping may change what the parameters depend on
         try:
-            self._refresh(now)
+            self.refresh(now)
             self._read_inbox()
             _HANDLERS[self.state](self, now)
-        except _UNCONTAINED:
+        except UNCONTAINED:
             raise
         except Exception as exc:
-            self._fail(now, exc)
+            self.fail(now, exc)
 
-    def _refresh(self, now: float) -> None:
+    def refresh(self, now: float) -> None:
+        """Bring ``ctx.now`` and ``ctx.world`` to ``now``: what a hook reads when it is called."""
         self.ctx.now = now
         if self._world is not None:
             self.ctx.world = self._world()
@@ -242,17 +237,9 @@ class DynamicAgent:
             return
         for cmd in self._inbox:
             self._ack = cmd.seq
-            if cmd.flag is Flag.START:
-                self._pending_start = True
-                self._pending_secure = bool(cmd.data.get("secure"))
-            elif cmd.flag is Flag.SUSP:
-                self._pending_susp = True
-                if "expected_s" in cmd.data:  # how long the interruption is expected to last
-                    self.ctx.memory["interruption_s"] = float(cmd.data["expected_s"])
-            elif cmd.flag is Flag.TERM:
-                # a term overrides the task's own ic_term, not a failure already being made safe
-                if self._pending_term is None or self._pending_term[1] == "self":
-                    self._pending_term = (str(cmd.data.get("reason", "terminated by the harmoniser")), "term")
+            if cmd.flag is Flag.SUSP and "expected_s" in cmd.data:  # how long the interruption is expected to last
+                self.ctx.memory["interruption_s"] = float(cmd.data["expected_s"])
+            self._latched.receive(cmd.flag.value, cmd.data, self.state)
         self._inbox.clear()
 
     # -- state behaviours ---------------------------------------------------------------
@@ -263,33 +250,35 @@ class DynamicAgent:
         self._comp_sp(now)
 
     def _comp_sp(self, now: float) -> None:
-        """``compSP`` and ``wait``: f^compSP (eq. 22), f^wait = f^compSP (eq. 27)."""
-        if self._pending_term is not None:
-            reason, cause = self._pending_term
-            self._end(now, reason, cause=cause, event="term")
-            return
-        if self._pending_start:
-            self._pending_start = False
-            self._pending_susp = False  # a susp that reached a non-executing agent is void
-            if self._pending_secure and self.state is S.WAIT:
-                self._start_secure(now)
-            else:
-                self._pending_secure = False
-                self._start_up_tsk(now)
-            return
-        self._pending_susp = False
-        why = self.task.check_terminate(self.ctx)
-        if why:
-            self._end(now, why, cause="self", event="term")
+        """``compSP`` and ``wait``: f^compSP (eq. 22), f^wait = f^compSP (eq. 27).
+
+        A latched command is taken first (``term``, then ``secure``, then ``start``: the
+        table's order); else the task's own ``ic_term`` (``check_terminate``), else the
+        schedule parameters are computed and reported.
+        """
+        t = fsm.enabled(self.state, self._guard)
+        if t is None:
+            why = self.task.check_terminate(self.ctx)
+            if why:
+                self._latched.terminate(why, "self")
+                t = fsm.enabled(self.state, self._guard)
+        if t is not None:
+            _COMMANDS[t.event](self, now)
             return
         self._params = self.task.compute_params(self.ctx)
         self._params_at = now
         self._publish()
         self.next_wake = _next_tick_of(now, self.rates.rep_rate)
 
+    def _terminate(self, now: float) -> None:
+        """``term [ic_term]``: end with the latched reason and cause."""
+        term = self._latched.term
+        assert term is not None
+        self._end(now, term.reason, cause=term.cause, event="term")
+
     def _start_up_tsk(self, now: float) -> None:
         self._fire("start", now)
-        self._refresh(now)  # plan from the world as it is now, after any effect applied this step
+        self.refresh(now)  # plan from the world as it is now, after any effect applied this step
         try:
             plan = self.task.update_task(self.ctx)
         except PlanningFailed as exc:
@@ -313,7 +302,7 @@ class DynamicAgent:
         if not plan.stages:  # nothing left to do (R6: done by someone else)
             self._end(now, "finished", cause="finished", event="planned")
             return
-        self._runner = StageRunner(plan)
+        self._runner = StageRunner(plan, self.id, self._trace)
         self._fire("planned", now)
         self._next_sp = _next_tick_of(now, self.rates.sp_up_rate)
         self._enter_stage(now)
@@ -330,17 +319,21 @@ class DynamicAgent:
                 self._finish_susp(now)
             return
         in_task = self.state is S.EXE_TSK
-        if in_task and (self._pending_susp or self._pending_term) and not stage.blocking:
+        if (t := fsm.enabled(self.state, self._guard)) is not None:  # exeTsk: suspend at a suspendable stage
             self.ctx.interrupted = stage
-            self._start_gen_susp(now)
+            self._start_gen_susp(now, t.event)
             return
         if self.core is None:
             raise ConfigError(f"agent {self.id}: a stage must run but no core agent was given")
-        runner.running = True  # before begin: a begin that raises still gets a guarded stop and its closing event
+        self.refresh(now)  # the stage before may just have changed the world
+        why = self.task.inapplicable(self.ctx, stage)
+        if why is not None:  # as on a robot: an action that cannot run fails, and changes nothing
+            runner.event(now, self.state, "begin")
+            self._stage_failed(now, stage, why)
+            return
         if in_task:
             self.ctx.stage_started = now
-        self._stage_event(now, "begin")
-        self.core.begin(self.id, stage, now)
+        runner.begin(self.core, self.state, now)
         self.next_wake = _next_tick_of(now, self.rates.task_exe_rate)
 
     def _exe(self, now: float) -> None:
@@ -349,24 +342,15 @@ class DynamicAgent:
         assert runner is not None and runner.stage is not None and self.core is not None
         stage = runner.stage
         in_task = self.state is S.EXE_TSK
-        if in_task and (self._pending_susp or self._pending_term) and not stage.blocking:
-            self._suspend_now(now, stage)
+        if (t := fsm.enabled(self.state, self._guard)) is not None:  # exeTsk: suspend at a suspendable stage
+            self._suspend_now(now, stage, t.event)
             return
-        if in_task and self._pending_start:
-            self._pending_start = False
         status = self.core.poll(self.id, stage, now)
         if status.state is SkillState.FAILED:
-            self._close_stage(now, "failed", reason=status.reason)
-            failure = f"stage {stage.label} failed: {status.reason}"
-            if not in_task:  # a suspension's own stage: nothing safer to fall back on
-                self._end(now, self._after_failure(failure), cause="failed", event="stage_failed")
-                return
-            # the task cannot go on, but what it leaves must be safe: genSusp, exeSusp, then end
-            self._pending_term = (failure, "failed")
-            self._suspend_now(now, stage, event="stage_failed")  # the stage is closed: nothing to stop
+            self._stage_failed(now, stage, status.reason or "no reason given")
             return
         if status.state is SkillState.SUCCEEDED:
-            self._close_stage(now, "done")
+            runner.close(now, self.state, "done")
             if in_task:
                 self.ctx.stage_started = None
                 self.ctx.done.append(stage)
@@ -376,12 +360,12 @@ class DynamicAgent:
             self._enter_stage(now)
             if self.state is not S.EXE_TSK:
                 return
-        elif in_task and self._pending_term is None:
+        elif in_task and self._latched.term is None:
             why = self.task.check_terminate(self.ctx)
             if why:  # ic_term: finish a blocking stage, then suspend safely, then end (eqs. 25-26)
-                self._pending_term = (why, "self")
-                if not stage.blocking:
-                    self._suspend_now(now, stage)
+                self._latched.terminate(why, "self")
+                if (t := fsm.enabled(self.state, self._guard)) is not None:
+                    self._suspend_now(now, stage, t.event)
                     return
         if in_task and now >= self._next_sp:
             self._params = self.task.compute_params(self.ctx)
@@ -390,6 +374,21 @@ class DynamicAgent:
             self._next_sp = _next_tick_of(now, self.rates.sp_up_rate)
         if runner.running:
             self.next_wake = _next_tick_of(now, self.rates.task_exe_rate)
+
+    def _stage_failed(self, now: float, stage: Stage, reason: str) -> None:
+        """The running stage failed (its skill said so, or it could not run): close it ``failed``; in
+        ``exeSusp`` the task ends, in ``exeTsk`` it is first made safe (genSusp, exeSusp), then ends."""
+        runner = self._runner
+        assert runner is not None
+        runner.close(now, self.state, "failed", reason=reason)
+        failure = f"stage {stage.label} failed: {reason}"
+        if fsm.resolve(self.state, "stage_failed", self._guard).target is S.END:
+            # a suspension's own stage: nothing safer to fall back on
+            self._end(now, self._after_failure(failure), cause="failed", event="stage_failed")
+            return
+        # the task cannot go on, but what it leaves must be safe: genSusp, exeSusp, then end
+        self._latched.terminate(failure, "failed")
+        self._suspend_now(now, stage, event="stage_failed")  # the stage is closed: nothing to stop
 
     def _suspend_now(self, now: float, stage: Stage, event: str = "suspend") -> None:
         """A suspendable stage of exeTsk ends at once for a pending susp or term (eq. 26), or a
@@ -401,16 +400,16 @@ class DynamicAgent:
 
     def _after_failure(self, why: str) -> str:
         """``why``, after the failure whose safe suspension it interrupted, if it did."""
-        if self._pending_term is not None and self._pending_term[1] == "failed":
-            return f"{self._pending_term[0]}; then {why}"
+        term = self._latched.term
+        if term is not None and term.cause == "failed":
+            return f"{term.reason}; then {why}"
         return why
 
     def _start_gen_susp(self, now: float, event: str = "suspend") -> None:
-        self._pending_susp = False
         self.ctx.suspended = True
-        self.ctx.terminating = self._pending_term is not None
+        self.ctx.terminating = self._latched.term is not None
         self._fire(event, now)
-        self._refresh(now)  # the stage that just ended may have changed the world (a pan put on the cooker)
+        self.refresh(now)  # the stage that just ended may have changed the world
         try:
             plan = self.task.generate_suspension(self.ctx)
         except PlanningFailed as exc:
@@ -425,10 +424,9 @@ class DynamicAgent:
         ``strict`` policy: whatever a ``conditional`` branch left unsafe for a short
         interruption is made safe now that the interruption has lasted.
         """
-        self._pending_secure = False
         self.ctx.terminating = False
         self._fire("secure", now)
-        self._refresh(now)
+        self.refresh(now)
         strategy = self.ctx.strategy
         self.ctx.strategy = replace(strategy, policy="strict")
         try:
@@ -442,7 +440,7 @@ class DynamicAgent:
 
     def _run_suspension(self, now: float, plan: StagePlan) -> None:
         self._emit_plan(now, plan)
-        self._runner = StageRunner(plan)
+        self._runner = StageRunner(plan, self.id, self._trace)
         self._ready_at = now + plan.sim_time
         if plan.sim_time > 0:
             self.next_wake = self._ready_at
@@ -457,33 +455,29 @@ class DynamicAgent:
         self._enter_stage(now)
 
     def _finish_susp(self, now: float) -> None:
-        if self._pending_term is not None:
-            reason, cause = self._pending_term
-            self._end(now, reason, cause=cause, event="finished")
+        term = self._latched.term
+        if fsm.resolve(self.state, "finished", self._guard).target is S.END:  # [ic_term]
+            assert term is not None
+            self._end(now, term.reason, cause=term.cause, event="finished")
             return
-        self._pending_start = False
         self._fire("finished", now)
         self._comp_sp(now)
 
     # -- helpers ------------------------------------------------------------------------------
 
     def _guard(self, name: str) -> bool:
-        """Evaluate a guard named in :data:`tasker.fsm.TRANSITIONS`."""
-        if name == "has_stages":
-            return self.ctx.plan is not None and bool(self.ctx.plan.stages)
-        if name == "no_stages":
-            return self.ctx.plan is None or not self.ctx.plan.stages
-        if name == "terminating":
-            return self._pending_term is not None
-        if name == "not_terminating":
-            return self._pending_term is None
-        raise ConfigError(f"agent {self.id}: the FSM names a guard {name!r} the agent does not know")
+        """Evaluate a guard named in :data:`tasker.fsm.TRANSITIONS` (meanings: :data:`tasker.fsm.GUARD_MEANING`)."""
+        evaluate = _GUARDS.get(name)
+        if evaluate is None:
+            raise ConfigError(f"agent {self.id}: the FSM names a guard {name!r} the agent does not know")
+        return evaluate(self)
 
     def _fire(self, event: str, now: float) -> None:
         """Fire ``event`` through the FSM table: the table picks the target; traced and reported."""
         t = fsm.resolve(self.state, event, self._guard)
         self._trace.emit(ev.Transition(now, self.id, event, self.state.value, t.target.value))
         self.state = t.target
+        self._latched.enter(t.target)
         if t.target is S.END:
             self.next_wake = math.inf
         else:
@@ -499,38 +493,21 @@ class DynamicAgent:
         self._trace.emit(ev.TaskEnded(now, self.id, self.ctx.task_type, reason, cause))
         self._publish()
 
-    def _fail(self, now: float, exc: BaseException) -> None:
-        """A hook, the core agent or a planner raised: end this task with cause ``error``."""
+    def fail(self, now: float, exc: BaseException) -> None:
+        """A hook, the core agent or a planner raised ``exc``: end this task with cause ``error``.
+
+        Called by the agent's own containment and by whoever asks a hook on its behalf
+        (:mod:`tasker.securing`'s estimates)."""
         if self.state is S.END:
             return
-        reason = _describe(exc, self.state)
+        reason = describe(exc, self.state)
         self._stop_stage(now, "failed", reason=reason)
         self._end(now, reason, cause="error", event="error")
 
     def _stop_stage(self, now: float, status: str, **extra: Any) -> None:
-        """Stop the running stage, if any: ``core.stop`` at most once a stage, guarded, then its closing event."""
-        runner = self._runner
-        if runner is None or not runner.running or runner.stage is None:
-            return
-        runner.running = False  # first: a stop that raises is never attempted twice
-        if self.core is not None:
-            try:
-                self.core.stop(self.id, runner.stage, now)
-            except _UNCONTAINED:
-                raise
-            except Exception as exc:
-                if status == "failed":
-                    extra["reason"] = f"{extra.get('reason', '')}; then {_describe(exc, self.state)}".lstrip("; ")
-                else:  # a stop that raises during a suspension is the task's error
-                    self._close_stage(now, "failed", reason=_describe(exc, self.state))
-                    raise
-        self._close_stage(now, status, **extra)
-
-    def _close_stage(self, now: float, status: str, **extra: Any) -> None:
-        runner = self._runner
-        assert runner is not None
-        runner.running = False
-        self._stage_event(now, status, **extra)
+        """Stop the running stage, if any (:meth:`tasker.stagerun.StageRunner.stop`)."""
+        if self._runner is not None:
+            self._runner.stop(self.core, self.state, now, status, **extra)
 
     def _publish(self) -> None:
         """pf^report: write the report buffer; tell the harmoniser only if it changed (newData)."""
@@ -539,13 +516,6 @@ class DynamicAgent:
             self.report = report
             if self._on_report is not None:
                 self._on_report(self)
-
-    def _stage_event(self, now: float, status: str, **extra: Any) -> None:
-        runner = self._runner
-        assert runner is not None and runner.stage is not None
-        stage = runner.stage
-        self._trace.emit(ev.StageChanged(now, self.id, self.state.value, runner.index, stage.action, list(stage.args),
-                                         stage.kind.value, status, **extra))
 
     def _emit_plan(self, now: float, plan: StagePlan) -> None:
         if not isinstance(plan, StagePlan):
@@ -565,27 +535,6 @@ class DynamicAgent:
                                      [s.to_json() for s in plan.stages], plan.note or None, info))
 
 
-_UNCONTAINED = (InvariantViolation, WorldError)
-"""Exceptions that are not one task's fault: a broken model invariant or a broken world."""
-
-_HERE = __file__
-
-
-def _describe(exc: BaseException, state: FsmState) -> str:
-    """``"<hook>() raised <Type>: <message> (in <state>)"``: where it came from, without file paths.
-
-    The hook is the first frame outside this module, so the reason names the task
-    hook or core-agent method the agent called (``update_task``, ``poll``, ...).
-    """
-    where = None
-    for frame in traceback.extract_tb(exc.__traceback__):
-        if frame.filename != _HERE:
-            where = frame.name
-            break
-    origin = f"{where}() raised " if where else ""
-    return f"{origin}{type(exc).__name__}: {exc} (in {state.value})"
-
-
 def _next_tick_of(now: float, rate: float) -> float:
     """The next instant of ``timer(rate)``: timers fire on one grid shared by every agent.
 
@@ -594,6 +543,36 @@ def _next_tick_of(now: float, rate: float) -> float:
     """
     return (math.floor(now * rate + 1e-9) + 1) / rate
 
+
+def _suspendable(agent: DynamicAgent) -> bool:
+    stage = agent._runner.stage if agent._runner is not None else None
+    return stage is not None and not stage.blocking
+
+
+_GUARDS: dict[str, Callable[[DynamicAgent], bool]] = {
+    "has_stages": lambda a: a.ctx.plan is not None and bool(a.ctx.plan.stages),
+    "no_stages": lambda a: a.ctx.plan is None or not a.ctx.plan.stages,
+    "ic_start": lambda a: a._latched.holds("ic_start"),
+    "ic_susp": lambda a: a._latched.holds("ic_susp"),
+    "ic_term": lambda a: a._latched.holds("ic_term"),
+    "not_ic_term": lambda a: not a._latched.holds("ic_term"),
+    "secure": lambda a: a._latched.holds("secure"),
+    "suspendable": _suspendable,
+}
+"""How the agent evaluates each guard of :data:`tasker.fsm.GUARDS`."""
+
+_COMMANDS: dict[str, Callable[[DynamicAgent, float], None]] = {
+    "term": DynamicAgent._terminate,
+    "start": DynamicAgent._start_up_tsk,
+    "secure": DynamicAgent._start_secure,
+}
+"""What the command rows that leave ``compSP`` and ``wait`` do (``suspend`` leaves ``exeTsk``)."""
+
+_TAKEN_BY_COMP_SP = {t.event for t in fsm.TRANSITIONS if t.auto and t.source in (S.COMP_SP, S.WAIT)}
+if set(_GUARDS) != set(fsm.GUARDS) or not _TAKEN_BY_COMP_SP <= set(_COMMANDS):  # the table and its runner agree
+    raise FSMError(f"the agent evaluates the guards {sorted(_GUARDS)} and takes the commands {sorted(_COMMANDS)} "
+                   f"in compSP and wait; the FSM table names the guards {list(fsm.GUARDS)} and the commands "
+                   f"{sorted(_TAKEN_BY_COMP_SP)}")
 
 _HANDLERS: dict[FsmState, Callable[[DynamicAgent, float], None]] = {
     S.INIT_COMM: DynamicAgent._init_comm,

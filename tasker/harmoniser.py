@@ -36,18 +36,19 @@ its ``strict`` safe state and waits again (``docs/model.md``).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
 from enum import StrEnum
-from typing import Any, overload
+from typing import Any, final
 
 from tasker import events as ev
 from tasker.agent import DynamicAgent
 from tasker.errors import AgentEnded, ConfigError, InvariantViolation, TaskerError, WorldError
 from tasker.messages import Command, Flag, FsmState, ScheduleParams, SPRequest
-from tasker.schedulers.base import Candidate, Scheduler, ScheduleView
-from tasker.schedulers.index import CandidateIndex
-from tasker.securing import HazardSource, HazardWatch
+from tasker.oscillation import OscillationGuard
+from tasker.schedulers.base import Candidate, Scheduler, ScheduleView, UnattendedHazard
+from tasker.schedulers.index import CandidateIndex, IdleCandidates
+from tasker.securing import HazardSource, HazardWatch, suspend_estimate
 from tasker.task import Effects
 from tasker.trace import Trace
 
@@ -74,57 +75,6 @@ class Request:
     args: Mapping[str, Any] = field(default_factory=dict)
     requester: str = "user"
     renews: str | None = None
-
-
-@dataclass(frozen=True, slots=True)
-class OscillationGuard:
-    """Hysteresis in the harmoniser: no task becomes ``exeDA`` more than ``count`` times in ``window_s``.
-
-    After the oscillation definition of the TaBSA benchmark: with no new request in
-    between, no task becomes ``exeDA`` a third time within 180 s.  The harmoniser
-    holds back a preemption (the scheduler chose a candidate while an agent
-    executes) when either the candidate or the executing agent has already become
-    ``exeDA`` ``count`` times within the last ``window_s`` seconds: the candidate
-    would be one too many, and the executing agent would have to become ``exeDA``
-    again to finish.  A new request clears the history (it may legitimately
-    preempt again, as in Appendix B).  Starting a task when no agent executes is
-    never held, so nothing starves.  Independent of the scheduler.
-    """
-
-    window_s: float = 180.0
-    count: int = 2
-
-    def __post_init__(self) -> None:
-        if not isinstance(self.window_s, int | float) or not self.window_s >= 0 or math.isinf(self.window_s):
-            raise ConfigError(f"OscillationGuard.window_s must be a number of seconds >= 0, got {self.window_s!r}")
-        if isinstance(self.count, bool) or not isinstance(self.count, int) or self.count < 1:
-            raise ConfigError(f"OscillationGuard.count must be an integer >= 1, got {self.count!r}")
-
-
-class _IdleCandidates(Sequence[Candidate]):
-    """``ScheduleView.candidates`` for an indexed scheduler: the scan's list, built only if read."""
-
-    def __init__(self, idle: Mapping[str, None], cands: Mapping[str, Candidate]) -> None:
-        self._idle, self._cands = idle, cands
-        self._items: list[Candidate] | None = None
-
-    def _list(self) -> list[Candidate]:
-        if self._items is None:
-            self._items = [c for a in self._idle if (c := self._cands.get(a)) is not None]
-        return self._items
-
-    def __len__(self) -> int:
-        return len(self._list())
-
-    @overload
-    def __getitem__(self, i: int) -> Candidate: ...
-    @overload
-    def __getitem__(self, i: slice) -> Sequence[Candidate]: ...
-    def __getitem__(self, i: int | slice) -> Candidate | Sequence[Candidate]:
-        return self._list()[i]
-
-    def __iter__(self) -> Iterator[Candidate]:
-        return iter(self._list())
 
 
 AgentFactory = Callable[[str, Request, float, Callable[[DynamicAgent], None]], DynamicAgent]
@@ -173,6 +123,7 @@ class TaskHarmoniser:
         hazard_waiting: bool = False,
         hazards: HazardSource | None = None,
         secure_margin_s: float = 5.0,
+        secure_over_higher: bool = False,
     ) -> None:
         if not isinstance(s_freq, int | float) or s_freq <= 0:
             raise ConfigError(f"sFreq must be a positive number of Hz, got {s_freq!r}")
@@ -183,12 +134,15 @@ class TaskHarmoniser:
         self.hazard_waiting = bool(hazard_waiting)  # hazard-aware waiting, a sweep factor
         self.hazards = hazards  # where hazard-aware waiting learns of hazards (None: it has nothing to watch)
         self.watch = HazardWatch(secure_margin_s, 1.0 / self.s_freq)  # hazard-aware waiting's memory
+        self.secure_over_higher = bool(secure_over_higher)  # may securing preempt a task of a higher class?
+        self._held_secures: set[tuple[str, str]] = set()  # (waiting agent, exeDA) whose securing was held
         self._securing: _Securing | None = None
         self._became: dict[str, list[float]] = {}  # when each agent became exeDA since the last new request
         self._factory = agent_factory
         self._trace = trace
         self.agents: dict[str, DynamicAgent] = {}  # A_da
         self._handovers: dict[tuple[str, str, float], Effects | None] = {}  # handover's answers
+        self._suspensions: dict[tuple[float, str, str], float] = {}  # _suspension_of's answers
         self.exe_da: str | None = None
         self.irr_da: str | None = None
         self._idle: dict[str, None] = {}  # D_r, in request order
@@ -246,8 +200,13 @@ class TaskHarmoniser:
 
     # -- f^harm ------------------------------------------------------------------------------
 
+    @final
     def step(self, now: float, timer: bool = False) -> None:
-        """One iteration of ``f^harm`` (eq. 36) at simulated time ``now``."""
+        """One iteration of ``f^harm`` (eq. 36) at simulated time ``now``.
+
+        The framework's loop: a subclass must not override it (``typing.final``); a
+        scheduling algorithm plugs in as a :class:`~tasker.schedulers.Scheduler`.
+        """
         self.now = now
         if self._requests:
             self._pf_init_da(now)
@@ -320,13 +279,16 @@ class TaskHarmoniser:
                 lowest = index.lowest(self._idle)
                 if lowest is None:
                     return
-                view = ScheduleView(now=now, exe=exe, candidates=_IdleCandidates(self._idle, self._cands),
+                view = ScheduleView(now=now, exe=exe, candidates=IdleCandidates(self._idle, self._cands),
                                     req_sp=self._req_sp, fresh=self._fresh, lowest=self._cands[lowest])
             else:
                 candidates = [c for a in self._idle if (c := self._cands.get(a)) is not None]
                 if not candidates:
                     return
                 view = ScheduleView(now=now, exe=exe, candidates=candidates, req_sp=self._req_sp, fresh=self._fresh)
+            if self.scheduler.reads_harmoniser:  # what a whole-queue scheduler weighs beyond the reports
+                view = replace(view, suspension=self._suspension_of if exe is not None else None,
+                               hazards=self._unattended())
             try:
                 decision = self.scheduler.schedule(view)
             except AgentEnded:
@@ -362,6 +324,34 @@ class TaskHarmoniser:
             del self._idle[choice]
             self.irr_da = choice
             self._roles_dirty = True
+
+    def _suspension_of(self, by: str) -> float:
+        """Seconds the executing agent needs to report ``wait`` if sent ``susp`` now with ``by`` as its
+        replacement (:func:`tasker.securing.suspend_estimate`, for the interruption that ``susp`` would
+        announce); one estimate per replacement and moment."""
+        if self.exe_da is None:
+            return 0.0
+        key = (self.now, self.exe_da, by)
+        if key not in self._suspensions:
+            if len(self._suspensions) > 256:
+                self._suspensions.clear()
+            expected = self._susp_data(by).get("expected_s")
+            self._suspensions[key] = suspend_estimate(self.agents[self.exe_da], self.now, expected)
+        return self._suspensions[key]
+
+    def _unattended(self) -> tuple[UnattendedHazard, ...]:
+        """The hazards that hold now while their agent is out of ``cmd``, with when that stretch began
+        (as hazard-aware waiting counts it, :class:`tasker.securing.HazardWatch`)."""
+        if self.hazards is None:
+            return ()
+        out = []
+        for hz in self.hazards():
+            agent = hz.agent
+            if agent is None or agent not in self.agents or agent in self._in_cmd:
+                continue
+            since = max(float(hz.since), self.watch.left_cmd.get(agent, float(hz.since)))
+            out.append(UnattendedHazard(agent, str(hz.name), float(hz.budget_s), since))
+        return tuple(out)
 
     def _candidate_index(self) -> CandidateIndex | None:
         """The heap of candidates' keys for the current scheduler, or None to scan (built on first use)."""
@@ -429,7 +419,8 @@ class TaskHarmoniser:
             return
         exe = self.agents.get(self.exe_da) if self.exe_da is not None else None
         try:
-            due = self.watch.due(now, self.hazards(), waiting, exe, self._order)
+            waiting = self._held_by_class(now, waiting, exe)
+            due = self.watch.due(now, self.hazards(), waiting, exe, self._order) if waiting else None
         except AgentEnded:
             self._remove_ended()
             return
@@ -450,6 +441,29 @@ class TaskHarmoniser:
         self._idle = dict.fromkeys(sorted(self._idle, key=lambda a: self._order.get(a, 0)))
         self.irr_da = agent
         self._roles_dirty = True
+
+    def _held_by_class(self, now: float, waiting: dict[str, DynamicAgent],
+                       exe: DynamicAgent | None) -> dict[str, DynamicAgent]:
+        """The safety rule: securing a hazard never preempts a task whose priority class outranks the
+        securing one (:meth:`Scheduler.outranks`) unless ``secure_over_higher`` allows it.  A waiting
+        agent held back this way, whose hazard is due, leaves one ``decision`` with ``rule: "secure
+        held"`` per executing task, saying which rule decided; it may secure once that task is done."""
+        top = self._cands.get(exe.id) if exe is not None else None
+        if top is None or self.secure_over_higher:
+            return waiting
+        held = {a: da for a, da in waiting.items()
+                if (c := self._cands.get(a)) is not None and self.scheduler.outranks(top, c)}
+        if held and self.hazards is not None:
+            due = self.watch.due(now, self.hazards(), held, exe, self._order, mark=False)
+            if due is not None and (due.agent, top.id) not in self._held_secures:
+                self._held_secures.add((due.agent, top.id))
+                self._trace.emit(ev.Decision(now, {
+                    "algorithm": self.scheduler.name, "rule": "secure held", "dac": due.agent, "exeDA": top.id,
+                    "switch": False, "hazard": str(due.hazard.name), "args": list(due.hazard.fact[1:]),
+                    "remaining_s": due.remaining_s,
+                    "why": "the executing task's priority class outranks the one that would secure its hazard "
+                           "(secure_over_higher is off)"}))
+        return {a: da for a, da in waiting.items() if a not in held}
 
     def _secure_done(self, now: float, agent: str) -> None:
         self._trace.emit(ev.SecureChanged(now, agent, "done"))

@@ -41,8 +41,9 @@ class SimulationLoop:
     """Builds the harmoniser and its agents and steps them on one simulated clock.
 
     ``strategies`` maps a task type to its :class:`Strategy`; others use ``strategy``.
-    ``hazard_waiting`` switches hazard-aware waiting on and ``hazards`` says which hazards
-    hold (both passed to the harmoniser; ``hazards`` may also be set later on
+    ``hazard_waiting`` switches hazard-aware waiting on, ``secure_over_higher`` lets it preempt a
+    task of a higher priority class (off: the safety rule), and ``hazards`` says which hazards
+    hold (all passed to the harmoniser; ``hazards`` may also be set later on
     ``harmoniser.hazards``, e.g. to a :meth:`tasker.meaning.Monitor.active` built on this loop).
     """
 
@@ -65,6 +66,7 @@ class SimulationLoop:
         horizon: float = 24 * 3600.0,
         hazard_waiting: bool = False,
         hazards: HazardSource | None = None,
+        secure_over_higher: bool = False,
     ) -> None:
         if not (isinstance(resolution, int | float) and 0 < resolution <= 1):
             raise ConfigError(f"resolution must be in (0, 1] seconds, got {resolution!r}")
@@ -82,7 +84,8 @@ class SimulationLoop:
         # hazard-aware waiting (a sweep factor): stored here and on the harmoniser, which implements it
         self.hazard_waiting = bool(hazard_waiting)
         self.harmoniser = TaskHarmoniser(scheduler, self._make_agent, trace=self.trace, mode=Mode(mode),
-                                         s_freq=s_freq, hazard_waiting=self.hazard_waiting, hazards=hazards)
+                                         s_freq=s_freq, hazard_waiting=self.hazard_waiting, hazards=hazards,
+                                         secure_over_higher=secure_over_higher)
         self._heap: list[tuple[int, int, int, Any]] = []
         self._seq = itertools.count()
         self._tick = 0
@@ -145,6 +148,7 @@ class SimulationLoop:
             core=self.core,
             motion=self.motion,
             handover=functools.partial(self.harmoniser.handover, agent_id),
+            hazards=functools.partial(self._owned_hazards, agent_id),
         )
         world = self._snapshot if self.world is not None else None
         agent = DynamicAgent(agent_id, task, ctx, trace=self.trace, rates=self.rates, core=self.core,
@@ -152,6 +156,14 @@ class SimulationLoop:
         self._wake(agent, self._tick + 1)
         self.all_agents.append(agent)
         return agent
+
+    def _owned_hazards(self, agent_id: str) -> tuple[tuple[str, tuple[str, ...]], ...]:
+        """The hazards ``agent_id`` owns that hold now (from the harmoniser's hazard source, e.g.
+        :meth:`tasker.meaning.Monitor.active`; none without one)."""
+        source = self.harmoniser.hazards
+        if source is None:
+            return ()
+        return tuple((str(h.name), tuple(h.fact)) for h in source() if h.agent == agent_id)
 
     def _snapshot(self) -> Any:
         """The world's snapshot for a hook; a world that raises stops the run (:class:`WorldError`)."""

@@ -69,11 +69,17 @@ class People:
 
     person: str
     roles: Mapping[str, tuple[Literal, ...]] = field(default_factory=dict)
+    safe: tuple[str, ...] = ()
+    """The roles the person may be left in when the task is suspended (a derived suspension
+    plans until the person holds one of them); empty: the folder says nothing about it."""
 
     def __post_init__(self) -> None:
         unknown = sorted(set(self.roles) - set(ROLES))
         if unknown:
             raise ValueError(f"People: unknown role(s) {unknown}; known: {list(ROLES)}")
+        undeclared = [r for r in self.safe if r not in self.roles]
+        if undeclared:
+            raise ValueError(f"People: safe role(s) {undeclared} are not declared; declared: {sorted(self.roles)}")
 
 
 @dataclass(frozen=True, slots=True)

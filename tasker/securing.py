@@ -23,16 +23,42 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 from tasker.errors import AgentEnded, ConfigError, InvariantViolation, PlanningFailed, WorldError
 from tasker.fsm import FsmState
 from tasker.stage import Stage, StagePlan
-
-if TYPE_CHECKING:
-    from tasker.agent import DynamicAgent
+from tasker.task import TaskContext, TaskType
 
 S = FsmState
+
+
+class WatchedAgent(Protocol):
+    """What the decision and the estimates read of a dynamic agent (:class:`tasker.agent.DynamicAgent` is one).
+
+    Defined here so that this module needs nothing of the agent's module, which calls it.
+    """
+
+    @property
+    def id(self) -> str: ...
+    @property
+    def state(self) -> FsmState: ...
+    @property
+    def ended(self) -> bool: ...
+    @property
+    def end_reason(self) -> str | None: ...
+    @property
+    def ctx(self) -> TaskContext: ...
+    @property
+    def task(self) -> TaskType: ...
+    @property
+    def progress(self) -> tuple[FsmState, int]: ...
+    @property
+    def ready_at(self) -> float: ...
+    @property
+    def stage_plan(self) -> StagePlan | None: ...
+    def refresh(self, now: float) -> None: ...
+    def fail(self, now: float, exc: BaseException) -> None: ...
 
 HazardSource = Callable[[], Iterable[Any]]
 """The hazards that hold now, each with ``agent``, ``name``, ``fact``, ``budget_s`` and ``since``
@@ -77,9 +103,10 @@ class HazardWatch:
         first, one scheduling period and the margin."""
         return secure_s + suspend_s + self.period_s + self.margin_s
 
-    def due(self, now: float, hazards: Iterable[Any], waiting: Mapping[str, DynamicAgent],
-            exe: DynamicAgent | None, order: Mapping[str, int]) -> Due | None:
-        """The waiting agent that must secure now, if any (its episodes are then marked secured).
+    def due(self, now: float, hazards: Iterable[Any], waiting: Mapping[str, WatchedAgent],
+            exe: WatchedAgent | None, order: Mapping[str, int], *, mark: bool = True) -> Due | None:
+        """The waiting agent that must secure now, if any (with ``mark``, its episodes are then
+        marked secured: they will not be secured twice).
 
         ``waiting`` are the idle agents whose report is ``wait``; ``exe`` the executing
         agent.  A hazard's unattended stretch began when it went on or when its agent
@@ -123,15 +150,16 @@ class HazardWatch:
             return None
         agent = best[2]
         remaining, hz = watched[agent]
-        _, _, secure_s, suspend_s = self._estimates.pop(agent)
-        self.secured.update(episodes[agent])
+        _, _, secure_s, suspend_s = self._estimates.pop(agent) if mark else self._estimates[agent]
+        if mark:
+            self.secured.update(episodes[agent])
         return Due(agent, hz, remaining, secure_s, suspend_s, tuple(episodes[agent]))
 
 
 # -- estimates ------------------------------------------------------------------------------
 
 
-def secure_estimate(agent: DynamicAgent, now: float) -> float:
+def secure_estimate(agent: WatchedAgent, now: float) -> float:
     """Seconds from ``now`` until a waiting agent asked to secure is safe.
 
     The task's own suspension under the ``strict`` policy from the world now (the
@@ -141,7 +169,7 @@ def secure_estimate(agent: DynamicAgent, now: float) -> float:
     return suspension_estimate(agent, now, "strict", agent.ctx.interrupted, None)
 
 
-def suspend_estimate(agent: DynamicAgent, now: float, expected_s: float | None = None) -> float:
+def suspend_estimate(agent: WatchedAgent, now: float, expected_s: float | None = None) -> float:
     """Seconds from ``now`` until an agent in ``cmd`` reports ``wait`` if it is sent ``susp`` now.
 
     In ``exeTsk``: what is left of a blocking stage and the blocking stages after it
@@ -154,16 +182,16 @@ def suspend_estimate(agent: DynamicAgent, now: float, expected_s: float | None =
     """
     if agent.ended:
         raise AgentEnded(agent.id, agent.end_reason or "ended")
-    runner = agent._runner
+    running, (_, at) = agent.stage_plan, agent.progress
     if agent.state in (S.GEN_SUSP, S.EXE_SUSP):
-        left = max(0.0, agent._ready_at - now) if agent.state is S.GEN_SUSP else 0.0
-        if runner is not None:
-            left += _stages_left(agent, now, runner.plan.stages, runner.index, lambda s: True)
+        left = max(0.0, agent.ready_at - now) if agent.state is S.GEN_SUSP else 0.0
+        if running is not None:
+            left += _stages_left(agent, now, running.stages, at, lambda s: True)
         return left
     if agent.state is S.UP_TSK and agent.ctx.plan is not None:
-        stages, index, left = agent.ctx.plan.stages, 0, max(0.0, agent._ready_at - now)
-    elif agent.state is S.EXE_TSK and runner is not None:
-        stages, index, left = runner.plan.stages, runner.index, 0.0
+        stages, index, left = agent.ctx.plan.stages, 0, max(0.0, agent.ready_at - now)
+    elif agent.state is S.EXE_TSK and running is not None:
+        stages, index, left = running.stages, at, 0.0
     else:
         return 0.0
     policy = agent.ctx.strategy.policy
@@ -176,7 +204,7 @@ def suspend_estimate(agent: DynamicAgent, now: float, expected_s: float | None =
     return estimate
 
 
-def _from(agent: DynamicAgent, now: float, stages: Sequence[Stage], index: int, policy: str,
+def _from(agent: WatchedAgent, now: float, stages: Sequence[Stage], index: int, policy: str,
           expected_s: float | None, whole: bool = False) -> float:
     """Suspending from stage ``index``: its blocking run (eq. 25), then the suspension at the first
     suspendable stage (eq. 26) — none left: the task ends instead.  ``whole``: the run not yet begun."""
@@ -187,7 +215,7 @@ def _from(agent: DynamicAgent, now: float, stages: Sequence[Stage], index: int, 
     return left + suspension_estimate(agent, now, policy, at, expected_s)
 
 
-def _stages_left(agent: DynamicAgent, now: float, stages: Sequence[Stage], index: int,
+def _stages_left(agent: WatchedAgent, now: float, stages: Sequence[Stage], index: int,
                  take: Callable[[Stage], bool], whole: bool = False) -> float:
     """Durations of ``stages`` from ``index`` while ``take`` holds; of a running stage of
     ``exeTsk``, what is left of it (unless ``whole``)."""
@@ -203,7 +231,7 @@ def _stages_left(agent: DynamicAgent, now: float, stages: Sequence[Stage], index
     return total
 
 
-def suspension_estimate(agent: DynamicAgent, now: float, policy: str, interrupted: Stage | None,
+def suspension_estimate(agent: WatchedAgent, now: float, policy: str, interrupted: Stage | None,
                         expected_s: float | None) -> float:
     """``generate_suspension`` on a copy of the agent's context (static strategy, ``policy``,
     interrupted at ``interrupted``): the seconds the plan takes, ``inf`` if it cannot be made.
@@ -214,7 +242,7 @@ def suspension_estimate(agent: DynamicAgent, now: float, policy: str, interrupte
     if agent.ended:
         raise AgentEnded(agent.id, agent.end_reason or "ended")
     try:
-        agent._refresh(now)
+        agent.refresh(now)
         memory = dict(agent.ctx.memory)
         if expected_s is not None:
             memory["interruption_s"] = float(expected_s)
@@ -230,5 +258,5 @@ def suspension_estimate(agent: DynamicAgent, now: float, policy: str, interrupte
     except (InvariantViolation, WorldError):
         raise
     except Exception as exc:
-        agent._fail(now, exc)
+        agent.fail(now, exc)
         raise AgentEnded(agent.id, agent.end_reason or "error") from exc

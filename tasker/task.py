@@ -1,7 +1,8 @@
 """Task types: what a user writes to add a task to the store.
 
-A task type is a class with **hooks**; the dynamic agent owns the loop and calls them
-at the moments the paper defines.  Override the hooks you need:
+A task type is a class with **hooks**; the dynamic agent owns the loop
+(:meth:`tasker.agent.DynamicAgent.step`, ``typing.final``) and calls them at the
+moments the paper defines.  Override the hooks you need:
 
 =====================  ===============================  ===================================
 hook                   called in (paper)                 returns
@@ -17,21 +18,38 @@ hook                   called in (paper)                 returns
 ``on_stage_done``      after each completed stage        nothing
 ``leaves``             another agent's estimate          the facts it would leave changed
                        (:attr:`TaskContext.handover`)     (:class:`Effects`) or None
+``check_args``         :meth:`TaskType.validate_args`     nothing; raise ``BadRequest``
 =====================  ===============================  ===================================
+
+Which hook when:
+
+* ``update_task`` is the one every task type must override: it turns the world as it is
+  now into the stages still to run (R6: what is done already is not planned again).
+* ``generate_suspension`` when being interrupted leaves something unsafe or undone (a
+  device on, an object held, a person waiting); the default suspends with nothing to do.
+* ``compute_params`` when the default cost (age plus the expected duration left) does not
+  say how urgent the task is; ``request_sp`` when the answer to ``cc`` depends on where
+  the robot starts (the default ignores the pose).
+* ``check_terminate`` when the task can become pointless on its own (the person got up).
+* ``initialise`` for per-agent set-up, never ``__init__``: one instance serves every agent,
+  so per-agent state lives in ``ctx.memory``.
+* ``on_stage_done`` to note progress; ``leaves`` when what the task changes matters to the
+  next task's estimates; ``check_args`` for checks the :class:`ArgSpec` types cannot make.
 
 ``update_task`` and ``generate_suspension`` may raise
 :class:`~tasker.errors.PlanningFailed`: the agent then ends (upTsk) with the reason in
 the trace.  A task type that wants a fallback (e.g. a static suspension when the
 planner fails) does it inside the hook and says so in ``StagePlan.note``.
 
-The public method :meth:`TaskType.validate_args` checks a request's arguments against
-the declared :class:`ArgSpec` tuple; task types add checks in ``check_args``.
+The framework's own method :meth:`TaskType.validate_args` checks a request's arguments
+against the declared :class:`ArgSpec` tuple and then calls ``check_args``: extend the
+checks there, do not override it.
 """
 
 from __future__ import annotations
 
 import random
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -68,6 +86,11 @@ class Effects:
 
 
 POLICIES = ("strict", "conditional")
+UPDATES = ("planned", "static")
+"""How upTsk builds exeTsk: plan from the world as it is, or the template (Alg. 3)."""
+SUSPENSIONS = ("planned", "static", "derived")
+"""How genSusp builds exeSusp: plan to the decision tree's goal, run its stages, or plan to the goal
+derived from the task's declarations."""
 """Suspension policies (:attr:`Strategy.policy`)."""
 
 _ARG_TYPES: dict[str, type] = {"str": str, "float": float, "int": int, "bool": bool, "pose": tuple}
@@ -121,10 +144,12 @@ class Strategy:
     """How a task builds its FSMs: ``update`` in upTsk, ``suspension`` in genSusp.
 
     Each is ``"planned"`` (call a planner on the world as it is) or ``"static"``
-    (the task's template ``exeTsk``, Alg. 3, and decision-tree ``exeSusp``, eq. 47).
-    Both pursue the same suspension goal.  ``policy`` is a separate factor applied to
+    (the task's template ``exeTsk``, Alg. 3, and decision-tree ``exeSusp``, eq. 47); both
+    pursue the goal of the decision tree's branch.  ``suspension`` may also be ``"derived"``:
+    plan to a goal derived from what the task declares (every hazard it owns off, every
+    person it affects in a safe role, its invariants), not from the tree.  ``policy`` is a separate factor applied to
     both: ``"strict"`` always reaches the safe state; ``"conditional"`` also allows the
-    branches a task declares as trading safety for time (e.g. leave the cooker on for a
+    branches a task declares as trading safety for time (e.g. leave a device on for a
     short interruption).
     """
 
@@ -133,9 +158,10 @@ class Strategy:
     policy: str = "strict"
 
     def __post_init__(self) -> None:
-        for name in ("update", "suspension"):
-            if getattr(self, name) not in ("planned", "static"):
-                raise ConfigError(f"Strategy.{name} must be 'planned' or 'static', got {getattr(self, name)!r}")
+        if self.update not in UPDATES:
+            raise ConfigError(f"Strategy.update must be one of {list(UPDATES)}, got {self.update!r}")
+        if self.suspension not in SUSPENSIONS:
+            raise ConfigError(f"Strategy.suspension must be one of {list(SUSPENSIONS)}, got {self.suspension!r}")
         if self.policy not in POLICIES:
             raise ConfigError(f"Strategy.policy must be one of {list(POLICIES)}, got {self.policy!r}")
 
@@ -178,6 +204,9 @@ class TaskContext:
     suspended: bool = False
     terminating: bool = False
     handover: Callable[[str | None], Effects | None] | None = None
+    hazards: Callable[[], Sequence[tuple[str, tuple[str, ...]]]] | None = None
+    """The hazards this agent owns that hold now, as ``(hazard name, ground fact)`` (set by the loop
+    from the harmoniser's hazard source; None without one): what a derived suspension turns off."""
 
     @property
     def current(self) -> Stage | None:
@@ -203,23 +232,29 @@ class TaskType:
     """Base class of a task type; see the module docstring for the hooks.
 
     Subclasses set :attr:`name`, :attr:`arg_specs` and :attr:`description`, and
-    override hooks.  One instance serves every agent of the type, so per-agent state
-    belongs in ``ctx.memory``, never on ``self``.  :attr:`meaning` declares what the
-    task means for safety and people (hazards, roles, physical bindings; see
-    :mod:`tasker.meaning`): the trace and the metrics read it, never the task's name.
+    override hooks (the module docstring says which hook when).  One instance serves
+    every agent of the type, so per-agent state belongs in ``ctx.memory``, never on
+    ``self``.  :attr:`meaning` declares what the task means for safety and people
+    (hazards, roles, physical bindings; see :mod:`tasker.meaning`): the trace and the
+    metrics read it, never the task's name.  :attr:`priority` declares how urgent the
+    type is against others, for schedulers that rank task types in classes.
     """
 
     name: str = ""
     description: str = ""
     arg_specs: tuple[ArgSpec, ...] = ()
     meaning: Meaning = NO_MEANING
+    priority: int | None = None
+    """The type's priority class, higher is more urgent; None: the lowest.  Alg. 2's classes
+    come from it when a scenario names none (a task folder declares it as ``[schedule] priority``)."""
 
     # -- framework-owned ------------------------------------------------------------
 
     def validate_args(self, args: Mapping[str, Any]) -> dict[str, Any]:
         """Check a request's arguments; return them completed with defaults.
 
-        Raises :class:`~tasker.errors.BadRequest` naming the argument at fault.
+        Raises :class:`~tasker.errors.BadRequest` naming the argument at fault.  The
+        framework's: do not override it; add checks in :meth:`check_args`, which it calls.
         """
         if not isinstance(args, Mapping):
             raise BadRequest(f"task {self.name!r}: arguments must be a mapping, got {type(args).__name__}")
@@ -243,42 +278,78 @@ class TaskType:
     # -- hooks ----------------------------------------------------------------------
 
     def check_args(self, args: dict[str, Any]) -> None:
-        """Extra argument checks (e.g. a named person exists); raise BadRequest."""
+        """Override to check what the :class:`ArgSpec` types cannot (e.g. two arguments differ);
+        raise :class:`~tasker.errors.BadRequest`.  Called by :meth:`validate_args` with the
+        arguments already typed and completed.  Default: nothing more to check."""
 
     def initialise(self, ctx: TaskContext) -> None:
-        """``initComm``: set up ``ctx.memory``."""
+        """Override to set up this agent's ``ctx.memory``; called once, in ``initComm``.
+
+        Use it, not ``__init__``, for anything per request: one instance serves every agent.
+        Default: nothing."""
 
     def compute_params(self, ctx: TaskContext) -> ScheduleParams:
-        """``compSP``: the schedule parameters now.  Default: cost = age, cTime = expected duration."""
+        """Override to say how urgent the task is now: its schedule parameters (eq. 19).
+
+        Called in ``compSP`` and ``wait`` at ``repRate`` and in ``exeTsk`` at ``SPupRate``
+        (eqs. 22, 24, 27), and when the harmoniser decides from one moment: it may be called more
+        than once at the same time, so what it returns should depend on ``ctx`` only.  Default: ``CostParams`` with
+        cost = age + cTime, cps = 1, cTime = the expected duration of the stages left."""
         remaining = ctx.remaining if ctx.plan is not None else ()
         c_time = sum(s.duration for s in remaining)
         return CostParams(self.name, cost=ctx.age + c_time, cps=1.0, c_time=c_time)
 
     def request_sp(self, ctx: TaskContext, request: SPRequest) -> Any:
-        """``reqSP``: an argument-dependent parameter.  Default answers ``cc`` from ``compute_params``."""
+        """Override to answer the harmoniser's argument-dependent request ``[spID, args]`` (eqs. 20-23).
+
+        Alg. 2 asks ``cc``: the cost if the task started from ``args["pose"]``.  Default:
+        ``cc`` and ``ccps`` from :meth:`compute_params`, whatever the pose."""
         params = self.compute_params(ctx)
         if isinstance(params, CostParams):
             return CompletionCost(cc=params.cost, ccps=params.cps)
         raise NotImplementedError(f"task type {self.name!r} does not answer reqSP {request.sp_id!r}")
 
     def update_task(self, ctx: TaskContext) -> StagePlan:
-        """``upTsk``: build ``exeTsk`` from the world as it is now."""
+        """Override (required): build ``exeTsk`` from the world as it is now; called in ``upTsk``.
+
+        Return the stages still to run (none if the work is done already, R6), or raise
+        :class:`~tasker.errors.PlanningFailed`, which ends the task with the reason traced."""
         raise NotImplementedError(f"task type {self.name!r} does not implement update_task")
 
     def generate_suspension(self, ctx: TaskContext) -> StagePlan:
-        """``genSusp``: build ``exeSusp``.  Default: nothing to do (the ``save`` behaviour of eq. 47)."""
+        """Override when an interruption would leave something unsafe or undone: build ``exeSusp``.
+
+        Called in ``genSusp`` (after ``susp``, a ``term``, the task's own ``ic_term``, a
+        failed stage, or to secure a hazard while waiting); ``ctx.interrupted``,
+        ``ctx.terminating`` and ``ctx.strategy.policy`` say which.  Default: nothing to do
+        (the ``save`` behaviour of eq. 47)."""
         return StagePlan((), Purpose.GEN_SUSP, strategy="static")
 
     def check_terminate(self, ctx: TaskContext) -> str | None:
-        """``ic_term`` set by the agent itself: a reason to end, or None to go on."""
+        """Override when the task can become pointless on its own: return why (``ic_term``), or None.
+
+        Called in ``compSP`` and ``wait`` at ``repRate`` and during each stage of ``exeTsk``;
+        in ``exeTsk`` the task then suspends safely before it ends.  Default: never."""
+        return None
+
+    def inapplicable(self, ctx: TaskContext, stage: Stage) -> str | None:
+        """Why ``stage`` cannot run in the world as it is now (``ctx.world``), or None if it can.
+
+        Asked before every stage begins, static and planned alike, as a robot would find out:
+        a stage whose action's precondition does not hold fails without running (its reason
+        starts with :data:`tasker.trace.INAPPLICABLE`) and applies no effect.  Override it for
+        a task type that knows its actions' preconditions (a PDDL task folder does); the
+        default knows none."""
         return None
 
     def on_stage_done(self, ctx: TaskContext, stage: Stage) -> None:
-        """Called after a stage of ``exeTsk`` or ``exeSusp`` completes."""
+        """Override to note progress in ``ctx.memory``; called after each stage of ``exeTsk`` or
+        ``exeSusp`` completes.  Default: nothing."""
 
     def leaves(self, ctx: TaskContext, how: Leaving) -> Effects | None:
-        """What this task would leave changed if left now (``suspend``: its genSusp would run;
-        ``complete``: it runs to its end), for the estimates of the task that comes next.
+        """Override when what this task changes matters to the next task's estimates: what it would
+        leave changed if left now (``suspend``: its genSusp would run; ``complete``: it runs to
+        its end).  Called for another agent's estimate (:attr:`TaskContext.handover`).
         Default: nothing for a suspension (the ``save`` behaviour); for a completion, the
         ``add``/``delete`` data of the stages of ``exeTsk`` still to run."""
         if how == "complete":

@@ -21,6 +21,10 @@ from tasker.support import reader
 EVENTS = KINDS
 """Every event kind a trace may hold (:data:`tasker.events.KINDS`)."""
 
+INAPPLICABLE = "inapplicable:"
+"""How the ``reason`` of a ``stage`` ``failed`` event begins when the stage's action could not run in the
+world as it was (a precondition did not hold): it was never started, and applied no effect."""
+
 FAILED = frozenset({"failed", "error"})
 """``end`` causes of an agent that did not do its task and was not stopped on purpose: a plan
 or a skill failed (``failed``), or an exception ended it (``error``); ``docs/trace.md``."""

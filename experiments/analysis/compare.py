@@ -24,7 +24,12 @@ from experiments.metrics.store import RunRow, Status
 ALL = "*"
 """The scenario column of rows pooled over every scenario (descriptive summaries only, never a verdict)."""
 
-TREATMENT = {"update": "planned", "suspension": "planned", "policy": "conditional", "hazard_waiting": "on"}
+LEVEL_ORDER = {"update": ("static", "planned"), "suspension": ("static", "planned", "derived"),
+               "policy": ("strict", "conditional"), "hazard_waiting": ("off", "on")}
+"""Each factor's levels, baseline first: of two levels compared, the later one is the treatment
+(``planned`` and ``derived`` against ``static``, ``derived`` against ``planned``)."""
+TREATMENT = {k: v[-1] for k, v in LEVEL_ORDER.items()}
+"""The last level of each factor (the treatment of every comparison it takes part in)."""
 """For each two-level factor, the level compared against the other (the difference is treatment − baseline)."""
 
 INFEASIBLE = re.compile(r"infeasib|unsolvable|no plan|PlanningFailed", re.IGNORECASE)
@@ -155,7 +160,9 @@ def comparisons(strategies: Iterable[str]) -> list[tuple[str, str, str]]:
                 continue
             k = differ[0]
             va, vb = Strategy(**{k: da[k]}).label.partition("=")[2], Strategy(**{k: db[k]}).label.partition("=")[2]
-            first_is_treatment = va == TREATMENT[k] if k in TREATMENT else va > vb
+            order = LEVEL_ORDER.get(k)
+            first_is_treatment = order.index(va) > order.index(vb) if order and va in order and vb in order \
+                else va > vb
             out.append((k, la, lb) if first_is_treatment else (k, lb, la))
     return sorted(out)
 

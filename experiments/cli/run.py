@@ -63,7 +63,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p.add_argument("scenario", help="shipped scenario name or scenario file")
     p.add_argument("--out", default=None, metavar="DIR", help="output folder (default: out/NAME)")
     p.add_argument("--seed", type=seed, default=None, help="seed, 0 <= N < 2**32 (default: the scenario's)")
-    p.add_argument("--suspension", choices=("static", "planned"), default=None,
+    p.add_argument("--suspension", choices=("static", "planned", "derived"), default=None,
                    help="genSusp strategy for every task (default: the scenario's)")
     p.add_argument("--update", choices=("static", "planned"), default=None,
                    help="upTsk strategy for every task (default: the scenario's)")

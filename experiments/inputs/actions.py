@@ -20,7 +20,9 @@ from tasker.support.reader import MAX_SECONDS, Table, check_name, suggest
 
 __all__ = ["NO_REQUESTS", "TABLES", "WORLD_EVENT_KINDS", "ScenarioError", "TimedAction", "located", "read_actions"]
 
-WORLD_EVENT_KINDS = ("posture", "door", "walk", "add", "delete")
+WORLD_EVENT_KINDS = ("posture", "door", "walk", "add", "delete", "device", "move")
+"""What a world event may do: a person's posture, a door, a person walking to a point, facts added or
+deleted, a device switched (``[device, state]``), an object moved to a place (``[object, place]``)."""
 
 TABLES = (("requests", "request"), ("terminations", "terminate"), ("changes", "change"),
           ("mode_changes", "mode"), ("world_events", "world"))
@@ -106,6 +108,8 @@ def _read(f: Table, kind: str, task_names: Collection[str] | None) -> dict[str, 
     if what == "walk" and (len(value) != 3 or not isinstance(value[0], str) or not value[0] or not all(
             isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) for v in value[1:])):
         raise f.error(what, f"expected [person, x, y] (x and y in metres), got {value!r}")
+    if what in ("device", "move") and (len(value) != 2 or not all(isinstance(v, str) and v for v in value)):
+        raise f.error(what, f"expected [{'device, state' if what == 'device' else 'object, place'}], got {value!r}")
     if what in ("add", "delete") and not (value and all(
             isinstance(x, list) and x and all(isinstance(a, str) and a for a in x) for x in value)):
         raise f.error(what, f"expected a non-empty list of facts (lists of non-empty strings), got {value!r}")

@@ -297,6 +297,12 @@ class _Checker:
 
                     check_name(f, what, value[0], self.world.people, f"person of world {self.world.name!r}")
                     check_point(self.world, f, what, float(value[1]), float(value[2]))
+                elif what == "device":
+                    check_name(f, what, value[0], self.world.devices, f"device of world {self.world.name!r}")
+                elif what == "move":
+                    things = {**self.world.objects, **{n: o["type"] for n, o in self.scn.objects.items()}}
+                    check_name(f, what, value[0], things, f"object of world {self.world.name!r} or the scenario")
+                    check_name(f, what, value[1], self.world.places, f"place of world {self.world.name!r}")
                 else:
                     for fact in value:
                         self.fact(f, what, fact)

@@ -7,16 +7,19 @@ what the robot and the synthetic scenario readers have in common.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 from tasker import schedulers
 from tasker.support.reader import InputError, Table
+from tasker.task import TaskType
 
 TASKS_HINT = "to add a task type, add its folder with --path DIR or TASKER_TASKS (see 'tasker new')"
 """What an unknown task type's error adds: how to add one."""
 
 MODES = ("IT", "CT")
 STRATEGIES = ("planned", "static")
+SUSPENSIONS = ("planned", "static", "derived")
 POLICIES = ("strict", "conditional")
 
 
@@ -54,6 +57,29 @@ def scheduler_options(s: Table, name: str, task_names: list[str] | None = None) 
     except Exception as exc:  # the scheduler's own check, e.g. hysteresis out of range
         raise s.error("scheduler_options", f"{exc}") from None
     return options
+
+
+def priority_classes(tasks: Iterable[TaskType]) -> list[list[str]]:
+    """Alg. 2's ``classes`` from what the task types declare (:attr:`tasker.task.TaskType.priority`,
+    a folder's ``[schedule] priority``): one class per priority, highest first, names sorted;
+    types that declare none form the lowest class, which ``classes`` leaves unlisted."""
+    by: dict[int, list[str]] = {}
+    for t in tasks:
+        if t.priority is not None:
+            by.setdefault(t.priority, []).append(t.name)
+    return [sorted(by[p]) for p in sorted(by, reverse=True)]
+
+
+def scheduler_defaults(name: str, options: Mapping[str, Any], tasks: Iterable[TaskType]) -> dict[str, Any]:
+    """``options`` completed with what the task types declare: ``alg2`` without ``classes`` gets
+    :func:`priority_classes` (when any type declares a priority).  The model names no task type,
+    so these defaults come from the folders, never from the scheduler."""
+    out = dict(options)
+    if name == "alg2" and "classes" not in out:
+        classes = priority_classes(tasks)
+        if classes:
+            out["classes"] = classes
+    return out
 
 
 MAX_RATE_HZ = 1000.0

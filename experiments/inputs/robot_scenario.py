@@ -38,6 +38,9 @@ class RobotScenario:
     people: dict[str, dict[str, Any]] = field(default_factory=dict)
     objects: dict[str, dict[str, Any]] = field(default_factory=dict)
     policy: str = "strict"
+    secure_over_higher: bool = False
+    """Hazard-aware waiting may preempt a task of a higher priority class to secure a hazard (off: the
+    safety rule of ``docs/model.md``)."""
     warnings: tuple[str, ...] = field(default=(), compare=False)
 
     def to_json(self) -> dict[str, Any]:

@@ -25,9 +25,11 @@ from typing import Any
 import numpy as np
 
 from experiments.inputs import fields
+from experiments.inputs import perturbation as perturbations
 from experiments.inputs.actions import TABLES, TimedAction, read_actions
-from experiments.inputs.fields import MODES, POLICIES, STRATEGIES, ScenarioError
+from experiments.inputs.fields import MODES, POLICIES, STRATEGIES, SUSPENSIONS, ScenarioError
 from experiments.inputs.filekinds import expect
+from experiments.inputs.perturbation import Perturbation
 from experiments.inputs.robot_scenario import RobotScenario
 from tasker.support import reader
 
@@ -108,7 +110,8 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
     sched = fields.scheduler(s)
     strategies: dict[str, dict[str, str]] = {}
     for task, t in s.named("strategies"):
-        strategies[task] = {k: str(t.string(k, choices=STRATEGIES)) for k in ("update", "suspension") if k in t}
+        strategies[task] = {k: str(t.string(k, choices=SUSPENSIONS if k == "suspension" else STRATEGIES))
+                            for k in ("update", "suspension") if k in t}
         t.done()
     actions = read_actions(top, world_events=True)
     people: dict[str, dict[str, Any]] = {}
@@ -146,10 +149,11 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
         s_freq=fields.rate(s, "s_freq", 1.0), rep_rate=fields.rate(s, "rep_rate", 1.0),
         task_exe_rate=fields.rate(s, "task_exe_rate", 10.0), sp_up_rate=fields.rate(s, "sp_up_rate", 1.0),
         update=str(s.string("update", "planned", choices=STRATEGIES)),
-        suspension=str(s.string("suspension", "planned", choices=STRATEGIES)), strategies=strategies,
+        suspension=str(s.string("suspension", "planned", choices=SUSPENSIONS)), strategies=strategies,
         seed=int(top.number("seed", 1, integer=True, min=0, max=reader.MAX_SEED)),
         horizon=float(s.number("horizon", 1800.0, positive=True, max=reader.MAX_SECONDS)),
         people=people, objects=objects, policy=str(s.string("policy", "strict", choices=POLICIES)),
+        secure_over_higher=bool(s.boolean("secure_over_higher", False)),
     )
     s.done()
     top.done(SCENARIO_KEYS)
@@ -159,7 +163,12 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
     from experiments.inputs import crossref
     from planners.bundled import task_types
 
-    return crossref.check_robot(scenario, top, task_types(list(task_paths)))
+    types = task_types(list(task_paths))
+    scenario = crossref.check_robot(scenario, top, types)
+    # what the scheduler is not told, the task folders may declare (alg2's classes from their priorities)
+    options = fields.scheduler_defaults(scenario.scheduler, scenario.scheduler_options, types)
+    return scenario if options == scenario.scheduler_options else dataclasses.replace(scenario,
+                                                                                      scheduler_options=options)
 
 
 @dataclass(frozen=True)
@@ -206,7 +215,8 @@ class InterruptionGrid:
 
 
 def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, pose_jitter: float = 0.5,
-              interruption: InterruptionGrid | None = None) -> RobotScenario:
+              interruption: InterruptionGrid | None = None,
+              perturbation: Perturbation | None = None) -> RobotScenario:
     """A variant of ``scenario`` drawn from ``seed``.
 
     * Request and event times are scaled by up to ``±time_jitter`` (what happens together
@@ -218,6 +228,9 @@ def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, 
       and walk times scaled like the rest, keeping each point in free space (the person's disc
       clear of walls and furniture, :class:`robot.scene.Scene`) and each leg clear of walls;
       a draw that fails 20 times keeps the original point.
+    * With a ``perturbation`` (and an ``interruption`` grid), exogenous world events are drawn
+      around the placed interruption (:mod:`experiments.inputs.perturbation`); everything else
+      is drawn exactly as without it, so the control arm is the same variant unperturbed.
 
     The same seed gives the same variant."""
     from robot.scene import PERSON_RADIUS, Scene
@@ -275,5 +288,12 @@ def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, 
             new_walk.sort()
             e["walk"] = [w for i, w in enumerate(new_walk) if i == 0 or w[0] > new_walk[i - 1][0]]
         people[name] = e
+    if perturbation is not None:
+        if placed is None:
+            raise ScenarioError(scenario.source, "perturbation: needs an interruption grid ([variants.NAME]) to "
+                                                 "place its window around")
+        offer = perturbations.candidates(spec, scenario.objects, actions, people)
+        drawn_events = perturbations.events(perturbation, f"{scenario.name}:{seed}", placed, **offer)
+        actions += [dataclasses.replace(a, origin=("perturbation", k)) for k, a in enumerate(drawn_events)]
     return dataclasses.replace(scenario, actions=tuple(sorted(actions, key=lambda a: a.t)), people=people,
                                seed=seed, name=f"{scenario.name}~{seed}")

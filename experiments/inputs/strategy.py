@@ -17,6 +17,8 @@ from typing import Any
 from tasker.support import reader
 
 STRATEGY_VALUES = ("static", "planned")
+SUSPENSION_VALUES = ("static", "planned", "derived")
+"""``suspension`` may also be ``derived`` (plan to the goal the task folder's declarations give)."""
 
 
 @dataclass(frozen=True)
@@ -36,10 +38,10 @@ class Strategy:
     hazard_waiting: bool | None = None
 
     def __post_init__(self) -> None:
-        for name in ("update", "suspension"):
+        for name, values in (("update", STRATEGY_VALUES), ("suspension", SUSPENSION_VALUES)):
             value = getattr(self, name)
-            if value is not None and value not in STRATEGY_VALUES:
-                raise ValueError(f"{name}: expected one of {list(STRATEGY_VALUES)}, got {value!r}")
+            if value is not None and value not in values:
+                raise ValueError(f"{name}: expected one of {list(values)}, got {value!r}")
         if self.policy is not None and self.policy not in POLICY_VALUES:
             raise ValueError(f"policy: expected one of {list(POLICY_VALUES)}, got {self.policy!r}")
         if self.hazard_waiting is not None and not isinstance(self.hazard_waiting, bool):
@@ -115,7 +117,7 @@ def expand(factors: Mapping[str, Sequence[Any]]) -> list[Strategy]:
 
 
 FACTOR_LEVELS: dict[str, tuple[Any, ...] | None] = {
-    "update": STRATEGY_VALUES, "suspension": STRATEGY_VALUES, "policy": POLICY_VALUES,
+    "update": STRATEGY_VALUES, "suspension": SUSPENSION_VALUES, "policy": POLICY_VALUES,
     "hazard_waiting": (False, True), "scheduler": None}
 """The levels each factor of a ``[factors]`` grid may take (``None``: a registered scheduler)."""
 

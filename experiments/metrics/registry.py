@@ -108,6 +108,10 @@ METRICS: tuple[Metric, ...] = (
     Metric("decisions.decisions", "count", N, "scheduling decisions"),
     Metric("decisions.switch_decisions", "count", N, "decisions that chose to switch"),
     Metric("decisions.decisions_by.*", "count", N, "decisions by algorithm/rule"),
+    Metric("decisions.cost_compared", "count", N, "Alg. 2 decisions that compared finite costs"),
+    Metric("decisions.margins.*", "count", N, "cost decisions by margin 1 − c_switch/c_wait (bins of 0.1)"),
+    Metric("decisions.hysteresis_flips.*", "count", N, "cost decisions that would have gone the other way "
+           "at this hysteresis"),
     Metric("safety.unattended_s", "s", L, "hazard time on while its owner was not in cmd, over owned hazards",
            label="hazard time unattended (s)"),
     Metric("safety.longest_unattended_s", "s", L, "the longest unbroken unattended stretch of an owned hazard"),
@@ -119,6 +123,21 @@ METRICS: tuple[Metric, ...] = (
            label="hazards left on at a switch"),
     Metric("safety.hazards_active_at_switch", "count", L, "owned hazards on, whoever's, at each entry into wait"),
     Metric("safety.unowned_hazards", "count", N, "hazard episodes nobody owns"),
+    Metric("safety.unattended_alive_s", "s", L, "hazard time unattended while its owner was alive (what a "
+           "suspension could attend to); the primary hazard outcome", label="hazard unattended, owner alive (s)"),
+    Metric("safety.severity_unattended_s", "s", L, "unattended_alive_s weighted by each hazard's declared severity"),
+    Metric("safety.unowned_s", "s", L, "time hazards nobody owns were on (doors opened by a person or an "
+           "exogenous event)", label="unowned hazard exposure (s)"),
+    Metric("suspensions.count", "count", N, "suspension episodes that closed (wait or end)"),
+    Metric("suspensions.safe", "count", H, "episodes that closed with no hazard of their agent on and every "
+           "stage applicable"),
+    Metric("suspensions.unsafe", "count", L, "episodes that closed with a hazard of their agent on, or ran an "
+           "inapplicable stage", label="unsafe suspensions"),
+    Metric("suspensions.all_safe", "bool", H, "every suspension of the run was safe (the binary outcome)",
+           label="all suspensions safe"),
+    Metric("suspensions.inapplicable_stages", "count", L, "suspension stages whose action could not run"),
+    *_stats("suspensions.time_to_safe_s", "s", L, "genSusp to wait or end, over safe suspensions",
+            label="time to a safe suspension (s)"),
     Metric(f"{_HAZARD}.episodes", "count", N, "owned episodes of this hazard"),
     Metric(f"{_HAZARD}.budget_s", "s", N, "its declared budget"),
     Metric(f"{_HAZARD}.active_s", "s", N, "time it was on"),

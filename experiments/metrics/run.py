@@ -23,7 +23,7 @@ from experiments.metrics.calibration import calibration
 from experiments.trace.timeline import CMD, AgentTimeline, HazardEpisode, Timeline, timeline
 from tasker import events as ev
 from tasker.fsm import FsmState
-from tasker.trace import FAILED
+from tasker.trace import FAILED, INAPPLICABLE
 
 S = FsmState
 Source = Timeline | Iterable[ev.Event | Mapping[str, Any]]
@@ -123,11 +123,39 @@ def switching(tl: Timeline) -> dict[str, Any]:
             "changes": sum(1 for c in tl.changes if c.ignored is None)}
 
 
+HYSTERESES = (0.85, 0.9, 0.95, 1.0)
+"""The hysteresis values a run's cost decisions are re-read under (how many would have gone the other way)."""
+MARGIN_BINS = 0.1
+"""Width of the bins of the cost decisions' margins ``1 − c_switch / c_wait`` (clipped to [−1, 1])."""
+
+
 def decisions(tl: Timeline) -> dict[str, Any]:
-    """Scheduling decisions: how many, by algorithm and rule, and how many chose to switch."""
+    """Scheduling decisions: how many, by algorithm and rule, and how many chose to switch; for Alg. 2's
+    finite cost comparisons, a histogram of their margins ``1 − c_switch / c_wait`` and, per hysteresis
+    of :data:`HYSTERESES`, how many would have decided the other way (a sensitivity check, decision by
+    decision: what would have happened after is not re-run)."""
     by = Counter(f"{d.algorithm}/{d.rule if d.rule is not None else '-'}" for d in tl.decisions)
+    margins: Counter[str] = Counter()
+    flips = dict.fromkeys((f"{h:g}" for h in HYSTERESES), 0)
+    compared = 0
+    for d in tl.decisions:
+        if d.rule != "cost":
+            continue
+        try:
+            cs, cw, h = float(d.get("c_switch")), float(d.get("c_wait")), float(d.get("hysteresis", 1.0))
+        except (TypeError, ValueError):
+            continue
+        if not (math.isfinite(cs) and math.isfinite(cw) and cw > 0 and math.isfinite(h)):
+            continue
+        compared += 1
+        margin = max(-1.0, min(1.0, 1.0 - cs / cw))
+        margins[f"{math.floor(margin / MARGIN_BINS + 1e-9) * MARGIN_BINS:+.1f}"] += 1
+        for other in HYSTERESES:
+            if (cs < other * cw) != (cs < h * cw):
+                flips[f"{other:g}"] += 1
     return {"decisions": len(tl.decisions), "switch_decisions": sum(d.switch for d in tl.decisions),
-            "decisions_by": dict(sorted(by.items()))}
+            "decisions_by": dict(sorted(by.items())), "cost_compared": compared,
+            "margins": dict(sorted(margins.items(), key=lambda kv: float(kv[0]))), "hysteresis_flips": flips}
 
 
 # -- safety: hazards -------------------------------------------------------------------------------
@@ -236,7 +264,38 @@ def safety(tl: Timeline) -> dict[str, Any]:
         "overrun_s": math.fsum(r["overrun_s"] for r in owned),
         "after_end_s": math.fsum(r["after_end_s"] for r in owned),
         "unowned_hazards": len(rows) - len(owned),
+        # within the owner's lifetime (what a suspension or hazard-aware waiting could attend to); the
+        # rest, after the owner ended, is a task-design defect reported apart (after_end_s)
+        "unattended_alive_s": math.fsum(r["unattended_s"] - r["after_end_s"] for r in owned),
+        "severity_unattended_s": math.fsum(float(r["severity"]) * (r["unattended_s"] - r["after_end_s"])
+                                           for r in owned),
+        "unowned_s": math.fsum(r["active_s"] for r in rows if r["agent"] is None),
     }
+
+
+def suspensions(tl: Timeline) -> dict[str, Any]:
+    """Each suspension episode (entering ``genSusp`` until ``wait`` or ``end``): was it *safe* — when
+    it closed, no hazard its agent owns was on, and every stage it executed was applicable
+    (``tasker.trace.INAPPLICABLE``) — and how long it took to get there."""
+    rows: list[dict[str, Any]] = []
+    for a in tl.agents.values():
+        for s in a.suspensions:
+            if s.outcome == "open":
+                continue
+            left_on = [f"{h.hazard}({', '.join(h.args)})" for h in _active_at(tl.hazards, s.end) if h.owner == a.id]
+            inapplicable = [r.action for r in s.stages if r.status == "failed" and (r.reason or "").startswith(
+                INAPPLICABLE)]
+            rows.append({"agent": a.id, "task_type": a.task_type, "start": s.start, "end": s.end,
+                         "trigger": s.trigger, "outcome": s.outcome,
+                         "strategy": s.plan.strategy if s.plan is not None else None,
+                         "stages": len(s.stages), "left_on": left_on, "inapplicable": inapplicable,
+                         "safe": not left_on and not inapplicable, "duration_s": s.duration})
+    rows.sort(key=lambda r: (r["start"], r["agent"]))
+    safe = [r for r in rows if r["safe"]]
+    return {"episodes": rows, "count": len(rows), "safe": len(safe), "unsafe": len(rows) - len(safe),
+            "all_safe": not rows or len(safe) == len(rows),
+            "inapplicable_stages": sum(len(r["inapplicable"]) for r in rows),
+            "time_to_safe_s": _stats([r["duration_s"] for r in safe])}
 
 
 # -- people -------------------------------------------------------------------------------------
@@ -292,7 +351,8 @@ def compute(events: Source) -> dict[str, Any]:
     tl = timeline(events)
     per, totals = tasks(tl)
     out = {"run": run_info(tl), "totals": totals, "switching": switching(tl), "decisions": decisions(tl),
-           "safety": safety(tl), "people": people(tl), "calibration": calibration(tl), "tasks": per}
+           "safety": safety(tl), "suspensions": suspensions(tl), "people": people(tl),
+           "calibration": calibration(tl), "tasks": per}
     return _clean(out)
 
 

@@ -26,9 +26,10 @@ from pathlib import Path
 from typing import Any
 
 import tasker
+from experiments.inputs import fields, synthetic
 from experiments.inputs import scenario as scenarios
-from experiments.inputs import synthetic
 from experiments.inputs.actions import TimedAction
+from experiments.inputs.perturbation import Perturbation
 from experiments.inputs.request_fields import asked_for
 from experiments.metrics import run as metrics
 from experiments.report.explain import INDEX, write_problems
@@ -102,12 +103,14 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
     per_type = {t: Strategy(update or s.get("update", default.update),
                             suspension or s.get("suspension", default.suspension), default.policy)
                 for t, s in scn.strategies.items()}
-    options = scn.scheduler_options if scheduler in (None, scn.scheduler) else {}
+    # another scheduler than the scenario's gets no options of its, but what the folders declare (alg2's classes)
+    options = scn.scheduler_options if scheduler in (None, scn.scheduler) else \
+        fields.scheduler_defaults(str(scheduler), {}, types)
     loop = SimulationLoop(
         store, schedulers.create(scheduler or scn.scheduler, **options), seed=seed, trace=trace,
         mode=Mode(scn.mode), s_freq=scn.s_freq, rates=Rates(scn.rep_rate, scn.task_exe_rate, scn.sp_up_rate),
         strategy=default, strategies=per_type, core=sim, world=sim, motion=sim.motion, horizon=scn.horizon,
-        hazard_waiting=hazard_waiting,
+        hazard_waiting=hazard_waiting, secure_over_higher=scn.secure_over_higher,
     )
     monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning,
                       lambda: sim.snapshot().facts, task_types=store.names(),
@@ -209,6 +212,12 @@ def _action(loop: SimulationLoop, sim: Any, made: _Made, a: TimedAction, sid: st
             sim.people[value[0]].go_to(loop.now, float(value[1]), float(value[2]))
         elif what == "door":
             sim.set_door(value[0], value[1])
+        elif what == "device":
+            sim.set_device(value[0], value[1])
+        elif what == "move":  # an object someone moved: wherever it was (not if the robot holds it)
+            if value[0] not in sim.held:
+                sim.apply(delete=[f for f in sim.facts if f[0] == "at" and len(f) == 3 and f[1] == value[0]],
+                          add=[("at", value[0], value[1])])
         elif what == "add":
             sim.apply(add=value)
         else:
@@ -249,14 +258,15 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
                  progress: bool = False, pictures: bool = True, task_paths: tuple[str, ...] = (),
                  policy: str | None = None, hazard_waiting: bool | None = None,
                  interruption: scenarios.InterruptionGrid | None = None,
-                 request_fields: bool = False) -> RunResult:
+                 perturbation: Perturbation | None = None, request_fields: bool = False) -> RunResult:
     """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced.
 
     ``task_paths``: task folders to load besides the bundled ones (``tasker run --path``).
     ``policy`` (``strict``/``conditional``) overrides the scenario's; ``hazard_waiting`` switches
     hazard-aware waiting on; ``interruption`` (with ``randomize``) places the interrupting request
-    in the seed's stratum (:class:`experiments.inputs.scenario.InterruptionGrid`); ``request_fields``: see
-    :func:`build_robot`."""
+    in the seed's stratum (:class:`experiments.inputs.scenario.InterruptionGrid`) and ``perturbation``
+    draws exogenous world events around it (:mod:`experiments.inputs.perturbation`);
+    ``request_fields``: see :func:`build_robot`."""
     if isinstance(source, scenarios.RobotScenario):
         kind, scn_path = "robot", Path(source.source)
     else:
@@ -274,7 +284,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         scn = source if isinstance(source, scenarios.RobotScenario) else scenarios.load(scn_path, task_paths=task_paths)
         run_seed = scn.seed if seed is None else seed
         if randomize:
-            scn = scenarios.randomize(scn, run_seed, interruption=interruption)
+            scn = scenarios.randomize(scn, run_seed, interruption=interruption, perturbation=perturbation)
         if mode is not None:
             scn = dataclasses.replace(scn, mode=mode)
         loop, sim = build_robot(scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler,
@@ -308,7 +318,8 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
                      "randomized": randomize,
                      "policy": None if kind == "synthetic" else loop.strategy.policy,
                      "hazard_waiting": bool(hazard_waiting),
-                     **({"interruption": interruption.to_json()} if interruption and randomize else {})},
+                     **({"interruption": interruption.to_json()} if interruption and randomize else {}),
+                     **({"perturbation": perturbation.to_json()} if perturbation and randomize else {})},
         "planner": _planner_config() if kind == "robot" else None,
         "host": platform.node(), "platform": platform.platform(), "python": sys.version.split()[0],
         "date": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "tasker_version": tasker.__version__,

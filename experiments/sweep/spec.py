@@ -15,6 +15,8 @@ from pathlib import Path
 from typing import Any
 
 from experiments.inputs.filekinds import expect
+from experiments.inputs.perturbation import KINDS as perturbation_kinds
+from experiments.inputs.perturbation import Perturbation
 from experiments.inputs.scenario import InterruptionGrid
 from experiments.inputs.strategy import FACTOR_LEVELS, FACTORS, Strategy, expand
 from experiments.metrics.store import JobKey
@@ -39,6 +41,7 @@ class Job:
     strategy: Strategy
     task_paths: tuple[str, ...] = ()  # absolute task folders (--path), so a Dask worker elsewhere loads the same
     interruption: InterruptionGrid | None = None  # where variants place the interruption ([variants.NAME])
+    perturbation: Perturbation | None = None  # exogenous world events around it ([perturbation])
 
     @property
     def key(self) -> JobKey:
@@ -56,6 +59,8 @@ class SweepSpec:
     sources: Mapping[str, str] = field(default_factory=dict)
     task_paths: tuple[str, ...] = ()
     variants: Mapping[str, InterruptionGrid] = field(default_factory=dict)
+    perturbation: Perturbation | None = None
+    """Exogenous world events drawn around each variant's interruption (:mod:`experiments.inputs.perturbation`)."""
 
     def __post_init__(self) -> None:
         if not self.scenarios:
@@ -77,7 +82,8 @@ class SweepSpec:
 
     def jobs(self) -> list[Job]:
         """Every job, scenario-major then seed then strategy (so paired runs finish close together)."""
-        return [Job(sc, self.sources.get(sc, sc), seed, st, self.task_paths, self.variants.get(sc))
+        return [Job(sc, self.sources.get(sc, sc), seed, st, self.task_paths, self.variants.get(sc),
+                    self.perturbation if sc in self.variants else None)
                 for sc in self.scenarios for seed in self.seeds for st in self.strategies]
 
     def to_json(self) -> dict[str, Any]:
@@ -85,6 +91,8 @@ class SweepSpec:
                                "strategies": [s.label for s in self.strategies], "sources": dict(self.sources)}
         if self.variants:
             out["variants"] = {sc: g.to_json() for sc, g in sorted(self.variants.items())}
+        if self.perturbation is not None:
+            out["perturbation"] = self.perturbation.to_json()
         return out
 
 
@@ -93,7 +101,7 @@ def looks_like_path(text: str) -> bool:
     return "/" in text or os.sep in text or text.endswith((".toml", ".json"))
 
 
-SPEC_KEYS = ("name", "scenarios", "seeds", "seed_start", "strategies", "factors", "variants")
+SPEC_KEYS = ("name", "scenarios", "seeds", "seed_start", "strategies", "factors", "variants", "perturbation")
 
 
 def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
@@ -197,8 +205,32 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
         raise top.error("seeds", f"the spec expands to {len(scenario_list)} scenarios x {len(seeds)} seeds x "
                                  f"{len(strategies)} strategies = {n} jobs, more than the {limit} a sweep may have")
     variants = _variants(top.table("variants", {}), scenario_list, sources)
+    perturbation = _perturbation(top, variants) if "perturbation" in top else None
     _warn_ignored_factors(top, scenario_list, sources, strategies)
-    return SweepSpec(tuple(scenario_list), seeds, tuple(strategies), name=name, sources=sources, variants=variants)
+    return SweepSpec(tuple(scenario_list), seeds, tuple(strategies), name=name, sources=sources, variants=variants,
+                     perturbation=perturbation)
+
+
+def _perturbation(top: reader.Table, variants: Mapping[str, InterruptionGrid]) -> Perturbation:
+    """``[perturbation]``: the pre-registered rates of exogenous world events (drawn only for the
+    scenarios with ``[variants.NAME]``: the window is placed around their interruption)."""
+    t = top.table("perturbation")
+    if not variants:
+        raise top.error("perturbation", "needs [variants.NAME]: the events are drawn around each variant's "
+                                        "interruption")
+    kinds = t.array("kinds", list(perturbation_kinds))
+    stand = t.array("stand_s", [10.0, 40.0])
+    try:
+        p = Perturbation(rate_per_min=float(t.number("rate_per_min", 3.0, min=0)),
+                         before_s=float(t.number("before_s", 20.0, min=0)),
+                         after_s=float(t.number("after_s", 60.0, min=0)),
+                         kinds=tuple(str(k) for k in kinds),
+                         stand_s=(float(stand[0]), float(stand[1])) if len(stand) == 2 and all(
+                             isinstance(v, int | float) and not isinstance(v, bool) for v in stand) else (-1.0, -1.0))
+    except ValueError as exc:
+        raise t.error(str(exc).partition(":")[0].split(",")[0], str(exc).partition(": ")[2]) from None
+    t.done()
+    return p
 
 
 def _warn_ignored_factors(top: reader.Table, scenario_list: Sequence[str], sources: Mapping[str, str],

@@ -63,7 +63,8 @@ def run_job(job: Job) -> tuple[dict[str, Any], dict[str, Any]]:
     st = job.strategy
     result = run_scenario(job.source, seed=job.seed, update=st.update, suspension=st.suspension,
                           scheduler=st.scheduler, randomize=True, task_paths=job.task_paths, policy=st.policy,
-                          hazard_waiting=st.hazard_waiting, interruption=job.interruption)
+                          hazard_waiting=st.hazard_waiting, interruption=job.interruption,
+                          perturbation=job.perturbation)
     return dict(result.record), dict(result.metrics)
 
 

@@ -22,7 +22,11 @@ The paper's algorithm has two classes, ``humanFell`` above ``guideHuman``:
 * an executing agent of a higher class is never preempted.
 
 Generalisation: ``classes`` is a list of lists of task-type names, highest first;
-types not listed form one implicit class below all others.  The paper's Alg. 2
+types not listed form one implicit class below all others.  The model names no task
+type: without ``classes`` every type is in one class and Alg. 2 is its cost comparison
+alone; a scenario gives the classes (``scheduler_options``), or they come from the task
+folders' declared priorities (:attr:`tasker.task.TaskType.priority`, read by the scenario
+loader).  The paper's Alg. 2
 reads ``exeDA``'s parameters in lines 22-26 even when no agent executes; here an
 empty ``exeDA`` means the candidate is started directly, as lines 9-12 do for
 ``humanFell`` (recorded as a decision with ``rule: "no exeDA"``).  In the paper only
@@ -43,8 +47,6 @@ from tasker.errors import ConfigError
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, ScheduleParams, SPRequest
 from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, ScheduleView
 
-DEFAULT_CLASSES: tuple[tuple[str, ...], ...] = (("human_fell",), ("guide_human",))
-
 
 def _mul(a: float, b: float) -> float:
     """``a*b`` with ``0*inf = 0``: no cost growth times any duration adds nothing."""
@@ -58,7 +60,7 @@ class Alg2(Scheduler):
     preemptive = True
     indexed = True  # dac is the lowest queue_key: the harmoniser may find it without a scan
 
-    def __init__(self, classes: Sequence[Sequence[str]] = DEFAULT_CLASSES, hysteresis: float = 1.0) -> None:
+    def __init__(self, classes: Sequence[Sequence[str]] = (), hysteresis: float = 1.0) -> None:
         if not isinstance(hysteresis, int | float) or not 0 < hysteresis <= 1:
             raise ConfigError(f"alg2: hysteresis must be in (0, 1], got {hysteresis!r}")
         if isinstance(classes, str | bytes) or not isinstance(classes, Sequence):
@@ -77,6 +79,10 @@ class Alg2(Scheduler):
         self.hysteresis = float(hysteresis)
         self._rank = rank
         self._lowest = len(self.classes)
+
+    def outranks(self, a: Candidate, b: Candidate) -> bool:
+        """``a``'s class is more urgent than ``b``'s (``classes`` is highest first)."""
+        return self.rank(a.task_type) < self.rank(b.task_type)
 
     def rank(self, task_type: str) -> int:
         """Priority class of a task type: 0 is the highest."""

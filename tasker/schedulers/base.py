@@ -128,6 +128,15 @@ class Scheduler:
     SWEEP: ClassVar[Mapping[str, tuple[Any, ...]]] = {}
     """Option values an experiment sweeps, as the algorithm's authors swept them (empty: none)."""
     indexed: ClassVar[bool] = False
+    reads_harmoniser: ClassVar[bool] = False
+
+    def outranks(self, a: Candidate, b: Candidate) -> bool:
+        """Whether ``a``'s priority class is above ``b``'s, in this scheduler's own terms (hazard-aware
+        waiting never preempts a task that outranks the one that would secure, unless the scenario
+        allows it).  Default: the scheduler has no classes, so nobody outranks anybody."""
+        return False
+    """True for a scheduler that reads :attr:`ScheduleView.suspension` and :attr:`ScheduleView.hazards`:
+    the harmoniser fills them only for such a one (they cost a suspension estimate per candidate)."""
     """True when :meth:`schedule` picks its candidate as the lowest :meth:`select_key`
     (through :meth:`ScheduleView.best`) and reads nothing else of the other candidates:
     the harmoniser then keeps the candidates in a heap updated on each report, and a

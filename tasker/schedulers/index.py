@@ -27,8 +27,8 @@ reference the tests compare whole traces against.
 from __future__ import annotations
 
 import heapq
-from collections.abc import Container, Mapping
-from typing import Any
+from collections.abc import Container, Iterator, Mapping, Sequence
+from typing import Any, overload
 
 from tasker.schedulers.base import Candidate, Scheduler
 
@@ -173,3 +173,29 @@ class CandidateIndex:
     def _compact(self) -> None:
         self._heap = [(key, version, agent) for agent, (key, version) in self._live.items()]
         heapq.heapify(self._heap)
+
+
+class IdleCandidates(Sequence[Candidate]):
+    """``ScheduleView.candidates`` for an indexed scheduler: the scan's list, built only if read."""
+
+    def __init__(self, idle: Mapping[str, None], cands: Mapping[str, Candidate]) -> None:
+        self._idle, self._cands = idle, cands
+        self._items: list[Candidate] | None = None
+
+    def _list(self) -> list[Candidate]:
+        if self._items is None:
+            self._items = [c for a in self._idle if (c := self._cands.get(a)) is not None]
+        return self._items
+
+    def __len__(self) -> int:
+        return len(self._list())
+
+    @overload
+    def __getitem__(self, i: int) -> Candidate: ...
+    @overload
+    def __getitem__(self, i: slice) -> Sequence[Candidate]: ...
+    def __getitem__(self, i: int | slice) -> Candidate | Sequence[Candidate]:
+        return self._list()[i]
+
+    def __iter__(self) -> Iterator[Candidate]:
+        return iter(self._list())

@@ -223,6 +223,7 @@ class LookAhead(Scheduler):
 
     name = "lookahead"
     preemptive = True
+    reads_harmoniser = True
 
     def __init__(self, node_budget: int = 2000, switch_penalty_s: float = 0.0, lateness_weight: float = 1.0,
                  hazard_weight: float = 1e4, budgets: Mapping[str, float] | None = None,

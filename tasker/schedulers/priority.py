@@ -33,6 +33,9 @@ class FixedPriority(Scheduler):
         p = getattr(c.params, "priority", None)
         return p if p is not None else self.priorities.get(c.task_type, self.default)
 
+    def outranks(self, a: Candidate, b: Candidate) -> bool:
+        return self.priority(a) > self.priority(b)
+
     def queue_key(self, c: Candidate) -> tuple[int, int]:
         return (-self.priority(c), c.order)
 

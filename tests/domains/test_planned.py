@@ -49,6 +49,7 @@ def test_partial_execution_plans_only_the_remaining_work(task: PddlTaskType) -> 
     full = steps(plan.stages)
     for k in range(1, len(full)):
         ctx_k = make_ctx(task, world=apply(ctx.world, plan.stages[:k]))
+        ctx_k.memory = ctx.memory  # the same agent: it remembers what it found ([problem] restore)
         again = task.update_task(ctx_k)
         problem = up_problem(task, task.planning_problem(ctx_k, Purpose.UP_TSK))
         check = validate_plan(problem, steps(again.stages))

@@ -90,7 +90,7 @@ BAD: list[tuple[list[str], str]] = [
     (["day", "--protocol", "tabsaa", "--out", "{tmp}/day"], "did you mean 'tabsa'"),
     (["day", "--schedulers", "alg3", "--out", "{tmp}/day"], "did you mean 'alg2'"),
     (["day", "--days", "0", "--out", "{tmp}/day"], "--days"),
-    (["docs", "--root", "{missing}"], "--root"),
+    (["docs", "--root", "{missing}"], "no docs/ folder"),
 ]
 
 

@@ -228,3 +228,34 @@ def test_a_live_trace_and_its_saved_file_give_the_same_metrics(demo: Trace, tmp_
 def test_infinities_become_strings() -> None:
     assert metrics._clean({"a": float("inf"), "b": [float("-inf"), 0.1 + 0.2], "c": -0.0}) == \
         {"a": "inf", "b": ["-inf", 0.3], "c": 0.0}
+
+
+def test_a_suspension_is_safe_only_with_its_hazards_off_and_every_stage_applicable() -> None:
+    b = Build().request(0, "d1").go(0, "d1", "initComm", "compSP", "upTsk", "exeTsk")
+    b.hazard(5, "d1", "cooker_on", "on", "stove", budget_s=10.0)
+    b.go(8, "d1", "exeTsk", "genSusp", "exeSusp").go(10, "d1", "exeSusp", "wait")  # left the cooker on: unsafe
+    b.go(25, "d1", "wait", "upTsk", "exeTsk").hazard(30, "d1", "cooker_on", "off", "stove", budget_s=10.0)
+    b.go(32, "d1", "exeTsk", "genSusp", "exeSusp")
+    b.stage(32, "d1", "place", "begin", fsm="exeSusp")
+    b.add(32, "stage", agent="d1", fsm="exeSusp", index=0, action="place", args=[], kind="blocking",
+          status="failed", reason="inapplicable: (surface hall) does not hold")
+    b.go(32, "d1", "exeSusp", "end")
+    b.add(32, "end", agent="d1", task_type="cook", reason="stage place failed", cause="failed")
+    b.request(40, "d2").go(40, "d2", "initComm", "compSP", "upTsk", "exeTsk", "genSusp", "exeSusp")
+    b.go(43, "d2", "exeSusp", "wait")  # nothing on: safe, 3 s to get there
+    s = metrics.compute(b.events)["suspensions"]
+    assert [(e["agent"], e["safe"], e["left_on"], e["inapplicable"]) for e in s["episodes"]] == [
+        ("d1", False, ["cooker_on(stove)"], []), ("d1", False, [], ["place"]), ("d2", True, [], [])]
+    assert (s["count"], s["safe"], s["unsafe"], s["all_safe"], s["inapplicable_stages"]) == (3, 1, 2, False, 1)
+    assert s["time_to_safe_s"] == {"mean": 3.0, "max": 3.0}
+
+
+def test_time_after_the_owner_ended_is_apart_from_time_it_could_attend() -> None:
+    b = Build().request(0, "d1").go(0, "d1", "initComm", "compSP", "upTsk", "exeTsk")
+    b.hazard(2, "d1", "door_open", "on", "door1", budget_s=60.0)
+    b.go(4, "d1", "exeTsk", "genSusp", "exeSusp").go(5, "d1", "exeSusp", "wait")
+    b.go(9, "d1", "wait", "upTsk", "exeTsk")
+    b.end(12, "d1").hazard(20, None, "door_open", "on", "door2", budget_s=60.0).add(30, "mode", mode="IT")
+    m = metrics.compute(b.events)["safety"]
+    assert m["unattended_s"] == 4.0 + 18.0 and m["after_end_s"] == 18.0 and m["unattended_alive_s"] == 4.0
+    assert m["unowned_s"] == 10.0

@@ -23,6 +23,7 @@ def _run(script: str, *args: str) -> str:
 def test_bench_planner_compares_every_problem_with_fast_downward_opt() -> None:
     out = _run("bench_planner.py", "--repeat", "1")
     assert "plan costs equal on every problem: yes" in out and "overall median speed-up" in out
+    assert "SAS identical on every problem: yes" in out
 
 
 def test_bench_estimates_measures_every_case() -> None:

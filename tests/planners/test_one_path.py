@@ -12,9 +12,9 @@ from unified_planning.shortcuts import OneshotPlanner
 import planners.cache as cache
 import tasker.support.diskcache
 from planners.checks import load_problem
-from planners.engine import register_engine
 from planners.fd import FDExit, FDOutcome
 from planners.planner import PddlText, Planner
+from planners.registration import register_engine
 from planners.results import PlanStatus, from_fd_outcome
 from tests.planners.conftest import DOMAIN, problem_text
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import pytest
 from unified_planning.shortcuts import OneshotPlanner
@@ -100,3 +101,55 @@ def test_deterministic() -> None:
     a = Planner(cache_size=0).solve(PddlText(DOMAIN, problem_text()))
     b = Planner(cache_size=0).solve(PddlText(DOMAIN, problem_text()))
     assert a.plan == b.plan and a.cost == b.cost
+
+
+class _Clock:
+    """A stand-in for ``time`` in :mod:`planners.planner`: it moves only when a solve runs."""
+
+    def __init__(self) -> None:
+        self.now = 100.0
+
+    def perf_counter(self) -> float:
+        return self.now
+
+
+def _slow_solves(monkeypatch: pytest.MonkeyPatch, seconds: float) -> _Clock:
+    """Every Fast Downward run of the facade takes ``seconds`` on a fake clock."""
+    import planners.planner as facade
+
+    clock, real = _Clock(), facade.run_fast_downward
+
+    def run(*args: Any, **kwargs: Any) -> Any:
+        clock.now += seconds
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(facade, "time", clock)
+    monkeypatch.setattr(facade, "run_fast_downward", run)
+    return clock
+
+
+def test_a_cache_hit_does_not_report_the_original_solve_time_again(monkeypatch: pytest.MonkeyPatch) -> None:
+    _slow_solves(monkeypatch, 5.0)
+    planner = Planner()
+    first = planner.solve(PddlText(DOMAIN, problem_text()))
+    again = planner.solve(PddlText(DOMAIN, problem_text()))
+    assert not first.cached and first.wall_time_s == 5.0
+    assert again.cached and again.wall_time_s == 0.0  # the look-up's time, on a clock only solves move
+
+
+def test_planner_wall_time_counts_each_solve_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """What ``planner_wall_time_s`` adds up (``planner_time_s`` of every planned upTsk, the
+    runner's metric) holds a solve's time once, however often its answer is reused."""
+    from planners.bundled import task_types
+    from planners.examples import StraightLineMotion, example_context
+    from planners.pddl_task import PddlTaskType
+
+    _slow_solves(monkeypatch, 5.0)
+    task = next(t for t in task_types() if t.name == "carry_object")
+    assert isinstance(task, PddlTaskType)
+    task = PddlTaskType(task.spec, task.domain, task.hooks, planner=Planner())
+    ctx = example_context(task, motion=StraightLineMotion())
+    assert ctx is not None
+    plans = [task.update_task(ctx) for _ in range(3)]
+    assert [p.info["cached"] for p in plans] == [False, True, True]
+    assert sum(p.info["planner_time_s"] for p in plans) == 5.0

@@ -12,8 +12,6 @@ from planners.bundled import task_types
 from planners.checks import DefinitionError
 from planners.loader import load_task, load_task_folder, store_loader
 
-GUIDE = domains.BUNDLED / "guide_human"
-
 
 def _copy(tmp_path: Path, name: str = "guide_human") -> Path:
     dst = tmp_path / name

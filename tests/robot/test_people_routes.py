@@ -124,7 +124,7 @@ def test_a_person_behind_the_script_goes_round_the_corner() -> None:
     p.walk = ((0.0, 0.0, 0.0), (0.1, 1.0, 0.0))  # a script far too fast for them
     seen = [(0.0, 0.0)]
     for k in range(1, 30):
-        p.step(k * 0.1, 0.1, frozenset(), (9.0, 9.0))
+        p.step(k * 0.1, 0.1, (9.0, 9.0))
         seen.append((p.x, p.y))
     for (x0, y0), (x1, y1) in itertools.pairwise(seen):
         if (x0 < 0.5) != (x1 < 0.5):  # crossing x = 0.5 round the tip (within a step: sampled per step)

@@ -82,3 +82,22 @@ def test_skipping_still_ticks_changes_nothing(paper, monkeypatch) -> None:
     monkeypatch.setattr(Simulation, "_fast_forward", lambda self, now: False)
     slow = scenario(Simulation(paper))
     assert fast == slow
+
+
+def test_a_sample_line_is_what_the_json_encoder_writes() -> None:
+    """Sample.line writes the JSON by hand (the encoder was a second of a day's run): the
+    same bytes as json.dumps(to_json(), sort_keys=True), whatever the numbers and names."""
+    import json
+    import random
+
+    from robot.recording import PersonState, Sample
+
+    rng = random.Random(3)
+    values = [0.0, -0.0, 1.0, -1e-5, 1e-5, 123456.789012, -3.14159265, 2.00005, 1e16]
+    for _ in range(300):
+        def v() -> float:
+            return rng.choice(values) if rng.random() < 0.3 else rng.uniform(-20, 20)
+        names = rng.sample(["zoe", "anna", "b_2", 'odd"name', "\u00e9mile", "x-y"], rng.randint(0, 4))
+        people = tuple(PersonState(n, v(), v(), v(), rng.choice(["standing", "sitting", "fallen"])) for n in names)
+        s = Sample(round(rng.uniform(0, 4000), 2), (v(), v(), v()), people)
+        assert s.line() == json.dumps(s.to_json(), sort_keys=True)

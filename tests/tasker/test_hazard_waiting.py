@@ -95,12 +95,16 @@ def watched(world: Facts, scheduler: Any, *, policy: str = "conditional", hazard
 
 
 def run(scheduler: str, *, hazard_waiting: bool, policy: str = "conditional", swap_to: str | None = None,
-        seed: int = 0, jitter: float = 0.0, **options: Any) -> tuple[list[dict[str, Any]], SimulationLoop]:
-    """stew at 0, chore (more urgent under ``scheduler``) at 5; ``swap_to`` replaces the scheduler at 6."""
+        seed: int = 0, jitter: float = 0.0, secure_over_higher: bool = True,
+        **options: Any) -> tuple[list[dict[str, Any]], SimulationLoop]:
+    """stew at 0, chore (more urgent under ``scheduler``) at 5; ``swap_to`` replaces the scheduler at 6.
+    ``secure_over_higher``: the scenario lets securing preempt the more urgent chore (these tests'
+    premise; the safety rule, which holds it back by default, has tests of its own)."""
     world = Facts()
     loop = watched(world, schedulers.create(scheduler, **options), policy=policy, hazard_waiting=hazard_waiting,
                    seed=seed, core=EffectExecutor(world, seed, jitter),
-                   rates=Rates(rep_rate=1.0, task_exe_rate=10.0, sp_up_rate=1.0))
+                   rates=Rates(rep_rate=1.0, task_exe_rate=10.0, sp_up_rate=1.0),
+                   secure_over_higher=secure_over_higher)
     loop.request(0.0, "stew", {"priority": 1, "deadline": 1000.0})
     loop.request(5.0, "chore", {"priority": 5, "deadline": 100.0})
     if swap_to is not None:
@@ -210,7 +214,7 @@ def test_the_margin_must_be_a_finite_number() -> None:
 
 def test_a_task_terminated_while_securing_ends_after_reaching_its_safe_state() -> None:
     world = Facts()
-    loop = watched(world, schedulers.create("priority"))
+    loop = watched(world, schedulers.create("priority"), secure_over_higher=True)  # the chore is more urgent
     loop.request(0.0, "stew", {"priority": 1})
     loop.request(5.0, "chore", {"priority": 5})
     trace = loop.trace
@@ -311,3 +315,24 @@ def test_a_shared_pattern_hazard_is_owned_by_whoever_made_it_true() -> None:
     loop.run()
     on = {tuple(e["fact"]): e["agent"] for e in loop.trace.events if e["event"] == "hazard" and e["status"] == "on"}
     assert on == {("open", "front"): None, ("open", "kitchen"): "d1", ("open", "bath"): "d2", ("open", "hall"): None}
+
+
+@pytest.mark.parametrize(("scheduler", "options"), [("priority", {}), ("alg2", {"classes": [["chore"], ["stew"]]})])
+def test_the_safety_rule_securing_never_preempts_a_higher_class_unless_allowed(scheduler: str,
+                                                                               options: dict[str, Any]) -> None:
+    """Before: hazard-aware waiting preempted a fallen person's task to turn off a tap.  By default it
+    waits for the more urgent task, and the trace says which rule decided; the scenario may allow it."""
+    held, _ = run(scheduler, hazard_waiting=True, secure_over_higher=False, **options)
+    assert not secures(held) or all(d["exeDA"] != "d2" for d in secures(held))
+    [why] = [e for e in held if e["event"] == "decision" and e.get("rule") == "secure held"]
+    assert (why["dac"], why["exeDA"], why["switch"], why["hazard"]) == ("d1", "d2", False, "flame")
+    assert not any(e["event"] == "command" and e["flag"] == "susp" and e["agent"] == "d2" for e in held)
+    allowed, _ = run(scheduler, hazard_waiting=True, secure_over_higher=True, **options)
+    assert [d["exeDA"] for d in secures(allowed)] == ["d2"]
+    assert not any(e["event"] == "decision" and e.get("rule") == "secure held" for e in allowed)
+
+
+def test_the_safety_rule_does_not_hold_back_securing_against_a_lower_class() -> None:
+    """The stew outranks the chore here: securing goes ahead, as before."""
+    events, _ = run("alg2", hazard_waiting=True, secure_over_higher=False, classes=[["stew"], ["chore"]])
+    assert not any(e["event"] == "decision" and e.get("rule") == "secure held" for e in events)

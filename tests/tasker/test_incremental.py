@@ -23,11 +23,12 @@ from experiments.inputs import synthetic
 from tasker import schedulers
 from tasker.agent import Rates
 from tasker.errors import ConfigError
-from tasker.harmoniser import TaskHarmoniser, _IdleCandidates
+from tasker.harmoniser import TaskHarmoniser
 from tasker.loop import SimulationLoop
 from tasker.messages import CostParams, ScheduleParams
 from tasker.schedulers.base import Candidate, ScheduleView
 from tasker.schedulers.index import CandidateIndex
+from tasker.schedulers.index import IdleCandidates as _IdleCandidates
 from tasker.store import TaskStore
 from tasker.synthetic import SyntheticTask, TimedExecutor
 from tasker.task import TaskContext

@@ -44,3 +44,49 @@ def test_tasker_sources_import_only_the_standard_library_and_itself() -> None:
                 top = name.split(".")[0]
                 assert top in stdlib or top == "tasker" or top in ALLOWED_THIRD_PARTY, f"{path}: imports {name}"
                 assert top not in PROJECT - {"tasker"}, f"{path}: imports {name}"
+
+
+def _tasker_imports() -> dict[str, set[str]]:
+    """Every ``tasker`` module and the ``tasker`` modules it imports: any import statement, at the
+    top, in a function or under ``TYPE_CHECKING``; ``from tasker import fsm`` imports ``tasker.fsm``."""
+    paths = {".".join(p.relative_to(ROOT).with_suffix("").parts).removesuffix(".__init__"): p
+             for p in sorted((ROOT / "tasker").rglob("*.py"))}
+
+    def module_of(name: str) -> str | None:
+        while name and name not in paths:
+            name = name.rpartition(".")[0]
+        return name or None
+
+    graph: dict[str, set[str]] = {}
+    for name, path in paths.items():
+        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+        found: set[str] = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                found.update(a.name for a in node.names)
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    parts = package.split(".")[: len(package.split(".")) - node.level + 1]
+                    base = ".".join(parts + ([base] if base else []))
+                found.update(f"{base}.{a.name}" if f"{base}.{a.name}" in paths else base for a in node.names)
+        graph[name] = {m for f in found if f.split(".")[0] == "tasker" and (m := module_of(f)) not in (None, name)}
+    return graph
+
+
+def test_no_import_circle_inside_tasker() -> None:
+    graph = _tasker_imports()
+    assert "tasker.securing" not in graph["tasker.agent"] or "tasker.agent" not in graph["tasker.securing"]
+
+    def reaches(start: str, goal: str) -> bool:
+        seen, todo = set(), [start]
+        while todo:
+            for nxt in graph[todo.pop()] - seen:
+                if nxt == goal:
+                    return True
+                seen.add(nxt)
+                todo.append(nxt)
+        return False
+
+    circles = sorted(m for m in graph if reaches(m, m))
+    assert not circles, f"modules on an import circle: {circles}"

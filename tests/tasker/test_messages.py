@@ -105,11 +105,12 @@ def test_one_table_drives_states_checks_and_diagrams() -> None:
 
 def test_events_resolve_through_guards() -> None:
     S = FsmState
-    t = fsm.resolve(S.EXE_SUSP, "finished", lambda g: g == "terminating")
+    t = fsm.resolve(S.EXE_SUSP, "finished", lambda g: g == "ic_term")
     assert t.target is S.END
-    assert fsm.resolve(S.EXE_SUSP, "finished", lambda g: g == "not_terminating").target is S.WAIT
+    assert fsm.resolve(S.EXE_SUSP, "finished", lambda g: g == "not_ic_term").target is S.WAIT
     with pytest.raises(FSMError, match=r"no event 'start' in exeTsk; it accepts \['suspend', 'finished'"):
         fsm.resolve(S.EXE_TSK, "start", lambda g: True)
     with pytest.raises(FSMError, match="no guard holds"):
         fsm.resolve(S.UP_TSK, "planned", lambda g: False)
-    assert set(fsm.GUARDS) == {"has_stages", "no_stages", "terminating", "not_terminating"}
+    assert set(fsm.GUARDS) == {"has_stages", "no_stages", "ic_term", "not_ic_term", "ic_start", "ic_susp", "secure",
+                               "suspendable"}

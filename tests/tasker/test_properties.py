@@ -19,14 +19,15 @@ left), and the trace obeys the rules of the model (:func:`check_trace`):
 
 Mutation run (each rule's mutant must be caught; apply one, run
 ``python -m pytest tests/tasker/test_properties.py -q -x``, revert with
-``git checkout tasker/``).  Results of the run at the commit that added the rules:
+``git checkout tasker/``).  Results of the run at the commit that moved the agent's
+commands into the FSM table (latched conditions, :mod:`tasker.conditions`):
 
 =========================  ================================================  ========
 rule                       mutant                                            result
 =========================  ================================================  ========
-terminations not dropped   ``agent._read_inbox``: ignore ``Flag.TERM``       caught
-blocking stages            ``agent._exe``: drop ``and not stage.blocking``   caught
-                           from the suspend-now test
+terminations not dropped   ``conditions.Latched.receive``: ignore ``term``   caught
+blocking stages            ``agent._suspendable``: drop                      caught
+                           ``and not stage.blocking`` (guard ``suspendable``)
 true causes                ``agent._end``: ``cause="finished"`` always        caught
 mode obeyed                ``harmoniser.step``: ``self.mode is Mode.IT`` ->   caught
                            ``True``
