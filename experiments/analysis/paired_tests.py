@@ -20,8 +20,6 @@ import random
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from scipy import stats
-
 MIN_PAIRS = 10
 """Below this many informative pairs (discordant, or with a non-zero difference) a test gives no
 verdict: 2 / 2**9 = 0.0039 > 0.05 / 16, so nine pairs could never pass Holm in a family of 16."""
@@ -47,7 +45,7 @@ class Effect:
         return self.informative >= MIN_PAIRS
 
 
-def _bootstrap(diffs: Sequence[float], seed: str) -> tuple[float, float]:
+def bootstrap_interval(diffs: Sequence[float], seed: str) -> tuple[float, float]:
     """95 % percentile interval of the mean of ``diffs``, resampling pairs (seeded)."""
     if not diffs:
         return math.nan, math.nan
@@ -60,6 +58,8 @@ def _bootstrap(diffs: Sequence[float], seed: str) -> tuple[float, float]:
 def mcnemar(baseline: Sequence[bool], treatment: Sequence[bool], *, seed: str = "") -> Effect:
     """Exact McNemar on paired binary outcomes: the effect is the difference in proportions
     (treatment − baseline), its interval bootstrapped over pairs; ``informative`` the discordant pairs."""
+    from scipy import stats
+
     if len(baseline) != len(treatment):
         raise ValueError("mcnemar: the two arms must be paired (same length)")
     up = sum(1 for a, b in zip(baseline, treatment, strict=True) if b and not a)
@@ -67,19 +67,21 @@ def mcnemar(baseline: Sequence[bool], treatment: Sequence[bool], *, seed: str = 
     n = len(baseline)
     diffs = [float(b) - float(a) for a, b in zip(baseline, treatment, strict=True)]
     p = float(stats.binomtest(up, up + down, 0.5).pvalue) if up + down else 1.0
-    low, high = _bootstrap(diffs, seed)
+    low, high = bootstrap_interval(diffs, seed)
     return Effect(math.fsum(diffs) / n if n else math.nan, low, high, n, up + down, p, "exact McNemar")
 
 
 def wilcoxon(baseline: Sequence[float], treatment: Sequence[float], *, seed: str = "") -> Effect:
     """Wilcoxon signed-rank on paired seconds (zero differences dropped: an identical pair says
     nothing either way); the effect is the mean difference (treatment − baseline) with a bootstrap interval."""
+    from scipy import stats
+
     if len(baseline) != len(treatment):
         raise ValueError("wilcoxon: the two arms must be paired (same length)")
     diffs = [b - a for a, b in zip(baseline, treatment, strict=True)]
     nonzero = [d for d in diffs if abs(d) > 1e-9]
     p = float(stats.wilcoxon(nonzero).pvalue) if len(nonzero) >= 1 and any(nonzero) else 1.0
-    low, high = _bootstrap(diffs, seed)
+    low, high = bootstrap_interval(diffs, seed)
     n = len(diffs)
     return Effect(math.fsum(diffs) / n if n else math.nan, low, high, n, len(nonzero), p, "Wilcoxon signed-rank")
 
@@ -93,6 +95,8 @@ def required_pairs(*, discordant: float | None = None, difference: float | None 
     and ``difference`` the difference in proportions.  Seconds (paired, normal approximation):
     ``sd`` of the paired differences and the difference ``delta`` worth detecting.  None when
     the pilot gives nothing to size (no discordant pairs, no spread)."""
+    from scipy import stats
+
     z = stats.norm.ppf(1 - alpha / 2) + stats.norm.ppf(power)
     if discordant is not None and difference is not None:
         if discordant <= 0 or difference == 0:

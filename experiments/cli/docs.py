@@ -27,12 +27,17 @@ def _docs(args: argparse.Namespace) -> int:
     return EXIT_FAILED if stale and args.check else EXIT_OK
 
 
+EXAMPLES = """\
+examples:
+  tasker docs            # rewrite docs/trace.md's event fields and docs/metrics.md's registry table
+  tasker docs --check    # exit 1 if one is out of date (CI runs this through a test)"""
+
+
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("docs", help="rewrite docs/'s generated parts (event fields, the metric registry)",
                        description="Rewrite the parts of docs/ generated from the code (the trace's event types, "
                                    "the metric registry); --check only reports the ones out of date (exit 1).",
-                       epilog="examples:\n  tasker docs            # rewrite docs/trace.md's and docs/metrics.md's "
-                              "generated parts\n  tasker docs --check    # exit 1 if one is out of date (CI)")
+                       epilog=EXAMPLES)
     p.add_argument("--check", action="store_true", help="write nothing; exit 1 if a part is out of date")
     p.add_argument("--root", default=str(ROOT), help="the project folder (default: this checkout)")
     p.set_defaults(func=_docs)

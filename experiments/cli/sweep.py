@@ -15,6 +15,7 @@ import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
 from experiments.cli.args import (
@@ -22,6 +23,7 @@ from experiments.cli.args import (
     EXIT_OK,
     UsageError,
     note,
+    positive_int,
     show_progress,
     workers,
     writable_dir,
@@ -29,11 +31,16 @@ from experiments.cli.args import (
 )
 from experiments.cli.run import add_path_option, task_paths
 
+if TYPE_CHECKING:
+    from experiments.sweep.driver import SweepSummary
+
 SWEEP_EXAMPLES = """\
 examples:
   tasker sweep experiments/sweep/specs/suspension.toml --db out/suspension.db --workers 2
   tasker sweep my_sweep.toml --db out/my.db --path ~/my_tasks          # with your own task folders
   tasker sweep my_sweep.toml --db out/my.db --scheduler-address tcp://head:8786   # on a Dask cluster
+  tasker sweep experiments/sweep/specs/strategies.toml --db out/s.db --seeds 1-20  # a pilot: seeds 1..20
+  tasker sweep experiments/sweep/specs/strategies.toml --db out/s.db --limit 30    # 30 more runs, then stop
   tasker sweep my_sweep.toml --db out/my.db --overwrite                  # delete what out/my.db holds, run all"""
 
 REPORT_EXAMPLES = """\
@@ -64,6 +71,11 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
                    help="delete the results database first and run every job afresh (a stored run is never "
                         "deleted without it)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar (also --quiet, or not a terminal)")
+    p.add_argument("--seeds", default=None, metavar="A-B",
+                   help="only these seeds of the spec: A-B, A,B,C or a mix (e.g. 1-20); the rest stay missing")
+    p.add_argument("--limit", type=positive_int, default=None, metavar="N",
+                   help="run at most N of the missing jobs (in the spec's order), then stop and say how long the "
+                        "rest would take")
     add_path_option(p)
     p.set_defaults(func=_sweep)
 
@@ -122,7 +134,14 @@ def _sweep(args: argparse.Namespace) -> int:
     from experiments.sweep.spec import load_spec
 
     spec = load_spec(args.spec)
-    paths = task_paths(args)
+    if args.seeds is not None:
+        from experiments.sweep.spec import select_seeds
+
+        try:
+            spec = select_seeds(spec, args.seeds)
+        except ValueError as exc:
+            raise UsageError("--seeds", str(exc)) from None
+    paths = [*spec.task_paths, *(p for p in task_paths(args) if p not in spec.task_paths)]
     if paths:
         from planners.bundled import task_types
 
@@ -137,13 +156,41 @@ def _sweep(args: argparse.Namespace) -> int:
             remove(args.db)
     with dask_scheduler(args.scheduler_address):
         summary = run_sweep(spec, args.db, workers=args.workers, scheduler_address=args.scheduler_address,
-                            retry_errors=args.retry_errors, progress=show_progress(args) and not args.no_progress)
+                            retry_errors=args.retry_errors, max_jobs=args.limit,
+                            progress=show_progress(args) and not args.no_progress)
     print(f"{spec.name}: {summary.total} jobs; {summary.skipped} already stored, {summary.ran} run "
           f"({summary.ok} ok, {summary.errors} errors) in {summary.wall:.1f} s on {summary.backend} workers")
+    if summary.not_run:
+        print(f"{summary.not_run} jobs not run yet; {_rest(summary, args.db)} (run the same command again to go on)")
     if summary.errors:
         print(f"{summary.errors} runs failed; see 'tasker report --db {args.db}' (rerun with --retry-errors)",
               file=sys.stderr)
     return EXIT_FAILED if summary.errors else EXIT_OK
+
+
+def _rest(summary: SweepSummary, db: str) -> str:
+    """How long the jobs not run should take: at this call's mean job time, or else the database's."""
+    per = summary.job_wall / summary.ran if summary.ran else None
+    source = "this run's"
+    if per is None:
+        from experiments.metrics.store import ResultStore
+
+        with ResultStore(db, readonly=True) as store:
+            walls = [r.wall for r in store.rows() if r.wall]
+        per, source = (sum(walls) / len(walls), "the stored runs'") if walls else (None, "")
+    left = summary.remaining_s(per)
+    if left is None:
+        return "no run time known yet to estimate the rest"
+    return (f"at {source} mean of {per:.1f} s a job on {summary.workers} worker(s), about "
+            f"{_duration(left)} more")
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
 
 
 def _report(args: argparse.Namespace) -> int:

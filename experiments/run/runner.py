@@ -90,6 +90,7 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
             people[name] = dataclasses.replace(people[name], **changes)
         spec = dataclasses.replace(spec, people=people)
     spec = _with_objects(scn, spec)
+    spec, from_world = _world_file_events(spec, str(scn.world))
     sim = Simulation(spec, seed=seed)
     loaded = task_types(task_paths)
     if request_fields or asked_for(scn.actions):
@@ -119,12 +120,24 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
     loop.harmoniser.hazards = monitor.active  # hazard-aware waiting learns of hazards from the monitor
     made = _Made(loop, Requester(store, loop.harmoniser, "scenario"))
     requests = 0  # the K-th request is the scenario's dK
-    for a in scn.actions:
+    for a in sorted([*from_world, *scn.actions], key=lambda a: a.t):  # stable: the world file's first at a tie
         if a.kind == "request":
             requests += 1
             store.validate(a.fields["task"], a.fields["args"])  # bad requests fail before the run
         loop.at(a.t, _action(loop, sim, made, a, f"d{requests}"))
     return loop, sim
+
+
+def _world_file_events(spec: Any, world: str) -> tuple[Any, list[TimedAction]]:
+    """The world file's own timed events (a person's ``events = [[t, posture]]``) taken out of the
+    people and returned as world events, so they run — and are traced — as a scenario's do."""
+    out = [TimedAction(float(t), "world", {"what": "posture", "value": [name, posture],
+                                           "note": f"world file {world}"})
+           for name, p in spec.people.items() for t, posture in p.events]
+    if not out:
+        return spec, []
+    people = {name: dataclasses.replace(p, events=()) for name, p in spec.people.items()}
+    return dataclasses.replace(spec, people=people), sorted(out, key=lambda a: a.t)
 
 
 def _with_objects(scn: scenarios.RobotScenario, spec: Any) -> Any:

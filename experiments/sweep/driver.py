@@ -54,6 +54,17 @@ class SweepSummary:
     not_run: int
     wall: float
     backend: str
+    job_wall: float = 0.0
+    """Worker wall seconds of the jobs this call ran (their sum), for an estimate of the rest."""
+    workers: int = 1
+
+    def remaining_s(self, mean_job_s: float | None = None) -> float | None:
+        """Wall seconds the ``not_run`` jobs should take on as many workers, at ``mean_job_s`` a job
+        (default: the mean of the jobs this call ran); None with nothing to go by."""
+        per = mean_job_s if mean_job_s is not None else (self.job_wall / self.ran if self.ran else None)
+        if per is None or not self.not_run:
+            return None if per is None else 0.0
+        return per * self.not_run / max(1, self.workers)
 
 
 @contextmanager
@@ -200,6 +211,7 @@ def run_sweep(
         spec_json = spec.to_json() if isinstance(spec, SweepSpec) else {"jobs": [list(k) for k in keys]}
         store.log_sweep(spec_json, _setup(n_workers, scheduler_address) | {"to_run": len(todo)})
         ok = errors = 0
+        job_wall = 0.0
         if todo:
             from tqdm import tqdm
 
@@ -211,6 +223,7 @@ def run_sweep(
                     job = by_key[out.key]
                     store.add(RunRow(job.scenario, job.seed, job.strategy.label, out.status,
                                      dict(out.record), dict(out.metrics), out.error, out.wall, out.worker))
+                    job_wall += out.wall
                     if out.status is Status.OK:
                         ok += 1
                     else:
@@ -219,4 +232,5 @@ def run_sweep(
                     bar.set_postfix(errors=errors, refresh=False)
     ran = ok + errors
     return SweepSummary(total=len(jobs), skipped=len(jobs) - missing, ran=ran, ok=ok, errors=errors,
-                        not_run=missing - ran, wall=time.perf_counter() - start, backend=backend)
+                        not_run=missing - ran, wall=time.perf_counter() - start, backend=backend,
+                        job_wall=job_wall, workers=n_workers)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -101,7 +101,7 @@ def looks_like_path(text: str) -> bool:
     return "/" in text or os.sep in text or text.endswith((".toml", ".json"))
 
 
-SPEC_KEYS = ("name", "scenarios", "seeds", "seed_start", "strategies", "factors", "variants", "perturbation")
+SPEC_KEYS = ("name", "scenarios", "seeds", "seed_start", "strategies", "factors", "variants", "perturbation", "paths")
 
 
 def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
@@ -146,6 +146,7 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
             raise at.error(i, f"{sc!r} is the scenario {files[resolved]!r} again (both are {resolved}): each "
                               "scenario once")
         files[resolved] = sc
+    paths = _paths(top, p.parent)
     start = int(top.number("seed_start", 0, integer=True, min=0, max=reader.MAX_SEED))
     seeds_raw = top.raw("seeds")
     if isinstance(seeds_raw, int) and not isinstance(seeds_raw, bool):
@@ -208,7 +209,43 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
     perturbation = _perturbation(top, variants) if "perturbation" in top else None
     _warn_ignored_factors(top, scenario_list, sources, strategies)
     return SweepSpec(tuple(scenario_list), seeds, tuple(strategies), name=name, sources=sources, variants=variants,
-                     perturbation=perturbation)
+                     perturbation=perturbation, task_paths=paths)
+
+
+def _paths(top: reader.Table, here: Path) -> tuple[str, ...]:
+    """``paths``: task folders (or folders of them) the scenarios need besides the bundled ones,
+    relative to the spec file; they come back absolute (``--path`` on the command line adds more)."""
+    at = top.at("paths", {})
+    out: list[str] = []
+    for i, entry in enumerate(top.array("paths", [])):
+        if not isinstance(entry, str) or not entry:
+            raise at.error(i, f"expected a task folder (a path relative to the spec), got {entry!r}")
+        folder = (here / entry).resolve()
+        if not folder.is_dir():
+            raise at.error(i, f"no such folder: {folder} (paths are relative to the spec file)")
+        out.append(str(folder))
+    return tuple(dict.fromkeys(out))
+
+
+def select_seeds(spec: SweepSpec, text: str) -> SweepSpec:
+    """``spec`` with only the seeds ``text`` names: ``A-B`` (inclusive), ``A,B,C`` or a mix
+    (``1-20,40``); each must be a seed of the spec.  Raises ValueError saying what was expected."""
+    chosen: list[int] = []
+    for part in (x.strip() for x in text.split(",")):
+        lo, dash, hi = part.partition("-")
+        try:
+            first, last = int(lo), int(hi if dash else lo)
+        except ValueError:
+            raise ValueError(f"expected seeds as A-B or A,B,C (e.g. 1-20), got {text!r}") from None
+        if last < first:
+            raise ValueError(f"{part!r}: expected a range low-high, got high < low")
+        chosen += [s for s in range(first, last + 1) if s not in chosen]
+    absent = [s for s in chosen if s not in spec.seeds]
+    if absent:
+        lo_s, hi_s = min(spec.seeds), max(spec.seeds)
+        raise ValueError(f"seed {absent[0]} is not a seed of the spec (its seeds: {len(spec.seeds)} from {lo_s} to "
+                         f"{hi_s})")
+    return replace(spec, seeds=tuple(s for s in spec.seeds if s in chosen))
 
 
 def _perturbation(top: reader.Table, variants: Mapping[str, InterruptionGrid]) -> Perturbation:

@@ -91,6 +91,7 @@ BAD: list[tuple[list[str], str]] = [
     (["day", "--schedulers", "alg3", "--out", "{tmp}/day"], "did you mean 'alg2'"),
     (["day", "--days", "0", "--out", "{tmp}/day"], "--days"),
     (["docs", "--root", "{missing}"], "no docs/ folder"),
+    (["results", "--replay", "nowhere", "1", "derived", "--out", "{tmp}"], "no scenario 'nowhere'"),
 ]
 
 
@@ -302,7 +303,7 @@ def test_sweep_jobs_carry_absolute_task_paths(tmp_path: Path, files: dict[str, s
 
     def fake(spec: Any, db: str, **_: object) -> Any:
         seen.append(spec)
-        return SimpleNamespace(total=0, skipped=0, ran=0, ok=0, errors=0, wall=0.0, backend="local")
+        return SimpleNamespace(total=0, skipped=0, ran=0, ok=0, errors=0, not_run=0, wall=0.0, backend="local")
 
     monkeypatch.setattr(experiments.sweep.driver, "run_sweep", fake)
     monkeypatch.chdir(tmp_path)

@@ -103,3 +103,18 @@ def test_device_and_move_world_events_are_checked_run_and_traced(tmp_path: Path)
                          ('move = ["pan"]', "expected \\[object, place\\]")):
         with pytest.raises(sc.ScenarioError, match=message):
             sc.load(_scenario(tmp_path, f"[[world_events]]\nt = 1.0\n{bad}\n"))
+
+
+def test_a_world_files_own_events_are_run_and_traced_like_a_scenarios(tmp_path: Path) -> None:
+    """The paper world makes Peter fall at 60 s and Sara at 90 s: the trace says so, once each, in time
+    order with the scenario's own events."""
+    from experiments.run.runner import run_scenario
+
+    path = tmp_path / "s.toml"
+    path.write_text('kind = "robot"\nname = "s"\nworld = "paper"\n[settings]\nhorizon = 95.0\n'
+                    '[[world_events]]\nt = 61.0\nposture = ["alice", "fallen"]\n')
+    with pytest.warns(UserWarning):
+        result = run_scenario(path, pictures=False)
+    world = [(e["t"], e["value"], e.get("note", "")) for e in result.trace.events if e["event"] == "world"]
+    assert world == [(60.0, ["peter", "fallen"], "world file paper"), (61.0, ["alice", "fallen"], ""),
+                     (90.0, ["sara", "fallen"], "world file paper")]
