@@ -26,6 +26,18 @@ from tasker.support import reader
 from tasker.task import POLICIES, ArgSpec
 
 SKILLS = ("navigate", "say", "manipulate", "wait")
+
+RESERVED_ARGS = {
+    "robot": "$robot is the robot",
+    "deadline": "a request field every task type takes (experiments.inputs.request_fields)",
+    "priority": "a request field every task type takes (experiments.inputs.request_fields)",
+    "death_at": "a request field every task type takes (experiments.inputs.request_fields)",
+}
+"""Argument names a task folder may not declare: the request fields would strip them from its own
+arguments (every request would then lack them), and ``$robot`` names the robot."""
+
+MAX_TIMEOUT_S = 24 * 3600.0
+"""The longest wall-clock limit of one planner call: a larger one (1e300) overflowed the clock."""
 """Skills the core agent offers (the contract with ``robot/``)."""
 
 COST_MODEL_ARG = "cost_model"
@@ -257,7 +269,7 @@ class _Reader:
             tables = t.tables(key)
             for b in tables:
                 policy = b.string("policy", "strict", choices=POLICIES)
-                limit = b.number("max_interruption_s", None, min=0)
+                limit = b.number("max_interruption_s", None, min=0, max=reader.MAX_SECONDS)
                 if (policy == "conditional") != (limit is not None):
                     raise self.fail(b, "max_interruption_s" if limit is not None else "policy",
                                     'a branch that trades safety for time has policy = "conditional" and '
@@ -300,7 +312,7 @@ def _action(r: _Reader, a: reader.Table, name: str) -> ActionSpec:
                                or not all(isinstance(t, str) and t.startswith("?") for t in travel)):
         raise r.fail(a, "travel", f"expected two parameters [\"?from\", \"?to\"], got {travel!r}")
     travel = travel and [t.lower() for t in travel]  # PDDL parameters are case-insensitive
-    duration = a.number("duration", None, min=0)
+    duration = a.number("duration", None, min=0, max=reader.MAX_SECONDS)
     to = a.string("to", None)
     to = to.lower() if to and to.startswith("?") else to
     text = a.string("text", None)
@@ -314,15 +326,32 @@ def _action(r: _Reader, a: reader.Table, name: str) -> ActionSpec:
 
 
 def _args(r: _Reader, top: reader.Table) -> tuple[ArgSpec, ...]:
-    out = []
+    out: list[ArgSpec] = []
+    first: dict[str, int | None] = {}
     for a in top.tables("args", []):
         name = a.string("name")
+        if name in RESERVED_ARGS:
+            raise r.fail(a, "name", f"{name!r} is reserved: {RESERVED_ARGS[name]}; name the argument otherwise")
+        if name in first:  # a request's argument is one value: which declaration would it follow?
+            where = f" (first at line {first[name]})" if first[name] else ""
+            raise r.fail(a, "name", f"argument {name!r} is declared twice{where}")
+        first[name] = a.line("name")
+        choices = a.array("choices", nonempty=True) if "choices" in a else None
         try:
             out.append(ArgSpec(name=name, type=a.string("type", "str"), required=a.boolean("required", True),
                                default=a.raw("default", None), help=a.string("help", "", empty=True),
-                               choices=tuple(a.raw("choices")) if "choices" in a else None))
+                               choices=tuple(choices) if choices is not None else None))
         except (ConfigError, TypeError) as exc:
             raise r.fail(a, None, str(exc)) from None
+        for k, choice in enumerate(choices or ()):  # a choice of another type could never be given
+            try:
+                out[-1].coerce(name, choice)
+            except BadRequest as exc:
+                raise r.fail(a.at("choices", {}), k, str(exc).split(": ", 1)[-1].replace(
+                    "expected one of", "a choice must be one of")) from None
+        if choices is not None and len({repr(c) for c in choices}) != len(choices):
+            dup = sorted({repr(c) for c in choices if [repr(x) for x in choices].count(repr(c)) > 1})
+            a.warn("choices", f"{', '.join(dup)} listed more than once")
         if out[-1].default is not None:  # a request without the argument gets it: it must fit the type
             try:
                 out[-1].coerce(name, out[-1].default)
@@ -405,7 +434,7 @@ def _hazards(r: _Reader, top: reader.Table) -> tuple[Hazard, ...]:
         fact = r.literal(h, "fact", fact_value)
         if fact[0] == "not":
             raise r.fail(h, "fact", f"a hazard is a fact that holds (no 'not'), got {list(fact)}")
-        budget = h.number("budget_s", min=0)
+        budget = h.number("budget_s", min=0, max=reader.MAX_SECONDS)
         severity = h.number("severity", 1.0, min=0)
         try:
             out.append(Hazard(name, fact, float(budget), float(severity), h.string("label", "", empty=True)))
@@ -416,6 +445,12 @@ def _hazards(r: _Reader, top: reader.Table) -> tuple[Hazard, ...]:
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise r.fail(top, "hazards", f"duplicate hazard name(s) {dup}")
+    facts = [x.fact for x in out]
+    for k, x in enumerate(out):  # one unsafe condition declared twice would be counted twice by every metric
+        if x.fact in facts[:k]:
+            other = out[facts.index(x.fact)]
+            raise r.fail(top.at("hazards", {}), k, f"hazard {x.name!r} has the fact of hazard {other.name!r} "
+                                                   f"({list(x.fact)}): one condition, counted twice")
     return tuple(out)
 
 
@@ -448,7 +483,8 @@ def _derived(r: _Reader, top: reader.Table) -> tuple[Literal, ...]:
 
 
 def _bindings(r: _Reader, top: reader.Table) -> tuple[RawBinding, ...]:
-    out = []
+    out: list[RawBinding] = []
+    where: dict[tuple[str, int], tuple[RawBinding, int | None]] = {}
     for b in top.tables("bindings", []):
         kind = b.string("kind", choices=BINDING_KINDS)
         fact = r.literal(b, "fact", b.raw("fact"))
@@ -462,8 +498,24 @@ def _bindings(r: _Reader, top: reader.Table) -> tuple[RawBinding, ...]:
                                       f"{reader.suggest(obj, variables)}")
         state = b.string("state", "on") if kind == "device" else "on"
         otherwise = b.string("otherwise", "off") if kind == "device" else "off"
+        if state == otherwise:  # removing the fact would leave it holding: the device could never say it ended
+            raise r.fail(b, "otherwise" if "otherwise" in b else "state",
+                         f"state and otherwise are both {state!r}: the fact would hold in either state, and a "
+                         "stage that removes it would change nothing")
         b.done()
-        out.append(RawBinding(kind, fact, obj, state, otherwise))
+        raw = RawBinding(kind, fact, obj, state, otherwise)
+        same = where.get((fact[0], len(fact)))
+        if same is not None:  # the world reads a fact from one physical state: which one?
+            other, line = same
+            at = f" (line {line})" if line else ""
+            if (other.kind, other.fact.index(other.object), other.state, other.otherwise) != (
+                    kind, fact.index(obj), state, otherwise):
+                raise r.fail(b, "fact", f"{fact[0]!r} is bound twice, differently: as {other.kind} of "
+                                        f"{other.object}{at} and as {kind} of {obj}; a fact is one physical state")
+            b.warn("fact", f"{fact[0]!r} is bound twice{at}, the same way: one [[bindings]] entry is enough")
+            continue
+        where[(fact[0], len(fact))] = (raw, b.line("fact"))
+        out.append(raw)
     return tuple(out)
 
 
@@ -478,9 +530,9 @@ def read_task_toml(path: Path) -> TaskSpec:
             raise r.fail(task, "name", f"'name' must be an identifier, got {name!r}")
         description = task.string("description", "", empty=True)
         domain = task.string("domain", "domain.pddl")
-        planning_time_s = task.number("planning_time_s", 0.5, min=0)
-        static_time_s = task.number("static_time_s", 0.05, min=0)
-        timeout_s = task.number("timeout_s", 10.0, min=0)
+        planning_time_s = task.number("planning_time_s", 0.5, min=0, max=reader.MAX_SECONDS)
+        static_time_s = task.number("static_time_s", 0.05, min=0, max=reader.MAX_SECONDS)
+        timeout_s = task.number("timeout_s", 10.0, min=0, max=MAX_TIMEOUT_S)
         r.note(task, "timeout_s")  # the [example]'s check may warn at it
         task.done()
         problem = top.table("problem")
@@ -504,7 +556,7 @@ def read_task_toml(path: Path) -> TaskSpec:
         static.done()
         schedule = top.table("schedule", {})
         cps = schedule.number("cps", 1.0, min=0)
-        travel_s = schedule.number("travel_s", 10.0, min=0)
+        travel_s = schedule.number("travel_s", 10.0, min=0, max=reader.MAX_SECONDS)
         priority = schedule.number("priority", None, integer=True)
         args = _args(r, top)
         original = _original_costs(r, schedule, top, args)

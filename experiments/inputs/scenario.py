@@ -156,7 +156,7 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
         update=str(s.string("update", "planned", choices=STRATEGIES)),
         suspension=str(s.string("suspension", "planned", choices=SUSPENSIONS)), strategies=strategies,
         seed=int(top.number("seed", 1, integer=True, min=0, max=reader.MAX_SEED)),
-        horizon=float(s.number("horizon", 1800.0, positive=True)),
+        horizon=float(s.number("horizon", 1800.0, positive=True, max=reader.MAX_SECONDS)),
         people=people, objects=objects, devices=devices, policy=str(s.string("policy", "strict", choices=POLICIES)),
         secure_over_higher=bool(s.boolean("secure_over_higher", False)),
     )
