@@ -58,7 +58,7 @@ args = {{ person = "john", destination = "kitchen" }}
 
 
 def _run(tmp_path: Path, task: str, paths: tuple[str, ...]) -> Path:
-    from experiments.runner import run_scenario
+    from experiments.run.runner import run_scenario
 
     scn = tmp_path / f"{task}.toml"
     scn.write_text(SCENARIO.format(task=task))
