@@ -103,6 +103,7 @@ class Simulation:
         self._person_spots: dict[str, Pose] | None = None  # the places people can be at (person_place)
         self._fallen: tuple[str, ...] = ()  # who lay fallen at the last look (Simulation._give_room)
         self.physics_ticks = 0  # control ticks that stepped MuJoCo (the rest: robot at rest, nothing to do)
+        self._people_seen = -1  # the scene's version after the last _sync_people
         self._sync_people()
         self._record()
 
@@ -145,13 +146,29 @@ class Simulation:
         return tuple(out)
 
     def _sync_people(self) -> None:
+        """The scene and MuJoCo follow the people: only those touched since the last look
+        (:attr:`robot.people.Person.touched`: stepped, or changed from outside), and of them
+        only who moved."""
         for p in self.people:
+            if not p.touched:
+                continue
+            p.touched = False
             self.scene.set_stepping_to(p.name, p.stepping_to())
             state = (p.x, p.y, p.yaw, p.posture)
-            if self._synced.get(p.name) != state:  # only who moved: the scene and MuJoCo follow
+            if self._synced.get(p.name) != state:
                 self._synced[p.name] = state
                 self.scene.set_person(p.name, p.x, p.y, p.posture)
                 self.mj.set_person(p.name, p.x, p.y, p.yaw, p.posture)
+        self._people_seen = self.scene.version
+
+    def _people_react(self) -> None:
+        """:meth:`_give_room`, then :meth:`_sync_people` — skipped when no person was touched
+        and the scene (people, doors) is as it was after the last time: both would change
+        nothing then."""
+        if self.scene.version == self._people_seen and not any(p.touched for p in self.people):
+            return
+        self._give_room()
+        self._sync_people()
 
     def _still_until(self, p: Person) -> float:
         """Until when person ``p`` certainly stays as they are (``self.time``: they may move now)."""
@@ -205,8 +222,7 @@ class Simulation:
         t = round(self._ticks * CONTROL_DT, 9)
         x, y, _ = self.mj.pose()
         self.people.step(t, CONTROL_DT, (x, y))
-        self._give_room()
-        self._sync_people()
+        self._people_react()
         cmd = self.skill.control(t, CONTROL_DT) if self.skill is not None else STOP
         self._last_cmd = cmd
         self.mj.command(cmd.v, cmd.w)
@@ -230,8 +246,7 @@ class Simulation:
 
     def advance(self, now: float) -> None:
         """Step control and physics in fixed ticks up to simulated time ``now``."""
-        self._give_room()  # a posture set from outside since the last tick
-        self._sync_people()
+        self._people_react()  # a posture set from outside since the last tick
         while self.time + CONTROL_DT <= now + 1e-9:
             if not self._fast_forward(now):
                 self._tick()
