@@ -100,6 +100,10 @@ class Simulation:
         self._last_cmd = STOP
         self._synced: dict[str, tuple[float, float, float, str]] = {}
         self._places_memo: dict[tuple[str, float, float], str] = {}
+        # rooms smallest first (ties by name): the first holding a point is spec.room_of's answer
+        self._rooms = sorted(self.spec.rooms.items(),
+                             key=lambda nb: ((nb[1][2] - nb[1][0]) * (nb[1][3] - nb[1][1]), nb[0]))
+        self._spot_rooms: dict[int, tuple[Mapping[str, Pose], dict[str | None, list[str]]]] = {}
         self._person_spots: dict[str, Pose] | None = None  # the places people can be at (person_place)
         self._fallen: tuple[str, ...] = ()  # who lay fallen at the last look (Simulation._give_room)
         self.physics_ticks = 0  # control ticks that stepped MuJoCo (the rest: robot at rest, nothing to do)
@@ -474,11 +478,17 @@ class Simulation:
         """What the facts of :meth:`snapshot` are made of, cheaply: equal keys, equal facts.
 
         The symbolic state, devices, doors, what is held and who follows or waits all bump
-        :attr:`version` when they change; the rest is where the robot and the people are and
-        the people's postures.  A monitor that asks only when this changes misses nothing
-        and skips the ticks in which nobody moved."""
-        x, y, _ = self.mj.pose()
-        return (self.version, x, y, tuple((p.x, p.y, p.posture) for p in self.people))
+        :attr:`version` when they change; the rest is the place the robot is at, and for
+        each person their posture and the place they are at (the robot's, when they follow
+        it or stand within ``TOGETHER`` of it) — exactly what :meth:`_facts_now` reads of
+        poses.  A monitor that asks only when this changes misses nothing, and skips the
+        ticks in which nobody changed place (the robot driving across a room, say)."""
+        rx, ry, _ = self.mj.pose()
+        here = self.nearest_place(rx, ry)
+        hypot = math.hypot
+        return (self.version, here, tuple(
+            (p.posture, here if p.following or hypot(p.x - rx, p.y - ry) <= TOGETHER else self.person_place(p.x, p.y))
+            for p in self.people))
 
     def person_place(self, x: float, y: float) -> str:
         """Where a person is, symbolically: :meth:`place_of` among the places that are not
@@ -506,8 +516,12 @@ class Simulation:
         return hit
 
     def room_of(self, x: float, y: float) -> str | None:
-        """The smallest room whose box holds ``(x, y)`` (ties by name), or None (:func:`robot.spec.room_of`)."""
-        return room_of(self.spec, x, y)
+        """The smallest room whose box holds ``(x, y)`` (ties by name), or None (:func:`robot.spec.room_of`:
+        the same answer, from the rooms sorted once by area and name)."""
+        for n, (x0, y0, x1, y1) in self._rooms:
+            if x0 <= x <= x1 and y0 <= y <= y1:
+                return n
+        return None
 
     def place_of(self, x: float, y: float, spots: Mapping[str, Pose]) -> str:
         """The nearest of ``spots`` that is not behind a wall (ties broken by name).
@@ -520,7 +534,13 @@ class Simulation:
 
         room = self.room_of(x, y)
         if room is not None:
-            inside = [n for n in spots if self.room_of(spots[n][0], spots[n][1]) == room]
+            by_room = self._spot_rooms.get(id(spots))
+            if by_room is None or by_room[0] is not spots:  # the spots' rooms: places never move
+                rooms: dict[str | None, list[str]] = {}
+                for n in spots:
+                    rooms.setdefault(self.room_of(spots[n][0], spots[n][1]), []).append(n)
+                by_room = self._spot_rooms[id(spots)] = (spots, rooms)
+            inside = by_room[1].get(room)
             if inside:
                 return nearest(inside)
         names = sorted(spots)
