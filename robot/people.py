@@ -51,11 +51,22 @@ Route = Callable[[Point, Point], tuple[Point, ...]]
 (just the two when the straight line is clear)."""
 
 
+class Revision:
+    """A count of changes to people, shared by everyone of one :class:`People`: equal counts,
+    nobody changed in between (what the world's :meth:`~robot.sim.Simulation.facts_key` keys on)."""
+
+    __slots__ = ("n",)
+
+    def __init__(self) -> None:
+        self.n = 0
+
+
 class Person:
     """One person's state: pose, posture, where the script and the reactions put them."""
 
-    def __init__(self, spec: PersonSpec, route: Route | None = None) -> None:
+    def __init__(self, spec: PersonSpec, route: Route | None = None, revision: Revision | None = None) -> None:
         self.spec = spec
+        self.revision = revision if revision is not None else Revision()
         self.name = spec.name
         self.x, self.y, self.yaw = spec.pose
         self.posture = spec.posture
@@ -78,6 +89,7 @@ class Person:
         """Something changed from outside: the next step runs, the world looks again."""
         self._idle_until = -math.inf
         self.touched = True
+        self.revision.n += 1
 
     @property
     def following(self) -> bool:
@@ -221,6 +233,7 @@ class Person:
         if t < self._idle_until:
             return
         self.touched = True
+        self.revision.n += 1
         self._step(t, dt, robot)
         self._idle_until = self._idle_after(t)
 
@@ -327,7 +340,8 @@ class People:
     """Everyone in the world, stepped together in name order (deterministic)."""
 
     def __init__(self, specs: Iterable[PersonSpec], route: Route | None = None) -> None:
-        self.by_name = {p.name: Person(p, route) for p in sorted(specs, key=lambda s: s.name)}
+        self.revision = Revision()  # bumped by every change to anyone
+        self.by_name = {p.name: Person(p, route, self.revision) for p in sorted(specs, key=lambda s: s.name)}
 
     def __getitem__(self, name: str) -> Person:
         return self.by_name[name]

@@ -47,6 +47,7 @@ from tasker.stage import Stage
 from tasker.world import Fact, Pose, WorldState
 
 CONTROL_DT = 0.02  # seconds: the base controller and the people run at 50 Hz
+STEPS = round(CONTROL_DT / TIMESTEP)  # MuJoCo steps a control tick
 AT_TOLERANCE = 0.3  # metres: the robot starts "at" a place this close
 TOGETHER = 1.5  # metres: a person this close to the robot is symbolically at the robot's place
 WAIT_MARGIN = 0.05  # metres beyond a standing person's radius and the robot's width (Simulation._aside_spot)
@@ -78,6 +79,8 @@ class Simulation:
         self._objects = self._object_types()
         # the last snapshot's facts, under the facts_key they were made for (snapshot)
         self._snapped: tuple[tuple[Any, ...], frozenset[Fact], tuple[tuple[str, Pose | None], ...]] | None = None
+        # the last facts_key, under what it was made from: (tick, version, people's revision)
+        self._key: tuple[tuple[int, int, int], tuple[Any, ...]] | None = None
         self.facts: set[Fact] = set(self.spec.facts)
         # devices are where their place is
         self.facts |= {("at", d.name, d.place) for d in self.spec.devices.values()}
@@ -106,6 +109,7 @@ class Simulation:
         self._spot_rooms: dict[int, tuple[Mapping[str, Pose], dict[str | None, list[str]]]] = {}
         self._person_spots: dict[str, Pose] | None = None  # the places people can be at (person_place)
         self._fallen: tuple[str, ...] = ()  # who lay fallen at the last look (Simulation._give_room)
+        self._door_changes = self._doors_seen = 0  # doors opened or closed, in all and at the last look
         self.physics_ticks = 0  # control ticks that stepped MuJoCo (the rest: robot at rest, nothing to do)
         self._people_seen = -1  # the scene's version after the last _sync_people
         self._sync_people()
@@ -233,7 +237,7 @@ class Simulation:
         # People are mocap bodies that touch nothing, so with no command and the base at
         # rest a physics step changes nothing worth its MuJoCo steps: skip it
         if cmd != STOP or not self.mj.at_rest():
-            self.mj.step(round(CONTROL_DT / TIMESTEP))
+            self.mj.step(STEPS)
             self.physics_ticks += 1
         self.time = t
         if self.recording.due(t):
@@ -258,6 +262,7 @@ class Simulation:
     def set_door(self, name: str, is_open: bool) -> None:
         """Open or close a door: the scene (and so every cached estimate) and MuJoCo follow."""
         self.door_open[name] = bool(is_open)
+        self._door_changes += 1
         self.version += 1
         self.scene.set_door(name, is_open)
         self.mj.set_door(name, is_open)
@@ -338,8 +343,12 @@ class Simulation:
         door between) steps to the nearest spot of their own room clear of every fallen person
         they see and of the doorways (:meth:`_aside_spot`; none within ``ASIDE_MAX``: they carry
         on) and stays there while that person is down; then they return to what they were
-        doing.  Whenever someone falls or gets up, everyone looks again."""
+        doing.  Whenever someone falls or gets up, everyone looks again; otherwise only those
+        touched since the last look (:attr:`robot.people.Person.touched`) can see anything new,
+        unless a door opened or closed."""
         fallen = tuple(p.name for p in self.people if p.posture == "fallen")
+        everyone = fallen != self._fallen or self._doors_seen != self._door_changes
+        self._doors_seen = self._door_changes
         if fallen != self._fallen:
             self._fallen = fallen
             for p in self.people:
@@ -348,6 +357,8 @@ class Simulation:
             return
         near = self._room_clear()
         for p in self.people:
+            if not (everyone or p.touched):
+                continue  # not moved, nothing about them changed: what they saw last time stands
             if p.giving_room is not None:
                 if p.following or p.posture != "standing":
                     p.giving_room = None
@@ -483,12 +494,17 @@ class Simulation:
         it or stand within ``TOGETHER`` of it) — exactly what :meth:`_facts_now` reads of
         poses.  A monitor that asks only when this changes misses nothing, and skips the
         ticks in which nobody changed place (the robot driving across a room, say)."""
+        made = (self._ticks, self.version, self.people.revision.n)  # nothing else moves anyone
+        if self._key is not None and self._key[0] == made:
+            return self._key[1]
         rx, ry, _ = self.mj.pose()
         here = self.nearest_place(rx, ry)
         hypot = math.hypot
-        return (self.version, here, tuple(
+        key = (self.version, here, tuple(
             (p.posture, here if p.following or hypot(p.x - rx, p.y - ry) <= TOGETHER else self.person_place(p.x, p.y))
             for p in self.people))
+        self._key = (made, key)
+        return key
 
     def person_place(self, x: float, y: float) -> str:
         """Where a person is, symbolically: :meth:`place_of` among the places that are not
