@@ -75,6 +75,7 @@ class Person:
         self._detour: list[Point] = []  # corners to walk round before heading for the script again
         self._event = 0
         self._trail: list[tuple[float, float]] = []
+        self._seg: list[float] = []  # the lengths of the trail's legs (Person._follow)
         self._following = False
         self._waiting = False
         self._aside: tuple[float, float] | None = None
@@ -200,14 +201,19 @@ class Person:
 
     def _follow(self, robot: tuple[float, float], dt: float) -> None:
         trail = self._trail
+        seg = self._seg  # seg[k]: the length from trail[k - 1] to trail[k], measured once
         if not trail:
             trail.append((self.x, self.y))
-        if math.hypot(robot[0] - trail[-1][0], robot[1] - trail[-1][1]) >= TRAIL_STEP:
+            seg[:] = [0.0]
+        last = trail[-1]
+        step = math.hypot(robot[0] - last[0], robot[1] - last[1])
+        if step >= TRAIL_STEP:
             trail.append(robot)
+            seg.append(step)
         # the trail point FOLLOW_GAP behind the robot, measured along the trail
         back, k = 0.0, len(trail) - 1
         while k > 0 and back < FOLLOW_GAP:
-            back += math.hypot(trail[k][0] - trail[k - 1][0], trail[k][1] - trail[k - 1][1])
+            back += seg[k]
             k -= 1
         budget = self.spec.speed * dt
         while budget > 1e-9 and len(trail) > 1 and k > 0:
@@ -217,6 +223,7 @@ class Person:
                 self.x, self.y = nx, ny
                 budget -= d
                 trail.pop(0)
+                seg.pop(0)
                 k -= 1
                 continue
             self._walk_to(nx, ny, budget / self.spec.speed)
