@@ -41,11 +41,12 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from planners import derived, original_costs, stagecheck
 from planners.checks import DefinitionError
+from planners.derived import INTERRUPTION_KEY
 from planners.estimates import estimator_for, executing
 from planners.planner import PddlText, Planner
 from planners.problem import (
-    CONNECTED,
     PLACE_TYPE,
     DomainModel,
     PortablePddl,
@@ -55,27 +56,20 @@ from planners.problem import (
     travel_table,
 )
 from planners.results import PlanResult, PlanStatus
+from planners.stagecheck import PLANNED_FROM_KEY
 from planners.stages import Bindings, StageBuilder, place_of, robot_name
 from planners.taskspec import COST_MODEL_ARG, ORIGINAL, Branch, Literal, TaskSpec
 from tasker.errors import BadRequest, PlanningFailed, UnknownName
 from tasker.meaning import Hazard, bind, matches
-from tasker.meaning import holds as holds_literal
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
 from tasker.stage import Purpose, Stage, StagePlan
 from tasker.task import Effects, Leaving, TaskContext, TaskType
-from tasker.trace import INAPPLICABLE
 from tasker.world import Pose, WorldState
 
-PLANNED_FROM_KEY = "_planned_from"
-"""``ctx.memory`` key: the last plans' stages, each with the facts it was made from."""
 PLANS_REMEMBERED = 8
-LOCATION = "at"
-MOVERS = frozenset({"robot", "person"})
-"""Object types whose ``at`` fact the world grounds from a pose (:meth:`PddlTaskType._assumed`)."""
-INTERRUPTION_KEY = "interruption_s"
+"""How many plans ``PLANNED_FROM_KEY`` (:mod:`planners.stagecheck`) keeps per agent."""
 RESTORE_KEY = "_restore_baseline"
 """``ctx.memory`` key: the facts of ``[problem] restore``'s patterns that held when the task first planned."""
-"""``ctx.memory`` key: expected length of an interruption (s); unknown means long."""
 PREPLAN_KEY = "_suspension_planned_ahead"
 """``ctx.memory`` key: (symbolic suspension problem, its plan's steps, empty if the goal held), or None: no plan."""
 
@@ -241,65 +235,8 @@ class PddlTaskType(TaskType):
                               f"{why.get(outcome.status, 'planner error')} for {goal}")
 
     def inapplicable(self, ctx: TaskContext, stage: Stage) -> str | None:
-        """Why ``stage`` cannot run now: the literals of its action's precondition that do not hold.
-
-        Checked in the state the planner would see — the world, the request's and ``task.py``'s
-        facts, Alg. 3's while suspended — except for what the stage's own plan is entitled to
-        assume: facts no world holds (an apology due) and where the robot and people are (the
-        world grounds those from poses, a metre from the place a plan means) are read from the
-        state the plan was made from, as its stages executed so far left it.  ``connected`` is
-        left out (the planner derives it from the motion model).  None when the stage can run,
-        when it would change nothing, or when the precondition is not a conjunction of literals."""
-        world = ctx.world
-        if not isinstance(world, WorldState) or stage.action not in self.domain.actions:
-            return None
-        try:
-            b = Bindings(ctx.args, world)
-            extra = b.literals(self.spec.facts) + (b.literals(self.spec.suspended_facts) if ctx.suspended else [])
-            extra += self._hook_facts(ctx, world)
-        except PlanningFailed:
-            return None
-        facts = world.facts | frozenset(extra)
-        add, delete = [tuple(f) for f in stage.data.get("add", ())], [tuple(f) for f in stage.data.get("delete", ())]
-        if add and all(f in facts for f in add) and not any(f in facts for f in delete):
-            return None  # it would change nothing (driving to where the robot stands): nothing to refuse
-        projected = self._projection(ctx, stage, frozenset(extra) - world.facts)
-        if projected is not None:
-            assumed, kinds = projected
-            facts = frozenset(f for f in facts if not self._assumed(f, kinds, world)) | assumed
-        unmet = [lit for lit in self.domain.unmet(stage.action, stage.args, facts) or ()
-                 if (lit[1] if lit[0] == "not" else lit[0]) != CONNECTED]
-        if not unmet:
-            return None
-        said = ", ".join(f"({' '.join(lit)})" for lit in unmet)
-        return f"{INAPPLICABLE} {stage.action}({' '.join(stage.args)}) needs {said}, which does not hold"
-
-    def _projection(self, ctx: TaskContext, stage: Stage,
-                    extra: frozenset[Literal]) -> tuple[frozenset[Literal], frozenset[str]] | None:
-        """What ``stage``'s plan may assume: the facts it was made from of the kinds :meth:`_assumed` names,
-        updated by the effects of the plan's stages before ``stage``; None for a stage of no plan made here."""
-        world = ctx.world
-        assert isinstance(world, WorldState)
-        kinds = frozenset(f[0] for f in extra)
-        for stages, planned_facts in reversed(ctx.memory.get(PLANNED_FROM_KEY, ())):
-            k = next((i for i, s in enumerate(stages) if s is stage), None)
-            if k is None:
-                continue
-            state = {f for f in planned_facts | extra if self._assumed(f, kinds, world)}
-            for done in stages[:k]:
-                state -= {tuple(f) for f in done.data.get("delete", ()) if self._assumed(tuple(f), kinds, world)}
-                state |= {tuple(f) for f in done.data.get("add", ()) if self._assumed(tuple(f), kinds, world)}
-            return frozenset(state), kinds
-        return None
-
-    @staticmethod
-    def _assumed(fact: Literal, extra_kinds: frozenset[str], world: WorldState) -> bool:
-        """A fact a plan reads from its own projection, not from the world now: one of a kind no world
-        holds (``extra_kinds``: the request's, ``task.py``'s, Alg. 3's), or where the robot or a person is
-        (an abstraction of a pose that the stage which drove there has met)."""
-        if fact[0] in extra_kinds:
-            return True
-        return fact[0] == LOCATION and len(fact) == 3 and world.objects.get(fact[1]) in MOVERS
+        """Why ``stage`` cannot run now, or None (:func:`planners.stagecheck.inapplicable`)."""
+        return stagecheck.inapplicable(self, ctx, stage)
 
     def compute_params(self, ctx: TaskContext) -> CostParams:
         """``cost = cps * (age + cTime)``; cTime and endPose from :meth:`estimate` of the state now.
@@ -332,68 +269,25 @@ class PddlTaskType(TaskType):
     def _original(self, ctx: TaskContext) -> bool:
         return self.spec.original_costs is not None and ctx.args.get(COST_MODEL_ARG) == ORIGINAL
 
-    def _original_state(self, ctx: TaskContext) -> tuple[WorldState, Pose, tuple[float, float, float], float, bool]:
-        """The world, the person's pose, the factors (walk, stand, sit), the rate of the person's
-        cost while they wait (``f_stand`` until greeted, then ``f_sit``: what the 2019 code answered
-        for a waiting or suspended guideHuman) and whether they walk with the robot now."""
-        model = self.spec.original_costs
-        assert model is not None
-        world = self._world(ctx)
-        b = Bindings(ctx.args, world)
-        person = b.token(model.person)
-        if person not in world.poses:
-            raise PlanningFailed("error", f"{self.name}: no pose for {person!r}")
-        f = tuple(float(ctx.args[t[1:]]) for t in model.factors) if model.factors else (1.0, 1.0, 1.0)
-        walking = bool(model.walk) and holds(world.facts, b.literals(model.walk))
-        greeted = walking or bool(model.sit) and holds(world.facts, b.literals(model.sit))
-        return world, world.poses[person], (f[0], f[1], f[2]), f[2] if greeted else f[1], walking
-
-    def _metres(self, ctx: TaskContext, start: Pose, goal: Pose) -> float:
-        if ctx.motion is None:
-            raise PlanningFailed("error", f"{self.name}: the {ORIGINAL} cost model needs a motion model")
-        est = ctx.motion.estimate(start, goal)
-        return float(est.distance_m) if est.reachable else math.inf
-
     def original_params(self, ctx: TaskContext) -> CostParams:
-        """The 2019 code's ``getSP()``: with *a* the robot's path to the person and *g* the
-        person's path to the destination (metres), ``cost = g·f_walk`` while the person walks
-        with the robot, else ``a·rate + g·f_walk``; ``cps = rate``; ``cTime = a + g`` (metres,
-        as the original); ``endPose`` the destination, or the person without one."""
-        model = self.spec.original_costs
-        assert model is not None
-        world, person, (f_walk, _, _), rate, walking = self._original_state(ctx)
-        a = 0.0 if walking else self._metres(ctx, world.poses[robot_name(world)], person)
-        end = person
-        g = 0.0
-        if model.destination is not None:
-            place = Bindings(ctx.args, world).token(model.destination)
-            if place not in world.poses:
-                raise PlanningFailed("error", f"{self.name}: no pose for {place!r}")
-            end = world.poses[place]
-            g = self._metres(ctx, person, end)
-        if not (math.isfinite(a) and math.isfinite(g)):
-            return CostParams(self.name, cost=math.inf, cps=rate, c_time=math.inf, end_pose=end)
-        return CostParams(self.name, cost=g * f_walk + (0.0 if walking else a * rate), cps=rate, c_time=a + g,
-                          end_pose=end)
+        """The 2019 code's ``getSP()`` (:func:`planners.original_costs.params`)."""
+        return original_costs.params(self, ctx)
 
     def original_completion(self, ctx: TaskContext, start: Pose | None) -> CompletionCost:
-        """The 2019 code's cost and suspend conditions: ``cc`` is the path from ``start`` to the
-        person times the waiting rate (the approach leg only), ``ccps`` that rate."""
-        world, person, _, rate, _ = self._original_state(ctx)
-        a = self._metres(ctx, start if start is not None else world.poses[robot_name(world)], person)
-        return CompletionCost(cc=a * rate if math.isfinite(a) else math.inf, ccps=rate)
+        """The 2019 code's cost and suspend conditions (:func:`planners.original_costs.completion`)."""
+        return original_costs.completion(self, ctx, start)
 
     # -- planning inputs (public for tests and tools) -----------------------------------
 
     def update_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], list[Literal]]:
         """upTsk: the world, the goal (with what ``[problem] restore`` asks back) and the extra init
         facts (request, Alg. 3, task.py)."""
-        world = self._world(ctx)
+        world = self.world_of(ctx)
         b = Bindings(ctx.args, world)
         extra = b.literals(self.spec.facts) + (b.literals(self.spec.suspended_facts) if ctx.suspended else [])
         goal = b.literals(self.spec.goal)
         goal += [lit for lit in self.restored(ctx, world) if lit not in goal]
-        return world, goal, extra + self._hook_facts(ctx, world)
+        return world, goal, extra + self.hook_facts(ctx, world)
 
     def restored(self, ctx: TaskContext, world: WorldState) -> list[Literal]:
         """``[problem] restore``: ``("not", fact)`` for every ground instance of a pattern (over the
@@ -422,7 +316,7 @@ class PddlTaskType(TaskType):
     def suspension_inputs(self, ctx: TaskContext) -> tuple[WorldState, list[Literal], Branch]:
         """genSusp: the world at interruption, the suspension goal and the branch that chose it
         (for ``derived``, a branch made of the derived goal and its label, with no stages)."""
-        world = self._world(ctx)
+        world = self.world_of(ctx)
         if ctx.strategy.suspension == "derived":
             goal, label = self.derived_goal(ctx, world)
             return world, goal, Branch(goal=tuple(goal), label=label)
@@ -430,88 +324,21 @@ class PddlTaskType(TaskType):
         return world, b.literals(branch.goal), branch
 
     def owned_hazards(self, ctx: TaskContext, world: WorldState) -> list[tuple[Hazard, Literal]]:
-        """The declared hazards that hold now and are this task's, as the hazard monitor owns them
-        (:class:`tasker.meaning.Monitor`): a pattern with ``$args`` through the request's arguments; one
-        without, when the monitor gives it to this agent (``ctx.hazards``) or a stage of this task made it
-        true (its ``add`` effects) and it still holds."""
-        robot = robot_name(world)
-        mine = {(name, tuple(f)) for name, f in (ctx.hazards() if ctx.hazards is not None else ())}
-        made = {tuple(f) for s in ctx.done for f in s.data.get("add", ())}
-        out: list[tuple[Hazard, Literal]] = []
-        for hz in self.spec.hazards:
-            atom = bind(hz.fact, ctx.args, robot)
-            if atom is None:
-                continue
-            by_args = any(tok.startswith("$") and tok != "$robot" for tok in hz.fact)
-            for f in matches(atom, world.facts):
-                if by_args or (hz.name, f) in mine or f in made:
-                    out.append((hz, f))
-        return out
+        """The declared hazards that hold now and are this task's (:func:`planners.derived.owned_hazards`)."""
+        return derived.owned_hazards(self, ctx, world)
 
     def derived_goal(self, ctx: TaskContext, world: WorldState) -> tuple[list[Literal], str]:
-        """The ``derived`` suspension goal and a label saying what it asks for.
+        """The ``derived`` suspension goal and a label saying what it asks for (:func:`planners.derived.goal`)."""
+        return derived.goal(self, ctx, world)
 
-        * every hazard this task owns (:meth:`owned_hazards`) off — under the ``conditional``
-          policy, a hazard whose ``budget_s`` is at least the expected interruption
-          (``ctx.memory["interruption_s"]``; unknown means long) may stay on;
-        * the task's person in one of the ``safe`` roles of ``[people]``: if none holds, the
-          role literal the planner reaches most cheaply (each is planned as the estimates plan);
-        * the ``[derived] invariants``."""
-        expected = ctx.memory.get(INTERRUPTION_KEY)
-        length = math.inf if expected is None else float(expected)
-        goal: list[Literal] = []
-        said: list[str] = []
-        for hz, fact in self.owned_hazards(ctx, world):
-            if ctx.strategy.policy == "conditional" and length <= hz.budget_s:
-                said.append(f"{hz.name}({', '.join(fact[1:])}) left on")
-                continue
-            goal.append(("not", *fact))
-            said.append(f"{hz.name}({', '.join(fact[1:])}) off")
-        b = Bindings(ctx.args, world)
-        goal += [lit for lit in b.literals(self.spec.invariants) if lit not in goal]
-        if self.spec.invariants:
-            said.append("invariants")
-        people = self.spec.people
-        if people is not None and people.safe:
-            robot = robot_name(world)
-            options = [lit for role in people.safe for pat in people.roles[role]
-                       if (lit := bind(pat, ctx.args, robot)) is not None]
-            if options and not any(holds_literal(lit, world.facts) for lit in options):
-                chosen = self._cheapest(ctx, world, goal, options)
-                if chosen is not None:
-                    goal.append(chosen)
-                    said.append(f"{ctx.args.get(people.person)} {' '.join(chosen)}")
-            else:
-                said.append(f"{ctx.args.get(people.person)} safe")
-        return goal, "derived: " + (", ".join(said) if said else "nothing to make safe")
-
-    def _cheapest(self, ctx: TaskContext, world: WorldState, goal: list[Literal],
-                  options: list[Literal]) -> Literal | None:
-        """Of ``options`` (a safe role's literals), the one added to ``goal`` the planner reaches at
-        the lowest cost (planned as the estimates plan: cached, travel with nobody in the way); the
-        first one if it reaches none (genSusp will then say it is unsolvable)."""
-        extra = self.suspension_facts(ctx, world)
-        travel = estimator_for(self).reference_table(world, ctx.motion)
-        best: tuple[float, int] | None = None
-        for k, lit in enumerate(options):
-            steps, status, _ = estimator_for(self).plan(ctx, world, [*goal, lit], extra)
-            if status is not PlanStatus.SOLVED:
-                continue
-            try:
-                cost = sum(s.duration for s in self.builder.from_steps(steps, travel, ctx.args))
-            except PlanningFailed:  # a leg the robot cannot drive now
-                continue
-            if best is None or (cost, k) < best:
-                best = (cost, k)
-        return options[best[1] if best is not None else 0]
 
     def suspension_facts(self, ctx: TaskContext, world: WorldState) -> list[Literal]:
         """genSusp's extra init facts: the request's and ``task.py``'s (e.g. carry_object's
         door-free passages), as for upTsk, but not Alg. 3's ``suspended_facts``."""
         b = Bindings(ctx.args, world)
-        return b.literals(self.spec.facts) + self._hook_facts(ctx, world)
+        return b.literals(self.spec.facts) + self.hook_facts(ctx, world)
 
-    def _hook_facts(self, ctx: TaskContext, world: WorldState) -> list[Literal]:
+    def hook_facts(self, ctx: TaskContext, world: WorldState) -> list[Literal]:
         """``task.py``'s ``extra_facts``: ground facts as tuples of strings, checked (a string
         would become a tuple of letters, a fact nobody declares, silently left out)."""
         if "extra_facts" not in self.hooks:
@@ -537,7 +364,7 @@ class PddlTaskType(TaskType):
 
     def static_update(self, ctx: TaskContext) -> StagePlan:
         """The template ``exeTsk`` (Alg. 3): fixed stages, variants chosen by ``ctx.suspended``."""
-        world = self._world(ctx)
+        world = self.world_of(ctx)
         stages = self._template_stages(ctx, world, travel_table(world, ctx.motion, self.spec.travel_s))
         return StagePlan(stages, Purpose.UP_TSK, strategy="static", sim_time=self.spec.static_time_s,
                          note="template exeTsk" + (" (suspended variant)" if ctx.suspended else ""))
@@ -548,7 +375,7 @@ class PddlTaskType(TaskType):
 
     def static_suspension(self, ctx: TaskContext) -> StagePlan:
         """The decision list ``exeSusp`` (eq. 47): the first branch whose condition holds."""
-        world = self._world(ctx)
+        world = self.world_of(ctx)
         branch, b = self.branch(ctx, world)
         travel = travel_table(world, ctx.motion, self.spec.travel_s)
         stages = self.builder.from_templates(branch.stages, b, travel, ctx.suspended)
@@ -575,7 +402,7 @@ class PddlTaskType(TaskType):
         return (f"; the robot cannot drive from {here!r} to {', '.join(map(repr, cut))} "
                 "(walled off, or behind a closed door)")
 
-    def _world(self, ctx: TaskContext) -> WorldState:
+    def world_of(self, ctx: TaskContext) -> WorldState:
         if not isinstance(ctx.world, WorldState):
             raise PlanningFailed("error", f"{self.name}: needs a WorldState, got {type(ctx.world).__name__}")
         return ctx.world
