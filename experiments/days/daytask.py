@@ -80,9 +80,9 @@ class DayTask(SyntheticTask):
                                   help="time the person is dead if not helped (falls; for metrics)"))
         # only what the protocol draws per request: a protocol that draws none keeps its traces as they were
         if isinstance(spec.pick_s, tuple):
-            self.arg_specs += (ArgSpec("pick", "float", required=False, help="seconds the pick takes"),)
+            self.arg_specs += (ArgSpec("pick_s", "float", required=False, help="seconds the pick takes"),)
         if isinstance(spec.place_s, tuple):
-            self.arg_specs += (ArgSpec("place", "float", required=False, help="seconds the place takes"),)
+            self.arg_specs += (ArgSpec("place_s", "float", required=False, help="seconds the place takes"),)
         if spec.carry_speed is not None:
             self.arg_specs += (ArgSpec("carry_speed", "float", required=False, help="speed of the carry, m/s"),)
 
@@ -98,9 +98,9 @@ class DayTask(SyntheticTask):
         if s.kind == "fall":
             return [go, Stage("help", kind=BLOCK, duration=args["work"])]
         carry = args.get("carry_speed") or self.speed
-        return [go, Stage("pick_up", kind=BLOCK, duration=_seconds(args.get("pick"), s.pick_s)),
+        return [go, Stage("pick_up", kind=BLOCK, duration=_seconds(args.get("pick_s"), s.pick_s)),
                 _move("carry", dest, carry, site, move),
-                Stage("place", kind=BLOCK, duration=_seconds(args.get("place"), s.place_s))]
+                Stage("place", kind=BLOCK, duration=_seconds(args.get("place_s"), s.place_s))]
 
     def _build(self, ctx: TaskContext, start: Pose | None, resume: bool) -> list[Stage]:
         rest = list(ctx.remaining) if ctx.plan is not None else self._template(ctx.args)

@@ -44,8 +44,8 @@ class DayRequest:
     """One request of a drawn day, before any backend gives it a form.
 
     ``site`` and ``dest`` are site names of the protocol; ``deadline`` and ``death_at``
-    absolute seconds; ``work`` (falls) and ``walk_speed`` (transports) as drawn; ``pick``,
-    ``place`` and ``carry_speed`` (pick-and-place) when the protocol draws them; ``xy`` where
+    absolute seconds; ``work`` (falls) and ``walk_speed`` (transports) as drawn; ``pick_s``,
+    ``place_s`` and ``carry_speed`` (pick-and-place) when the protocol draws them; ``xy`` where
     the person is when the protocol draws positions in rooms (else the site's spot).
     """
 
@@ -59,8 +59,8 @@ class DayRequest:
     work: float | None = None
     walk_speed: float | None = None
     death_at: float | None = None
-    pick: float | None = None
-    place: float | None = None
+    pick_s: float | None = None
+    place_s: float | None = None
     carry_speed: float | None = None
     xy: Pose | None = None
 
@@ -142,8 +142,8 @@ def draw(protocol: Protocol, seed: int) -> tuple[DayRequest, ...]:
                 assert spec.death_after_s is not None
                 extra["death_at"] = round(deadline + spec.death_after_s, 1)
             else:
-                for key in ("pick", "place"):
-                    value = getattr(spec, f"{key}_s")
+                for key in ("pick_s", "place_s"):
+                    value = getattr(spec, key)
                     if isinstance(value, tuple):
                         extra[key] = round(rng.uniform(*value), 1)
                 if spec.carry_speed is not None:
@@ -174,7 +174,7 @@ def generate(protocol: Protocol, seed: int, *, scheduler: str = "alg2",
             args["death_at"] = r.death_at
         else:
             args["dest"] = list(protocol.sites[r.dest])
-            args |= {k: v for k, v in (("pick", r.pick), ("place", r.place), ("carry_speed", r.carry_speed))
+            args |= {k: v for k, v in (("pick_s", r.pick_s), ("place_s", r.place_s), ("carry_speed", r.carry_speed))
                      if v is not None}
         actions.append(TimedAction(r.t, "request", {"task": r.kind, "args": args}))
     rate = 1.0 / protocol.step_s

@@ -193,7 +193,7 @@ def _robot(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) 
             objects[obj] = {"type": rt.object_type, "place": backend.places[r.site], "facts": []}
         args: dict[str, Any] = {k: values.get(v, v) for k, v in rt.args.items()}
         args |= {"deadline": r.deadline, "priority": r.priority}
-        drawn = {"$work": r.work, "$pick": r.pick, "$place": r.place}
+        drawn = {"$work": r.work, "$pick": r.pick_s, "$place": r.place_s}
         args |= {action + SUFFIX: drawn[v] for action, v in rt.durations.items() if drawn[v] is not None}
         if r.death_at is not None:
             args["death_at"] = r.death_at

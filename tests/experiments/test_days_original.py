@@ -52,7 +52,7 @@ def test_the_draw_is_tabsas(original: protocol.Protocol) -> None:
             if r.kind == "transport":
                 assert r.walk_speed is not None and 0.01 <= r.walk_speed <= 0.1
             if r.kind == "pick_place":
-                assert 60.0 <= (r.pick or 0) <= 300.0 and 60.0 <= (r.place or 0) <= 300.0
+                assert 60.0 <= (r.pick_s or 0) <= 300.0 and 60.0 <= (r.place_s or 0) <= 300.0
                 assert r.carry_speed is not None and 0.01 <= r.carry_speed <= 0.1
 
 
@@ -82,7 +82,7 @@ def test_the_work_of_a_day_is_tabsas_share_of_it(original: protocol.Protocol) ->
                 elif r.kind == "fall":
                     total += r.work or 0.0
                 else:
-                    total += day_draw_seconds(r.pick, spec.pick_s) + day_draw_seconds(r.place, spec.place_s) \
+                    total += day_draw_seconds(r.pick_s, spec.pick_s) + day_draw_seconds(r.place_s, spec.place_s) \
                         + d / (r.carry_speed or proto.robot_speed)
         return total / (20 * proto.length_s)
 
@@ -136,7 +136,7 @@ def test_a_type_that_is_not_preemptive_runs_blocking_from_its_first_stage(origin
     stages = fall._template({"site": (0.0, 0.0), "dest": None, "work": 100.0})
     assert [s.kind for s in stages] == [StageKind.BLOCKING, StageKind.BLOCKING]
     carry = DayTask(original.tasks["pick_place"], 0.5, 1.0)
-    stages = carry._template({"site": (0.0, 0.0), "dest": (3.0, 4.0), "pick": 70.0, "place": 80.0,
+    stages = carry._template({"site": (0.0, 0.0), "dest": (3.0, 4.0), "pick_s": 70.0, "place_s": 80.0,
                               "carry_speed": 0.05})
     assert all(s.kind is StageKind.BLOCKING for s in stages)
     assert [s.duration for s in stages if s.action in ("pick_up", "place")] == [70.0, 80.0]
@@ -387,8 +387,8 @@ def test_a_robot_day_of_tabsas_protocol_takes_the_drawn_work(tmp_path: Path) -> 
                                                          "guide_human": "finished"}
     took = {(t, s.action): s.end - s.begin for t, x in by_type.items() for s in x.stages if s.end is not None}
     assert took["human_fell", "call_help"] == pytest.approx(drawn["fall"].work, abs=0.2)
-    assert took["carry_object", "pick"] == pytest.approx(drawn["pick_place"].pick, abs=0.2)
-    assert took["carry_object", "place"] == pytest.approx(drawn["pick_place"].place, abs=0.2)
+    assert took["carry_object", "pick"] == pytest.approx(drawn["pick_place"].pick_s, abs=0.2)
+    assert took["carry_object", "place"] == pytest.approx(drawn["pick_place"].place_s, abs=0.2)
     for t in ("human_fell", "carry_object"):
         assert {s.kind for s in by_type[t].stages} == {"blocking"}
     assert "suspendable" in {s.kind for s in by_type["guide_human"].stages}
