@@ -36,6 +36,7 @@ from robot.estimator import APPROACH, MotionEstimator
 from robot.mjworld import TIMESTEP, MjApartment
 from robot.motion import BasePlanner, open_planner
 from robot.people import People, Person
+from robot.places import Places
 from robot.recording import PersonState, Recorder
 from robot.scene import PERSON_RADIUS, Scene, point_box_distance, segments_clear
 from robot.skills import SKILLS, Skill
@@ -51,7 +52,6 @@ STEPS = round(CONTROL_DT / TIMESTEP)  # MuJoCo steps a control tick
 AT_TOLERANCE = 0.3  # metres: the robot starts "at" a place this close
 TOGETHER = 1.5  # metres: a person this close to the robot is symbolically at the robot's place
 WAIT_MARGIN = 0.05  # metres beyond a standing person's radius and the robot's width (Simulation._aside_spot)
-PLACE_MEMO = 4096  # points whose place is remembered (Simulation._memo_place), then forgotten all at once
 ASIDE_STEP, ASIDE_MAX, ASIDE_DIRECTIONS = 0.1, 3.0, 16  # where a person stepping aside looks for a spot
 
 
@@ -102,12 +102,7 @@ class Simulation:
         self._ticks = 0
         self._last_cmd = STOP
         self._synced: dict[str, tuple[float, float, float, str]] = {}
-        self._places_memo: dict[tuple[str, float, float], str] = {}
-        # rooms smallest first (ties by name): the first holding a point is spec.room_of's answer
-        self._rooms = sorted(self.spec.rooms.items(),
-                             key=lambda nb: ((nb[1][2] - nb[1][0]) * (nb[1][3] - nb[1][1]), nb[0]))
-        self._spot_rooms: dict[int, tuple[Mapping[str, Pose], dict[str | None, list[str]]]] = {}
-        self._person_spots: dict[str, Pose] | None = None  # the places people can be at (person_place)
+        self.places = Places(self.spec, self.scene)
         self._fallen: tuple[str, ...] = ()  # who lay fallen at the last look (Simulation._give_room)
         self._door_changes = self._doors_seen = 0  # doors opened or closed, in all and at the last look
         self.physics_ticks = 0  # control ticks that stepped MuJoCo (the rest: robot at rest, nothing to do)
@@ -507,62 +502,20 @@ class Simulation:
         return key
 
     def person_place(self, x: float, y: float) -> str:
-        """Where a person is, symbolically: :meth:`place_of` among the places that are not
-        the places of devices (people are not "at the stove"), or among all places if none."""
-        if self._person_spots is None:
-            device_places = {d.place for d in self.spec.devices.values()}
-            self._person_spots = {n: p for n, p in self.spec.places.items()
-                                  if n not in device_places} or dict(self.spec.places)
-        return self._memo_place("person", self._person_spots, x, y)
+        """Where a person is, symbolically (:meth:`robot.places.Places.person_place`)."""
+        return self.places.person_place(x, y)
 
     def nearest_place(self, x: float, y: float) -> str:
-        """Where the robot (or anything) at ``(x, y)`` is: :meth:`place_of` among all places."""
-        return self._memo_place("any", self.spec.places, x, y)
-
-    def _memo_place(self, which: str, spots: Mapping[str, Pose], x: float, y: float) -> str:
-        """:meth:`place_of` among ``spots`` (named ``which``) remembered per point: walls, rooms
-        and places never change during a run, and every snapshot grounds everyone, most of whom
-        stand where they stood."""
-        key = (which, x, y)
-        hit = self._places_memo.get(key)
-        if hit is None:
-            if len(self._places_memo) >= PLACE_MEMO:
-                self._places_memo.clear()
-            hit = self._places_memo[key] = self.place_of(x, y, spots)
-        return hit
+        """Where the robot (or anything) at ``(x, y)`` is (:meth:`robot.places.Places.nearest_place`)."""
+        return self.places.nearest_place(x, y)
 
     def room_of(self, x: float, y: float) -> str | None:
-        """The smallest room whose box holds ``(x, y)`` (ties by name), or None (:func:`robot.spec.room_of`:
-        the same answer, from the rooms sorted once by area and name)."""
-        for n, (x0, y0, x1, y1) in self._rooms:
-            if x0 <= x <= x1 and y0 <= y <= y1:
-                return n
-        return None
+        """The smallest room whose box holds ``(x, y)`` (:meth:`robot.places.Places.room_of`)."""
+        return self.places.room_of(x, y)
 
     def place_of(self, x: float, y: float, spots: Mapping[str, Pose]) -> str:
-        """The nearest of ``spots`` that is not behind a wall (ties broken by name).
-
-        The nearest place of the room that holds ``(x, y)``; if that room has none, the
-        nearest place in sight (the straight line to it crosses no wall); else the nearest.
-        """
-        def nearest(names: Iterable[str]) -> str:
-            return min(names, key=lambda n: (math.hypot(spots[n][0] - x, spots[n][1] - y), n))
-
-        room = self.room_of(x, y)
-        if room is not None:
-            by_room = self._spot_rooms.get(id(spots))
-            if by_room is None or by_room[0] is not spots:  # the spots' rooms: places never move
-                rooms: dict[str | None, list[str]] = {}
-                for n in spots:
-                    rooms.setdefault(self.room_of(spots[n][0], spots[n][1]), []).append(n)
-                by_room = self._spot_rooms[id(spots)] = (spots, rooms)
-            inside = by_room[1].get(room)
-            if inside:
-                return nearest(inside)
-        names = sorted(spots)
-        ends = np.array([spots[n][:2] for n in names], dtype=float)
-        seen = segments_clear(np.repeat([[x, y]], len(names), axis=0), ends, self.scene.walls, 1e-6)
-        return nearest([n for n, ok in zip(names, seen, strict=True) if ok] or names)
+        """The nearest of ``spots`` not behind a wall (:meth:`robot.places.Places.place_of`)."""
+        return self.places.place_of(x, y, spots)
 
     def apply(self, add: Iterable[Iterable[str]] = (), delete: Iterable[Iterable[str]] = ()) -> None:
         """Change the symbolic state: ``delete`` first, then ``add`` (lists of ground facts)."""

@@ -44,9 +44,9 @@ def test_nested_rooms_use_the_smallest(flat) -> None:
 def test_remembered_places_are_the_places_computed_afresh(paper, monkeypatch: pytest.MonkeyPatch) -> None:
     import random
 
-    import robot.sim as sim_module
+    import robot.places as places_module
 
-    monkeypatch.setattr(sim_module, "PLACE_MEMO", 16)  # forgotten and remembered again along the way
+    monkeypatch.setattr(places_module, "PLACE_MEMO", 16)  # forgotten and remembered again along the way
     sim = Simulation(paper)
     device_places = {d.place for d in paper.devices.values()}
     people_spots = {n: p for n, p in paper.places.items() if n not in device_places}
