@@ -197,7 +197,11 @@ class Checker:
             from experiments.inputs import scenario as scenarios
 
             for sc in specs[0].scenarios:  # a file (absolute in sources), or a shipped scenario's name
-                self.check(specs[0].sources.get(sc) or str(scenarios.resolve(sc)))
+                src = specs[0].sources.get(sc) or str(scenarios.resolve(sc))
+                if src.endswith(".toml") and Path(src).is_file():  # with the spec's own `paths`, as its runs load it
+                    self._toml(Path(src), also=list(specs[0].task_paths))
+                else:
+                    self.check(src)
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
