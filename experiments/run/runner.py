@@ -93,7 +93,7 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
     spec, from_world = _world_file_events(spec, str(scn.world))
     sim = Simulation(spec, seed=seed)
     loaded = task_types(task_paths)
-    if request_fields or asked_for(scn.actions):
+    if request_fields or scn.request_fields or asked_for(scn.actions):
         from experiments.inputs.request_fields import with_request_fields
 
         loaded = [with_request_fields(t) for t in loaded]
