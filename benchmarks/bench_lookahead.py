@@ -14,7 +14,8 @@
    limit, over the best order known (the better of CP-SAT with 10x its limit and the
    branch and bound with 100x its budget), and the wall time of one search of each.
 4. The other schedulers' decision on the views of part 1, against Alg. 2's, measured in the
-   same run (ratio = scheduler / alg2): ``wspt``, ``atc`` and TaBSA's agents.  TaBSA's
+   same run (ratio = scheduler / alg2): ``edf``, ``wspt``, ``atc`` and TaBSA's agents (every
+   scheduler of the day tables besides the look-ahead and Alg. 2).  TaBSA's
    agents keep state (estimates read at events, the request table), so each timed
    decision is a fresh scheduler's first: every estimate read and, for
    ``tabsa-scheduler``, the table of slots built — their dearest decision.
@@ -35,7 +36,7 @@ from tasker.schedulers.lookahead import LookAhead, solve
 
 SPEED = 0.5
 SIZES = (1, 2, 4, 8, 12, 16, 32, 64)
-OTHERS = ("wspt", "atc", "tabsa-simple", "tabsa-simple2", "tabsa-distance", "tabsa-scheduler")
+OTHERS = ("edf", "wspt", "atc", "tabsa-simple", "tabsa-simple2", "tabsa-distance", "tabsa-scheduler")
 
 
 def make_view(n: int, seed: int = 0) -> ScheduleView:

@@ -46,7 +46,10 @@ BASELINE = "4b70084"
 _WORKER = """
 import json, sys, time, warnings
 warnings.simplefilter("ignore")
-from experiments.runner import run_scenario
+try:
+    from experiments.run.runner import run_scenario
+except ImportError:  # the baseline, before experiments/ was layered
+    from experiments.runner import run_scenario
 cpu = []
 for seed in range(1, {seeds} + 1):
     t = time.process_time()
@@ -108,7 +111,7 @@ ENTRY_POINTS = (
      "Planner.solve"),
     ("schedule-parameter estimates, less plans and motion (planners.estimates)", "planners.estimates",
      "Estimator.estimate"),
-    ("writing the run's files (trajectory, trace, problems)", "experiments.runner", "_save"),
+    ("writing the run's files (trajectory, trace, problems)", "experiments.run.runner", "_save"),
 )
 
 
@@ -155,7 +158,7 @@ def profile() -> int:
 
     warnings.simplefilter("ignore")
     sys.path.insert(0, str(ROOT))
-    from experiments.runner import run_scenario
+    from experiments.run.runner import run_scenario
 
     totals: dict[str, float] = {}
     calls: dict[str, int] = {}

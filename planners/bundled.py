@@ -16,6 +16,7 @@ from domains import BUNDLED
 from planners.loader import load_task, load_task_folder
 from planners.pddl_task import PddlTaskType
 from tasker.errors import ConfigError
+from tasker.meaning import Binding
 from tasker.task import TaskType
 
 ENV_VAR = "TASKER_TASKS"
@@ -46,4 +47,32 @@ def task_types(extra: Iterable[str | Path] = ()) -> list[TaskType]:
     if dup:
         where = "; ".join(f"{n!r} by {' and '.join(map(str, files[n])) or 'two task types'}" for n in dup)
         raise ConfigError(f"task type name(s) defined twice: {where} (a [task] name must be unique)")
+    check_bindings(unique)
     return unique
+
+
+def _where(t: TaskType) -> str:
+    return str(t.spec.folder / "task.toml") if isinstance(t, PddlTaskType) else f"task type {t.name!r}"
+
+
+def check_bindings(types: Iterable[TaskType]) -> None:
+    """The world reads a bound fact from one physical state, whichever task type bound it
+    (:meth:`robot.sim.Simulation.bind`): two task types that bind a predicate differently — another
+    kind, object or device state — for the same objects would have the first one win silently.
+    A :class:`ConfigError` naming both folders."""
+    seen: dict[tuple[str, int], list[tuple[Binding, TaskType]]] = {}
+    for t in types:
+        for b in t.meaning.bindings:
+            key = (b.predicate, len(b.fact))
+            for other, owner in seen.get(key, []):
+                if owner is t:
+                    continue
+                same = (b.kind, b.fact.index(b.object), b.state, b.otherwise) == (
+                    other.kind, other.fact.index(other.object), other.state, other.otherwise)
+                overlap = not b.types or not other.types or set(b.types) & set(other.types)
+                if not same and overlap:
+                    raise ConfigError(f"{b.predicate!r} is bound as {other.kind} of {other.object} by "
+                                      f"{_where(owner)} and as {b.kind} of {b.object} by {_where(t)}: the world "
+                                      "reads a fact from one physical state (bind it the same way in both, or "
+                                      "name the predicate differently in one domain)")
+            seen.setdefault(key, []).append((b, t))

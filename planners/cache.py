@@ -22,11 +22,12 @@ from __future__ import annotations
 import json
 from collections.abc import Iterable
 from pathlib import Path
+from typing import Any
 
 from tasker import __version__
 from tasker.support.diskcache import ENV_VAR, cache_dir, content_key, entry_path, write_atomic
 
-__all__ = ["ENV_VAR", "cache_dir", "content_key", "file_parts", "passed", "record"]
+__all__ = ["ENV_VAR", "cache_dir", "content_key", "file_parts", "passed", "record", "remembered"]
 
 
 def file_parts(files: Iterable[Path]) -> list[str | bytes]:
@@ -41,6 +42,19 @@ def passed(kind: str, key: str) -> bool:
     """Whether a check of ``kind`` with this content key passed before."""
     m = entry_path(kind, key, ".json")
     return m is not None and m.is_file()
+
+
+def remembered(kind: str, key: str) -> dict[str, Any] | None:
+    """What :func:`record` kept of a check of ``kind`` that passed with this content key (e.g. the
+    warnings it gave, to be given again), or ``None``; an unreadable marker counts as none."""
+    m = entry_path(kind, key, ".json")
+    if m is None or not m.is_file():
+        return None
+    try:
+        info = json.loads(m.read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return None
+    return info if isinstance(info, dict) else None
 
 
 def record(kind: str, key: str, info: dict[str, object] | None = None) -> None:

@@ -139,7 +139,7 @@ def _nested(domain_text: str) -> list[object] | None:
 
     try:
         nested: list[object] = lisp_parser.parse_nested_list(io.StringIO(domain_text))
-    except (ParseError, StopIteration):  # StopIteration: no token at all
+    except (ParseError, StopIteration, RecursionError):  # StopIteration: no token at all
         return None
     return nested
 
@@ -228,9 +228,88 @@ class CheckedDomain:
     text: str
 
 
+MAX_PDDL_DEPTH = 32
+"""Parentheses within each other at most this deep: a task's domain needs about 8 (an effect's
+``when`` inside ``forall`` inside ``and``); unified-planning's reader runs out of Python's recursion
+at about 50."""
+
+_COMMENT = re.compile(r";[^\n]*")
+
+
+def check_depth(text: str, file: str | Path) -> None:
+    """Refuse PDDL nested deeper than :data:`MAX_PDDL_DEPTH` (a very deep goal), with its line: the
+    readers (unified-planning's, Fast Downward's) recurse once a level and would crash on it."""
+    depth = 0
+    for n, line in enumerate(_COMMENT.sub("", text).split("\n"), start=1):
+        for ch in line:
+            if ch == "(":
+                depth += 1
+                if depth > MAX_PDDL_DEPTH:
+                    raise PddlError(file, f"parentheses nested more than {MAX_PDDL_DEPTH} deep: the PDDL readers "
+                                          "cannot read it (write the goal or condition flatter)", n)
+            elif ch == ")":
+                depth -= 1
+
+
+def _types_line(text: str) -> int | None:
+    m = re.search(r"\(\s*:types\b", _COMMENT.sub("", text), re.IGNORECASE)
+    return text.count("\n", 0, m.start()) + 1 if m else None
+
+
+def check_types(domain_text: str, file: str | Path) -> None:
+    """Refuse a cycle of types (``a - b`` and ``b - a``): each reader follows the parents up and
+    never gets to ``object``.  Read from Fast Downward's s-expression reader."""
+    nested = _nested(domain_text)
+    if nested is None:
+        return
+    parent: dict[str, str] = {}
+    for block in nested:
+        if isinstance(block, list) and block[:1] == [":types"]:
+            pending: list[str] = []
+            items = block[1:]
+            i = 0
+            while i < len(items):
+                tok = items[i]
+                if tok == "-" and i + 1 < len(items) and isinstance(items[i + 1], str):
+                    for name in pending:
+                        parent.setdefault(name, items[i + 1])
+                    pending, i = [], i + 2
+                    continue
+                if isinstance(tok, str):
+                    pending.append(tok)
+                i += 1
+    for start in parent:
+        seen = [start]
+        node = start
+        while node in parent:
+            node = parent[node]
+            if node in seen:
+                cycle = seen[seen.index(node):] + [node]
+                raise PddlError(file, f"the types form a cycle: {' - '.join(cycle)} (each type's parent must lead "
+                                      "to object)", _types_line(domain_text))
+            seen.append(node)
+
+
+def _domain_name(text: str) -> tuple[str, int] | None:
+    """The name a PDDL text gives its domain (``(domain NAME)`` or a problem's ``(:domain NAME)``), and its line."""
+    code = _COMMENT.sub("", text)
+    m = re.search(r"\(\s*:?domain\s+([^\s()]+)", code, re.IGNORECASE)
+    return (m.group(1).lower(), code.count("\n", 0, m.start()) + 1) if m else None
+
+
+def check_problem_domain(domain_text: str, problem_text: str, file: str | Path) -> None:
+    """A problem names its domain (``(:domain NAME)``): one naming another was planned silently."""
+    mine, theirs = _domain_name(domain_text), _domain_name(problem_text)
+    if mine and theirs and mine[0] != theirs[0]:
+        raise PddlError(file, f"the problem is for domain {theirs[0]!r}, but the domain given is {mine[0]!r} "
+                              "(give the problem's own domain, or correct its (:domain ...))", theirs[1])
+
+
 def load_domain(path: str | Path) -> CheckedDomain:
     """Read and check a ``domain.pddl``; raise :class:`PddlError` naming the file and line."""
     text = _read(path)
+    check_depth(text, path)
+    check_types(text, path)
     check_constructs(text, path)
     check_requirements(text, path)
     check_numeric(parse_domain(text, path), text, path)
@@ -270,11 +349,14 @@ def parse_domain(text: str, file: str | Path = "<domain>") -> up.model.Problem:
     import unified_planning as up
     from unified_planning.io import PDDLReader
 
+    check_depth(text, file)
     try:
         with _lenient_names():
             return PDDLReader().parse_problem_string(text)
     except (pyparsing.ParseBaseException, SyntaxError, up.exceptions.UPException, KeyError, ValueError) as exc:
         raise _located(file, exc) from None
+    except RecursionError:  # deeper than unified-planning's reader manages, though within check_depth
+        raise PddlError(file, "nested too deep for the PDDL reader (write it flatter)") from None
 
 
 def load_problem_text(
@@ -285,11 +367,15 @@ def load_problem_text(
     import unified_planning as up
     from unified_planning.io import PDDLReader
 
+    check_depth(problem_text, problem_file)
+    check_problem_domain(domain.text, problem_text, problem_file)
     try:
         with _lenient_names():
             problem = PDDLReader().parse_problem_string(domain.text, problem_text)
     except (pyparsing.ParseBaseException, SyntaxError, up.exceptions.UPException, KeyError, ValueError) as exc:
         raise _located(problem_file, exc) from None
+    except RecursionError:
+        raise PddlError(problem_file, "nested too deep for the PDDL reader (write it flatter)") from None
     check_kind(problem, problem_file)
     return problem
 

@@ -16,11 +16,13 @@ by Fast Downward's parser (:mod:`planners.schema`), checked or remembered.
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 import inspect
 import string
 import sys
 import types
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -41,9 +43,24 @@ _HOOK_PARAMS = {"extra_facts": "ctx, world", "check_args": "args", "check_termin
 the suspension goal: that is declared in ``[[suspension]]``, so both strategies pursue it."""
 
 
+def _file_parts(files: list[Path]) -> list[str | bytes]:
+    """The names and bytes of the files the checks read (:func:`planners.cache.file_parts`), each read
+    within the readers' limits: a device or a huge file is refused before it is hashed."""
+    parts: list[str | bytes] = []
+    for p in files:
+        if not p.exists() and not p.is_symlink():
+            parts += [p.name, b"\0absent"]
+            continue
+        try:
+            parts += [p.name, reader.read_bytes(p)]
+        except reader.InputError as exc:
+            raise DefinitionError(p, exc.message) from None
+    return parts
+
+
 def _load_hooks(spec: TaskSpec) -> dict[str, Any]:
     path = spec.folder / "task.py"
-    if not path.is_file():
+    if not path.exists() and not path.is_symlink():
         return {}
     mod_name = f"tasker_tasks_{spec.name}"
     module_spec = importlib.util.spec_from_file_location(mod_name, path)
@@ -58,8 +75,12 @@ def _load_hooks(spec: TaskSpec) -> dict[str, Any]:
             except reader.InputError as bad:
                 raise DefinitionError(path, bad.message, bad.line) from None
         raise DefinitionError(path, f"syntax error: {exc.msg}", exc.lineno, exc.offset) from None
+    except SystemExit as exc:  # it ended tasker with its code and no word
+        raise DefinitionError(path, f"called sys.exit({'' if exc.code is None else repr(exc.code)}) on import: a "
+                                    "task.py defines hooks, it does not end the program",
+                              hook_line(exc, path)) from None
     except Exception as exc:  # noqa: BLE001 - any import-time failure is a definition error
-        raise DefinitionError(path, f"failed to import: {type(exc).__name__}: {exc}") from None
+        raise DefinitionError(path, f"failed to import: {type(exc).__name__}: {exc}", hook_line(exc, path)) from None
     sys.modules[mod_name] = module
     hooks = {n: getattr(module, n) for n in HOOK_NAMES if callable(getattr(module, n, None))}
     unknown = sorted(n for n in vars(module) if not n.startswith("_") and n not in HOOK_NAMES
@@ -74,7 +95,32 @@ def _load_hooks(spec: TaskSpec) -> dict[str, Any]:
             if isinstance(fn, types.FunctionType):
                 raise DefinitionError(path, f"{name}{inspect.signature(fn)}: a hook {name} takes "
                                             f"({_HOOK_PARAMS[name]})", fn.__code__.co_firstlineno) from None
-    return hooks
+    return {name: _guarded(fn, name, path) for name, fn in hooks.items()}
+
+
+class HookExited(DefinitionError):
+    """A ``task.py`` hook called ``sys.exit()``: an exception like any other the hook raises, so its
+    task ends alone (cause ``error``) and the message names the folder, not a bare exit status."""
+
+
+def _guarded(fn: Any, name: str, path: Path) -> Any:
+    """``fn`` (a hook of ``path``) with ``sys.exit()`` turned into :class:`HookExited`, and the hook
+    named in :mod:`tasker.support.hookmark` while it runs (a process it kills is reported with it)."""
+    from tasker.support import hookmark
+
+    where = f"{name} of {path}"
+
+    @functools.wraps(fn)
+    def hook(*args: Any, **kwargs: Any) -> Any:
+        with hookmark.inside(where):
+            try:
+                return fn(*args, **kwargs)
+            except SystemExit as exc:
+                code = "" if exc.code is None else repr(exc.code)
+                raise HookExited(path, f"{name} called sys.exit({code}): a hook returns or raises, it does not "
+                                       "end the program", hook_line(exc, path)) from None
+
+    return hook
 
 
 def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
@@ -294,21 +340,32 @@ def load_task(folder: str | Path, *, use_cache: bool = True) -> PddlTaskType:
     folder = Path(folder)
     spec = read_task_toml(folder / "task.toml")
     # what the checks read: task.toml, the domain and task.py (not, e.g., a problem.pddl lying beside them)
-    key = cache.content_key("task-folder", cache.file_parts([folder / "task.toml", spec.domain_file,
-                                                              folder / "task.py"]))
-    remembered = use_cache and cache.passed("task-folder", key)
+    key = cache.content_key("task-folder", _file_parts([folder / "task.toml", spec.domain_file, folder / "task.py"]))
+    remembered = cache.remembered("task-folder", key) if use_cache else None
     # a remembered folder skips unified-planning's reading of the domain (and its import, ~1 s);
     # the DomainModel is read the same way either way (planners.schema), so answers do not depend on it
-    dm = DomainModel(remembered_domain(spec.domain_file) if remembered else load_domain(spec.domain_file))
+    dm = DomainModel(remembered_domain(spec.domain_file) if remembered is not None else load_domain(spec.domain_file))
     _cross_check(spec, dm)
     _check_suspension(spec, dm)
     bindings = _check_meaning(spec, dm)
     task = PddlTaskType(spec, dm, hooks=_load_hooks(spec))
     task.meaning = meaning_of(spec, bindings)
     task.priority = spec.priority
-    if not remembered:
-        _check_example(task)
-        cache.record("task-folder", key, {"folder": str(folder.resolve()), "name": spec.name})
+    if remembered is not None:  # what the checks found doubtful then is as true now: said again
+        for w in remembered.get("warnings", []):
+            if isinstance(w, dict):
+                warnings.warn_explicit(reader.InputWarning(str(w.get("text"))), reader.InputWarning,
+                                       str(w.get("file")), int(w.get("line") or 0), module="tasker.support.reader")
+    else:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", reader.InputWarning)
+            _check_example(task)
+        said = [w for w in caught if issubclass(w.category, reader.InputWarning)]
+        for w in caught:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, module="tasker.support.reader")
+        cache.record("task-folder", key, {"folder": str(folder.resolve()), "name": spec.name,
+                                          "warnings": [{"text": str(w.message), "file": w.filename,
+                                                        "line": w.lineno} for w in said]})
     return task
 
 

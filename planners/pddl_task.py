@@ -19,7 +19,10 @@ Hooks, and what they do here:
 * ``compute_params`` / ``request_sp`` — ``cost = cps * (age + cTime)``: the discomfort
   accumulated by completion, with ``cTime`` and ``endPose`` from the plan upTsk would make
   from the state asked about (:mod:`planners.estimates`), timed with ``ctx.motion``;
-  unreachable or unsolvable means ``inf``.
+  unreachable or unsolvable means ``inf``.  A request with ``cost_model = "taskER-2019"``
+  (offered by a folder with ``[schedule.taskER-2019]``) gets the original TaskER code's
+  parameters instead: path metres weighted per person (:meth:`PddlTaskType.original_params`,
+  ``docs/model.md``).
 
 An unsolvable task raises :class:`~tasker.errors.PlanningFailed`; an unsolvable
 suspension or a planner time-out falls back to the static strategy, said in the note.
@@ -32,7 +35,7 @@ import contextlib
 import itertools
 import math
 import traceback
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from contextvars import ContextVar
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -53,7 +56,7 @@ from planners.problem import (
 )
 from planners.results import PlanResult, PlanStatus
 from planners.stages import Bindings, StageBuilder, place_of, robot_name
-from planners.taskspec import Branch, Literal, TaskSpec
+from planners.taskspec import COST_MODEL_ARG, ORIGINAL, Branch, Literal, TaskSpec
 from tasker.errors import BadRequest, PlanningFailed, UnknownName
 from tasker.meaning import Hazard, bind, matches
 from tasker.meaning import holds as holds_literal
@@ -148,6 +151,27 @@ class PddlTaskType(TaskType):
         return self._planner or default_planner()
 
     # -- hooks ----------------------------------------------------------------------
+
+    def validate_args(self, args: Mapping[str, Any]) -> dict[str, Any]:
+        """As :meth:`TaskType.validate_args`, except that the cost model's arguments stay out of a
+        request that does not give them (it gets the default model, and its trace says what was
+        asked), and the original model needs its factors."""
+        out = super().validate_args(args)
+        model = self.spec.original_costs
+        if model is None:
+            return out
+        for name in model.args:
+            if args.get(name) is None:
+                out.pop(name, None)
+        if out.get(COST_MODEL_ARG) == ORIGINAL:
+            missing = [f[1:] for f in model.factors or () if f[1:] not in out]
+            if missing:
+                raise BadRequest(f"task {self.name!r}: {COST_MODEL_ARG} = {ORIGINAL!r} needs the argument(s) "
+                                 f"{missing} (cost per metre; docs/model.md)")
+        elif any(f[1:] in out for f in model.factors or ()):
+            raise BadRequest(f"task {self.name!r}: the factors {[f[1:] for f in model.factors or ()]} apply only with "
+                             f"{COST_MODEL_ARG} = {ORIGINAL!r}")
+        return out
 
     def check_args(self, args: dict[str, Any]) -> None:
         if "check_args" in self.hooks:
@@ -284,6 +308,8 @@ class PddlTaskType(TaskType):
         suspension of the state now is planned here too (:meth:`_preplan_suspension`)."""
         if executing(ctx) and ctx.strategy.suspension != "static" and isinstance(ctx.world, WorldState):
             self._preplan_suspension(ctx)
+        if self._original(ctx):
+            return self.original_params(ctx)
         c_time, end = self.estimate(ctx, None)
         cost = self.spec.cps * (ctx.age + c_time) if math.isfinite(c_time) else math.inf
         return CostParams(self.name, cost=cost, cps=self.spec.cps, c_time=c_time, end_pose=end)
@@ -294,10 +320,68 @@ class PddlTaskType(TaskType):
             raise UnknownName("schedule parameter", request.sp_id, [SP_COMPLETION])
         pose = next((request.args[k] for k in ("pose", "start_pose", "end_pose") if request.args.get(k)), None)
         start = (float(pose[0]), float(pose[1]), float(pose[2]) if len(pose) > 2 else 0.0) if pose else None
+        if self._original(ctx):
+            return self.original_completion(ctx, start)
         after = request.args.get("after")
         c_time, _ = self.estimate(ctx, start, after=str(after) if after is not None else None)
         cc = self.spec.cps * (ctx.age + c_time) if math.isfinite(c_time) else math.inf
         return CompletionCost(cc=cc, ccps=self.spec.cps)
+
+    # -- the original TaskER cost model (2019) --------------------------------------------
+
+    def _original(self, ctx: TaskContext) -> bool:
+        return self.spec.original_costs is not None and ctx.args.get(COST_MODEL_ARG) == ORIGINAL
+
+    def _original_state(self, ctx: TaskContext) -> tuple[WorldState, Pose, tuple[float, float, float], float, bool]:
+        """The world, the person's pose, the factors (walk, stand, sit), the rate of the person's
+        cost while they wait (``f_stand`` until greeted, then ``f_sit``: what the 2019 code answered
+        for a waiting or suspended guideHuman) and whether they walk with the robot now."""
+        model = self.spec.original_costs
+        assert model is not None
+        world = self._world(ctx)
+        b = Bindings(ctx.args, world)
+        person = b.token(model.person)
+        if person not in world.poses:
+            raise PlanningFailed("error", f"{self.name}: no pose for {person!r}")
+        f = tuple(float(ctx.args[t[1:]]) for t in model.factors) if model.factors else (1.0, 1.0, 1.0)
+        walking = bool(model.walk) and holds(world.facts, b.literals(model.walk))
+        greeted = walking or bool(model.sit) and holds(world.facts, b.literals(model.sit))
+        return world, world.poses[person], (f[0], f[1], f[2]), f[2] if greeted else f[1], walking
+
+    def _metres(self, ctx: TaskContext, start: Pose, goal: Pose) -> float:
+        if ctx.motion is None:
+            raise PlanningFailed("error", f"{self.name}: the {ORIGINAL} cost model needs a motion model")
+        est = ctx.motion.estimate(start, goal)
+        return float(est.distance_m) if est.reachable else math.inf
+
+    def original_params(self, ctx: TaskContext) -> CostParams:
+        """The 2019 code's ``getSP()``: with *a* the robot's path to the person and *g* the
+        person's path to the destination (metres), ``cost = g·f_walk`` while the person walks
+        with the robot, else ``a·rate + g·f_walk``; ``cps = rate``; ``cTime = a + g`` (metres,
+        as the original); ``endPose`` the destination, or the person without one."""
+        model = self.spec.original_costs
+        assert model is not None
+        world, person, (f_walk, _, _), rate, walking = self._original_state(ctx)
+        a = 0.0 if walking else self._metres(ctx, world.poses[robot_name(world)], person)
+        end = person
+        g = 0.0
+        if model.destination is not None:
+            place = Bindings(ctx.args, world).token(model.destination)
+            if place not in world.poses:
+                raise PlanningFailed("error", f"{self.name}: no pose for {place!r}")
+            end = world.poses[place]
+            g = self._metres(ctx, person, end)
+        if not (math.isfinite(a) and math.isfinite(g)):
+            return CostParams(self.name, cost=math.inf, cps=rate, c_time=math.inf, end_pose=end)
+        return CostParams(self.name, cost=g * f_walk + (0.0 if walking else a * rate), cps=rate, c_time=a + g,
+                          end_pose=end)
+
+    def original_completion(self, ctx: TaskContext, start: Pose | None) -> CompletionCost:
+        """The 2019 code's cost and suspend conditions: ``cc`` is the path from ``start`` to the
+        person times the waiting rate (the approach leg only), ``ccps`` that rate."""
+        world, person, _, rate, _ = self._original_state(ctx)
+        a = self._metres(ctx, start if start is not None else world.poses[robot_name(world)], person)
+        return CompletionCost(cc=a * rate if math.isfinite(a) else math.inf, ccps=rate)
 
     # -- planning inputs (public for tests and tools) -----------------------------------
 

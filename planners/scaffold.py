@@ -18,6 +18,10 @@ def scaffold(name: str, folder: Path) -> list[Path]:
     for ``tasker plan``.  The folder must not exist or be empty."""
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
         raise UsageError("TASK", f"expected a lower-case identifier such as fetch_cup, got {name!r}")
+    taken = bundled_names()
+    if name in taken:  # the folder would load beside the bundled one, and every command refuse both
+        raise UsageError("TASK", f"{name!r} is the name of a bundled task type ({', '.join(sorted(taken))}): "
+                                 f"a task name must be unique; choose another, e.g. my_{name}")
     if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
         raise UsageError("DIR", f"{folder} exists and is not empty; choose a new folder")
     try:
@@ -33,6 +37,19 @@ def scaffold(name: str, folder: Path) -> list[Path]:
             written.append(dst)
     written.append(_write_example_problem(folder))
     return written
+
+
+def bundled_names() -> set[str]:
+    """The ``[task] name`` of every bundled task folder, read from their ``task.toml`` (none loaded)."""
+    from domains import BUNDLED
+    from tasker.support import reader
+
+    out = set()
+    for toml in sorted(BUNDLED.glob("*/task.toml")):
+        name = reader.load(toml).table("task").raw("name", None)
+        if isinstance(name, str):
+            out.add(name)
+    return out
 
 
 def _write_example_problem(folder: Path) -> Path:

@@ -26,7 +26,27 @@ from tasker.support import reader
 from tasker.task import POLICIES, ArgSpec
 
 SKILLS = ("navigate", "say", "manipulate", "wait")
+
+RESERVED_ARGS = {
+    "robot": "$robot is the robot",
+    "deadline": "a request field every task type takes (experiments.inputs.request_fields)",
+    "priority": "a request field every task type takes (experiments.inputs.request_fields)",
+    "death_at": "a request field every task type takes (experiments.inputs.request_fields)",
+}
+"""Argument names a task folder may not declare: the request fields would strip them from its own
+arguments (every request would then lack them), and ``$robot`` names the robot."""
+
+MAX_TIMEOUT_S = 24 * 3600.0
+"""The longest wall-clock limit of one planner call: a larger one (1e300) overflowed the clock."""
 """Skills the core agent offers (the contract with ``robot/``)."""
+
+COST_MODEL_ARG = "cost_model"
+"""The request argument that chooses a task's cost model, when its folder offers a choice."""
+COST_MODELS = ("seconds", "taskER-2019")
+"""Cost models (``docs/model.md``): ``seconds``, ours and the default (costs that add, in
+seconds); ``taskER-2019``, the original TaskER code's (path metres weighted per person),
+offered by a folder that declares ``[schedule.taskER-2019]``."""
+ORIGINAL = COST_MODELS[1]
 
 Literal = tuple[str, ...]
 
@@ -72,6 +92,31 @@ class Branch:
 
 
 @dataclass(frozen=True, slots=True)
+class OriginalCosts:
+    """``[schedule.taskER-2019]``: what the original TaskER code's cost model measures for this task.
+
+    ``person`` is whom the robot goes to (leg *a*, the robot's path to them); ``destination``,
+    if any, where it then takes them (leg *g*, their path there; the task ends there, else
+    at the person).  ``walk``: literals that hold while the person walks with the robot;
+    ``sit``: literals that hold once the person was greeted (the 2019 code asked them to sit
+    and wait).  ``factors``: the request arguments giving the cost per metre while walking,
+    standing (not yet greeted) and sitting; without them every factor is 1.
+    ``planners.pddl_task`` computes the parameters; ``docs/model.md`` gives the formulas.
+    """
+
+    person: str
+    destination: str | None = None
+    walk: tuple[Literal, ...] = ()
+    sit: tuple[Literal, ...] = ()
+    factors: tuple[str, str, str] | None = None
+
+    @property
+    def args(self) -> tuple[str, ...]:
+        """The request arguments of the model: the choice and the factors."""
+        return (COST_MODEL_ARG, *(f[1:] for f in self.factors or ()))
+
+
+@dataclass(frozen=True, slots=True)
 class ExampleWorld:
     """A world state and request shipped with the task: for ``tasker fsm``, tests and benchmarks."""
 
@@ -114,6 +159,8 @@ class TaskSpec:
     """``[problem] restore``: patterns of facts the task leaves as it found them — a ground instance
     that did not hold when the task first planned must not hold at its goal (a door it opened is
     closed again)."""
+    original_costs: OriginalCosts | None = None
+    """``[schedule.taskER-2019]``: the folder offers the original TaskER cost model."""
     lines: Mapping[str, int | None] = field(default_factory=dict)
     """Where each checked field is written (``"hazards[0].fact"`` -> line), for later checks."""
 
@@ -222,7 +269,7 @@ class _Reader:
             tables = t.tables(key)
             for b in tables:
                 policy = b.string("policy", "strict", choices=POLICIES)
-                limit = b.number("max_interruption_s", None, min=0)
+                limit = b.number("max_interruption_s", None, min=0, max=reader.MAX_SECONDS)
                 if (policy == "conditional") != (limit is not None):
                     raise self.fail(b, "max_interruption_s" if limit is not None else "policy",
                                     'a branch that trades safety for time has policy = "conditional" and '
@@ -265,7 +312,7 @@ def _action(r: _Reader, a: reader.Table, name: str) -> ActionSpec:
                                or not all(isinstance(t, str) and t.startswith("?") for t in travel)):
         raise r.fail(a, "travel", f"expected two parameters [\"?from\", \"?to\"], got {travel!r}")
     travel = travel and [t.lower() for t in travel]  # PDDL parameters are case-insensitive
-    duration = a.number("duration", None, min=0)
+    duration = a.number("duration", None, min=0, max=reader.MAX_SECONDS)
     to = a.string("to", None)
     to = to.lower() if to and to.startswith("?") else to
     text = a.string("text", None)
@@ -279,15 +326,32 @@ def _action(r: _Reader, a: reader.Table, name: str) -> ActionSpec:
 
 
 def _args(r: _Reader, top: reader.Table) -> tuple[ArgSpec, ...]:
-    out = []
+    out: list[ArgSpec] = []
+    first: dict[str, int | None] = {}
     for a in top.tables("args", []):
         name = a.string("name")
+        if name in RESERVED_ARGS:
+            raise r.fail(a, "name", f"{name!r} is reserved: {RESERVED_ARGS[name]}; name the argument otherwise")
+        if name in first:  # a request's argument is one value: which declaration would it follow?
+            where = f" (first at line {first[name]})" if first[name] else ""
+            raise r.fail(a, "name", f"argument {name!r} is declared twice{where}")
+        first[name] = a.line("name")
+        choices = a.array("choices", nonempty=True) if "choices" in a else None
         try:
             out.append(ArgSpec(name=name, type=a.string("type", "str"), required=a.boolean("required", True),
                                default=a.raw("default", None), help=a.string("help", "", empty=True),
-                               choices=tuple(a.raw("choices")) if "choices" in a else None))
+                               choices=tuple(choices) if choices is not None else None))
         except (ConfigError, TypeError) as exc:
             raise r.fail(a, None, str(exc)) from None
+        for k, choice in enumerate(choices or ()):  # a choice of another type could never be given
+            try:
+                out[-1].coerce(name, choice)
+            except BadRequest as exc:
+                raise r.fail(a.at("choices", {}), k, str(exc).split(": ", 1)[-1].replace(
+                    "expected one of", "a choice must be one of")) from None
+        if choices is not None and len({repr(c) for c in choices}) != len(choices):
+            dup = sorted({repr(c) for c in choices if [repr(x) for x in choices].count(repr(c)) > 1})
+            a.warn("choices", f"{', '.join(dup)} listed more than once")
         if out[-1].default is not None:  # a request without the argument gets it: it must fit the type
             try:
                 out[-1].coerce(name, out[-1].default)
@@ -295,6 +359,50 @@ def _args(r: _Reader, top: reader.Table) -> tuple[ArgSpec, ...]:
                 raise r.fail(a, "default", str(exc).split(": ", 1)[-1]) from None
         a.done()
     return tuple(out)
+
+
+def _original_costs(r: _Reader, schedule: reader.Table, top: reader.Table,
+                    args: tuple[ArgSpec, ...]) -> OriginalCosts | None:
+    """``[schedule.taskER-2019]``, checked against the declared request arguments: a folder that
+    offers the model declares ``cost_model`` (choices: the models), and one that does not, does not."""
+    by_name = {a.name: a for a in args}
+    choice = by_name.get(COST_MODEL_ARG)
+    if ORIGINAL not in schedule:
+        if choice is not None:
+            raise r.fail(top, "args", f"argument {COST_MODEL_ARG!r} chooses a cost model, and only a folder "
+                                      f"with [schedule.{ORIGINAL}] offers another than {COST_MODELS[0]!r}")
+        return None
+    t = schedule.table(ORIGINAL)
+    r.note(t)
+    if choice is None or choice.required or choice.choices is None or set(choice.choices) != set(COST_MODELS):
+        raise r.fail(t, None, f"a folder that offers the {ORIGINAL} cost model declares the optional argument "
+                              f"{COST_MODEL_ARG!r} with choices = {list(COST_MODELS)}")
+
+    def arg_token(key: str, kind: str) -> str:
+        tok = t.string(key)
+        if not tok.startswith("$") or tok[1:] not in by_name or by_name[tok[1:]].type != kind:
+            raise r.fail(t, key, f"expected $name of a request argument of type {kind!r} "
+                                 f"(declared: {', '.join('$' + a for a in by_name)}), got {tok!r}")
+        return tok
+
+    person = arg_token("person", "str")
+    destination = arg_token("destination", "str") if "destination" in t else None
+    factors: tuple[str, str, str] | None = None
+    if "factors" in t:
+        raw = t.raw("factors")
+        if not isinstance(raw, list) or len(raw) != 3:
+            raise r.fail(t, "factors", f"expected [\"$walk\", \"$stand\", \"$sit\"] (three request arguments), "
+                                       f"got {raw!r}")
+        names = []
+        for k, tok in enumerate(raw):
+            arg = by_name.get(tok[1:]) if isinstance(tok, str) and tok.startswith("$") else None
+            if arg is None or arg.type != "float" or arg.required:
+                raise r.fail(t, "factors", f"factors[{k}]: expected $name of an optional float argument, got {tok!r}")
+            names.append(tok)
+        factors = (names[0], names[1], names[2])
+    out = OriginalCosts(person, destination, r.literals(t, "walk"), r.literals(t, "sit"), factors)
+    t.done()
+    return out
 
 
 def _example(r: _Reader, top: reader.Table) -> ExampleWorld | None:
@@ -326,7 +434,7 @@ def _hazards(r: _Reader, top: reader.Table) -> tuple[Hazard, ...]:
         fact = r.literal(h, "fact", fact_value)
         if fact[0] == "not":
             raise r.fail(h, "fact", f"a hazard is a fact that holds (no 'not'), got {list(fact)}")
-        budget = h.number("budget_s", min=0)
+        budget = h.number("budget_s", min=0, max=reader.MAX_SECONDS)
         severity = h.number("severity", 1.0, min=0)
         try:
             out.append(Hazard(name, fact, float(budget), float(severity), h.string("label", "", empty=True)))
@@ -337,6 +445,12 @@ def _hazards(r: _Reader, top: reader.Table) -> tuple[Hazard, ...]:
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise r.fail(top, "hazards", f"duplicate hazard name(s) {dup}")
+    facts = [x.fact for x in out]
+    for k, x in enumerate(out):  # one unsafe condition declared twice would be counted twice by every metric
+        if x.fact in facts[:k]:
+            other = out[facts.index(x.fact)]
+            raise r.fail(top.at("hazards", {}), k, f"hazard {x.name!r} has the fact of hazard {other.name!r} "
+                                                   f"({list(x.fact)}): one condition, counted twice")
     return tuple(out)
 
 
@@ -369,7 +483,8 @@ def _derived(r: _Reader, top: reader.Table) -> tuple[Literal, ...]:
 
 
 def _bindings(r: _Reader, top: reader.Table) -> tuple[RawBinding, ...]:
-    out = []
+    out: list[RawBinding] = []
+    where: dict[tuple[str, int], tuple[RawBinding, int | None]] = {}
     for b in top.tables("bindings", []):
         kind = b.string("kind", choices=BINDING_KINDS)
         fact = r.literal(b, "fact", b.raw("fact"))
@@ -383,8 +498,24 @@ def _bindings(r: _Reader, top: reader.Table) -> tuple[RawBinding, ...]:
                                       f"{reader.suggest(obj, variables)}")
         state = b.string("state", "on") if kind == "device" else "on"
         otherwise = b.string("otherwise", "off") if kind == "device" else "off"
+        if state == otherwise:  # removing the fact would leave it holding: the device could never say it ended
+            raise r.fail(b, "otherwise" if "otherwise" in b else "state",
+                         f"state and otherwise are both {state!r}: the fact would hold in either state, and a "
+                         "stage that removes it would change nothing")
         b.done()
-        out.append(RawBinding(kind, fact, obj, state, otherwise))
+        raw = RawBinding(kind, fact, obj, state, otherwise)
+        same = where.get((fact[0], len(fact)))
+        if same is not None:  # the world reads a fact from one physical state: which one?
+            other, line = same
+            at = f" (line {line})" if line else ""
+            if (other.kind, other.fact.index(other.object), other.state, other.otherwise) != (
+                    kind, fact.index(obj), state, otherwise):
+                raise r.fail(b, "fact", f"{fact[0]!r} is bound twice, differently: as {other.kind} of "
+                                        f"{other.object}{at} and as {kind} of {obj}; a fact is one physical state")
+            b.warn("fact", f"{fact[0]!r} is bound twice{at}, the same way: one [[bindings]] entry is enough")
+            continue
+        where[(fact[0], len(fact))] = (raw, b.line("fact"))
+        out.append(raw)
     return tuple(out)
 
 
@@ -399,9 +530,9 @@ def read_task_toml(path: Path) -> TaskSpec:
             raise r.fail(task, "name", f"'name' must be an identifier, got {name!r}")
         description = task.string("description", "", empty=True)
         domain = task.string("domain", "domain.pddl")
-        planning_time_s = task.number("planning_time_s", 0.5, min=0)
-        static_time_s = task.number("static_time_s", 0.05, min=0)
-        timeout_s = task.number("timeout_s", 10.0, min=0)
+        planning_time_s = task.number("planning_time_s", 0.5, min=0, max=reader.MAX_SECONDS)
+        static_time_s = task.number("static_time_s", 0.05, min=0, max=reader.MAX_SECONDS)
+        timeout_s = task.number("timeout_s", 10.0, min=0, max=MAX_TIMEOUT_S)
         r.note(task, "timeout_s")  # the [example]'s check may warn at it
         task.done()
         problem = top.table("problem")
@@ -425,18 +556,20 @@ def read_task_toml(path: Path) -> TaskSpec:
         static.done()
         schedule = top.table("schedule", {})
         cps = schedule.number("cps", 1.0, min=0)
-        travel_s = schedule.number("travel_s", 10.0, min=0)
+        travel_s = schedule.number("travel_s", 10.0, min=0, max=reader.MAX_SECONDS)
         priority = schedule.number("priority", None, integer=True)
+        args = _args(r, top)
+        original = _original_costs(r, schedule, top, args)
         schedule.done()
         spec = TaskSpec(
             folder=path.parent, name=name, description=description, domain_file=path.parent / domain,
-            args=_args(r, top), goal=goal, facts=facts, suspended_facts=suspended_facts,
+            args=args, goal=goal, facts=facts, suspended_facts=suspended_facts,
             suspension=r.branches(top, "suspension"), actions=actions, static_update=static_update,
             cps=float(cps), travel_s=float(travel_s), planning_time_s=float(planning_time_s),
             static_time_s=float(static_time_s), timeout_s=float(timeout_s), example=_example(r, top),
             priority=None if priority is None else int(priority),
             hazards=_hazards(r, top), people=_people(r, top), bindings=_bindings(r, top),
-            invariants=_derived(r, top), restore=tuple(restore), lines=r.lines,
+            invariants=_derived(r, top), restore=tuple(restore), original_costs=original, lines=r.lines,
         )
         top.done()
     return spec

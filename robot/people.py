@@ -51,11 +51,22 @@ Route = Callable[[Point, Point], tuple[Point, ...]]
 (just the two when the straight line is clear)."""
 
 
+class Revision:
+    """A count of changes to people, shared by everyone of one :class:`People`: equal counts,
+    nobody changed in between (what the world's :meth:`~robot.sim.Simulation.facts_key` keys on)."""
+
+    __slots__ = ("n",)
+
+    def __init__(self) -> None:
+        self.n = 0
+
+
 class Person:
     """One person's state: pose, posture, where the script and the reactions put them."""
 
-    def __init__(self, spec: PersonSpec, route: Route | None = None) -> None:
+    def __init__(self, spec: PersonSpec, route: Route | None = None, revision: Revision | None = None) -> None:
         self.spec = spec
+        self.revision = revision if revision is not None else Revision()
         self.name = spec.name
         self.x, self.y, self.yaw = spec.pose
         self.posture = spec.posture
@@ -64,11 +75,62 @@ class Person:
         self._detour: list[Point] = []  # corners to walk round before heading for the script again
         self._event = 0
         self._trail: list[tuple[float, float]] = []
-        self.following = False
-        self.waiting = False
-        self.aside: tuple[float, float] | None = None  # where a waiting person steps to first
-        # (fallen person, where to stand or None to stand still): room given to someone fallen
-        self.giving_room: tuple[str, tuple[float, float] | None] | None = None
+        self._seg: list[float] = []  # the lengths of the trail's legs (Person._follow)
+        self._following = False
+        self._waiting = False
+        self._aside: tuple[float, float] | None = None
+        self._giving_room: tuple[str, tuple[float, float] | None] | None = None
+        # steps before this time change nothing (:meth:`_idle_after`); any change from outside resets it
+        self._idle_until = -math.inf
+        # set whenever the person may have changed (a step that ran, a reaction, a posture or a
+        # walk given): the world syncs its scene and MuJoCo from the people it finds touched
+        self.touched = True
+
+    def _poke(self) -> None:
+        """Something changed from outside: the next step runs, the world looks again."""
+        self._idle_until = -math.inf
+        self.touched = True
+        self.revision.n += 1
+
+    @property
+    def following(self) -> bool:
+        """The person follows the robot (the world sets it from a ``follower`` binding)."""
+        return self._following
+
+    @following.setter
+    def following(self, value: bool) -> None:
+        self._following = value
+        self._poke()
+
+    @property
+    def waiting(self) -> bool:
+        """The person was told to wait (the world sets it from a ``waiting`` binding)."""
+        return self._waiting
+
+    @waiting.setter
+    def waiting(self, value: bool) -> None:
+        self._waiting = value
+        self._poke()
+
+    @property
+    def aside(self) -> tuple[float, float] | None:
+        """Where a waiting person steps to first (None: they wait where they are)."""
+        return self._aside
+
+    @aside.setter
+    def aside(self, value: tuple[float, float] | None) -> None:
+        self._aside = value
+        self._poke()
+
+    @property
+    def giving_room(self) -> tuple[str, tuple[float, float] | None] | None:
+        """(fallen person, where to stand or None to carry on): room given to someone fallen."""
+        return self._giving_room
+
+    @giving_room.setter
+    def giving_room(self, value: tuple[str, tuple[float, float] | None] | None) -> None:
+        self._giving_room = value
+        self._poke()
 
     @property
     def pose(self) -> Pose:
@@ -76,6 +138,7 @@ class Person:
 
     def set_posture(self, posture: str) -> None:
         self.posture = posture
+        self._poke()
 
     def scripted(self, t: float) -> tuple[float, float] | None:
         """Where the script wants the person at time ``t`` (None: no walk scripted)."""
@@ -125,6 +188,7 @@ class Person:
         walk += [(t + walked / self.spec.speed, q[0], q[1]) for q, walked in self._way((self.x, self.y), (x, y))]
         self.walk = tuple(walk) if len(walk) > 1 else ((t, x, y),)
         self._detour = []
+        self._poke()
 
     def _walk_to(self, tx: float, ty: float, dt: float, stop_at: float = 0.0) -> None:
         dx, dy = tx - self.x, ty - self.y
@@ -137,14 +201,19 @@ class Person:
 
     def _follow(self, robot: tuple[float, float], dt: float) -> None:
         trail = self._trail
+        seg = self._seg  # seg[k]: the length from trail[k - 1] to trail[k], measured once
         if not trail:
             trail.append((self.x, self.y))
-        if math.hypot(robot[0] - trail[-1][0], robot[1] - trail[-1][1]) >= TRAIL_STEP:
+            seg[:] = [0.0]
+        last = trail[-1]
+        step = math.hypot(robot[0] - last[0], robot[1] - last[1])
+        if step >= TRAIL_STEP:
             trail.append(robot)
+            seg.append(step)
         # the trail point FOLLOW_GAP behind the robot, measured along the trail
         back, k = 0.0, len(trail) - 1
         while k > 0 and back < FOLLOW_GAP:
-            back += math.hypot(trail[k][0] - trail[k - 1][0], trail[k][1] - trail[k - 1][1])
+            back += seg[k]
             k -= 1
         budget = self.spec.speed * dt
         while budget > 1e-9 and len(trail) > 1 and k > 0:
@@ -154,6 +223,7 @@ class Person:
                 self.x, self.y = nx, ny
                 budget -= d
                 trail.pop(0)
+                seg.pop(0)
                 k -= 1
                 continue
             self._walk_to(nx, ny, budget / self.spec.speed)
@@ -161,27 +231,68 @@ class Person:
 
     def step(self, t: float, dt: float, robot: tuple[float, float]) -> None:
         """Move the person from ``t - dt`` to ``t``: reactions are the flags the world sets from
-        the task folders' bindings, never a task's predicates."""
+        the task folders' bindings, never a task's predicates.
+
+        A person who stands still and will until ``_idle_until`` (lying, waiting, before or
+        after their script; :meth:`_idle_after`) is not stepped before then: such a step
+        would change nothing.  Whatever changes them from outside (a posture, a walk, a
+        reaction) ends that at once."""
+        if t < self._idle_until:
+            return
+        self.touched = True
+        self.revision.n += 1
+        self._step(t, dt, robot)
+        self._idle_until = self._idle_after(t)
+
+    def _idle_after(self, t: float) -> float:
+        """After a step to ``t``: until when further steps certainly change nothing (``-inf``:
+        the next may).  Still are the fallen, those at the spot they give room or wait at,
+        and those before their script's first waypoint or at its last; until their next
+        scripted posture at the latest (and the script's start)."""
+        events = self.spec.events
+        nxt = events[self._event][0] if self._event < len(events) else math.inf
+        if self._following:
+            return -math.inf
+        if self.posture == "fallen":
+            return nxt
+        room = self._giving_room
+        spot = room[1] if room is not None else None
+        if spot is None and self._waiting:
+            if self._aside is None:
+                return nxt
+            spot = self._aside
+        if spot is not None:
+            return nxt if math.hypot(spot[0] - self.x, spot[1] - self.y) <= 1e-9 else -math.inf
+        walk = self.walk
+        if not walk:
+            return nxt
+        if t < walk[0][0]:
+            return min(nxt, walk[0][0])
+        if t > walk[-1][0] and not self._detour and math.hypot(self.x - walk[-1][1], self.y - walk[-1][2]) <= 1e-9:
+            return nxt
+        return -math.inf
+
+    def _step(self, t: float, dt: float, robot: tuple[float, float]) -> None:
         events = self.spec.events
         while self._event < len(events) and events[self._event][0] <= t:
             self.posture = events[self._event][1]
             self._event += 1
-        if not self.following and self._trail:
+        if not self._following and self._trail:
             self._trail = []
         target = self.scripted(t)
-        if self.posture == "fallen" or self.giving_room is not None and self.giving_room[1] is not None \
-                or self.waiting or self.following or target is None:
+        if self.posture == "fallen" or self._giving_room is not None and self._giving_room[1] is not None \
+                or self._waiting or self._following or target is None:
             self._detour = []  # a reaction (or no script): the way back is found afresh
         if self.posture == "fallen":
             return
-        if self.giving_room is not None and self.giving_room[1] is not None:
-            self._walk_to(self.giving_room[1][0], self.giving_room[1][1], dt)
+        if self._giving_room is not None and self._giving_room[1] is not None:
+            self._walk_to(self._giving_room[1][0], self._giving_room[1][1], dt)
             return
-        if self.waiting:
-            if self.aside is not None:
-                self._walk_to(self.aside[0], self.aside[1], dt)
+        if self._waiting:
+            if self._aside is not None:
+                self._walk_to(self._aside[0], self._aside[1], dt)
             return
-        if self.following:
+        if self._following:
             self._stand_up()
             self._follow(robot, dt)
             return
@@ -221,8 +332,8 @@ class Person:
         :attr:`aside`), while not there yet; None otherwise."""
         if self.posture == "fallen":
             return None
-        spot = self.giving_room[1] if self.giving_room is not None else None
-        spot = spot if spot is not None else (self.aside if self.waiting else None)
+        spot = self._giving_room[1] if self._giving_room is not None else None
+        spot = spot if spot is not None else (self._aside if self._waiting else None)
         if spot is None or math.hypot(spot[0] - self.x, spot[1] - self.y) <= 1e-9:
             return None
         return spot
@@ -236,7 +347,8 @@ class People:
     """Everyone in the world, stepped together in name order (deterministic)."""
 
     def __init__(self, specs: Iterable[PersonSpec], route: Route | None = None) -> None:
-        self.by_name = {p.name: Person(p, route) for p in sorted(specs, key=lambda s: s.name)}
+        self.revision = Revision()  # bumped by every change to anyone
+        self.by_name = {p.name: Person(p, route, self.revision) for p in sorted(specs, key=lambda s: s.name)}
 
     def __getitem__(self, name: str) -> Person:
         return self.by_name[name]

@@ -47,6 +47,7 @@ from tasker.stage import Stage
 from tasker.world import Fact, Pose, WorldState
 
 CONTROL_DT = 0.02  # seconds: the base controller and the people run at 50 Hz
+STEPS = round(CONTROL_DT / TIMESTEP)  # MuJoCo steps a control tick
 AT_TOLERANCE = 0.3  # metres: the robot starts "at" a place this close
 TOGETHER = 1.5  # metres: a person this close to the robot is symbolically at the robot's place
 WAIT_MARGIN = 0.05  # metres beyond a standing person's radius and the robot's width (Simulation._aside_spot)
@@ -78,6 +79,8 @@ class Simulation:
         self._objects = self._object_types()
         # the last snapshot's facts, under the facts_key they were made for (snapshot)
         self._snapped: tuple[tuple[Any, ...], frozenset[Fact], tuple[tuple[str, Pose | None], ...]] | None = None
+        # the last facts_key, under what it was made from: (tick, version, people's revision)
+        self._key: tuple[tuple[int, int, int], tuple[Any, ...]] | None = None
         self.facts: set[Fact] = set(self.spec.facts)
         # devices are where their place is
         self.facts |= {("at", d.name, d.place) for d in self.spec.devices.values()}
@@ -100,9 +103,15 @@ class Simulation:
         self._last_cmd = STOP
         self._synced: dict[str, tuple[float, float, float, str]] = {}
         self._places_memo: dict[tuple[str, float, float], str] = {}
+        # rooms smallest first (ties by name): the first holding a point is spec.room_of's answer
+        self._rooms = sorted(self.spec.rooms.items(),
+                             key=lambda nb: ((nb[1][2] - nb[1][0]) * (nb[1][3] - nb[1][1]), nb[0]))
+        self._spot_rooms: dict[int, tuple[Mapping[str, Pose], dict[str | None, list[str]]]] = {}
         self._person_spots: dict[str, Pose] | None = None  # the places people can be at (person_place)
         self._fallen: tuple[str, ...] = ()  # who lay fallen at the last look (Simulation._give_room)
+        self._door_changes = self._doors_seen = 0  # doors opened or closed, in all and at the last look
         self.physics_ticks = 0  # control ticks that stepped MuJoCo (the rest: robot at rest, nothing to do)
+        self._people_seen = -1  # the scene's version after the last _sync_people
         self._sync_people()
         self._record()
 
@@ -145,13 +154,29 @@ class Simulation:
         return tuple(out)
 
     def _sync_people(self) -> None:
+        """The scene and MuJoCo follow the people: only those touched since the last look
+        (:attr:`robot.people.Person.touched`: stepped, or changed from outside), and of them
+        only who moved."""
         for p in self.people:
+            if not p.touched:
+                continue
+            p.touched = False
             self.scene.set_stepping_to(p.name, p.stepping_to())
             state = (p.x, p.y, p.yaw, p.posture)
-            if self._synced.get(p.name) != state:  # only who moved: the scene and MuJoCo follow
+            if self._synced.get(p.name) != state:
                 self._synced[p.name] = state
                 self.scene.set_person(p.name, p.x, p.y, p.posture)
                 self.mj.set_person(p.name, p.x, p.y, p.yaw, p.posture)
+        self._people_seen = self.scene.version
+
+    def _people_react(self) -> None:
+        """:meth:`_give_room`, then :meth:`_sync_people` — skipped when no person was touched
+        and the scene (people, doors) is as it was after the last time: both would change
+        nothing then."""
+        if self.scene.version == self._people_seen and not any(p.touched for p in self.people):
+            return
+        self._give_room()
+        self._sync_people()
 
     def _still_until(self, p: Person) -> float:
         """Until when person ``p`` certainly stays as they are (``self.time``: they may move now)."""
@@ -205,15 +230,14 @@ class Simulation:
         t = round(self._ticks * CONTROL_DT, 9)
         x, y, _ = self.mj.pose()
         self.people.step(t, CONTROL_DT, (x, y))
-        self._give_room()
-        self._sync_people()
+        self._people_react()
         cmd = self.skill.control(t, CONTROL_DT) if self.skill is not None else STOP
         self._last_cmd = cmd
         self.mj.command(cmd.v, cmd.w)
         # People are mocap bodies that touch nothing, so with no command and the base at
         # rest a physics step changes nothing worth its MuJoCo steps: skip it
         if cmd != STOP or not self.mj.at_rest():
-            self.mj.step(round(CONTROL_DT / TIMESTEP))
+            self.mj.step(STEPS)
             self.physics_ticks += 1
         self.time = t
         if self.recording.due(t):
@@ -230,8 +254,7 @@ class Simulation:
 
     def advance(self, now: float) -> None:
         """Step control and physics in fixed ticks up to simulated time ``now``."""
-        self._give_room()  # a posture set from outside since the last tick
-        self._sync_people()
+        self._people_react()  # a posture set from outside since the last tick
         while self.time + CONTROL_DT <= now + 1e-9:
             if not self._fast_forward(now):
                 self._tick()
@@ -239,6 +262,7 @@ class Simulation:
     def set_door(self, name: str, is_open: bool) -> None:
         """Open or close a door: the scene (and so every cached estimate) and MuJoCo follow."""
         self.door_open[name] = bool(is_open)
+        self._door_changes += 1
         self.version += 1
         self.scene.set_door(name, is_open)
         self.mj.set_door(name, is_open)
@@ -319,8 +343,12 @@ class Simulation:
         door between) steps to the nearest spot of their own room clear of every fallen person
         they see and of the doorways (:meth:`_aside_spot`; none within ``ASIDE_MAX``: they carry
         on) and stays there while that person is down; then they return to what they were
-        doing.  Whenever someone falls or gets up, everyone looks again."""
+        doing.  Whenever someone falls or gets up, everyone looks again; otherwise only those
+        touched since the last look (:attr:`robot.people.Person.touched`) can see anything new,
+        unless a door opened or closed."""
         fallen = tuple(p.name for p in self.people if p.posture == "fallen")
+        everyone = fallen != self._fallen or self._doors_seen != self._door_changes
+        self._doors_seen = self._door_changes
         if fallen != self._fallen:
             self._fallen = fallen
             for p in self.people:
@@ -329,6 +357,8 @@ class Simulation:
             return
         near = self._room_clear()
         for p in self.people:
+            if not (everyone or p.touched):
+                continue  # not moved, nothing about them changed: what they saw last time stands
             if p.giving_room is not None:
                 if p.following or p.posture != "standing":
                     p.giving_room = None
@@ -459,11 +489,22 @@ class Simulation:
         """What the facts of :meth:`snapshot` are made of, cheaply: equal keys, equal facts.
 
         The symbolic state, devices, doors, what is held and who follows or waits all bump
-        :attr:`version` when they change; the rest is where the robot and the people are and
-        the people's postures.  A monitor that asks only when this changes misses nothing
-        and skips the ticks in which nobody moved."""
-        x, y, _ = self.mj.pose()
-        return (self.version, x, y, tuple((p.x, p.y, p.posture) for p in self.people))
+        :attr:`version` when they change; the rest is the place the robot is at, and for
+        each person their posture and the place they are at (the robot's, when they follow
+        it or stand within ``TOGETHER`` of it) — exactly what :meth:`_facts_now` reads of
+        poses.  A monitor that asks only when this changes misses nothing, and skips the
+        ticks in which nobody changed place (the robot driving across a room, say)."""
+        made = (self._ticks, self.version, self.people.revision.n)  # nothing else moves anyone
+        if self._key is not None and self._key[0] == made:
+            return self._key[1]
+        rx, ry, _ = self.mj.pose()
+        here = self.nearest_place(rx, ry)
+        hypot = math.hypot
+        key = (self.version, here, tuple(
+            (p.posture, here if p.following or hypot(p.x - rx, p.y - ry) <= TOGETHER else self.person_place(p.x, p.y))
+            for p in self.people))
+        self._key = (made, key)
+        return key
 
     def person_place(self, x: float, y: float) -> str:
         """Where a person is, symbolically: :meth:`place_of` among the places that are not
@@ -491,8 +532,12 @@ class Simulation:
         return hit
 
     def room_of(self, x: float, y: float) -> str | None:
-        """The smallest room whose box holds ``(x, y)`` (ties by name), or None (:func:`robot.spec.room_of`)."""
-        return room_of(self.spec, x, y)
+        """The smallest room whose box holds ``(x, y)`` (ties by name), or None (:func:`robot.spec.room_of`:
+        the same answer, from the rooms sorted once by area and name)."""
+        for n, (x0, y0, x1, y1) in self._rooms:
+            if x0 <= x <= x1 and y0 <= y <= y1:
+                return n
+        return None
 
     def place_of(self, x: float, y: float, spots: Mapping[str, Pose]) -> str:
         """The nearest of ``spots`` that is not behind a wall (ties broken by name).
@@ -505,7 +550,13 @@ class Simulation:
 
         room = self.room_of(x, y)
         if room is not None:
-            inside = [n for n in spots if self.room_of(spots[n][0], spots[n][1]) == room]
+            by_room = self._spot_rooms.get(id(spots))
+            if by_room is None or by_room[0] is not spots:  # the spots' rooms: places never move
+                rooms: dict[str | None, list[str]] = {}
+                for n in spots:
+                    rooms.setdefault(self.room_of(spots[n][0], spots[n][1]), []).append(n)
+                by_room = self._spot_rooms[id(spots)] = (spots, rooms)
+            inside = by_room[1].get(room)
             if inside:
                 return nearest(inside)
         names = sorted(spots)

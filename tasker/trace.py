@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from tasker.events import KINDS, Event, TraceError, parse
+from tasker.support import reader
 
 EVENTS = KINDS
 """Every event kind a trace may hold (:data:`tasker.events.KINDS`)."""
@@ -119,43 +120,46 @@ def read(path: str | Path) -> list[dict[str, Any]]:
     """Read a ``trace.jsonl`` back (infinities stay as the strings ``"inf"``).
 
     Every line must be an event: a JSON object with ``t`` (a number) and ``event`` (a
-    string).  A damaged file (cut short, a stray byte, a line that is no event) is a
-    ``ValueError`` naming the file and the line."""
+    string).  A damaged file (cut short, a stray byte, a line that is no event, nested too
+    deep, a number beyond 64 bits) is a :class:`~tasker.events.TraceError` (a ``ValueError``) naming
+    the file and the line; a missing file, a folder or a device is one naming the file."""
     return [record for _, record in _records(path)]
 
 
+MAX_TRACE_BYTES = 512 * 2**20
+"""The largest trace read whole (a simulated day's is a few MB)."""
+
+
 def _records(path: str | Path) -> Iterator[tuple[int, dict[str, Any]]]:
-    data = Path(path).read_bytes()
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        at = data[: exc.start].count(b"\n") + 1
-        raise ValueError(f"{path}:{at}: not UTF-8 text (byte {data[exc.start]:#04x})") from None
+    try:  # a folder, a device, a huge file, a stray byte: named
+        text = reader.read_text(path, limit=MAX_TRACE_BYTES)
+    except reader.InputError as exc:
+        raise TraceError(f"{path}:{exc.line}: {exc.message.removeprefix('is ')}" if exc.line else str(exc)) from None
     for n, line in enumerate(text.splitlines(), start=1):
         if line.strip():
-            try:
-                event = json.loads(line)
-            except json.JSONDecodeError as exc:
-                raise ValueError(f"{path}:{n}: not a JSON object: {exc.msg}") from None
-            except RecursionError:
-                raise ValueError(f"{path}:{n}: nested too deeply to be an event") from None
+            try:  # within the readers' limits: nesting, 64-bit integers
+                event = reader.parse_json(line, path, line=n)
+            except reader.InputError as exc:
+                message = exc.message.removeprefix("not valid JSON: ").removeprefix("not readable JSON: ")
+                raise TraceError(f"{path}:{n}: not a JSON object: {message}" if not exc.field
+                                 else f"{path}:{n}: {exc.field}: {exc.message}") from None
             if not isinstance(event, dict):
-                raise ValueError(f"{path}:{n}: not a JSON object: {line.strip()[:40]}")
+                raise TraceError(f"{path}:{n}: not a JSON object: {line.strip()[:40]}")
             t = event.get("t")
             if not isinstance(event.get("event"), str) or isinstance(t, bool) or not isinstance(t, int | float):
-                raise ValueError(f"{path}:{n}: not an event: expected \"t\" (a number) and \"event\" (a string)")
+                raise TraceError(f"{path}:{n}: not an event: expected \"t\" (a number) and \"event\" (a string)")
             yield n, event
 
 
 def read_events(path: str | Path) -> list[Event]:
     """:func:`read`, each event typed (:func:`tasker.events.parse`): a damaged event (a missing
-    or wrong field) is a ``ValueError`` naming the file, the line and the field."""
+    or wrong field) is a :class:`~tasker.events.TraceError` naming the file, the line and the field."""
     out = []
     for n, record in _records(path):
         try:
             out.append(parse(record))
         except TraceError as exc:
-            raise ValueError(f"{path}:{n}: {exc}") from None
+            raise TraceError(f"{path}:{n}: {exc}") from None
     return out
 
 

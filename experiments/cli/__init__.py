@@ -32,6 +32,7 @@ SUBCOMMAND_MODULES = (
     "experiments.cli.day",    # day
     "experiments.cli.docs",   # docs
     "experiments.cli.results",  # results
+    "experiments.cli.paper",  # paper
     "experiments.cli.serve",  # serve
     # Add a subcommand here: a module with ``register(subparsers)`` (e.g. explain, an HTML report).
 )

@@ -53,6 +53,18 @@ exit status:
 SEED_LIMIT = 2**32
 """Seeds are ``0 <= seed < 2**32``: what NumPy, OMPL and MuJoCo all accept."""
 
+MAX_TIMEOUT_S = 24 * 3600.0
+"""The longest time-out an option may give (a day): a larger one (1e300) overflowed the clock."""
+
+MAX_WORKERS = 1024
+"""The most local worker processes an option may ask for (a huge count overflowed, or forked on)."""
+
+
+def shown(value: object) -> str:
+    """A value as an error shows it: a number of hundreds of digits by its length."""
+    text = str(value)
+    return text if len(text) <= 30 else f"an integer of {len(text.lstrip('-'))} digits"
+
 
 def did_you_mean(name: str, known: Iterable[str]) -> str:
     """``" (did you mean 'x'?)"`` for the closest known name, or ``""``."""
@@ -65,7 +77,7 @@ def seed_error(value: object) -> str | None:
     if isinstance(value, bool) or not isinstance(value, int):
         return f"expected an integer seed 0 <= seed < 2**32, got {value!r}"
     if not 0 <= value < SEED_LIMIT:
-        return f"expected a seed 0 <= seed < 2**32, got {value}"
+        return f"expected a seed 0 <= seed < 2**32, got {shown(value)}"
     return None
 
 
@@ -74,7 +86,8 @@ def seed(text: str) -> int:
     try:
         value = int(text, 0)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer seed 0 <= seed < 2**32, got {text!r}") from None
+        raise argparse.ArgumentTypeError(f"expected an integer seed 0 <= seed < 2**32, got {shown(repr(text))}") \
+            from None
     why = seed_error(value)
     if why:
         raise argparse.ArgumentTypeError(why)
@@ -89,6 +102,8 @@ def positive_seconds(text: str) -> float:
         raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
     if not (math.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"expected a finite number of seconds > 0, got {text!r}")
+    if value > MAX_TIMEOUT_S:
+        raise argparse.ArgumentTypeError(f"expected at most {MAX_TIMEOUT_S:g} s (a day), got {text!r}")
     return value
 
 
@@ -104,13 +119,21 @@ def non_negative_seconds(text: str) -> float:
 
 
 def positive_int(text: str) -> int:
-    """``type=`` for counts such as ``--workers``: an integer >= 1."""
+    """``type=`` for counts such as ``--days``: an integer >= 1."""
     try:
         value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {shown(repr(text))}") from None
     if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {value}")
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {shown(value)}")
+    return value
+
+
+def workers(text: str) -> int:
+    """``type=`` for ``--workers``: an integer in ``1 … MAX_WORKERS``."""
+    value = positive_int(text)
+    if value > MAX_WORKERS:
+        raise argparse.ArgumentTypeError(f"expected at most {MAX_WORKERS} worker processes, got {shown(value)}")
     return value
 
 
@@ -121,7 +144,7 @@ def non_negative_int(text: str) -> int:
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}") from None
     if value < 0:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {value}")
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {shown(value)}")
     return value
 
 
@@ -221,6 +244,12 @@ def run_handler(handler: Callable[[argparse.Namespace], Any], args: argparse.Nam
     except OSError as exc:
         print(f"tasker {command}: error: {error_text(exc)}", file=sys.stderr)
         return EXIT_USAGE
+    except SystemExit as exc:  # code that is not tasker's (a plugin) ended the program: say so, not a bare status
+        print(f"tasker {command}: internal error: sys.exit({'' if exc.code is None else repr(exc.code)}) was "
+              "called while the command ran" + ("" if verbose else " (--verbose shows where)"), file=sys.stderr)
+        if verbose:
+            traceback.print_exc()
+        return EXIT_INTERNAL
     except Exception as exc:  # noqa: BLE001 - a command line never shows a traceback unasked
         print(f"tasker {command}: internal error: {type(exc).__name__}: {exc}"
               + ("" if verbose else " (a bug in tasker; --verbose shows the traceback)"), file=sys.stderr)

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import functools
-import tomllib
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -22,6 +21,7 @@ from typing import Any
 
 from experiments.cli.args import EXIT_FAILED, EXIT_OK, error_text
 from experiments.cli.run import add_path_option, task_paths
+from tasker.support import reader
 from tasker.support.reader import InputWarning
 
 EXAMPLES = """\
@@ -32,6 +32,11 @@ examples:
   tasker check my_scenario.toml --path ~/my_tasks    # a scenario that requests your own task types"""
 
 
+def _local(exc: reader.InputError) -> str:
+    """A reader's error about the file a problem line already names: ``line N: field: what``."""
+    return ": ".join(x for x in (f"line {exc.line}" if exc.line else "", exc.field, exc.message) if x)
+
+
 class Checker:
     """Runs the checks and collects ``(path, problem)`` pairs and ``(path, what)`` successes."""
 
@@ -39,6 +44,7 @@ class Checker:
         self.paths = paths
         self.problems: list[tuple[str, str]] = []
         self.passed: list[tuple[str, str]] = []
+        self.loaded: dict[Path, bool] = {}  # task folder -> it passed its checks
         self._store: Any = None
         self._store_error: str | None = None
 
@@ -47,7 +53,7 @@ class Checker:
 
         try:
             fn()
-        except (TaskerError, OSError, ValueError, tomllib.TOMLDecodeError) as exc:
+        except (TaskerError, OSError, ValueError) as exc:
             self.problems.append((str(where), error_text(exc)))
             return False
         self.passed.append((str(where), what))
@@ -92,6 +98,7 @@ class Checker:
             warnings.simplefilter("always", InputWarning)
             ok = self.attempt(p, "task folder: PDDL, task.toml and the [example] solved",
                               lambda: load_task(p, use_cache=False))
+        self.loaded[p.resolve()] = ok
         for w in caught:  # shown as any other warning; they only change what "ok" claims
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         if ok and any(issubclass(w.category, InputWarning) for w in caught):
@@ -100,17 +107,21 @@ class Checker:
     def _pddl(self, p: Path) -> None:
         from planners.checks import load_domain
 
-        text = p.read_text(encoding="utf-8", errors="replace").lower()
+        try:
+            text = reader.read_text(p).lower()
+        except reader.InputError as exc:
+            self.problems.append((str(p), _local(exc)))
+            return
         if "(:domain" in text:
             self.problems.append((str(p), "a PDDL problem is checked with its domain: tasker plan DOMAIN PROBLEM"))
             return
         self.attempt(p, "PDDL domain", lambda: load_domain(p))
 
     def _toml(self, p: Path, also: list[str] | None = None) -> None:
-        try:
-            raw = tomllib.loads(p.read_text(encoding="utf-8-sig"))  # a byte-order mark as reader.read_text
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-            self.problems.append((str(p), f"not valid TOML: {exc}"))
+        try:  # within the readers' limits, as every loader reads it
+            raw = reader.loads(reader.read_text(p), p).data
+        except reader.InputError as exc:
+            self.problems.append((str(p), _local(exc)))
             return
         if p.name == "task.toml" or "task" in raw and "actions" in raw:
             self._task_folder(p.parent)
@@ -202,10 +213,32 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p.set_defaults(func=_check)
 
 
+def _task_folders(targets: list[str]) -> list[Path]:
+    """The targets that are task folders (or folders of them), resolved."""
+    out = []
+    for t in targets:
+        p = Path(t)
+        try:
+            if (p / "task.toml").is_file() or (p.is_dir() and any((q / "task.toml").is_file() for q in p.iterdir())):
+                out.append(p.resolve())
+        except (OSError, ValueError):  # unreadable, or no file name: its own check says so
+            continue
+    return out
+
+
 def _check(args: argparse.Namespace) -> int:
     checker = Checker(task_paths(args))
-    for t in args.targets:
+    folders = _task_folders(args.targets)
+    first = [t for t in args.targets if "\x00" not in t and Path(t).resolve() in folders]
+    for t in first:  # task folders first: a scenario checked with them requests their task types, as with --path
         checker.check(t)
+    for f in folders:  # those that loaded (a broken one has said so already, once)
+        subs = [f] if (f / "task.toml").is_file() else [q.resolve() for q in f.iterdir() if (q / "task.toml").is_file()]
+        if all(checker.loaded.get(q) for q in subs) and str(f) not in checker.paths:
+            checker.paths.append(str(f))
+    for t in args.targets:
+        if t not in first:
+            checker.check(t)
     if not args.quiet:
         for where, what in checker.passed:
             print(f"ok     {where}: {what}")

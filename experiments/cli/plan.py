@@ -102,31 +102,41 @@ def _task_for_domain(domain_text: str, extra: list[str], beside: Path | None = N
 
 
 def _stages_for(domain_text: str, result: PlanResult, extra: list[str],
-                beside: Path | None = None) -> tuple[Stage, ...]:
-    """Stages of a plan: the task type's skills when the domain is a registered task's.
-
-    A task folder of this domain that does not load is said on stderr: its stages would
-    otherwise print as skill-less and instant, as if the domain were no task's."""
+                beside: Path | None = None) -> tuple[Stage, ...] | str:
+    """Stages of a plan: the task type's skills, kinds and durations when the domain is a task
+    folder's ``domain.pddl`` (the folder it sits in, or a registered one with its name and text);
+    else why there are none — a stage without its task folder has no skill, kind or duration, and
+    printing "suspendable, 0 s" for each would say what nobody declared."""
     from tasker.errors import TaskerError
-    from tasker.stage import Stage
 
     assert result.plan is not None
+    m = _DOMAIN_NAME.search(domain_text)
+    name = m.group(1) if m else "?"
     try:
         task = _task_for_domain(domain_text, extra, beside)
     except TaskerError as exc:
         print(f"tasker plan: warning: the stages have no skills or durations: the domain's task folder does "
               f"not load: {exc}", file=sys.stderr)
-        task = None
-    if task is not None:
+        return "the domain's task folder does not load (see the warning)"
+    if task is None:
+        return (f"domain {name!r} is no task folder's: stages (skill, kind, duration) come from a task folder's "
+                "task.toml; give its folder with --path")
+    unknown = sorted({s[0] for s in result.plan if s[0] not in task.spec.actions or s[0] not in task.domain.actions
+                      or len(s) - 1 != len(task.domain.actions[s[0]].params)})
+    if unknown:  # a domain of the same name with other actions: its stages would be guessed
+        return (f"the plan's action(s) {', '.join(unknown)} are not those of {task.spec.domain_file} (task "
+                f"{task.name!r}, whose domain has this name)")
+    try:
         return task.builder.from_steps(result.plan, {}, {})
-    return tuple(Stage(s[0], tuple(s[1:])) for s in result.plan)
+    except (KeyError, ValueError, TaskerError) as exc:
+        return f"the plan does not fit task {task.name!r}'s task.toml: {type(exc).__name__}: {exc}"
 
 
 def _read_arg(path: str, argument: str) -> str:
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise UsageError(argument, f"{path}: no such file")
-    try:
+    try:  # a folder, a device, a huge or binary file: named by the reader
         return reader.read_text(p)
     except reader.InputError as exc:
         raise UsageError(argument, str(exc)) from None
@@ -167,9 +177,13 @@ def plan_command(args: argparse.Namespace) -> int:
         for k, step in enumerate(result.plan, 1):
             print(f"  {k:3d}. ({' '.join(step)})")
         if not getattr(args, "quiet", False):
-            print("stages:")
-            for k, s in enumerate(_stages_for(domain_text, result, extra, Path(args.domain).parent), 1):
-                print(f"  {k:3d}. {s.label} [{s.kind.value}, skill={s.skill or '-'}, {s.duration:g} s]")
+            stages = _stages_for(domain_text, result, extra, Path(args.domain).parent)
+            if isinstance(stages, str):
+                print(f"stages: none shown: {stages}")
+            else:
+                print("stages:")
+                for k, s in enumerate(stages, 1):
+                    print(f"  {k:3d}. {s.label} [{s.kind.value}, skill={s.skill or '-'}, {s.duration:g} s]")
     else:
         print(f"{result.status.value}: {result.message or 'no plan'} ({result.planner})")
     return EXIT_OK if result.solved else EXIT_FAILED
@@ -217,11 +231,16 @@ def fsm_command(args: argparse.Namespace) -> int:
     """Print a task's exeTsk or exeSusp FSM for its example world."""
     from tasker.stage import Purpose
 
+    if args.after is not None and args.purpose != "genSusp":
+        raise UsageError("--after", "applies to --purpose genSusp (the exeSusp FSM after K stages of exeTsk); "
+                                    "the exeTsk FSM has no K")
     task = _find_task(args.task_type, _paths(args))
     plan = example_plan(task, Purpose(args.purpose), args.strategy, args.after)
-    print(plan.to_dot() if args.format == "dot" else plan.to_mermaid(), end="")
-    if plan.note:
-        print(f"%% note: {plan.note}" if args.format == "mermaid" else f"// note: {plan.note}")
+    text = plan.to_dot() if args.format == "dot" else plan.to_mermaid()
+    if plan.note:  # one comment line, whatever the label it comes from holds
+        note = " ".join(plan.note.split())
+        text = text.rstrip("\n") + "\n" + (f"%% note: {note}" if args.format == "mermaid" else f"// note: {note}")
+    sys.stdout.write(text.rstrip("\n") + "\n")  # a file that ends with its last line, as diagram tools expect
     return EXIT_OK
 
 

@@ -25,6 +25,7 @@ from experiments.cli.args import (
     note,
     positive_int,
     show_progress,
+    workers,
     writable_dir,
     writable_file,
 )
@@ -39,7 +40,8 @@ examples:
   tasker sweep my_sweep.toml --db out/my.db --path ~/my_tasks          # with your own task folders
   tasker sweep my_sweep.toml --db out/my.db --scheduler-address tcp://head:8786   # on a Dask cluster
   tasker sweep experiments/sweep/specs/strategies.toml --db out/s.db --seeds 1-20  # a pilot: seeds 1..20
-  tasker sweep experiments/sweep/specs/strategies.toml --db out/s.db --limit 30    # 30 more runs, then stop"""
+  tasker sweep experiments/sweep/specs/strategies.toml --db out/s.db --limit 30    # 30 more runs, then stop
+  tasker sweep my_sweep.toml --db out/my.db --overwrite                  # delete what out/my.db holds, run all"""
 
 REPORT_EXAMPLES = """\
 examples:
@@ -54,14 +56,20 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("sweep", help="run scenarios × seeds × strategies into a results database (resumable)",
                        description="Run every job of a sweep spec (TOML) that the results database does not hold "
                                    "yet, in parallel; each result is stored as it finishes, so an interrupted "
-                                   "sweep resumes where it stopped.",
+                                   "sweep resumes where it stopped. A stored run is never deleted unless asked "
+                                   "by name: --retry-errors (the errors only) or --overwrite (all).",
                        epilog=SWEEP_EXAMPLES)
     p.add_argument("spec", help="sweep spec (.toml): scenarios, seeds, strategies")
     p.add_argument("--db", required=True, help="results database (SQLite; created if missing)")
-    p.add_argument("--workers", type=positive_int, default=None, help="local worker processes (default: CPU count)")
+    p.add_argument("--workers", type=workers, default=None,
+                   help="local worker processes, at most 1024 (default: CPU count)")
     p.add_argument("--scheduler-address", default=None, metavar="ADDRESS",
                    help="run on this Dask scheduler (e.g. tcp://host:8786) instead of local processes")
-    p.add_argument("--retry-errors", action="store_true", help="run again the jobs stored with status error")
+    p.add_argument("--retry-errors", action="store_true",
+                   help="run again the jobs stored with status error (the jobs stored as ok are kept)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="delete the results database first and run every job afresh (a stored run is never "
+                        "deleted without it)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar (also --quiet, or not a terminal)")
     p.add_argument("--seeds", default=None, metavar="A-B",
                    help="only these seeds of the spec: A-B, A,B,C or a mix (e.g. 1-20); the rest stay missing")
@@ -72,7 +80,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p.set_defaults(func=_sweep)
 
     r = sub.add_parser("report", help="tables, CSV and plots from a results database",
-                       description="Compare the strategies of a sweep: mean and 95 %% CI per metric, paired "
+                       description="Compare the strategies of a sweep: mean and 95 % CI per metric, paired "
                                    "planned vs static differences, bar charts.",
                        epilog=REPORT_EXAMPLES)
     r.add_argument("--db", required=True, help="results database written by 'tasker sweep'")
@@ -140,6 +148,12 @@ def _sweep(args: argparse.Namespace) -> int:
         task_types(paths)  # every task folder checked here, before any job
         spec = dataclasses.replace(spec, task_paths=tuple(paths))
     writable_file(args.db, "--db")
+    if args.overwrite:
+        from experiments.metrics.store import remove
+        from experiments.sweep.driver import lease
+
+        with lease(args.db):  # a sweep still writing into it keeps its runs: this one stops instead
+            remove(args.db)
     with dask_scheduler(args.scheduler_address):
         summary = run_sweep(spec, args.db, workers=args.workers, scheduler_address=args.scheduler_address,
                             retry_errors=args.retry_errors, max_jobs=args.limit,

@@ -167,7 +167,7 @@ def register(subparsers: Any) -> None:
                     "points, from OMPL paths over TIAGo's base in the world. Exits 1 when a pair is unreachable.",
         epilog="examples:\n"
                "  tasker cost paper kitchen bedroom\n"
-               "  tasker cost paper kitchen bedroom hall livingroom --json   # the 4 x 4 matrix\n"
+               "  tasker cost paper kitchen bedroom hall living --json   # the 4 x 4 matrix\n"
                "  tasker cost flat 5.0,2.0 2.5,1.8,0 --seed 7")
     c.add_argument("world", metavar="WORLD", help="a shipped world name (paper, flat) or a .toml path")
     c.add_argument("points", metavar="PLACE", nargs="+", help="two or more place names or x,y[,yaw] points")

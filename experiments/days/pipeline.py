@@ -3,10 +3,10 @@
 The shape is Gymnasium's ``EnvSpec`` + ``make``: protocols are registered by name
 (:func:`register`; ``tabsa``, ``tabsa-short`` and ``tabsa-rush`` are shipped), and
 :func:`make` turns a name (or a protocol file), a seed and a backend into a :class:`Day` —
-the scenario that backend runs, built from the one draw of :func:`experiments.days.protocol.draw`:
+the scenario that backend runs, built from the one draw of :func:`experiments.days.draw.draw`:
 
 * ``synthetic``: a :class:`experiments.inputs.synthetic.SyntheticScenario` of timed stages
-  (:class:`experiments.days.protocol.DayTask`);
+  (:class:`experiments.days.daytask.DayTask`);
 * ``robot``: a :class:`experiments.inputs.scenario.RobotScenario` in the protocol's world
   (``[robot_backend]``): each protocol task type is a task folder with its arguments,
   a person of the world per request is scripted to walk to the request's site before
@@ -33,8 +33,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from experiments.days import draw as draws
 from experiments.days import protocol as protocols
-from experiments.days.protocol import DayRequest, Protocol
+from experiments.days.draw import DayRequest
+from experiments.days.protocol import Protocol
+from experiments.days.robot_work import SUFFIX, wrapper_for
+from experiments.days.specs import SchedulerSpec, parse
 from experiments.inputs.actions import TimedAction
 from experiments.inputs.strategy import FACTORS
 from experiments.inputs.synthetic import SyntheticScenario
@@ -75,6 +79,8 @@ def names() -> list[str]:
 register("tabsa", PROTOCOLS_DIR / "tabsa.toml")
 register("tabsa-short", PROTOCOLS_DIR / "tabsa_short.toml")
 register("tabsa-rush", PROTOCOLS_DIR / "tabsa_rush.toml")
+register("tabsa-original", PROTOCOLS_DIR / "tabsa_original.toml")
+register("tabsa-anywhere", PROTOCOLS_DIR / "tabsa_anywhere.toml")
 
 
 def resolve(name_or_path: str | Path) -> Path:
@@ -105,8 +111,12 @@ def task_names(proto: Protocol, backend: str) -> dict[str, str]:
     return {k: k for k in proto.tasks}
 
 
-def scheduler_options(proto: Protocol, name: str, backend: str = "synthetic") -> dict[str, Any]:
-    """Options each scheduler gets from the protocol: what it can know of the day's task types."""
+def scheduler_options(proto: Protocol, name: str, backend: str = "synthetic", seed: int = 0) -> dict[str, Any]:
+    """Options each scheduler gets from the protocol and the day: what it can know of the day's task types.
+
+    ``alg2``: the priority classes; the look-ahead: the falls' hazard budget and a switch
+    penalty; TaBSA's agents: the protocol's non-preemptive types (``non_preemptive``, the task
+    names ``backend`` runs) and, for the two that draw at random, the day's ``seed``."""
     to = task_names(proto, backend)
     if name == "alg2":  # priority classes, highest first
         prios = sorted({s.priority for s in proto.tasks.values()}, reverse=True)
@@ -115,13 +125,22 @@ def scheduler_options(proto: Protocol, name: str, backend: str = "synthetic") ->
         budgets = {to[k]: s.death_after_s for k, s in proto.tasks.items() if s.death_after_s is not None}
         penalty = max((s.suspend_s for s in proto.tasks.values()), default=0.0) + proto.planning_time_s
         return {"switch_penalty_s": penalty, "budgets": budgets}
+    if name in TABSA_AGENTS:
+        out: dict[str, Any] = {"non_preemptive": [to[k] for k in proto.non_preemptive]}
+        if name in ("tabsa-simple", "tabsa-simple2"):
+            out["seed"] = seed
+        return out
     return {}
+
+
+TABSA_AGENTS = ("tabsa-simple", "tabsa-simple2", "tabsa-distance", "tabsa-scheduler")
+"""TaBSA's agents (:mod:`tasker.schedulers.tabsa`): they take the protocol's non-preemptive types."""
 
 
 # -- the backends --------------------------------------------------------------------------------------
 
 def _synthetic(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) -> SyntheticScenario:
-    return protocols.generate(proto, seed, scheduler=scheduler, scheduler_options=options)
+    return draws.generate(proto, seed, scheduler=scheduler, scheduler_options=options)
 
 
 def _robot(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) -> Any:
@@ -135,7 +154,7 @@ def _robot(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) 
                           "backend only")
     world = load_world(backend.world)
     pool = sorted(world.people)
-    requests = protocols.draw(proto, seed)
+    requests = draws.draw(proto, seed)
     need = sum(1 for r in requests if "$person" in backend.tasks[r.kind].args.values())
     if need > len(pool):
         raise ConfigError(f"{proto.source}: day {seed} needs {need} people and world {world.name!r} has "
@@ -153,10 +172,14 @@ def _robot(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) 
             person = pool.pop(0)
             values["$person"] = person
             release = r.death_at if rt.posture else None  # the spot is held until then at most
-            spot = _free_spot(held, r.site, len(backend.spots[r.site]), r.t - backend.lead_s,
-                              math.inf if release is None else release + backend.lead_s)
             home = world.people[person].pose
-            people[person] = _script(home, backend.spots[r.site][spot], r, backend.lead_s)
+            lead = _lead(backend.lead_s, home, r.xy if r.xy is not None else backend.spots[r.site][0], r.walk_speed)
+            if r.xy is not None:  # drawn anywhere free in a room: their own spot
+                where: tuple[float, ...] = r.xy
+            else:
+                where = backend.spots[r.site][_free_spot(held, r.site, len(backend.spots[r.site]), r.t - lead,
+                                                         math.inf if release is None else release + backend.lead_s)]
+            people[person] = _script(home, where, r, lead)
             if rt.posture:
                 actions.append(TimedAction(r.t, "world", {"what": "posture", "value": [person, rt.posture],
                                                                 "note": f"{person}: {rt.posture}"}))
@@ -170,6 +193,8 @@ def _robot(proto: Protocol, seed: int, scheduler: str, options: dict[str, Any]) 
             objects[obj] = {"type": rt.object_type, "place": backend.places[r.site], "facts": []}
         args: dict[str, Any] = {k: values.get(v, v) for k, v in rt.args.items()}
         args |= {"deadline": r.deadline, "priority": r.priority}
+        drawn = {"$work": r.work, "$pick": r.pick, "$place": r.place}
+        args |= {action + SUFFIX: drawn[v] for action, v in rt.durations.items() if drawn[v] is not None}
         if r.death_at is not None:
             args["death_at"] = r.death_at
         renew = {} if rt.renew_after_s is None else {"renew": {
@@ -207,6 +232,19 @@ def _taken_away(t: float, person: str, home: tuple[float, ...], why: str,
             TimedAction(t, "world", {"what": "walk", "value": [person, home[0], home[1]], "note": note, **when})]
 
 
+ROUTE_FACTOR = 2.0
+"""A person's walk from home to their spot is scripted to take at least this many times the
+straight line at their pace: the way round walls and through the front door is longer, and a
+script faster than they walk would leave them behind it (TaBSA's people walk at 0.01-0.1 m/s)."""
+
+
+def _lead(lead: float, home: tuple[float, ...], spot: tuple[float, ...], speed: float | None) -> float:
+    """How long before the call a person sets out: ``lead``, or longer for a slow walker."""
+    if speed is None:
+        return lead
+    return max(lead, ROUTE_FACTOR * math.hypot(spot[0] - home[0], spot[1] - home[1]) / speed)
+
+
 def _script(home: tuple[float, ...], spot: tuple[float, ...], r: DayRequest, lead: float) -> dict[str, Any]:
     """A person's pose and walk: from home to ``spot`` by the call (:func:`_taken_away` takes
     them home again)."""
@@ -222,6 +260,14 @@ def _script(home: tuple[float, ...], spot: tuple[float, ...], r: DayRequest, lea
     if r.walk_speed is not None:
         entry["speed"] = r.walk_speed
     return entry
+
+
+def robot_work(proto: Protocol) -> dict[str, tuple[tuple[str, ...], bool]]:
+    """Per task folder the robot day runs: the actions given drawn durations, and whether it is preemptive
+    (:func:`experiments.days.robot_work.wrapper_for`)."""
+    if proto.robot is None:
+        return {}
+    return {rt.task: (tuple(rt.durations), proto.tasks[kind].preemptive) for kind, rt in proto.robot.tasks.items()}
 
 
 _BACKENDS: dict[str, Callable[[Protocol, int, str, dict[str, Any]], Any]] = {
@@ -273,7 +319,7 @@ class Day:
         with tempfile.TemporaryDirectory(prefix="tasker-day-") as tmp:
             where = Path(out) if out is not None else Path(tmp)
             result = run_scenario(self.scenario, seed=self.seed, out=where, pictures=False, request_fields=True,
-                                  **settings)
+                                  task_wrapper=wrapper_for(robot_work(self.protocol)), **settings)
             _, samples, _ = read_trajectory(where / "trajectory.jsonl")
         return DayRun(list(result.trace.events), tuple(samples), result.record)
 
@@ -292,25 +338,25 @@ def make(protocol: str | Path | Protocol, seed: int, *, backend: str = "syntheti
          scheduler_options: Mapping[str, Any] | None = None) -> Day:
     """Day ``seed`` of ``protocol`` (a registered name, a file, or a loaded protocol) on ``backend``.
 
-    ``scheduler_options`` default to what the protocol tells the scheduler
-    (:func:`scheduler_options`)."""
+    ``scheduler`` is a scheduler spec (:mod:`experiments.days.specs`: a registered name, with
+    options as ``NAME:OPTION=VALUE``).  ``scheduler_options`` default to what the protocol and the
+    day tell the scheduler (:func:`scheduler_options`), with the spec's options over them."""
     if backend not in _BACKENDS:
         raise ConfigError(f"unknown backend {backend!r}{suggest(backend, BACKENDS)}; known: {', '.join(BACKENDS)}")
-    from tasker import schedulers
-
-    if scheduler not in schedulers.names():
-        raise ConfigError(f"unknown scheduler {scheduler!r}{suggest(scheduler, schedulers.names())}; "
-                          f"known: {', '.join(schedulers.names())}")
+    spec = parse(scheduler)
     proto = load(protocol)
-    options = dict(scheduler_options) if scheduler_options is not None else scheduler_options_for(proto, scheduler,
-                                                                                                   backend)
-    return Day(proto, seed, backend, scheduler, _BACKENDS[backend](proto, seed, scheduler, options))
+    options = (dict(scheduler_options) | spec.as_dict() if scheduler_options is not None
+               else scheduler_options_for(proto, spec, backend, seed))
+    return Day(proto, seed, backend, spec.label, _BACKENDS[backend](proto, seed, spec.name, options))
 
 
-def scheduler_options_for(proto: Protocol, scheduler: str, backend: str) -> dict[str, Any]:
+def scheduler_options_for(proto: Protocol, scheduler: str | SchedulerSpec, backend: str,
+                          seed: int = 0) -> dict[str, Any]:
+    """What :func:`make` gives ``scheduler`` (a spec or its text): the day's options, then the spec's."""
+    spec = parse(scheduler) if isinstance(scheduler, str) else scheduler
     if backend == "robot" and proto.robot is None:
-        return {}
-    return scheduler_options(proto, scheduler, backend)
+        return spec.as_dict()
+    return scheduler_options(proto, spec.name, backend, seed) | spec.as_dict()
 
 
 def build_day(protocol: Protocol, seed: int, scheduler: str, scheduler_options: dict[str, Any] | None = None,

@@ -1,18 +1,17 @@
-"""Day protocols (TaBSA-like) and a seeded generator of synthetic days.
+"""Day protocols (TaBSA-like): the file format, read and checked.
 
 A protocol file (``experiments/days/protocols/tabsa.toml``, documented in ``docs/benchmark.md``)
-says how a day is drawn: its length and step, the robot's speed, the apartment's sites,
-the arrival process, and for each task type (transport, fall, pick_place) how many a day,
-priority, cost weight, deadline window and stage durations.  :func:`load` reads it with
-the strict reader; :func:`generate` draws one day from a seed and returns it as a
-:class:`experiments.inputs.synthetic.SyntheticScenario` — the one scenario representation the
-synthetic backend runs (:func:`experiments.inputs.synthetic.run`).
+says how a day is drawn: its length and step, the robot's speed, the apartment's sites and
+where people stand, the arrival process, and for each task type (transport, fall,
+pick_place) how many a day, priority, cost weight, deadline window, stage durations and
+whether it can be interrupted; optionally how the day runs on the robot backend.
+:func:`load` reads it with the strict reader.  :mod:`experiments.days.draw` draws one day
+from a seed; :mod:`experiments.days.daytask` are its task types on the synthetic backend;
+:mod:`experiments.days.pipeline` builds either backend's scenario from the one draw.
 
-The day's task types are :class:`DayTask`, synthetic tasks whose stages are built from
-each request's arguments and from where the robot is: a motion stage lasts the distance
-over the speed of whoever sets the pace (the robot, or the person it escorts).  Each
-request records its ``deadline`` and, for a fall, ``death_at`` (deadline +
-``death_after_s``), so the metrics can judge from the trace alone.
+Two arrival processes: ``uniform`` (ours: a call uniform over ``[0, last_call_s)``, the
+deadline a per-type window after it) and ``before_deadline`` (TaBSA's ``my_tasks.py``: the
+deadline uniform over the day, the call uniform before it, at least ``call_lead_s`` before).
 """
 
 from __future__ import annotations
@@ -20,27 +19,21 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-import math
-import random
 import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from experiments.inputs.actions import TimedAction
 from experiments.inputs.filekinds import expect
-from experiments.inputs.synthetic import SyntheticScenario
-from tasker.agent import Rates
-from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
-from tasker.stage import Purpose, Stage, StageKind, StagePlan
 from tasker.support.reader import Table, check_name, suggest
 from tasker.support.reader import load as read_table
-from tasker.synthetic import SyntheticTask
-from tasker.task import ArgSpec, TaskContext
 
 Pose = tuple[float, ...]
 KINDS = ("transport", "fall", "pick_place")
-SUSP, BLOCK = StageKind.SUSPENDABLE, StageKind.BLOCKING
+PROCESSES = ("uniform", "before_deadline")
+"""Arrival processes: ours (``uniform``) and TaBSA's (``before_deadline``); see the module docstring."""
+POSITIONS = ("sites", "rooms")
+"""Where a request's person is: at a spot of its site (``sites``), or anywhere free in a room (``rooms``)."""
 MAX_REQUESTS = 10_000
 """A protocol whose counts add up to more requests a day than this is refused (a typo such as
 ``count = 1200000`` would otherwise run for hours; 9 000 take a minute on the synthetic backend)."""
@@ -48,29 +41,52 @@ MAX_STEPS = 1_000_000
 """A protocol whose day has more steps than this (``length_s / step_s``) is refused: the loop steps
 through the whole day (about 2 million steps take 5 s of one synthetic day, and a robot day far
 more), so ``length_s = 1e9`` never ended; the shipped days have 720 to 2 880 steps."""
-_RESUME_STAGES = ("go_back", "apologise", "pick_again")
 TOP_KEYS = ("name", "day", "robot", "apartment", "arrivals", "tasks", "robot_backend")
 """The top-level keys and tables of a protocol file."""
+Range = tuple[float, float]
 
 
 @dataclass(frozen=True)
 class TaskSpec:
-    """One task type of a protocol.  Durations in seconds, speeds in m/s; pairs are uniform ranges."""
+    """One task type of a protocol.  Durations in seconds, speeds in m/s; pairs are uniform ranges.
+
+    ``priority``: the type's static priority; ``priorities`` (when not empty) the values a
+    request's priority is drawn from, uniformly (TaBSA: 1, 2 or 3 per transport), and
+    ``priority`` is then their highest (a type-level class, as ``alg2`` needs one).
+    ``deadline_s``: the deadline's window after the call (``uniform`` arrivals; ``None`` with
+    ``before_deadline``).  ``deadline_draws``: TaBSA's pick-and-place is three tasks (pick,
+    place, carry) each drawn with its own deadline and call; the whole takes the latest
+    deadline and the earliest call.  ``pick_s``/``place_s``: a number, or a range drawn per
+    request; ``carry_speed``: the carry's pace, drawn per request (``None``: the robot's).
+    ``preemptive``: false for a type that, once started, runs to its end (TaBSA's falls and
+    pick-and-place).
+    """
 
     kind: str
     count: int
     priority: int
     weight: float
-    deadline_s: tuple[float, float]
-    person_speed: tuple[float, float] = (0.0, 0.0)
-    work_s: tuple[float, float] = (0.0, 0.0)
+    deadline_s: Range | None
+    person_speed: Range = (0.0, 0.0)
+    work_s: Range = (0.0, 0.0)
     greet_s: float = 0.0
     goodbye_s: float = 0.0
-    pick_s: float = 0.0
-    place_s: float = 0.0
+    pick_s: float | Range = 0.0
+    place_s: float | Range = 0.0
     suspend_s: float = 0.0
     resume_s: float = 0.0
     death_after_s: float | None = None
+    priorities: tuple[int, ...] = ()
+    preemptive: bool = True
+    deadline_draws: int = 1
+    carry_speed: Range | None = None
+
+
+_ADDED: dict[str, Any] = {"priorities": (), "preemptive": True, "deadline_draws": 1, "carry_speed": None,
+                          "process": "uniform", "call_lead_s": 0.0, "positions": "sites", "clearance_m": 0.0,
+                          "durations": {}}
+"""Fields added after days were stored: left out of :meth:`Protocol.digest` while they hold their
+default, so that a protocol written before them keeps its digest (and its stored days resume)."""
 
 
 @dataclass(frozen=True)
@@ -85,6 +101,8 @@ class RobotTask:
     ``renew_after_s``: a request of this type whose task fails (a plan, a skill or a hook
     failed) is made again this long after, until its ``death_at`` (or the day's end): the
     need stands until served, as in TaBSA.  ``None``: a failed task stays failed.
+    ``durations``: per action of the folder, the drawn value its stage takes (``$work`` of a
+    fall, ``$pick`` and ``$place`` of a pick-and-place; :mod:`experiments.days.robot_work`).
     """
 
     kind: str
@@ -93,6 +111,7 @@ class RobotTask:
     object_type: str | None = None
     posture: str | None = None
     renew_after_s: float | None = None
+    durations: dict[str, str] = dataclasses.field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -127,21 +146,39 @@ class Protocol:
     last_call_s: float
     tasks: dict[str, TaskSpec]
     robot: RobotBackend | None = None
+    process: str = "uniform"
+    call_lead_s: float = 0.0
+    positions: str = "sites"
+    clearance_m: float = 0.0
 
     @property
     def death_after_s(self) -> float | None:
         return self.tasks["fall"].death_after_s if "fall" in self.tasks else None
 
+    @property
+    def non_preemptive(self) -> tuple[str, ...]:
+        """The task types that, once started, run to their end (``preemptive = false``)."""
+        return tuple(k for k, s in self.tasks.items() if not s.preemptive)
+
     def digest(self) -> str:
         """A SHA-256 of what its days are drawn and run from: every checked value (not the file's
         comments, layout or place) and, with a robot backend, the bytes of its world file.  Stored
         with each day, so that a resumed run does not mix days of two versions of a protocol."""
-        values = dataclasses.asdict(self)
+        values = _without_defaults(dataclasses.asdict(self))
+        for spec in [*values["tasks"].values(), *(values["robot"] or {}).get("tasks", {}).values()]:
+            _without_defaults(spec)
         values.pop("source")
         h = hashlib.sha256(json.dumps(values, sort_keys=True, default=str).encode())
         if self.robot is not None:
             h.update(Path(self.robot.world).read_bytes())
         return h.hexdigest()
+
+
+def _without_defaults(values: dict[str, Any]) -> dict[str, Any]:
+    for key, default in _ADDED.items():
+        if key in values and values[key] == default:
+            del values[key]
+    return values
 
 
 # -- reading ---------------------------------------------------------------------------------------
@@ -166,10 +203,37 @@ def _pose(t: Table, key: str, value: Any) -> Pose:
     return float(value[0]), float(value[1])
 
 
-def _task(t: Table, kind: str) -> TaskSpec:
+def _number_or_range(t: Table, key: str) -> float | Range:
+    """A duration: a number, or a range ``[low, high]`` drawn per request."""
+    return _range(t, key) if isinstance(t.raw(key), list) else float(t.number(key, min=0))
+
+
+def _priority(t: Table) -> tuple[int, tuple[int, ...]]:
+    """``priority``: an integer, or a list of integers drawn from per request (then the type's is the highest)."""
+    value = t.raw("priority")
+    if isinstance(value, list):
+        if not value or not all(isinstance(v, int) and not isinstance(v, bool) for v in value):
+            raise t.error("priority", f"expected an integer or a non-empty list of integers (drawn from per request), "
+                                      f"got {value!r}")
+        return max(value), tuple(value)
+    return int(t.number("priority", integer=True)), ()
+
+
+def _task(t: Table, kind: str, process: str) -> TaskSpec:
+    priority, priorities = _priority(t)
+    if process == "uniform":
+        deadline: Range | None = _range(t, "deadline_s")
+        draws = 1
+    else:
+        if "deadline_s" in t:
+            raise t.error("deadline_s", f"not used with arrivals.process = {process!r}: the deadline is drawn over "
+                                        "the day and the call before it (remove it)")
+        deadline = None
+        draws = int(t.number("deadline_draws", 1, integer=True, min=1, max=10))
     common: dict[str, Any] = dict(
-        kind=kind, count=t.number("count", integer=True, min=0), priority=t.number("priority", integer=True),
-        weight=t.number("weight", min=0), deadline_s=_range(t, "deadline_s"),
+        kind=kind, count=t.number("count", integer=True, min=0), priority=priority, priorities=priorities,
+        weight=t.number("weight", min=0), deadline_s=deadline, deadline_draws=draws,
+        preemptive=t.boolean("preemptive", True),
     )
     if kind == "transport":
         spec = TaskSpec(**common, person_speed=_range(t, "person_speed", positive=True),
@@ -178,8 +242,10 @@ def _task(t: Table, kind: str) -> TaskSpec:
     elif kind == "fall":
         spec = TaskSpec(**common, work_s=_range(t, "work_s"), death_after_s=t.number("death_after_s", min=0))
     else:
-        spec = TaskSpec(**common, pick_s=t.number("pick_s", min=0), place_s=t.number("place_s", min=0),
-                        suspend_s=t.number("suspend_s", min=0), resume_s=t.number("resume_s", min=0))
+        carry = _range(t, "carry_speed", positive=True) if "carry_speed" in t else None
+        spec = TaskSpec(**common, pick_s=_number_or_range(t, "pick_s"), place_s=_number_or_range(t, "place_s"),
+                        suspend_s=t.number("suspend_s", min=0), resume_s=t.number("resume_s", min=0),
+                        carry_speed=carry)
     t.done()
     return spec
 
@@ -193,7 +259,7 @@ def load(path: str | Path) -> Protocol:
     day, robot, apartment = top.table("day"), top.table("robot"), top.table("apartment")
     arrivals, tasks_t = top.table("arrivals"), top.table("tasks")
     for t, keys in ((day, ("length_s", "step_s", "start")), (robot, ("speed", "start_site", "planning_time_s")),
-                    (arrivals, ("process", "last_call_s"))):
+                    (arrivals, ("process", "last_call_s", "call_lead_s"))):
         t.declare(keys)
     length = day.number("length_s", positive=True)
     step = day.number("step_s", positive=True)
@@ -210,19 +276,33 @@ def load(path: str | Path) -> Protocol:
     sites = {name: _pose(sites_t, name, v) for name, v in sites_t.items()}
     if len(sites) < 2:
         raise sites_t.error(None, f"expected at least two sites (tasks go from one to another), got {len(sites)}")
+    positions = apartment.string("positions", "sites", choices=POSITIONS)
+    clearance = apartment.number("clearance_m", 0.3 if positions == "rooms" else 0.0, min=0)
+    if positions == "sites" and "clearance_m" in apartment:
+        raise apartment.error("clearance_m", "only with positions = 'rooms' (how far a drawn position keeps from "
+                                             "walls and furniture)")
     apartment.done()
     speed = robot.number("speed", positive=True)
     start_site = robot.name("start_site", sites, "site")
     planning = robot.number("planning_time_s", 0.0, min=0)
     robot.done()
-    arrivals.string("process", "uniform", choices=("uniform",))
-    last_call = arrivals.number("last_call_s", length, positive=True, max=length)
+    process = arrivals.string("process", "uniform", choices=PROCESSES)
+    if process == "uniform":
+        last_call = arrivals.number("last_call_s", length, positive=True, max=length)
+        lead = 0.0
+    else:
+        for key in ("last_call_s",):
+            if key in arrivals:
+                raise arrivals.error(key, f"not used with process = {process!r}: deadlines are drawn over the whole "
+                                          "day and each call before its deadline (remove it)")
+        last_call = length
+        lead = arrivals.number("call_lead_s", 5.0, min=0)
     arrivals.done()
     tasks: dict[str, TaskSpec] = {}
     for kind in tasks_t.keys():
         if kind not in KINDS:
             raise tasks_t.error(kind, f"unknown task type {kind!r}{suggest(kind, KINDS)} (known: {', '.join(KINDS)})")
-        tasks[kind] = _task(tasks_t.table(kind), kind)
+        tasks[kind] = _task(tasks_t.table(kind), kind, process)
     if not tasks:
         raise tasks_t.error(None, f"expected at least one of {', '.join(KINDS)}")
     total = sum(spec.count for spec in tasks.values())
@@ -235,10 +315,14 @@ def load(path: str | Path) -> Protocol:
             "count", f"the day's counts add up to {total} requests, more than the {MAX_REQUESTS} a day may have")
     tasks_t.done()
     backend = _robot_backend(top.table("robot_backend"), Path(path), sites, tasks) if "robot_backend" in top else None
+    if positions == "rooms" and backend is None:
+        raise apartment.error("positions", "'rooms' draws positions in the rooms of the [robot_backend]'s world: "
+                                           "the protocol needs one")
     top.done(also=TOP_KEYS)  # robot_backend is optional: listed among the valid keys even when absent
     return Protocol(name=top.data["name"], source=str(path), start=start, length_s=length, step_s=step,
                     robot_speed=speed, start_site=start_site, planning_time_s=planning, sites=sites,
-                    last_call_s=last_call, tasks=tasks, robot=backend)
+                    last_call_s=last_call, tasks=tasks, robot=backend, process=process, call_lead_s=lead,
+                    positions=positions, clearance_m=clearance)
 
 
 _VARIABLES = ("$site", "$dest", "$person", "$object")
@@ -308,7 +392,8 @@ def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str
         variables = {"$site": "place", "$dest": "place", "$person": "person", **({"$object": obj} if obj else {})}
         check_template(tt, types[name], args, variables, spec)  # names, required ones, each of its PDDL type
         renew = tt.number("renew_after_s", None, positive=True)
-        out[kind] = RobotTask(kind, name, args, obj, posture, renew)
+        durations = _durations(tt, kind, tasks[kind], types[name])
+        out[kind] = RobotTask(kind, name, args, obj, posture, renew, durations)
         tt.done()
     missing = sorted(set(tasks) - set(out))
     if missing:
@@ -318,6 +403,30 @@ def _robot_backend(t: Table, path: Path, sites: dict[str, Pose], tasks: dict[str
     t.done()
     return RobotBackend(world=str(world_file.resolve()), places=places, spots=spots, tasks=out, lead_s=lead,
                         task_exe_rate=exe_rate)
+
+
+DRAWN = {"fall": ("$work",), "pick_place": ("$pick", "$place"), "transport": ()}
+"""What each type draws per request that a robot task's ``durations`` may give a stage."""
+
+
+def _durations(t: Table, kind: str, spec: TaskSpec, task: Any) -> dict[str, str]:
+    """``durations = { ACTION = "$work" }``: actions of the task folder, each given a value the type draws."""
+    if "durations" not in t:
+        return {}
+    d = t.table("durations")
+    actions = sorted(getattr(getattr(task, "spec", None), "actions", {}) or {})
+    drawn = [v for v in DRAWN[kind] if v != "$pick" or isinstance(spec.pick_s, tuple)]
+    drawn = [v for v in drawn if v != "$place" or isinstance(spec.place_s, tuple)]
+    out: dict[str, str] = {}
+    for action, _ in d.items():
+        check_name(d, action, action, actions, "action", f"an action of task folder {task.name!r}")
+        value = d.string(action)
+        if value not in drawn:
+            have = f"one of {', '.join(drawn)}" if drawn else "nothing: this protocol's type draws no duration"
+            raise d.error(action, f"expected a value the {kind} requests draw ({have}), got {value!r}")
+        out[action] = value
+    d.done()
+    return out
 
 
 def _not_standable(spec: Any, xy: Pose) -> str:
@@ -332,200 +441,3 @@ def _not_standable(spec: Any, xy: Pose) -> str:
 
 def _suggest(value: str) -> str:
     return suggest(value, _VARIABLES)
-
-
-# -- the day's task types --------------------------------------------------------------------------
-
-def _dist(a: Pose | None, b: Pose | None) -> float:
-    if a is None or b is None:
-        return 0.0
-    return math.hypot(a[0] - b[0], a[1] - b[1])
-
-
-def _move(action: str, target: Pose, speed: float, origin: Pose | None = None) -> Stage:
-    """A motion stage; ``origin`` set means the motion has a fixed start (escort, carry)."""
-    return Stage(action, kind=SUSP, duration=0.0 if origin is None else _dist(origin, target) / speed,
-                 skill="timed", data={"site": target, "from": origin, "speed": speed})
-
-
-class DayTask(SyntheticTask):
-    """A protocol task type; its stages come from the request (site, dest, work, walk speed).
-
-    ``transport``: go to the person, greet (blocking), escort at the person's pace to
-    ``dest``, goodbye (blocking); suspended while escorting, the robot asks the person to
-    wait (blocking) and apologises on return.  ``fall``: go to the person, help for
-    ``work`` seconds (blocking: not interruptible).  ``pick_place``: go to the object,
-    pick (blocking), carry to ``dest``, place (blocking); suspended while carrying, the
-    robot puts the object down and picks it up again on return.
-
-    A stopped motion stage restarts from its origin (the synthetic executor does not
-    track partial motion), after the robot has travelled back there: progress lost to
-    an interruption is a real cost here, as is the travel.
-    """
-
-    def __init__(self, spec: TaskSpec, robot_speed: float, planning_time: float) -> None:
-        super().__init__(spec.kind, [Stage("placeholder")], weight=spec.weight, speed=robot_speed,
-                         planning_time=planning_time)
-        self.spec = spec
-        self.description = f"protocol task {spec.kind!r}"
-        self.arg_specs = (*self.arg_specs,
-                          ArgSpec("dest", "pose", required=False, help="where the person or object goes"),
-                          ArgSpec("work", "float", required=False, default=0.0, help="seconds of work on site"),
-                          ArgSpec("walk_speed", "float", required=False, default=robot_speed,
-                                  help="pace of the escorted person (m/s)"),
-                          ArgSpec("death_at", "float", required=False,
-                                  help="time the person is dead if not helped (falls; for metrics)"))
-
-    # -- stages -------------------------------------------------------------------------------------
-    def _template(self, args: dict[str, Any]) -> list[Stage]:
-        s, site, dest = self.spec, args["site"], args["dest"]
-        go = _move("go_to", site, self.speed)
-        if s.kind == "transport":
-            return [go, Stage("meet", kind=BLOCK, duration=s.greet_s),
-                    _move("escort", dest, args["walk_speed"], site), Stage("goodbye", kind=BLOCK, duration=s.goodbye_s)]
-        if s.kind == "fall":
-            return [go, Stage("help", kind=BLOCK, duration=args["work"])]
-        return [go, Stage("pick_up", kind=BLOCK, duration=s.pick_s), _move("carry", dest, self.speed, site),
-                Stage("place", kind=BLOCK, duration=s.place_s)]
-
-    def _build(self, ctx: TaskContext, start: Pose | None, resume: bool) -> list[Stage]:
-        rest = list(ctx.remaining) if ctx.plan is not None else self._template(ctx.args)
-        rest = [st for st in rest if st.action not in _RESUME_STAGES]  # an unfinished resume is rebuilt below
-        out: list[Stage] = []
-        pose = start
-        first = rest[0] if rest else None
-        if resume and first is not None and first.data.get("from") is not None:
-            origin = first.data["from"]
-            out.append(Stage("go_back", kind=SUSP, duration=_dist(pose, origin) / self.speed, skill="timed",
-                             data={"site": origin, "from": None, "speed": self.speed}))
-            pose = origin
-            if self.spec.resume_s:
-                action = "apologise" if self.spec.kind == "transport" else "pick_again"
-                out.append(Stage(action, kind=BLOCK, duration=self.spec.resume_s))
-        for st in rest:
-            if "speed" in st.data:
-                origin = st.data["from"]
-                d = _dist(pose if origin is None else origin, st.data["site"]) / st.data["speed"]
-                st = Stage(st.action, kind=st.kind, duration=d, skill="timed", data=st.data)
-                pose = st.data["site"]
-            out.append(st)
-        return out
-
-    def update_task(self, ctx: TaskContext) -> StagePlan:
-        ctx.memory["waiting"] = False
-        stages = self._build(ctx, self._robot_pose(ctx), resume=ctx.suspended)
-        return StagePlan(tuple(stages), Purpose.UP_TSK, strategy="static", sim_time=self.planning_time)
-
-    def generate_suspension(self, ctx: TaskContext) -> StagePlan:
-        ctx.memory["waiting"] = True
-        stopped = ctx.interrupted
-        stages: tuple[Stage, ...] = ()
-        if stopped is not None and stopped.data.get("from") is not None and self.spec.suspend_s:
-            action = "ask_to_stay" if self.spec.kind == "transport" else "set_down"
-            stages = (Stage(action, kind=BLOCK, duration=self.spec.suspend_s),)
-        return StagePlan(stages, Purpose.GEN_SUSP, strategy="static", sim_time=self.planning_time)
-
-    # -- estimates ----------------------------------------------------------------------------------
-    def _c_time(self, ctx: TaskContext, start: Pose | None) -> float:
-        started = ctx.plan is not None and not ctx.memory.get("waiting", False)
-        if started and start is None:
-            return self._remaining(ctx)  # executing: what is left of the current plan
-        # not started, waiting, or asked "from another pose" (i.e. resumed later): the plan it would build
-        stages = self._build(ctx, start, resume=started or ctx.suspended)
-        return sum(s.duration for s in stages) + self.planning_time
-
-    def _end_pose(self, ctx: TaskContext) -> Pose | None:
-        return ctx.args["dest"] if ctx.args["dest"] is not None else ctx.args["site"]
-
-    def compute_params(self, ctx: TaskContext) -> CostParams:
-        c_time = self._c_time(ctx, None if ctx.plan is not None and not ctx.memory.get("waiting")
-                              else self._robot_pose(ctx))
-        w = ctx.args["weight"]
-        return CostParams(self.name, cost=w * (ctx.age + c_time), cps=w, c_time=c_time, end_pose=self._end_pose(ctx),
-                          deadline=ctx.args["deadline"], priority=ctx.args["priority"])
-
-    def request_sp(self, ctx: TaskContext, request: SPRequest) -> CompletionCost:
-        if request.sp_id != SP_COMPLETION:
-            return super().request_sp(ctx, request)
-        pose = request.args.get("pose")
-        c_time = self._c_time(ctx, tuple(pose) if pose is not None else self._robot_pose(ctx))
-        w = ctx.args["weight"]
-        return CompletionCost(cc=w * (ctx.age + c_time), ccps=w)
-
-
-# -- generating a day ------------------------------------------------------------------------------
-
-def task_types(protocol: Protocol) -> tuple[DayTask, ...]:
-    return tuple(DayTask(spec, protocol.robot_speed, protocol.planning_time_s) for spec in protocol.tasks.values())
-
-
-@dataclass(frozen=True)
-class DayRequest:
-    """One request of a drawn day, before any backend gives it a form.
-
-    ``site`` and ``dest`` are site names of the protocol; ``deadline`` and ``death_at``
-    absolute seconds; ``work`` (falls) and ``walk_speed`` (transports) as drawn.
-    """
-
-    t: float
-    kind: str
-    site: str
-    dest: str
-    deadline: float
-    priority: int
-    weight: float
-    work: float | None = None
-    walk_speed: float | None = None
-    death_at: float | None = None
-
-
-def draw(protocol: Protocol, seed: int) -> tuple[DayRequest, ...]:
-    """The requests of day ``seed``, in call order: the same seed gives the same day.
-
-    Each task type draws its own stream (``random.Random(f"{name}:{seed}:{kind}")``), so
-    adding a type to a protocol leaves the other types' draws unchanged.  Both backends
-    are built from this one draw (:mod:`experiments.days.pipeline`).
-    """
-    sites = sorted(protocol.sites)
-    requests: list[tuple[float, int, DayRequest]] = []
-    for kind, spec in protocol.tasks.items():
-        rng = random.Random(f"{protocol.name}:{seed}:{kind}")
-        for _ in range(spec.count):
-            call = round(rng.uniform(0.0, protocol.last_call_s), 1)
-            deadline = round(call + rng.uniform(*spec.deadline_s), 1)
-            a, b = rng.sample(sites, 2)
-            extra: dict[str, Any] = {}
-            if kind == "transport":
-                extra["walk_speed"] = round(rng.uniform(*spec.person_speed), 3)
-            elif kind == "fall":
-                extra["work"] = round(rng.uniform(*spec.work_s), 1)
-                assert spec.death_after_s is not None
-                extra["death_at"] = round(deadline + spec.death_after_s, 1)
-            requests.append((call, len(requests), DayRequest(call, kind, a, b, deadline, spec.priority, spec.weight,
-                                                             **extra)))
-    requests.sort(key=lambda r: (r[0], r[1]))
-    return tuple(r for *_, r in requests)
-
-
-def generate(protocol: Protocol, seed: int, *, scheduler: str = "alg2",
-             scheduler_options: dict[str, Any] | None = None) -> SyntheticScenario:
-    """Day ``seed`` of ``protocol`` (:func:`draw`) as a synthetic scenario."""
-    actions = []
-    for r in draw(protocol, seed):
-        args: dict[str, Any] = {"site": list(protocol.sites[r.site]), "deadline": r.deadline, "priority": r.priority,
-                                "weight": r.weight}
-        if r.kind == "transport":
-            args["dest"] = list(protocol.sites[r.dest])
-            args["walk_speed"] = r.walk_speed
-        elif r.kind == "fall":
-            args["work"] = r.work
-            args["death_at"] = r.death_at
-        else:
-            args["dest"] = list(protocol.sites[r.dest])
-        actions.append(TimedAction(r.t, "request", {"task": r.kind, "args": args}))
-    rate = 1.0 / protocol.step_s
-    return SyntheticScenario(
-        name=f"{protocol.name}-day{seed}", tasks=task_types(protocol), actions=tuple(actions), scheduler=scheduler,
-        scheduler_options=dict(scheduler_options or {}), mode="IT", s_freq=rate, rates=Rates(rate, rate, rate),
-        jitter=0.0, seed=seed, horizon=protocol.length_s,
-    )

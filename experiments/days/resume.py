@@ -27,12 +27,18 @@ def check_resumable(db: Path, scenario: str, proto: protocols.Protocol) -> None:
     """A :class:`ConfigError` when ``db`` holds days of ``scenario`` (``PROTOCOL@BACKEND``) drawn from
     another version of ``proto``: resumed, they would be compared with days of this one as if alike.
     Days stored without a digest (by an older tasker, or imported from a ``days.jsonl``) are kept."""
-    from experiments.metrics.store import ResultStore
+    from experiments.metrics.store import ResultStore, holds_results
 
-    if not db.is_file():
+    if not holds_results(db):  # nothing stored (or what a failed first write left): nothing to compare
         return
     with ResultStore(db, readonly=True) as store:
-        stored = {r.record.get("protocol_digest") for r in store.rows() if r.scenario == scenario}
+        rows = [r for r in store.rows() if r.scenario == scenario]
+    for r in rows:  # the table reads every stored day: a damaged one is named now, not after the new days ran
+        why = _day_problem(r.metrics) if r.status.value == "ok" else None
+        if why:
+            raise ConfigError(f"{db}: the stored day (seed {r.seed}, {r.strategy}): "
+                              f"{why[0] + ': ' if why[0] else ''}{why[1]} (a damaged database)")
+    stored = {r.record.get("protocol_digest") for r in rows}
     if stored - {None, proto.digest()}:
         raise ConfigError(f"{db} holds days of {proto.source} as it was when they ran, and it has changed since "
                           f"(a value of the protocol{', or its world file' if proto.robot else ''}): new days would "
@@ -56,6 +62,8 @@ def _day_problem(r: Any) -> tuple[str, str] | None:
     seed = r.get("seed")
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         return "seed", f"expected an integer >= 0, got {json.dumps(seed)}"
+    if not isinstance(r.get("strategy", "default"), str):
+        return "strategy", f"expected a strategy label, got {json.dumps(r.get('strategy'))[:40]}"
     try:
         Strategy.parse(r.get("strategy", "default"))
     except (ValueError, TypeError) as exc:
@@ -78,17 +86,18 @@ def import_log(log: Path, db: Path, protocol: str, backend: str) -> None:
     The whole file is checked first: a damaged line is an :class:`~tasker.support.reader.InputError`
     naming it (and nothing is imported)."""
     from experiments.metrics.store import ResultStore, RunRow, Status
-    from tasker.support.reader import InputError, read_text
+    from tasker.support.reader import InputError, parse_json, read_text
 
     days = []
     for n, line in enumerate(read_text(log).splitlines(), start=1):
         if not line.strip():
             continue
-        try:
-            r = json.loads(line)
-        except json.JSONDecodeError as exc:
-            raise InputError(log, f"not a JSON object: {exc.msg} (a days.jsonl that tasker day wrote, or "
-                                  "resume without it)", line=n) from None
+        try:  # within the readers' limits: nesting, 64-bit integers
+            r = parse_json(line, log, line=n)
+        except InputError as exc:
+            what = exc.message.removeprefix("not valid JSON: ").removeprefix("not readable JSON: ")
+            raise InputError(log, f"not a JSON object: {what} (a days.jsonl that tasker day wrote, or resume "
+                                  "without it)", line=n, field=exc.field) from None
         why = _day_problem(r)
         if why:
             raise InputError(log, f"{why[1]} (a days.jsonl that tasker day wrote, or resume without it)", line=n,

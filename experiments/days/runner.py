@@ -30,9 +30,10 @@ from experiments.trace.timeline import Timeline
 from tasker.errors import ConfigError
 
 
-def scheduler_options(proto: protocols.Protocol, name: str, backend: str = "synthetic") -> dict[str, Any]:
+def scheduler_options(proto: protocols.Protocol, name: str, backend: str = "synthetic", seed: int = 0,
+                      ) -> dict[str, Any]:
     """Options each scheduler gets from the protocol (:func:`experiments.days.pipeline.scheduler_options`)."""
-    return day_pipeline.scheduler_options(proto, name, backend)
+    return day_pipeline.scheduler_options(proto, name, backend, seed)
 
 
 def run_day(protocol: str, seed: int, scheduler: str, backend: str = "synthetic",
@@ -51,7 +52,7 @@ def run_day(protocol: str, seed: int, scheduler: str, backend: str = "synthetic"
     kinds = {v: k for k, v in day_pipeline.task_names(proto, backend).items()}
     tl = Timeline.of(run.events)  # the day's trace, read once
     out = {"scheduler": scheduler, "seed": seed, "backend": backend, "strategy": Strategy(**settings).label,
-           **day_metrics(tl, day_end=proto.length_s, kinds=kinds)}
+           **day_metrics(tl, day_end=proto.length_s, kinds=kinds, step_s=proto.step_s)}
     if backend == "robot":
         out |= path_metrics(tl, run.samples)
         out |= hazard_metrics(tl)

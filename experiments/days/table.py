@@ -2,9 +2,19 @@
 
 :func:`report` is what ``tasker day`` writes to ``table.md``: :func:`table` per strategy
 (metrics per scheduler, mean ± half-width of the 95 % t interval over days; how the days
-ended; ``lookahead`` against each baseline, paired by seed, Wilcoxon signed-rank,
-Holm-corrected), the strategies against the first under every scheduler, and the days that
-failed to run.
+ended, by TaBSA's stopping rule and by ours; ``lookahead`` against each baseline, paired by
+seed), the strategies against the first under every scheduler, and the days that failed to run.
+
+**Every comparison** gives its effect size — the mean paired difference over days with its
+95 % t interval, and how many days it was lower, tied, higher — the Wilcoxon signed-rank p
+Holm-corrected over every test of the table, and a verdict from the metric's registered
+direction (:mod:`experiments.metrics.registry`): *better*, *worse*, or *no difference shown*.
+**No verdict below a minimum number of days** (:func:`min_days`), fixed by the family's size
+before any result: with n paired days the signed-rank test's smallest two-sided p is
+2^(1 − n) (every day differing in one direction), and Holm multiplies the smallest p by the
+number m of tests, so below n = ⌈log2(2m / α)⌉ days no test of the table could reject at
+α = 0.05 and "no difference shown" would be a statement about the number of days, not the
+schedulers: the verdict reads *too few days* instead.
 """
 
 from __future__ import annotations
@@ -16,8 +26,12 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from experiments.analysis.stats import estimate, holm
-from experiments.metrics.day import ENDINGS
+from experiments.analysis.stats import ALPHA, estimate, holm
+from experiments.metrics.day import ENDINGS, TABSA_ENDINGS
+from experiments.metrics.registry import Direction, direction
+
+OURS = ("simple", "simple2", "distance")
+"""Our priority-first readings of TaBSA's agents: labelled "(ours)" beside TaBSA's own (``tabsa-*``)."""
 
 
 def _ci(values: Sequence[float]) -> tuple[float, float]:
@@ -46,6 +60,8 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
         *((f"completion − deadline: {t} (s)", f"gap_{t}",
            lambda r, t=t: r["per_type"].get(t, {}).get("completion_minus_deadline_s")) for t in types),
         ("dead falls", "dead", lambda r: r["dead_falls"]),
+        ("completion − death time: fall (s, TaBSA)", "death_gap", lambda r: r.get("completion_minus_death_s")),
+        ("completed by TaBSA's stop (TaBSA)", "tabsa_completed", lambda r: r.get("tabsa_completed")),
         # robot rows: synthetic stages never fail; a day stored before renewals existed made none
         ("failed tasks not served by their renewals (robot)", "failed", lambda r: _robot(r, r["failed"])),
         ("requests made again after a failed task (robot)", "renewals", lambda r: _robot(r, r.get("renewals", 0))),
@@ -73,15 +89,33 @@ def _metric_rows(types: Sequence[str]) -> list[tuple[str, str, Any]]:
     return rows
 
 
-PAIRED = ("dead", "abandonments", "lateness", "gap", "completed", "interruptions", "travel")
+PAIRED = ("dead", "abandonments", "lateness", "gap", "completed", "tabsa_completed", "interruptions", "travel")
 STRATEGY_PAIRED = (*PAIRED, "suspensions", "susp_time", "hazard_s", "hazard_after", "overruns", "left_on")
 """Strategies differ in how a task suspends: their comparison adds what the suspensions cost."""
+REGISTERED = {"dead": "day.dead_falls", "abandonments": "day.abandonments", "lateness": "day.lateness_s",
+              "gap": "day.completion_minus_deadline_s", "completed": "day.completed",
+              "tabsa_completed": "day.tabsa_completed", "interruptions": "day.interruptions",
+              "travel": "day.travel_m", "suspensions": "day.suspensions_with_stages",
+              "susp_time": "day.suspension_time_s", "hazard_s": "day.hazard_unattended_s",
+              "hazard_after": "day.hazard_after_end_s", "overruns": "day.hazard_overruns",
+              "left_on": "day.hazards_left_at_switch"}
+"""Each compared row's registered metric: its direction gives the verdict."""
+
+
+def min_days(tests: int, alpha: float = ALPHA) -> int:
+    """The fewest paired days at which a Wilcoxon signed-rank test, Holm-corrected over ``tests``
+    tests, could reject at ``alpha``: the smallest n with 2^(1 − n) · tests < alpha."""
+    return max(2, math.ceil(math.log2(2 * max(1, tests) / alpha) + 1e-12))
 
 
 def _wilcoxon(diff: np.ndarray) -> float:
     if len(diff) == 0 or np.all(diff == 0):
         return 1.0
     return float(stats.wilcoxon(diff, zero_method="zsplit").pvalue)
+
+
+def _header(name: str) -> str:
+    return f"{name} (ours)" if name.split(":")[0] in OURS else name
 
 
 def table(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead", title: str = "") -> str:
@@ -91,8 +125,9 @@ def table(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead",
     types = sorted({t for r in results for t in r["per_type"]})
     rows = _metric_rows(types)
     days = len(by[names[0]]) if names else 0
+    heads = [_header(n) for n in names]
     out = [f"## {title}" if title else "", f"{days} days per scheduler; mean ± half-width of the 95 % CI over days.",
-           "", "| metric | " + " | ".join(names) + " |", "|---|" + "---|" * len(names)]
+           "", "| metric | " + " | ".join(heads) + " |", "|---|" + "---|" * len(names)]
     for label, _, get in rows:
         cells = []
         for n in names:
@@ -100,24 +135,50 @@ def table(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead",
             cells.append(_fmt(*_ci(vals)) if vals else "–")
         if any(c != "–" for c in cells):  # e.g. path metrics exist only on the robot backend
             out.append(f"| {label} | " + " | ".join(cells) + " |")
-    out += ["", "How the days ended (TaBSA's first stopping condition; the day is run to its end):", "",
-            "| ending | " + " | ".join(names) + " |", "|---|" + "---|" * len(names)]
+    if any("tabsa_ending" in r for r in results):  # days stored before TaBSA's rule was read have none
+        out += ["", "How the days end by TaBSA's rule (`test_planner.py` stops its day at the first of these; "
+                "its oscillation: the task of a step with more than 2 gaps in 180 s; the day is run to its end "
+                "here, so the rows above count the whole day):", "",
+                "| ending (TaBSA) | " + " | ".join(heads) + " |", "|---|" + "---|" * len(names)]
+        for ending in TABSA_ENDINGS:
+            out.append(f"| {ending} | " + " | ".join(
+                str(sum(1 for r in by[n] if r.get("tabsa_ending") == ending)) for n in names) + " |")
+    out += ["", "How the days ended by our rule (our oscillation: a task's third start within 180 s):", "",
+            "| ending (ours) | " + " | ".join(heads) + " |", "|---|" + "---|" * len(names)]
     for ending in ENDINGS:
         out.append(f"| {ending} | " + " | ".join(str(sum(1 for r in by[n] if r["ending"] == ending)) for n in names)
                    + " |")
     if reference in by and len(names) > 1:
-        out += ["", f"Paired over days: {reference} − baseline (mean ± 95 % CI; negative is fewer/earlier); "
-                "Wilcoxon signed-rank, Holm-corrected over every test in this table.", "",
-                "| metric | baseline | difference | p (Holm) |", "|---|---|---|---|"]
+        out += ["", *_paired_intro(f"{reference} − baseline")]
         out += _paired(rows, [(n, by[reference], by[n]) for n in names if n != reference])
     return "\n".join(line for line in out if line is not None).lstrip("\n") + "\n"
+
+
+def _paired_intro(what: str) -> list[str]:
+    return [f"Paired over days: {what}.  Effect: the mean difference with its 95 % t interval (negative: "
+            "fewer/earlier), and the days it was lower / tied / higher.  p: Wilcoxon signed-rank, Holm-corrected "
+            "over every test of this table; verdict from the metric's registered direction, none below the "
+            "minimum number of days (see docs/benchmark.md).", "",
+            "| metric | compared with | days | difference (95 % CI) | lower / tied / higher | p (Holm) | verdict |",
+            "|---|---|---|---|---|---|---|"]
+
+
+def _verdict(key: str, mean: float, p: float, n: int, least: int) -> str:
+    if n < least:
+        return f"too few days (< {least})"
+    if math.isnan(p) or p >= ALPHA:
+        return "no difference shown"
+    way = direction(REGISTERED.get(key, ""))
+    if way is None or way is Direction.NEITHER:
+        return "differs"
+    return "better" if (mean < 0) == (way is Direction.LOWER) else "worse"
 
 
 def _paired(rows: Sequence[tuple[str, str, Any]],
             groups: Sequence[tuple[str, Sequence[Mapping[str, Any]], Sequence[Mapping[str, Any]]]],
             keys: Sequence[str] = PAIRED) -> list[str]:
-    """Table lines ``| metric | name | a − b | p (Holm) |`` for each metric of ``keys`` and each
-    ``(name, a days, b days)``, paired by seed; Holm over every line."""
+    """Table lines (see :func:`_paired_intro`) for each metric of ``keys`` and each ``(name, a days,
+    b days)``, ``a − b`` paired by seed; Holm over every line, verdicts from :data:`REGISTERED`."""
     tests = []
     getters = {key: (label, get) for label, key, get in rows}
     for key in keys:
@@ -128,10 +189,16 @@ def _paired(rows: Sequence[tuple[str, str, Any]],
             if not pairs:
                 continue
             diff = np.array([a - b for a, b in pairs], dtype=float)
-            tests.append((label, name, diff, _wilcoxon(diff)))
+            tests.append((key, label, name, diff, _wilcoxon(diff)))
     adjusted = holm([p for *_, p in tests])
-    return [f"| {label} | {n} | {_fmt(*_ci(list(diff)))} | {p:.3g} |"
-            for (label, n, diff, _), p in zip(tests, adjusted, strict=True)]
+    least = min_days(len(tests))
+    out = []
+    for (key, label, n, diff, _), p in zip(tests, adjusted, strict=True):
+        mean, half = _ci(list(diff))
+        counts = f"{int(np.sum(diff < 0))} / {int(np.sum(diff == 0))} / {int(np.sum(diff > 0))}"
+        out.append(f"| {label} | {_header(n)} | {len(diff)} | {_fmt(mean, half)} | {counts} | {p:.3g} | "
+                   f"{_verdict(key, mean, p, len(diff), least)} |")
+    return out
 
 
 def report(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead", title: str = "") -> str:
@@ -151,9 +218,7 @@ def report(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead"
               for lb in labels for n in names}
         types = sorted({t for r in ok for t in r["per_type"]})
         lines = [f"## Strategies compared: each − `{first}`, under the same scheduler",
-                 "Paired over days (mean ± 95 % CI; negative is fewer/earlier); Wilcoxon signed-rank, "
-                 "Holm-corrected over every test in this table.", "",
-                 "| metric | strategy, scheduler | difference | p (Holm) |", "|---|---|---|---|"]
+                 *_paired_intro(f"each strategy − `{first}`, under the same scheduler")]
         lines += _paired(_metric_rows(types), [(f"`{lb}`, {n}", of[lb, n], of[first, n])
                                                for lb in labels[1:] for n in names], STRATEGY_PAIRED)
         text = "\n".join(parts) + "\n" + "\n".join(lines) + "\n"

@@ -16,7 +16,7 @@ from typing import Any
 
 from experiments.inputs.fields import MODES, ScenarioError
 from experiments.inputs.request_fields import FIELD_NAMES
-from tasker.support.reader import Table, check_name, suggest
+from tasker.support.reader import MAX_SECONDS, Table, check_name, suggest
 
 __all__ = ["NO_REQUESTS", "TABLES", "WORLD_EVENT_KINDS", "ScenarioError", "TimedAction", "located", "read_actions"]
 
@@ -54,7 +54,7 @@ def read_actions(top: Table, *, task_names: Collection[str] | None = None,
         if kind == "world" and not world_events:
             continue
         for i, f in enumerate(top.tables(key, [])):
-            t = float(f.number("t", min=0))
+            t = float(f.number("t", min=0, max=MAX_SECONDS))  # the clock steps to it: 1e300 never came
             out.append(TimedAction(t, kind, _read(f, kind, task_names), (key, i)))
             f.done()
     actions = tuple(sorted(out, key=lambda a: a.t))

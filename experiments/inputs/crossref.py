@@ -181,6 +181,12 @@ class _Checker:
             for name, sig in getattr(d, "predicates", {}).items():
                 self.predicates.setdefault(name, set()).add(len(sig))
 
+    @property
+    def devices(self) -> dict[str, tuple[str, str]]:
+        """Every device, the world's and the scenario's: name -> (type, state at the start)."""
+        out = {n: (d.type, d.state) for n, d in self.world.devices.items()}
+        return out | {n: (d["type"], d["state"]) for n, d in self.scn.devices.items()}
+
     def warn(self, t: Table, key: str | int | None, message: str) -> None:
         self.warnings.append(t.warn(key, message))
 
@@ -209,10 +215,29 @@ class _Checker:
                 check_name(t, "type", entry["type"], self.types, "object type")
             check_name(t, "place", entry["place"], self.world.places, f"place of world {self.world.name!r}")
             self.objects[name] = entry["type"]
+        self.scenario_devices()
         for name, entry in self.scn.objects.items():
             t = ot.at(name, ot.data[name])
             for i, fact in enumerate(entry["facts"]):
                 self.fact(t.at("facts", {}), i, fact)
+
+    def scenario_devices(self) -> None:
+        """``[devices.NAME]``: a new name, a type of the task types' domains, a place of the world."""
+        from robot.spec import name_problem
+
+        dt = self.top.table("devices", {})
+        for name, entry in self.scn.devices.items():
+            t = dt.at(name, dt.data[name])
+            if name in self.objects:
+                raise dt.error(name, f"the name {name!r} is already a {self.objects[name]} of world "
+                                     f"{self.world.name!r} or of this scenario's [objects]; expected a new name")
+            bad = name_problem(name)
+            if bad:
+                raise dt.error(name, bad)
+            if self.types:
+                check_name(t, "type", entry["type"], self.types, "device type")
+            check_name(t, "place", entry["place"], self.world.places, f"place of world {self.world.name!r}")
+            self.objects[name] = entry["type"]
 
     def fact(self, t: Table, key: str | int, fact: Sequence[str]) -> None:
         """A fact names a known predicate with its arity, over objects of the world."""
@@ -298,7 +323,7 @@ class _Checker:
                     check_name(f, what, value[0], self.world.people, f"person of world {self.world.name!r}")
                     check_point(self.world, f, what, float(value[1]), float(value[2]))
                 elif what == "device":
-                    check_name(f, what, value[0], self.world.devices, f"device of world {self.world.name!r}")
+                    check_name(f, what, value[0], self.devices, f"device of world {self.world.name!r} or the scenario")
                 elif what == "move":
                     things = {**self.world.objects, **{n: o["type"] for n, o in self.scn.objects.items()}}
                     check_name(f, what, value[0], things, f"object of world {self.world.name!r} or the scenario")
@@ -326,7 +351,7 @@ class _Checker:
         ``device``) never applies: the robot would, say, "hold" the item only symbolically.  A device
         in a state its binding does not name (``"On"`` for ``"on"``) reads as the fact not holding."""
         meaning = getattr(task, "meaning", None)
-        things = {"device": set(self.world.devices), "door": set(self.world.doors),
+        things = {"device": set(self.devices), "door": set(self.world.doors),
                   "held": set(self.world.objects) | set(self.scn.objects),
                   "follower": set(self.world.people), "waiting": set(self.world.people)}
         for b in getattr(meaning, "bindings", ()):
@@ -340,10 +365,10 @@ class _Checker:
                                      f"{self.world.name!r}, so the fact stays symbolic"
                                      + (f" (kind = {' or '.join(map(repr, fits))}?)" if fits else ""))
             if b.kind == "device":
-                for n, d in sorted(self.world.devices.items()):
-                    if d.type in b.types and d.state not in (b.state, b.otherwise):
+                for n, (ty, state) in sorted(self.devices.items()):
+                    if ty in b.types and state not in (b.state, b.otherwise):
                         self.warn(f, "task", f"device {n!r} of world {self.world.name!r} starts in state "
-                                             f"{d.state!r}, and task type {task.name!r} reads {list(b.fact)} from "
+                                             f"{state!r}, and task type {task.name!r} reads {list(b.fact)} from "
                                              f"state {b.state!r} (else {b.otherwise!r}): it starts as not holding; "
                                              f"expected state = {b.state!r} or {b.otherwise!r}")
 

@@ -82,8 +82,13 @@ def scheduler_defaults(name: str, options: Mapping[str, Any], tasks: Iterable[Ta
     return out
 
 
+MAX_RATE_HZ = 1000.0
+"""The fastest rate a scenario may set (the model's run at 1 to 10 Hz): a rate of 1e300 Hz made the
+loop step forever."""
+
+
 def rate(s: Table, key: str, default: float) -> float:
-    return float(s.number(key, default, positive=True))
+    return float(s.number(key, default, positive=True, max=MAX_RATE_HZ))
 
 
 def _suggest(name: str, known: list[str]) -> str:

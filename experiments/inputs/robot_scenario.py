@@ -15,7 +15,9 @@ class RobotScenario:
     """A checked robot scenario.
 
     ``objects`` are the scenario's own things (``[objects.NAME]``):
-    ``{name: {"type", "place", "facts"}}``; ``warnings`` what the loader accepted but
+    ``{name: {"type", "place", "facts"}}``; ``devices`` its own devices (``[devices.NAME]``),
+    added to the world like a world file's ``[devices]``: ``{name: {"type", "place", "state"}}``;
+    ``warnings`` what the loader accepted but
     doubts (a request after the horizon, two identical requests that overlap).
     """
 
@@ -37,6 +39,7 @@ class RobotScenario:
     horizon: float = 1800.0
     people: dict[str, dict[str, Any]] = field(default_factory=dict)
     objects: dict[str, dict[str, Any]] = field(default_factory=dict)
+    devices: dict[str, dict[str, Any]] = field(default_factory=dict)
     policy: str = "strict"
     secure_over_higher: bool = False
     """Hazard-aware waiting may preempt a task of a higher priority class to secure a hazard (off: the

@@ -33,12 +33,13 @@ from experiments.inputs.perturbation import Perturbation
 from experiments.inputs.robot_scenario import RobotScenario
 from tasker.support import reader
 
-__all__ = ["InterruptionGrid", "RobotScenario", "ScenarioError", "load", "randomize", "resolve", "kind_of", "SCENARIOS"]
+__all__ = ["InterruptionGrid", "RobotScenario", "ScenarioError", "load", "randomize", "resolve", "kind_of", "SCENARIOS",
+           "with_devices"]
 
 SCENARIOS = Path(__file__).resolve().parent / "scenarios"
 
 
-SCENARIO_KEYS = ("kind", "name", "world", "seed", "settings", "people", "objects", *(k for k, _ in TABLES))
+SCENARIO_KEYS = ("kind", "name", "world", "seed", "settings", "people", "objects", "devices", *(k for k, _ in TABLES))
 
 
 def resolve(name_or_path: str | Path) -> Path:
@@ -142,6 +143,10 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
             facts.append([str(a) for a in fact])
         objects[name] = {"type": of.string("type"), "place": of.string("place"), "facts": facts}
         of.done()
+    devices: dict[str, dict[str, Any]] = {}
+    for name, df in top.named("devices"):  # as a world file's [devices]: a type, a place, a state
+        df.done(("type", "place", "state"))  # a misspelt key is named as such, not as a missing one
+        devices[name] = {"type": df.string("type"), "place": df.string("place"), "state": df.string("state", "off")}
     scenario = RobotScenario(
         name=str(top.string("name", p.stem)), source=source, world=world, actions=actions,
         scheduler=sched, scheduler_options=dict(s.table("scheduler_options", {}).items()),
@@ -151,8 +156,8 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
         update=str(s.string("update", "planned", choices=STRATEGIES)),
         suspension=str(s.string("suspension", "planned", choices=SUSPENSIONS)), strategies=strategies,
         seed=int(top.number("seed", 1, integer=True, min=0, max=reader.MAX_SEED)),
-        horizon=float(s.number("horizon", 1800.0, positive=True)),
-        people=people, objects=objects, policy=str(s.string("policy", "strict", choices=POLICIES)),
+        horizon=float(s.number("horizon", 1800.0, positive=True, max=reader.MAX_SECONDS)),
+        people=people, objects=objects, devices=devices, policy=str(s.string("policy", "strict", choices=POLICIES)),
         secure_over_higher=bool(s.boolean("secure_over_higher", False)),
         request_fields=bool(s.boolean("request_fields", False)),
     )
@@ -170,6 +175,27 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
     options = fields.scheduler_defaults(scenario.scheduler, scenario.scheduler_options, types)
     return scenario if options == scenario.scheduler_options else dataclasses.replace(scenario,
                                                                                       scheduler_options=options)
+
+
+def with_devices(scenario: RobotScenario, spec: Any) -> Any:
+    """The world ``spec`` (a :class:`robot.spec.WorldSpec`) with the scenario's ``[devices]``, as if its
+    file listed them; a name the world uses or a place it lacks is a :class:`ScenarioError` (a scenario
+    loaded with its checks has been refused for these already, with the line)."""
+    if not scenario.devices:
+        return spec
+    from robot.spec import Device
+
+    devices = dict(spec.devices)
+    taken = {*spec.places, *spec.people, *spec.devices, *spec.doors, *spec.objects, "robot"}
+    for name, d in sorted(scenario.devices.items()):
+        if name in taken:
+            raise ScenarioError(scenario.source, f"the world {spec.name!r} already has something called {name!r}",
+                                field=f"devices.{name}")
+        if d["place"] not in spec.places:
+            raise ScenarioError(scenario.source, f"no place {d['place']!r} in world {spec.name!r}; known: "
+                                                 f"{', '.join(sorted(spec.places))}", field=f"devices.{name}.place")
+        devices[name] = Device(name, d["type"], d["place"], d["state"])
+    return dataclasses.replace(spec, devices=devices)
 
 
 @dataclass(frozen=True)
@@ -293,7 +319,7 @@ def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, 
         if placed is None:
             raise ScenarioError(scenario.source, "perturbation: needs an interruption grid ([variants.NAME]) to "
                                                  "place its window around")
-        offer = perturbations.candidates(spec, scenario.objects, actions, people)
+        offer = perturbations.candidates(with_devices(scenario, spec), scenario.objects, actions, people)
         drawn_events = perturbations.events(perturbation, f"{scenario.name}:{seed}", placed, **offer)
         actions += [dataclasses.replace(a, origin=("perturbation", k)) for k, a in enumerate(drawn_events)]
     return dataclasses.replace(scenario, actions=tuple(sorted(actions, key=lambda a: a.t)), people=people,

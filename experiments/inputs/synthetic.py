@@ -57,7 +57,7 @@ SYNTHETIC_KEYS = ("kind", "name", "seed", "settings", "tasks", *(k for k, _ in T
 
 def _stage(f: Table) -> Stage:
     kind = f.string("kind", "suspendable", choices=("suspendable", "blocking"))
-    duration = float(f.number("duration", min=0))
+    duration = float(f.number("duration", min=0, max=reader.MAX_SECONDS))
     data: dict[str, Any] = {}
     if "site" in f:
         data["site"] = _site(f)
@@ -124,7 +124,7 @@ def load(path: str | Path) -> SyntheticScenario:
                     fields.rate(settings, "sp_up_rate", 1.0)),
         jitter=float(settings.number("jitter", 0.0, min=0, max=1)),
         seed=int(top.number("seed", 0, integer=True, min=0, max=reader.MAX_SEED)),
-        horizon=float(settings.number("horizon", 24 * 3600.0, positive=True)),
+        horizon=float(settings.number("horizon", 24 * 3600.0, positive=True, max=reader.MAX_SECONDS)),
     )
     settings.done()
     top.done(SYNTHETIC_KEYS)

@@ -29,10 +29,15 @@ from tasker.trace import FAILED, number
 OSCILLATION_SWITCHES = 3
 OSCILLATION_WINDOW_S = 180.0
 ENDINGS = ("all done", "a fall died", "oscillation", "time ran out")
+TABSA_STEP_S = 5.0
+"""TaBSA's step (``SystemConfig.dt``): its oscillation rule looks at the task run in each step."""
+TABSA_GAPS = 2
+"""TaBSA's oscillation (``my_eval_functions.py``, ``StatisticEval``): the task run in this step
+ran in more than this many separate stretches (gaps between them) in the window."""
 
 
 def day_metrics(events: Timeline | Iterable[ev.Event | Mapping[str, Any]], *, day_end: float | None = None,
-                kinds: Mapping[str, str] | None = None) -> dict[str, Any]:
+                kinds: Mapping[str, str] | None = None, step_s: float = TABSA_STEP_S) -> dict[str, Any]:
     """The protocol metrics of one day's trace (see the module docstring and ``docs/benchmark.md``).
 
     ``kinds`` maps a trace's task type to the protocol's task type (the robot backend runs
@@ -41,8 +46,12 @@ def day_metrics(events: Timeline | Iterable[ev.Event | Mapping[str, Any]], *, da
     ``day_end`` is when the day stops (default: the time of the last event).  A fall is
     dead when it was not finished by its request's ``death_at`` and that time falls
     within the day.  A switch to a task is a ``start`` command to its agent; the day
-    oscillates when a task gets its third switch within 180 s of the first of the three.
-    An interruption is a suspension not made because the task's own stage failed.
+    oscillates (ours) when a task gets its third switch within 180 s of the first of the
+    three.  An interruption is a suspension not made because the task's own stage failed.
+
+    TaBSA's own readings (``tabsa_*``, :func:`tabsa_oscillation`, :func:`tabsa_stop`): its
+    oscillation, sampled every ``step_s``; the time its day would have stopped, and why; the
+    needs served by then; and each served fall's completion − death time.
     """
     tl = timeline(events)
     end_t = day_end if day_end is not None else tl.t_end
@@ -78,7 +87,8 @@ def day_metrics(events: Timeline | Iterable[ev.Event | Mapping[str, Any]], *, da
                        "failed": sum(a in unserved_failed for a in asked), "renewals": len(mine) - len(asked),
                        "completion_minus_deadline_s": _mean(gaps), "lateness_s": sum(max(0.0, g) for g in gaps),
                        "late": sum(1 for g in gaps if g > 0), "interruptions": n_int,
-                       "interruptions_per_task": n_int / len(asked) if asked else None}
+                       "interruptions_per_task": n_int / len(asked) if asked else None,
+                       "gaps_s": gaps}
         for a in asked:
             death = args[a].get("death_at")
             if death is not None and number(death) <= end_t and served.get(a, math.inf) > number(death):
@@ -92,7 +102,14 @@ def day_metrics(events: Timeline | Iterable[ev.Event | Mapping[str, Any]], *, da
     else:
         ending = "all done" if len(served) == len(firsts) else "time ran out"
     all_gaps = [served[a] - number(args[a]["deadline"]) for a in served if args[a].get("deadline") is not None]
+    to_death = [served[a] - number(args[a]["death_at"]) for a in served if args[a].get("death_at") is not None]
+    t_osc = tabsa_oscillation(tl, end_t, step_s)
+    stop_t, stop_why = tabsa_stop(served, len(firsts), first_death, t_osc, end_t)
+    for t, row in per_type.items():
+        row["tabsa_completed"] = sum(1 for a in served if kind[a] == t and served[a] <= stop_t)
     return {
+        "completion_minus_death_s": _mean(to_death), "tabsa_oscillation_t": t_osc, "tabsa_ending": stop_why,
+        "tabsa_stop_t": stop_t, "tabsa_completed": sum(1 for when in served.values() if when <= stop_t),
         "requested": len(firsts), "completed": len(served), "failed": len(unserved_failed),
         "renewals": len(kind) - len(firsts),
         "completion_minus_deadline_s": _mean(all_gaps), "lateness_s": sum(max(0.0, g) for g in all_gaps),
@@ -125,3 +142,46 @@ def _oscillation(starts: Mapping[str, list[float]]) -> float | None:
     hits = [ts[i + k] for ts in starts.values() for i in range(len(ts) - k)
             if ts[i + k] - ts[i] <= OSCILLATION_WINDOW_S]
     return min(hits) if hits else None
+
+
+def tabsa_oscillation(tl: Timeline, day_end: float, step_s: float = TABSA_STEP_S) -> float | None:
+    """When TaBSA's oscillation rule first fires, or None.
+
+    TaBSA (``StatisticEval.calculate_results``) keeps the task run in each of the last
+    ``180 / step + 1`` steps; the day oscillates when the task run in this step has more than
+    :data:`TABSA_GAPS` gaps between its runs there (a gap: other steps between two of its runs),
+    so at least four separate stretches in three minutes.
+    Here the task run in a step is the need (a renewal is its request's need) whose agent is
+    ``exeDA`` at the step's time; steps before the day count as idle."""
+    width = int(OSCILLATION_WINDOW_S / step_s) + 1
+    changes = tl.exe_changes()
+    k, current = 0, None
+    window: list[str | None] = [None] * width
+    for n in range(int(day_end / step_s) + 1):
+        t = n * step_s
+        while k < len(changes) and changes[k][0] <= t + 1e-9:
+            current = changes[k][1]
+            k += 1
+        job = tl.needs.get(current, current) if current is not None else None
+        window.append(job)
+        window.pop(0)
+        if job is None or window.count(job) <= TABSA_GAPS:
+            continue
+        idx = [i for i, x in enumerate(window) if x == job]
+        if sum(1 for i, j in zip(idx, idx[1:], strict=False) if j - i > 1) > TABSA_GAPS:
+            return t
+    return None
+
+
+TABSA_ENDINGS = ("all done", "a fall died", "oscillation", "time ran out")
+"""How TaBSA's day ends (``test_planner.py``: its loop stops at the first; the day's end otherwise)."""
+
+
+def tabsa_stop(served: Mapping[str, float], needs: int, first_death: float | None, oscillation: float | None,
+               day_end: float) -> tuple[float, str]:
+    """When and why TaBSA's day would stop: the earliest of every need served, a fall dead,
+    TaBSA's oscillation; else the day's end ("time ran out")."""
+    done = max(served.values()) if served and len(served) == needs else None
+    stops = [(t, why) for t, why in ((done, "all done"), (first_death, "a fall died"), (oscillation, "oscillation"))
+             if t is not None and t <= day_end]
+    return min(stops, key=lambda s: (s[0], TABSA_ENDINGS.index(s[1]))) if stops else (day_end, "time ran out")

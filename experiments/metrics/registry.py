@@ -204,6 +204,12 @@ METRICS: tuple[Metric, ...] = (
     Metric("day.hazard_after_end_s", "s", L, "unattended after the owner ended (as safety.after_end_s)"),
     Metric("day.hazard_overruns", "count", L, "hazard budget overruns"),
     Metric("day.hazards_left_at_switch", "count", L, "hazards left on at a switch"),
+    Metric("day.completion_minus_death_s", "s", L, "TaBSA: completion − death time, mean over served falls",
+           label="completion − death time, falls (s)"),
+    Metric("day.tabsa_oscillation_t", "s", N, "TaBSA: when the task of a step first had more than 2 gaps in 180 s"),
+    Metric("day.tabsa_stop_t", "s", N, "TaBSA: when its day would stop (all done, a fall dead, oscillation, end)"),
+    Metric("day.tabsa_completed", "count", H, "TaBSA: needs served by the time its day would stop",
+           label="completed by TaBSA's stop"),
 )
 """Every registered metric, in the order ``docs/metrics.md`` lists them."""
 

@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from tasker.errors import TaskerError
+from tasker.support import reader
 
 SCHEMA_VERSION = 1
 
@@ -58,6 +59,12 @@ CREATE TABLE IF NOT EXISTS sweeps (
 );
 """
 
+MAX_ROWS = 1_000_000
+"""The most runs a results database may hold (a sweep has at most 100 000 jobs)."""
+
+MAX_CELL_BYTES = 16 * 2**20
+"""The largest record, metrics or error text of one run (a run's are a few kB)."""
+
 JobKey = tuple[str, int, str]
 """``(scenario, seed, strategy)``: what identifies one run of a sweep."""
 
@@ -68,6 +75,41 @@ _COLUMNS = {
              "finished"),
     "sweeps": ("id", "started", "spec", "setup"),
 }
+
+
+def _remove(path: Path) -> None:
+    """Delete a database file with its ``-wal``, ``-shm`` and ``-journal`` files (those that exist)."""
+    for p in (path, *(Path(f"{path}{x}") for x in ("-wal", "-shm", "-journal"))):
+        try:
+            p.unlink(missing_ok=True)
+        except OSError:
+            pass
+
+
+def holds_results(path: str | Path) -> bool:
+    """Whether ``path`` is a results database that holds anything: a missing file, an empty one or
+    a database a failed first write left without the schema is none, and never blocks a run."""
+    p = Path(path)
+    if not p.is_file() or p.stat().st_size == 0:
+        return False
+    with ResultStore(p, readonly=True, empty_ok=True) as store:
+        return store._has_schema
+
+
+def remove(path: str | Path) -> bool:
+    """Delete the results database at ``path`` (``--overwrite``); ``False`` if there was none.
+
+    Only a results database (or an empty file) is deleted: another program's file is refused
+    (:class:`StoreError`), as every write to one is."""
+    p = Path(path)
+    if not p.exists():
+        return False
+    if p.is_file() and p.stat().st_size > 0:
+        ResultStore(p, readonly=True, empty_ok=True).close()  # refuses a file that is not one
+    elif not p.is_file():
+        raise StoreError(f"{p}: is not a file, expected a results database")
+    _remove(p)
+    return True
 
 
 class StoreError(TaskerError, RuntimeError):
@@ -132,12 +174,14 @@ class ResultStore:
     Use as a context manager, or call :meth:`close`.
     """
 
-    def __init__(self, path: str | Path, *, readonly: bool = False) -> None:
+    def __init__(self, path: str | Path, *, readonly: bool = False, empty_ok: bool = False) -> None:
         self.path = Path(path)
         self.readonly = readonly
+        self._has_schema = True
         if readonly:
             if not self.path.is_file():
-                raise StoreError(f"{self.path}: no such results database")
+                raise StoreError(f"{self.path}: " + ("no such results database" if not self.path.exists() else
+                                                     "is not a regular file, expected a results database"))
             try:
                 # mode=ro: a reader never creates, migrates or journals anything.  Without a live
                 # writer (no -wal file: a sweep removes it when it closes) the file is opened
@@ -146,16 +190,21 @@ class ResultStore:
                 flags = "mode=ro" if live else "mode=ro&immutable=1"
                 self._db = sqlite3.connect(f"{self.path.resolve().as_uri()}?{flags}", uri=True, timeout=30.0,
                                            isolation_level=None)
-                self._check_schema(must_exist=True)
+                self._has_schema = not self._check_schema(must_exist=not empty_ok)
             except sqlite3.DatabaseError as exc:
                 raise StoreError(f"{self.path}: not a results database: {exc}") from None
             return
         if self.path.is_dir():
             raise StoreError(f"{self.path}: is a directory, expected a results database file")
+        if self.path.exists() and not self.path.is_file():
+            raise StoreError(f"{self.path}: is not a regular file (a device, a pipe or a socket), expected a "
+                             "results database file")
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise StoreError(f"{self.path}: cannot create its folder: {exc.strerror or exc}") from None
+        new = not self.path.exists() or self.path.stat().st_size == 0
+        self._db = None  # type: ignore[assignment]
         try:
             # isolation_level=None: we issue BEGIN/COMMIT ourselves, one transaction per run
             self._db = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
@@ -169,7 +218,17 @@ class ResultStore:
                             db.execute(statement)
                     db.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),))
         except sqlite3.DatabaseError as exc:
-            raise StoreError(f"{self.path}: not a results database: {exc}") from None
+            if self._db is not None:
+                self._db.close()
+            if new:  # a first write that failed (a full disk): leave nothing that would block the next run
+                _remove(self.path)
+            what = "not a results database" if isinstance(exc, sqlite3.DatabaseError) and not isinstance(
+                exc, sqlite3.OperationalError) else "cannot create the results database"
+            raise StoreError(f"{self.path}: {what}: {exc}") from None
+        except StoreError:
+            self._db.close()
+            raise
+        self._has_schema = True
 
     def _check_schema(self, *, must_exist: bool) -> bool:
         """Is this an empty database (``True``), ours (``False``), or neither (:class:`StoreError`)?"""
@@ -209,7 +268,8 @@ class ResultStore:
         try:
             yield self._db
         except BaseException:
-            self._db.execute("ROLLBACK")
+            if self._db.in_transaction:  # SQLite has rolled back already after some errors (a full disk)
+                self._db.execute("ROLLBACK")
             raise
         self._db.execute("COMMIT")
 
@@ -234,6 +294,9 @@ class ResultStore:
                 )
         except sqlite3.IntegrityError:
             return False
+        except sqlite3.DatabaseError as exc:  # a full disk, a file made read-only meanwhile
+            raise StoreError(f"{self.path}: cannot store a result: {exc} (what was stored before is kept: "
+                             "run the same command again to go on)") from None
         return True
 
     def keys(self, status: Status | None = None) -> set[JobKey]:
@@ -261,6 +324,15 @@ class ResultStore:
                + (" WHERE status = ?" if status is not None else "") + " ORDER BY scenario, seed, strategy")
         args = (status.value,) if status is not None else ()
         try:
+            n = self.count()
+            if n > MAX_ROWS:
+                raise StoreError(f"{self.path}: {n} runs, more than the {MAX_ROWS} a results database may hold")
+            big = self._db.execute("SELECT id FROM runs WHERE length(CAST(record AS BLOB)) > ? OR "
+                                   "length(CAST(metrics AS BLOB)) > ? OR length(CAST(error AS BLOB)) > ? LIMIT 1",
+                                   (MAX_CELL_BYTES,) * 3).fetchone()
+            if big is not None:
+                raise StoreError(f"{self.path}: runs row id={big[0]}: a value larger than "
+                                 f"{MAX_CELL_BYTES // 2**20} MiB, more than a run records")
             return [self._row(*r) for r in self._db.execute(sql, args)]
         except sqlite3.DatabaseError as exc:
             raise StoreError(f"{self.path}: cannot read the runs: {exc}") from None
@@ -282,15 +354,21 @@ class ResultStore:
             raise bad("status", f"expected one of {[x.value for x in Status]}, got {st!r}") from None
         decoded = []
         for column, text in (("record", rec), ("metrics", met)):
-            try:
-                value = json.loads(text)
-            except (TypeError, ValueError) as exc:
-                raise bad(column, f"not JSON ({exc})") from None
+            if not isinstance(text, str):
+                raise bad(column, f"not JSON (expected text, got {type(text).__name__})")
+            try:  # within the readers' limits: nesting, 64-bit integers
+                value = reader.parse_json(text, "row")
+            except reader.InputError as exc:
+                why = exc.message.removeprefix("not valid JSON: ").removeprefix("not readable JSON: ")
+                raise bad(column, f"not JSON ({exc.field + ': ' if exc.field else ''}{why})") from None
             if not isinstance(value, dict):
                 raise bad(column, f"expected a JSON object, got {type(value).__name__}")
             decoded.append(value)
         if wall is not None and (isinstance(wall, bool) or not isinstance(wall, int | float)):
-            raise bad("wall", f"expected a number, got {wall!r}")
+            raise bad("wall", f"expected a number, got {wall!r:.40}")
+        for column, value in (("error", err), ("worker", worker)):
+            if value is not None and not isinstance(value, str):
+                raise bad(column, f"expected text, got {value!r:.40}")
         try:
             return RunRow(s, n, k, status, decoded[0], decoded[1], err, wall, worker, fin)
         except ValueError as exc:
@@ -309,9 +387,13 @@ class ResultStore:
     def sweeps(self) -> list[dict[str, Any]]:
         """Every logged sweep start, oldest first: ``started``, ``spec``, ``setup``."""
         out = []
-        for sid, st, sp, se in self._db.execute("SELECT id, started, spec, setup FROM sweeps ORDER BY id"):
+        for sid, st, sp, se in self._db.execute("SELECT id, started, spec, setup FROM sweeps ORDER BY id LIMIT ?",
+                                                (MAX_ROWS,)):
             try:
-                out.append({"started": st, "spec": json.loads(sp), "setup": json.loads(se)})
-            except (TypeError, ValueError) as exc:
-                raise StoreError(f"{self.path}: sweeps row id={sid}: not JSON ({exc})") from None
+                if not all(isinstance(x, str) and len(x) <= MAX_CELL_BYTES for x in (sp, se)):
+                    raise reader.InputError("row", "expected JSON text")
+                out.append({"started": st, "spec": reader.parse_json(sp, "row"), "setup": reader.parse_json(se, "row")})
+            except reader.InputError as exc:
+                why = exc.message.removeprefix("not valid JSON: ").removeprefix("not readable JSON: ")
+                raise StoreError(f"{self.path}: sweeps row id={sid}: not JSON ({why})") from None
         return out

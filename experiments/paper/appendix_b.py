@@ -24,7 +24,9 @@ trace's ``role`` events, which the task folders declare, never from action names
 The trace is read once, as a :class:`~experiments.trace.timeline.Timeline`.  Decision
 values may be ``inf`` (written as the string ``"inf"``): every number is read through
 :func:`num`, and a non-finite comparison never counts as a cost-decided step.
-``docs/paper.md`` explains each step; ``experiments/paper/report.py`` tabulates them.
+``docs/paper.md`` explains each step; ``experiments/paper/report.py`` tabulates them.  The
+numbers are in the cost model's units: seconds for ours, metres for the original
+(``cost_model = "taskER-2019"``).
 """
 
 from __future__ import annotations
@@ -195,7 +197,7 @@ def check(source: Source) -> list[Step]:
     where = "" if s is not None or d is None else f"no switch; closest at t={_fmt(d.t)}: "
     steps.append(Step("John walked toward his destination: guide John (d1) takes back over",
                       s is not None and won and cheaper and apologises, s.t if s else None,
-                      f"{where}{why}; d1 cTime {_fmt(before)} s when suspended, {_fmt(after)} s at this decision; "
+                      f"{where}{why}; d1 cTime {_fmt(before)} when suspended, {_fmt(after)} at this decision; "
                       f"resumes with the apology {sorted(apologies)}: {apologises}", cs, cw))
     t = s.t if s else t
 

@@ -1,45 +1,101 @@
-"""The numbers of ``docs/paper.md``, generated from traces: each Appendix B step and its reproduction rate.
+"""The numbers of ``docs/paper.md``, generated from traces: each Appendix B step, per scenario and model.
 
-    python -m experiments.paper.report --variants 50 --out docs/paper.md
-
-runs the paper scenario (``experiments/inputs/scenarios/paper.toml``) as shipped and
-``--variants`` randomised variants of it (:func:`experiments.inputs.scenario.randomize`,
-seeds 1..N: request and event times within ±25 %, people's poses and John's walk
-within 0.5 m), each with Alg. 2's hysteresis 1.0 (the paper's rule) and 0.9 (the
-original ROS code), checks every trace with :func:`experiments.paper.appendix_b.check`,
-and writes Markdown: per step, the time, ``c_switch``, ``c_wait`` and the margin
-``1 - c_switch/c_wait`` of the shipped run, then how many variants reproduce each
-step and the whole sequence.  With ``--out FILE`` the text replaces what lies between
-the markers ``<!-- paper_report:begin -->`` and ``<!-- paper_report:end -->`` in FILE
-(appended if the markers are absent); without it, it is printed.  Nothing in it is
-typed by hand; the same arguments give the same text (runs are deterministic).
+``tasker paper`` (:mod:`experiments.cli.paper`) runs, for each scenario of :data:`SCENARIOS`
+and each :class:`Config` of :data:`CONFIGS` (a cost model with a switching rule), the
+scenario as shipped and ``variants`` randomised variants of it
+(:func:`experiments.inputs.scenario.randomize`, seeds 1..N: request and event times within
+±25 %, every person's poses and walk within 0.5 m), checks every trace with
+:func:`experiments.paper.appendix_b.check`, and renders Markdown: side by side, which step
+holds in which scenario under which model; then, per scenario and configuration, each step's
+time, ``c_switch``, ``c_wait`` and margin ``1 - c_switch/c_wait``, how many variants reproduce
+each step and the whole sequence, and (for our model, in seconds) each start's predicted
+``cTime`` against what followed.  :func:`splice` puts the text between the markers
+``<!-- paper_report:begin -->`` and ``<!-- paper_report:end -->`` of a document.  Nothing
+in it is typed by hand; the same arguments give the same text (runs are deterministic).
 """
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
-import json
 import math
-import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
-from pathlib import Path
+from dataclasses import dataclass
 from typing import Any
+
+from experiments.analysis.tables import markdown_table
 
 BEGIN = "<!-- paper_report:begin -->"
 END = "<!-- paper_report:end -->"
-HYSTERESES = (1.0, 0.9)
+SCENARIOS = ("paper", "paper-2019")
+"""Fig. 10 as we draw it, and the layout reconstructed from the original verification's record."""
+
+ORIGINAL_FACTORS: dict[str, tuple[float, float, float]] = {"john": (0.15, 0.15, 0.3), "alice": (0.2, 0.2, 0.3)}
+"""(walk, stand, sit) cost per metre of each guided person in the original code
+(``bin/tiago_guideHuman`` at ``56ab62c``: ``factor_walk/stand/sit[0]`` John, ``[1]`` Alice)."""
 
 
-def _scenario(hysteresis: float, variant: int | None, scenario: str = "paper") -> Any:
+@dataclass(frozen=True)
+class Config:
+    """A cost model (``planners.taskspec.COST_MODELS``) and Alg. 2's hysteresis."""
+
+    model: str
+    hysteresis: float
+
+    @property
+    def label(self) -> str:
+        return f"{'ours' if self.model == 'seconds' else self.model}, h = {self.hysteresis}"
+
+
+CONFIGS = (Config("seconds", 1.0), Config("seconds", 0.9), Config("taskER-2019", 0.9))
+"""Ours with the paper's rule (1.0) and the original code's (0.9); the original model with its own
+rule (``c_switch < 0.9 * c_wait``, the 2019 harmoniser)."""
+
+Job = tuple[str, Config, int | None]
+"""(scenario, configuration, variant seed or None for the scenario as shipped)."""
+Run = dict[str, Any]
+
+
+def with_model(scn: Any, model: str) -> Any:
+    """``scn`` with every request of a task type that offers ``model`` asking for it; where the
+    model takes factors, each person's from :data:`ORIGINAL_FACTORS` (the person is the request
+    argument the task folder's model names)."""
+    if model == "seconds":
+        return scn
+    from experiments.inputs.actions import TimedAction
+    from planners.bundled import task_types
+    from planners.pddl_task import PddlTaskType
+    from planners.taskspec import COST_MODEL_ARG
+    from tasker.errors import ConfigError
+
+    offers = {t.name: t.spec.original_costs for t in task_types()
+              if isinstance(t, PddlTaskType) and t.spec.original_costs is not None}
+    actions = []
+    for a in scn.actions:
+        costs = offers.get(a.fields.get("task")) if a.kind == "request" else None
+        if costs is not None:
+            args = {**a.fields["args"], COST_MODEL_ARG: model}
+            if costs.factors:
+                person = args[costs.person[1:]]
+                if person not in ORIGINAL_FACTORS:
+                    raise ConfigError(f"{scn.source}: the original model has no factors for {person!r} "
+                                      f"(known: {', '.join(ORIGINAL_FACTORS)})")
+                args.update(zip((f[1:] for f in costs.factors), ORIGINAL_FACTORS[person], strict=True))
+            a = TimedAction(a.t, a.kind, {**a.fields, "args": args}, a.origin)
+        actions.append(a)
+    return dataclasses.replace(scn, actions=tuple(actions))
+
+
+def scenario_for(job: Job) -> Any:
+    """The scenario a job runs: loaded, randomised (a variant), its model and hysteresis set."""
     from experiments.inputs import scenario as scenarios
 
-    scn = scenarios.load(scenarios.resolve(scenario))
+    name, config, variant = job
+    scn = scenarios.load(scenarios.resolve(name))
     if variant is not None:
         scn = scenarios.randomize(scn, variant)
-    options = {**scn.scheduler_options, "hysteresis": hysteresis}
-    return dataclasses.replace(scn, scheduler_options=options)
+    scn = with_model(scn, config.model)
+    return dataclasses.replace(scn, scheduler_options={**scn.scheduler_options, "hysteresis": config.hysteresis})
 
 
 def predictions(events: Sequence[Any]) -> list[dict[str, Any]]:
@@ -61,14 +117,12 @@ def predictions(events: Sequence[Any]) -> list[dict[str, Any]]:
     return out
 
 
-def run_one(job: tuple[float, int | None, str]) -> dict[str, Any]:
-    """Run the scenario (``variant`` None: as shipped) with ``hysteresis``; check Appendix B
-    (``steps``) and compare each start's predicted cTime with what followed (``predictions``)."""
+def run_one(job: Job) -> Run:
+    """Run one job; check Appendix B (``steps``) and each start's prediction (``predictions``)."""
     from experiments.paper import appendix_b
     from experiments.run.runner import RunAborted, RunResult, run_scenario
 
-    hysteresis, variant, scenario = job
-    scn = _scenario(hysteresis, variant, scenario)
+    scn = scenario_for(job)
     try:
         events = list(run_scenario(scn, seed=scn.seed, pictures=False).trace.events)
     except RunAborted as exc:  # the trace so far still says which steps happened
@@ -80,13 +134,26 @@ def run_one(job: tuple[float, int | None, str]) -> dict[str, Any]:
     return {"steps": steps, "predictions": predictions(events)}
 
 
+def jobs(scenarios: Sequence[str], variants: int) -> list[Job]:
+    """Every scenario × configuration, as shipped then variants 1..``variants``."""
+    return [(s, c, v) for s in scenarios for c in CONFIGS for v in (None, *range(1, variants + 1))]
+
+
+def run_all(todo: Sequence[Job], workers: int, done: Callable[[int], None] | None = None) -> dict[Job, Run]:
+    """Run ``todo`` on ``workers`` processes (in order; ``done(k)`` after each result)."""
+    out: dict[Job, Run] = {}
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        for k, (job, result) in enumerate(zip(todo, pool.map(run_one, todo), strict=True)):
+            out[job] = result
+            if done is not None:
+                done(k + 1)
+    return out
+
+
 def _f(x: float | None, digits: int = 1) -> str:
     if x is None:
         return "–"
     return f"{x:.{digits}f}" if math.isfinite(x) else str(x)
-
-
-Run = dict[str, Any]
 
 
 def _pct(x: float | None) -> str:
@@ -101,7 +168,7 @@ def _median(xs: Sequence[float]) -> float | None:
     return xs[m] if len(xs) % 2 else (xs[m - 1] + xs[m]) / 2
 
 
-def _estimate_rows(runs: Sequence[Run]) -> tuple[int, float | None, float | None, int]:
+def _estimates(runs: Sequence[Run]) -> tuple[int, float | None, float | None, int]:
     """Over the starts that ran to their end: n, median and largest |realised/predicted - 1|,
     and how many starts had no finite prediction."""
     errs = [abs(p["realised_s"] / p["predicted_s"] - 1) for r in runs for p in r["predictions"]
@@ -110,51 +177,120 @@ def _estimate_rows(runs: Sequence[Run]) -> tuple[int, float | None, float | None
     return len(errs), _median(errs), max(errs, default=None), unknown
 
 
-def render(shipped: dict[float, Run], variants: dict[float, list[Run]], n: int, command: str) -> str:
-    lines = [BEGIN, "", f"*Generated by `{command}` from the runs' traces; do not edit by hand.*", ""]
-    for h in HYSTERESES:
-        steps = shipped[h]["steps"]
-        lines += [f"#### The shipped scenario, hysteresis {h}", "",
-                  "`margin` is `1 - c_switch / c_wait` of the deciding comparison (a switch needs more than "
-                  f"`1 - {h}`); for a cost step that did not happen, of the comparison that came closest.", "",
-                  "| # | step | holds | t (s) | c_switch | c_wait | margin |", "|---|---|---|---|---|---|---|"]
-        for k, st in enumerate(steps, 1):
-            lines.append(f"| {k} | {st['name']} | {'yes' if st['ok'] else '**no**'} | {_f(st['t'])} | "
-                         f"{_f(st['c_switch'])} | {_f(st['c_wait'])} | {_pct(st['margin'])} |")
-        lines += ["", "What the checker saw:", ""]
-        lines += [f"{k}. {st['detail']}" for k, st in enumerate(steps, 1)]
+def _whole(runs: Sequence[Run]) -> int:
+    return sum(1 for r in runs if all(st["ok"] for st in r["steps"]))
+
+
+def _summary(results: dict[Job, Run], scenarios: Sequence[str], n: int) -> list[str]:
+    names = [st["name"] for st in results[(scenarios[0], CONFIGS[0], None)]["steps"]]
+    header = ["#", "step"] + [f"{s}: {c.label}" for s in scenarios for c in CONFIGS]
+    rows = []
+    for k, name in enumerate(names):
+        cells = []
+        for s in scenarios:
+            for c in CONFIGS:
+                st = results[(s, c, None)]["steps"][k]
+                held = sum(1 for v in range(1, n + 1) if results[(s, c, v)]["steps"][k]["ok"])
+                mark = "yes" if st["ok"] else "**no**"
+                margin = f" {_pct(st['margin'])}" if st["margin"] is not None else ""
+                cells.append(f"{mark}{margin}" + (f"; {held}/{n}" if n else ""))
+        rows.append((str(k + 1), name, *cells))
+    rows.append(("", "**the whole sequence, every step with its cause**",
+                 *(("yes" if all(st["ok"] for st in results[(s, c, None)]["steps"]) else "**no**")
+                   + (f"; {_whole([results[(s, c, v)] for v in range(1, n + 1)])}/{n}" if n else "")
+                   for s in scenarios for c in CONFIGS)))
+    return markdown_table(header, rows)
+
+
+def _shipped(run: Run, scenario: str, config: Config) -> list[str]:
+    lines = [f"##### `{scenario}`, {config.label}", "",
+             *markdown_table(["#", "step", "holds", "t (s)", "c_switch", "c_wait", "margin"],
+                             [(str(k), st["name"], "yes" if st["ok"] else "**no**", _f(st["t"]), _f(st["c_switch"], 3),
+                               _f(st["c_wait"], 3), _pct(st["margin"])) for k, st in enumerate(run["steps"], 1)]),
+             "", "What the checker saw:", ""]
+    lines += [f"{k}. {st['detail']}" for k, st in enumerate(run["steps"], 1)]
+    if config.model == "seconds":
         lines += ["", "Each `start`: the cTime the agent reported (predicted) and the seconds until it was "
                   "suspended or ended (realised; comparable only when it ran to its end):", "",
-                  "| agent | started at (s) | predicted (s) | realised (s) | ran to its end |", "|---|---|---|---|---|"]
-        for p in shipped[h]["predictions"]:
-            lines.append(f"| {p['agent']} | {_f(p['t'])} | {_f(p['predicted_s'])} | {_f(p['realised_s'])} | "
-                         f"{'yes' if p['ended'] else 'no'} |")
-        lines.append("")
-    if n:
-        names = [st["name"] for st in shipped[HYSTERESES[0]]["steps"]]
-        lines += [f"#### Reproduction over {n} randomised variants (seeds 1..{n})", "",
-                  "Per step: variants in which it holds with its cause; for the cost steps, the median "
-                  "margin over all variants that made the comparison.", "",
-                  "| # | step | " + " | ".join(f"h = {h} | median margin" for h in HYSTERESES) + " |",
-                  "|---|---|" + "---|---|" * len(HYSTERESES)]
-        for k, name in enumerate(names):
-            cells = []
-            for h in HYSTERESES:
-                runs = variants[h]
-                margins = [r["steps"][k]["margin"] for r in runs if r["steps"][k]["margin"] is not None]
-                cells += [f"{sum(1 for r in runs if r['steps'][k]['ok'])}/{n}", _pct(_median(margins))]
-            lines.append(f"| {k + 1} | {name} | " + " | ".join(cells) + " |")
-        whole = []
-        for h in HYSTERESES:
-            whole += [f"{sum(1 for r in variants[h] if all(st['ok'] for st in r['steps']))}/{n}", ""]
-        lines.append("| | **the whole sequence, every step with its cause** | " + " | ".join(whole) + " |")
-        lines += ["", "Estimates against what happened, over the variants' starts that ran to their end:", "",
-                  "| hysteresis | starts | median \\|realised/predicted − 1\\| | largest | starts with no finite "
-                  "prediction |", "|---|---|---|---|---|"]
-        for h in HYSTERESES:
-            m, med, worst, unknown = _estimate_rows(variants[h])
-            lines.append(f"| {h} | {m} | {_pct(med).lstrip('+')} | {_pct(worst).lstrip('+')} | {unknown} |")
-        lines.append("")
+                  *markdown_table(["agent", "started at (s)", "predicted (s)", "realised (s)", "ran to its end"],
+                                  [(p["agent"], _f(p["t"]), _f(p["predicted_s"]), _f(p["realised_s"]),
+                                    "yes" if p["ended"] else "no") for p in run["predictions"]])]
+    return [*lines, ""]
+
+
+def _variants(results: dict[Job, Run], scenario: str, n: int) -> list[str]:
+    names = [st["name"] for st in results[(scenario, CONFIGS[0], None)]["steps"]]
+    rows = []
+    for k, name in enumerate(names):
+        cells = []
+        for c in CONFIGS:
+            runs = [results[(scenario, c, v)] for v in range(1, n + 1)]
+            margins = [r["steps"][k]["margin"] for r in runs if r["steps"][k]["margin"] is not None]
+            cells += [f"{sum(1 for r in runs if r['steps'][k]['ok'])}/{n}", _pct(_median(margins))]
+        rows.append((str(k + 1), name, *cells))
+    rows.append(("", "**the whole sequence, every step with its cause**",
+                 *(x for c in CONFIGS for x in (f"{_whole([results[(scenario, c, v)] for v in range(1, n + 1)])}/{n}",
+                                                ""))))
+    header = ["#", "step"] + [x for c in CONFIGS for x in (c.label, "median margin")]
+    est = []
+    for c in CONFIGS:
+        if c.model == "seconds":
+            m, med, worst, unknown = _estimates([results[(scenario, c, v)] for v in range(1, n + 1)])
+            est.append((c.label, str(m), _pct(med).lstrip("+"), _pct(worst).lstrip("+"), str(unknown)))
+    return [f"##### `{scenario}`: reproduction over {n} randomised variants (seeds 1..{n})", "",
+            "Per step: variants in which it holds with its cause; for the cost steps, the median margin over all "
+            "variants that made the comparison.", "", *markdown_table(header, rows), "",
+            "Our estimates against what happened, over the variants' starts that ran to their end (the original "
+            "model's cTime is in metres: not comparable):", "",
+            *markdown_table(["configuration", "starts", "median |realised/predicted − 1|", "largest",
+                             "starts with no finite prediction"], est), ""]
+
+
+def _recorded(rows: Sequence[tuple[float, str, float, float, float | None, float | None]]) -> list[str]:
+    table = [(_f(t), "ours" if model == "seconds" else model, _f(cs, 3), _f(cw, 3), _pct(1 - cs / cw),
+              "yes" if cs < cw else "no", "yes" if cs < 0.9 * cw else "no", _f(rcs, 3), _f(rcw, 3))
+             for t, model, cs, cw, rcs, rcw in rows]
+    return ["#### The recorded comparisons of step 3, recomputed on their geometry", "",
+            "Guide John (dac) over guide Alice (exeDA) where the record puts the robot, John and Alice "
+            "(`experiments.paper.recorded`: straight-line distances equal to those the record implies; both tasks "
+            "aged 0, so that the ages, which add the same to both sides, do not dilute the margin):", "",
+            *markdown_table(["recorded t", "model", "c_switch", "c_wait", "margin", "switch at h = 1.0", "at h = 0.9",
+                             "recorded c_switch", "recorded c_wait"], table), ""]
+
+
+def _layout() -> list[str]:
+    from experiments.paper.reconstruction import derive, residuals
+
+    lay = derive()
+    points = [("Alice's destination", lay.alice_dest), ("John's destination", lay.john_dest), ("Alice", lay.alice),
+              ("where John waited", lay.john_waited), ("John's start", lay.john_walk[0][1]),
+              ("the robot at 2508.6", lay.robot), ("Peter", lay.peter), ("Sara", lay.sara)]
+    guided = [abs(rec - got) for _, what, rec, got in residuals(lay) if "guided" in what]
+    return ["#### The reconstruction of `paper-2019`", "",
+            "`experiments.paper.reconstruction.derive()`, in its frame (metres; the files shift it by [2.5, 2.0]); "
+            f"the destinations are {_f(lay.john_dest[0], 2)} m apart; the straight guided walk fits the 9 recorded "
+            f"rows with rms {_f(lay.fit_rms, 3)} m (largest {_f(max(guided), 3)} m); every other recorded distance "
+            "it is made from, it meets exactly.", "",
+            *markdown_table(["point", "x", "y"], [(name, _f(x, 2), _f(y, 2)) for name, (x, y) in points]), ""]
+
+
+def render(results: dict[Job, Run], scenarios: Sequence[str], n: int, command: str, commit: str,
+           recorded: Sequence[tuple[float, str, float, float, float | None, float | None]] = ()) -> str:
+    """The generated block of ``docs/paper.md``: made by ``command`` at ``commit``; ``recorded``
+    is :func:`experiments.paper.recorded.rows` (left out when empty)."""
+    lines = [BEGIN, "", f"*Generated by `{command}` at commit `{commit}` from the runs' traces; do not edit by "
+             "hand.*", "", *(_recorded(recorded) if recorded else []),
+             *(_layout() if "paper-2019" in scenarios else []),
+             "#### Side by side: which step holds, per scenario and model", "",
+             "Each cell: the scenario as shipped (with the deciding comparison's margin `1 - c_switch / c_wait`, "
+             "or for a cost step that did not happen the closest one's), then in how many randomised variants the "
+             "step holds with its cause.", "", *_summary(results, scenarios, n), ""]
+    for s in scenarios:
+        lines += [f"#### `{s}`", ""]
+        for c in CONFIGS:
+            lines += _shipped(results[(s, c, None)], s, c)
+        if n:
+            lines += _variants(results, s, n)
     lines.append(END)
     return "\n".join(lines) + "\n"
 
@@ -166,43 +302,3 @@ def splice(text: str, block: str) -> str:
         _, tail = rest.split(END, 1)
         return head + block.rstrip("\n") + tail
     return text.rstrip("\n") + "\n\n" + block
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m experiments.paper.report", description=__doc__.split("\n\n")[0],
-                                epilog="example: python -m experiments.paper.report --variants 50 --out docs/paper.md")
-    p.add_argument("--variants", type=int, default=50, help="randomised variants per hysteresis (default 50)")
-    p.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
-    p.add_argument("--out", type=Path, help="Markdown file whose generated block to replace")
-    p.add_argument("--json", type=Path, help="also write every run's checked steps and predictions here (JSON)")
-    p.add_argument("--scenario", default="paper", help=argparse.SUPPRESS)
-    args = p.parse_args(argv)
-    if args.variants < 0:
-        p.error(f"--variants must be >= 0, got {args.variants}")
-    if args.jobs < 1:
-        p.error(f"--jobs must be >= 1, got {args.jobs}")
-    if args.out is not None and not args.out.is_file():
-        p.error(f"--out {args.out}: no such file")
-    jobs: list[tuple[float, int | None, str]] = [(h, None, args.scenario) for h in HYSTERESES]
-    jobs += [(h, v, args.scenario) for h in HYSTERESES for v in range(1, args.variants + 1)]
-    with ProcessPoolExecutor(max_workers=args.jobs) as pool:
-        results = list(pool.map(run_one, jobs))
-    shipped = {h: results[k] for k, h in enumerate(HYSTERESES)}
-    rest = results[len(HYSTERESES):]
-    variants = {h: rest[k * args.variants:(k + 1) * args.variants] for k, h in enumerate(HYSTERESES)}
-    command = f"python -m experiments.paper.report --variants {args.variants}" + (
-        f" --out {args.out}" if args.out else "")
-    block = render(shipped, variants, args.variants, command)
-    if args.json is not None:
-        runs = [{"hysteresis": h, "variant": v, **r} for (h, v, _), r in zip(jobs, results, strict=True)]
-        args.json.write_text(json.dumps(runs, indent=1, default=str) + "\n")
-    if args.out is None:
-        sys.stdout.write(block)
-    else:
-        args.out.write_text(splice(args.out.read_text(), block))
-        print(f"wrote {args.out}")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

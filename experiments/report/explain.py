@@ -7,6 +7,12 @@ unified-planning's default ``PDDLReader``, reads; ``index.json`` lists them by a
 simulated time and purpose.  :func:`explain` picks the problem in force for an agent
 at a time (the last one planned at or before it) and pairs it with the trace events
 that moved the agent: ``decision``, ``command``, ``transition`` and ``end``.
+
+A run folder is data someone may send: it is read only inside itself.  Every file
+``index.json`` names is resolved inside ``problems/`` (an absolute path, ``..`` or a link
+leading out is refused, never read or copied), every file is read within the readers'
+limits (:mod:`tasker.support.reader`: a regular file, UTF-8, nesting, 64-bit numbers),
+and a damaged one is named as damaged.
 """
 
 from __future__ import annotations
@@ -21,17 +27,17 @@ from typing import Any
 
 from experiments.trace.timeline import Timeline
 from tasker import events as ev
-from tasker.errors import TaskerError
+from tasker.support import reader
 
 PROBLEMS = "problems"
 INDEX = "index.json"
 MOVING_EVENTS = (ev.Decision, ev.CommandSent, ev.Transition, ev.TaskEnded)
-"""The events that move an agent: what ``tasker explain`` lists."""
 """The trace events that move an agent, which :func:`explain` lists."""
 
 
-class ExplainError(TaskerError, ValueError):
-    """A run folder, agent or time that ``tasker explain`` cannot explain."""
+class ExplainError(reader.InputError):
+    """A run folder, agent or time that ``tasker explain`` cannot explain (a damaged file of the
+    run folder is named with its line and field, as every reader's errors are)."""
 
 
 # ----------------------------------------------------------------------------------------- writing
@@ -146,24 +152,61 @@ def _short(v: Any) -> str:
     return str(v)
 
 
-def load_index(run_dir: Path) -> list[dict[str, Any]]:
-    """The ``problems/index.json`` of a run folder, with clear errors for what is missing."""
+MAX_RECORDS = 100_000
+"""The most planning records an ``index.json`` may list (a day of planning is a few thousand)."""
+
+
+def _inside(root: Path, name: str, what: str) -> Path:
+    """``root/name`` for a file of the run folder ``root`` (already resolved), or an :class:`ExplainError`:
+    a run folder is data someone may send, so it is read only inside itself — an absolute path, a
+    ``..`` or a link that leads out of it is refused, never followed."""
+    if not name or "\x00" in name:
+        raise ExplainError(root, f"expected a file name of the run folder, got {name!r}", field=what)
+    p = Path(name)
+    if p.is_absolute():
+        raise ExplainError(root, f"{name!r} is an absolute path: a run folder names only its own files, and "
+                                 "this one is not read", field=what)
+    target = (root / p).resolve()
+    if not target.is_relative_to(root):
+        raise ExplainError(root, f"{name!r} leads out of the run folder (to {target}): a run folder names only "
+                                 "its own files, and this one is not read", field=what)
+    return target
+
+
+def _read(root: Path, name: str, what: str) -> str:
+    """A text file of the run folder (inside it, a regular file within the readers' limits, UTF-8)."""
+    return reader.read_text(_inside(root, name, what), ExplainError)
+
+
+def _root(run_dir: Path) -> Path:
     if not run_dir.is_dir():
         raise ExplainError(f"{run_dir}: no such run folder (give the --out folder of `tasker run`)")
+    return run_dir.resolve()
+
+
+def load_index(run_dir: Path) -> list[dict[str, Any]]:
+    """The ``problems/index.json`` of a run folder, with clear errors for what is missing or damaged."""
+    root = _root(run_dir)
     path = run_dir / PROBLEMS / INDEX
-    if not path.is_file():
+    if not path.exists() and not path.is_symlink():
         raise ExplainError(f"{path}: no planning record: the run planned nothing with the planned strategy "
                            f"(static strategies write no PDDL), or was written before `problems/` existed")
-    try:
-        index = json.loads(path.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as exc:
-        raise ExplainError(f"{path}:{exc.lineno}: not valid JSON: {exc.msg}") from None
+    text = _read(root, f"{PROBLEMS}/{INDEX}", "index")
+    index = reader.parse_json(text, path, ExplainError)
     if not isinstance(index, list):
         raise ExplainError(f"{path}: expected a list of planning records, got {_json_kind(index)}")
+    if len(index) > MAX_RECORDS:
+        raise ExplainError(f"{path}: {len(index)} planning records, more than the {MAX_RECORDS} a run folder may have")
     for i, entry in enumerate(index):
         why = _record_problem(entry)
         if why:
             raise ExplainError(f"{path}: record [{i}]: {why} (the file is damaged: run the scenario again)")
+        for key in ("domain", "problem", "plan_file"):
+            if entry.get(key) is not None:
+                try:
+                    _inside(root / PROBLEMS, entry[key], key)
+                except ExplainError as exc:
+                    raise ExplainError(f"{path}: record [{i}]: {key}: {exc.message}") from None
     return index
 
 
@@ -180,8 +223,9 @@ def _record_problem(entry: Any) -> str | None:
     t = entry.get("t")
     if isinstance(t, bool) or not isinstance(t, int | float) or not math.isfinite(t):
         return f"t: expected a finite number, got {_json_kind(t) if 't' in entry else 'nothing'}"
-    if entry.get("plan_file") is not None and not isinstance(entry["plan_file"], str):
-        return f"plan_file: expected a string, got {_json_kind(entry['plan_file'])}"
+    for key in ("plan_file", "label", "message"):
+        if entry.get(key) is not None and not isinstance(entry[key], str):
+            return f"{key}: expected a string, got {_json_kind(entry[key])}"
     return None
 
 
@@ -191,18 +235,20 @@ def _json_kind(value: Any) -> str:
         return "an object"
     if isinstance(value, list):
         return "an array"
-    return json.dumps(value)
+    return json.dumps(value)[:60]
 
 
 def load_trace(run_dir: Path) -> Timeline:
-    """The run's timeline (empty if it has no trace); a damaged trace is an :class:`ExplainError`."""
+    """The run's timeline (empty if it has no trace); a damaged trace — or a ``trace.jsonl`` that is a
+    folder, a device or a link out of the run folder — is an :class:`ExplainError`."""
     path = run_dir / "trace.jsonl"
-    if not path.is_file():
+    if not path.exists() and not path.is_symlink():
         return Timeline([])
+    inside = _inside(_root(run_dir), "trace.jsonl", "trace")
     try:
-        return Timeline.read(path)
+        return Timeline.read(inside)
     except ValueError as exc:
-        raise ExplainError(str(exc)) from None
+        raise ExplainError(str(exc).replace(str(inside), str(path), 1)) from None
 
 
 def moved(tl: Timeline, agent: str, until: float | None = None) -> list[ev.Event]:
@@ -239,13 +285,10 @@ def explain(run_dir: str | Path, agent: str, at: float | None = None) -> Explana
         raise ExplainError(f"{run / PROBLEMS / INDEX}: {agent} had not planned yet at t={at:g} s; it planned at "
                            f"t = {times}")
     entry = chosen[-1]
-    folder = run / PROBLEMS
-    try:
-        domain = (folder / entry["domain"]).read_text(encoding="utf-8")
-        problem = (folder / entry["problem"]).read_text(encoding="utf-8")
-        plan = (folder / entry["plan_file"]).read_text(encoding="utf-8") if entry.get("plan_file") else None
-    except OSError as exc:
-        raise ExplainError(f"{folder}: {exc.strerror}: {exc.filename}") from None
+    folder = _root(run) / PROBLEMS
+    domain = _read(folder, entry["domain"], "domain")
+    problem = _read(folder, entry["problem"], "problem")
+    plan = _read(folder, entry["plan_file"], "plan_file") if entry.get("plan_file") else None
     return Explanation(agent, at, entry, domain, problem, plan, tuple(moved(load_trace(run), agent, at)))
 
 

@@ -1,15 +1,19 @@
-"""The frame of every ``report.html``: one self-contained page, plotly figures in ``<div>`` elements, tables.
+"""The frame of every ``report.html``: one page, plotly figures in ``<div>`` elements, tables.
 
-The page works offline: plotly's JavaScript is inlined once (no CDN).  Figures get the ids
+The page works offline: plotly's JavaScript is inlined once (no CDN) — or, for folders that
+hold many pages (a day run's), referenced from one ``plotly.min.js`` written beside them
+(:func:`shared_plotly`), so that each page does not carry its 4-5 MB.  Figures get the ids
 their callers give them and no wall-clock value is added, so the same inputs give the same bytes.
-The run page (:mod:`experiments.report.run_page`) and the sweep page (:mod:`experiments.report.sweep_page`)
-are built from these.
+The run page (:mod:`experiments.report.run_page`, always self-contained), the sweep page
+(:mod:`experiments.report.sweep_page`) and the day page (:mod:`experiments.report.day_page`) are
+built from these.
 """
 
 from __future__ import annotations
 
 import html
 from collections.abc import Iterable, Sequence
+from pathlib import Path
 from typing import Any
 
 import plotly.graph_objects as go
@@ -27,12 +31,30 @@ text-align:left} th{background:#f4f4f4} .num{text-align:right;font-variant-numer
 """
 
 
-def page(title: str, sections: Iterable[str]) -> str:
-    """A whole HTML document with plotly's JavaScript inlined once."""
+PLOTLY_JS = "plotly.min.js"
+"""The name of the shared copy of plotly's JavaScript (:func:`shared_plotly`)."""
+
+
+def page(title: str, sections: Iterable[str], *, plotly_src: str | None = None) -> str:
+    """A whole HTML document with plotly's JavaScript inlined once, or, with ``plotly_src``, loaded
+    from that relative path (see :func:`shared_plotly`)."""
+    script = (f'<script type="text/javascript" src="{html.escape(plotly_src)}"></script>' if plotly_src is not None
+              else f'<script type="text/javascript">{get_plotlyjs()}</script>')
     return "\n".join([
         "<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">', f"<title>{html.escape(title)}</title>",
-        f"<style>{_CSS}</style>", f'<script type="text/javascript">{get_plotlyjs()}</script>', "</head><body>",
+        f"<style>{_CSS}</style>", script, "</head><body>",
         f"<h1>{html.escape(title)}</h1>", *sections, "</body></html>", ""])
+
+
+def shared_plotly(folder: Path) -> str:
+    """Write plotly's JavaScript once into ``folder`` (:data:`PLOTLY_JS`; rewritten only when it
+    differs) and return the name a page in ``folder`` loads it by (``page(..., plotly_src=...)``)."""
+    path = folder / PLOTLY_JS
+    text = get_plotlyjs()
+    if not path.is_file() or path.read_text(encoding="utf-8") != text:
+        folder.mkdir(parents=True, exist_ok=True)
+        path.write_text(text, encoding="utf-8")
+    return PLOTLY_JS
 
 
 def figure_div(fig: go.Figure | dict[str, Any], div_id: str) -> str:

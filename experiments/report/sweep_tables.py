@@ -83,6 +83,13 @@ def markdown(analysis: Analysis, title: str = "Sweep report") -> str:
            f"{len({r.strategy for r in rows})} strategies."
            + (f" tasker {', '.join(versions)}." if versions else "")
            + (f" Hosts: {', '.join(hosts)}." if hosts else ""), ""]
+    fallback = [r for r in ok if numeric_metrics(r.metrics).get("totals.static_fallbacks", 0.0) > 0]
+    if fallback:
+        cells_fb = sorted({(r.scenario, r.strategy) for r in fallback})
+        out += [f"**{len(fallback)} runs had a planner fallback to static** (a planned genSusp or upTsk the planner "
+                "could not solve in time, or at all, ran the static template instead; counted under the strategy "
+                "asked for): " + "; ".join(f"{sc} {st}" for sc, st in cells_fb[:10])
+                + (f" and {len(cells_fb) - 10} more cells" if len(cells_fb) > 10 else "") + ".", ""]
     hazard, helped = _primary_names(rows, analysis.primary)
     cells = primary_cells(rows, analysis.primary)
     out += ["## Primary outcome: hazard-unattended time vs time-to-help", "",

@@ -43,7 +43,7 @@ from tasker.loop import SimulationLoop
 from tasker.meaning import Monitor
 from tasker.requester import Requester
 from tasker.store import TaskStore
-from tasker.task import Strategy
+from tasker.task import Strategy, TaskType
 from tasker.trace import FAILED, Trace
 
 
@@ -67,7 +67,8 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, **options: Any) -> t
 def build_robot_actions(scn: scenarios.RobotScenario, *, seed: int, update: str | None = None,
                         suspension: str | None = None, scheduler: str | None = None,
                         trace: Trace | None = None, task_paths: tuple[str, ...] = (), policy: str | None = None,
-                        hazard_waiting: bool = False, request_fields: bool = False
+                        hazard_waiting: bool = False, request_fields: bool = False,
+                        task_wrapper: Callable[[TaskType], TaskType] | None = None
                         ) -> tuple[SimulationLoop, Any, Actions]:
     """The loop, the simulation and the :class:`Actions` of a robot scenario, every action scheduled.
 
@@ -75,7 +76,8 @@ def build_robot_actions(scn: scenarios.RobotScenario, *, seed: int, update: str 
     ``policy`` (default: the scenario's) reaches every task's :class:`Strategy`;
     ``hazard_waiting`` is passed to the loop; ``request_fields`` lets every task type take
     the requests' ``deadline`` and ``priority`` (:mod:`experiments.inputs.request_fields`); it is on
-    whenever the scenario's requests give one or its ``settings.request_fields`` is true.
+    whenever the scenario's requests give one or its ``settings.request_fields`` is true.  ``task_wrapper``
+    is applied to every task type after that (a day's drawn work: :mod:`experiments.days.robot_work`).
     A ``people`` entry may set a person's ``pose``, ``walk`` and walking ``speed``."""
     from planners.bundled import task_types
     from robot.sim import Simulation
@@ -105,6 +107,8 @@ def build_robot_actions(scn: scenarios.RobotScenario, *, seed: int, update: str 
         from experiments.inputs.request_fields import with_request_fields
 
         loaded = [with_request_fields(t) for t in loaded]
+    if task_wrapper is not None:
+        loaded = [task_wrapper(t) for t in loaded]
     store = TaskStore(loaded)
     types = [store.get(n) for n in store.names()]
     sim.bind(b for t in types for b in t.meaning.bindings)  # the world reads the folders' bindings
@@ -170,7 +174,9 @@ def _world_file_events(spec: Any, world: str) -> tuple[Any, list[TimedAction]]:
 
 def _with_objects(scn: scenarios.RobotScenario, spec: Any) -> Any:
     """The world with the scenario's ``[objects]``: each gets its type, ``("at", name, place)``
-    and its facts (its pose is its place's, see :meth:`robot.sim.Simulation.snapshot`)."""
+    and its facts (its pose is its place's, see :meth:`robot.sim.Simulation.snapshot`); and with
+    its ``[devices]``, as if the world file listed them."""
+    spec = scenarios.with_devices(scn, spec)
     if not scn.objects:
         return spec
     objects = dict(spec.objects)
@@ -300,6 +306,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
                  policy: str | None = None, hazard_waiting: bool | None = None,
                  interruption: scenarios.InterruptionGrid | None = None,
                  perturbation: Perturbation | None = None, request_fields: bool = False,
+                 task_wrapper: Callable[[TaskType], TaskType] | None = None,
                  live: Callable[[SimulationLoop, Any, Actions], scenarios.RobotScenario] | None = None) -> RunResult:
     """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced.
 
@@ -308,10 +315,10 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
     hazard-aware waiting on; ``interruption`` (with ``randomize``) places the interrupting request
     in the seed's stratum (:class:`experiments.inputs.scenario.InterruptionGrid`) and ``perturbation``
     draws exogenous world events around it (:mod:`experiments.inputs.perturbation`);
-    ``request_fields``: see :func:`build_robot_actions`.  ``live`` drives a robot scenario's loop instead
-    of running it to its end (``tasker serve``, :mod:`experiments.serve`): it gets the loop, the
-    simulation and their :class:`Actions`, and returns the scenario that replays what it ran (the
-    scenario ``run.json`` records)."""
+    ``request_fields`` and ``task_wrapper``: see :func:`build_robot_actions`.  ``live`` drives a robot
+    scenario's loop instead of running it to its end (``tasker serve``, :mod:`experiments.serve`): it gets
+    the loop, the simulation and their :class:`Actions`, and returns the scenario that replays what it ran
+    (the scenario ``run.json`` records)."""
     if isinstance(source, scenarios.RobotScenario):
         kind, scn_path = "robot", Path(source.source)
     else:
@@ -335,7 +342,8 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
             scn = dataclasses.replace(scn, mode=mode)
         loop, sim, actions = build_robot_actions(
             scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler, task_paths=task_paths,
-            policy=policy, hazard_waiting=bool(hazard_waiting), request_fields=request_fields)
+            policy=policy, hazard_waiting=bool(hazard_waiting), request_fields=request_fields,
+            task_wrapper=task_wrapper)
         spec_json = {"kind": "robot", **scn.to_json()}
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")

@@ -71,30 +71,46 @@ class SweepSummary:
 def lease(db_path: str | Path) -> Iterator[None]:
     """Hold the sweep lease of a results database: one driver at a time, or a clear :class:`SweepError`.
 
-    An exclusive ``flock`` on ``<db>.lock``, which says who holds it.  The kernel drops
-    the lock when the holder dies, even by ``kill -9``, so a stale lease never blocks a
-    resumption.  Readers (``tasker report``) take no lease.
+    An exclusive ``flock`` on ``<db>.lock``, which says who holds it, removed when the lease
+    ends.  The kernel drops the lock when the holder dies, even by ``kill -9``, so a stale
+    lease (a file left by a killed driver) never blocks a resumption.  Readers (``tasker
+    report``) take no lease.
     """
     lock = Path(f"{db_path}.lock")
     try:
         lock.parent.mkdir(parents=True, exist_ok=True)
-        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
     except OSError as exc:
         raise SweepError(f"{db_path}: cannot take the sweep lease ({lock}: {exc.strerror or exc})") from None
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        holder = os.pread(fd, 512, 0).decode("utf-8", "replace").strip() or "another process"
+    while True:
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise SweepError(f"{db_path}: cannot take the sweep lease ({lock}: {exc.strerror or exc})") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.pread(fd, 512, 0).decode("utf-8", "replace").strip() or "another process"
+            os.close(fd)
+            raise SweepError(f"{db_path}: another sweep is running on this database ({holder}); two drivers "
+                             "would run the same jobs. Wait for it to end (then run again to resume), or use "
+                             "another database") from None
+        try:  # the holder before us deletes the file as it ends: a lock on a deleted file holds nothing
+            same = os.fstat(fd).st_ino == os.stat(lock).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            break
         os.close(fd)
-        raise SweepError(f"{db_path}: another sweep is running on this database ({holder}); two drivers would "
-                         "run the same jobs. Wait for it to end (then run again to resume), or use another "
-                         "database") from None
     try:
         os.ftruncate(fd, 0)
         os.pwrite(fd, f"pid {os.getpid()} on {socket.gethostname()}, since "
                       f"{datetime.now(UTC).isoformat(timespec='seconds')}".encode(), 0)
         yield
     finally:
+        try:  # removed while still held, so no one can take a lock on the file being removed
+            lock.unlink()
+        except OSError:
+            pass
         fcntl.flock(fd, fcntl.LOCK_UN)
         os.close(fd)
 
@@ -110,18 +126,36 @@ def absolute_source(source: str) -> str:
 
 
 def precheck(jobs: Iterable[Job]) -> None:
-    """Load every distinct scenario of ``jobs`` once, so a bad one fails before any job runs."""
+    """Every check a job would fail, before any job runs: each distinct scenario is loaded once, and
+    for each of its strategies the first job's run is built — its randomised variant drawn (with the
+    spec's interruption grid), its world, task types and scheduler made — without running it.  A
+    fault is a :class:`SweepError` naming the scenario and the strategy (the file's own errors keep
+    their file and line): values that pass the spec's checks and then fail every job stop here."""
     from experiments.inputs import scenario as scenarios
     from experiments.inputs import synthetic
+    from experiments.run.runner import build_robot
 
-    jobs = list(jobs)
-    paths = {j.source: j.task_paths for j in jobs}
-    for source in sorted({j.source for j in jobs}):
+    first: dict[tuple[str, str], Job] = {}
+    for j in jobs:
+        first.setdefault((j.source, j.strategy.label), j)
+    loaded: dict[str, Any] = {}
+    for (source, label), job in sorted(first.items()):
         path = scenarios.resolve(source)
-        if scenarios.kind_of(path) == "robot":
-            scenarios.load(path, task_paths=paths.get(source, ()))
-        else:
-            synthetic.load(path)
+        if source not in loaded:  # its own faults: the scenario's error, with its file and line
+            robot = scenarios.kind_of(path) == "robot"
+            loaded[source] = (scenarios.load(path, task_paths=job.task_paths) if robot else synthetic.load(path))
+        scn, st = loaded[source], job.strategy
+        try:
+            if isinstance(scn, scenarios.RobotScenario):
+                variant = scenarios.randomize(scn, job.seed, interruption=job.interruption)
+                build_robot(variant, seed=job.seed, update=st.update, suspension=st.suspension,
+                            scheduler=st.scheduler, task_paths=job.task_paths, policy=st.policy,
+                            hazard_waiting=bool(st.hazard_waiting))
+            else:
+                synthetic.build(scn, seed=job.seed, scheduler=st.scheduler)
+        except Exception as exc:  # noqa: BLE001 - whatever it is, every job like it would fail
+            raise SweepError(f"scenario {job.scenario!r} with strategy {label!r} (seed {job.seed}) cannot run, so no "
+                             f"job of it would: {type(exc).__name__}: {exc}") from None
 
 
 def _setup(workers: int, address: str | None) -> dict[str, Any]:

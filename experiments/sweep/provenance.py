@@ -31,8 +31,11 @@ ROOT = Path(__file__).resolve().parents[2]
 
 @dataclass(frozen=True)
 class Digest:
-    """One run a document vouches for: which job of which spec (``perturbed``: with the spec's
-    ``[perturbation]``, else the control arm without it) and its trace's SHA-256."""
+    """One run a document vouches for and its trace's SHA-256: a job of a sweep spec (``spec`` its
+    path from the project's root; ``perturbed``: with the spec's ``[perturbation]``, else the control
+    arm without it), or, with ``spec`` empty, a plain ``tasker run`` of ``scenario`` (a shipped name
+    or a path from the root; ``seed`` -1 for the scenario's own; ``strategy`` a label or empty for the
+    scenario's own settings)."""
 
     spec: str
     perturbed: bool
@@ -95,11 +98,27 @@ def digest(spec_path: str, job: Job, perturbed: bool) -> Digest:
     return Digest(spec_path, perturbed, job.scenario, job.seed, job.strategy.label, trace_digest(job))
 
 
+def run_digest(scenario: str, *, seed: int | None = None, strategy: str = "", root: Path = ROOT) -> Digest:
+    """The digest of a plain run of ``scenario`` (as ``tasker run`` runs it: not randomised)."""
+    from experiments.inputs.strategy import Strategy
+    from experiments.run.runner import run_scenario
+
+    st = Strategy.parse(strategy) if strategy else Strategy()
+    source = scenario if not scenario.endswith(".toml") else str(root / scenario)
+    with tempfile.TemporaryDirectory(prefix="tasker-provenance-") as tmp:
+        out = Path(tmp) / "run"
+        run_scenario(source, seed=seed, update=st.update, suspension=st.suspension, scheduler=st.scheduler,
+                     policy=st.policy, hazard_waiting=st.hazard_waiting, out=out, pictures=False)
+        sha = hashlib.sha256((out / "trace.jsonl").read_bytes()).hexdigest()
+    return Digest("", False, scenario, -1 if seed is None else seed, strategy, sha)
+
+
 def render(p: Provenance) -> list[str]:
     """The block: a comment with the JSON, then a visible section."""
     data = {"commit": p.commit, "digests": [d.to_json() for d in p.digests]}
-    body = [[Path(d.scenario).stem, "perturbed" if d.perturbed else "control", str(d.seed),
-             d.strategy, f"`{d.sha256[:16]}`"] for d in p.digests]
+    body = [[Path(d.scenario).stem, "tasker run" if not d.spec else "perturbed" if d.perturbed else "control",
+             "its own" if d.seed < 0 else str(d.seed), d.strategy or "its own settings", f"`{d.sha256[:16]}`"]
+            for d in p.digests]
     return ["## Provenance", "",
             f"Generated on commit `{p.commit}`. The traces of these runs, run again with the code beside this "
             "document, must have the digests below (`tests/experiments/test_drift.py` checks them in CI; "
@@ -128,13 +147,16 @@ def verify(p: Provenance, root: Path = ROOT) -> list[str]:
     specs: dict[str, SweepSpec] = {}
     changed = []
     for d in p.digests:
-        if d.spec not in specs:
-            specs[d.spec] = load_spec(root / d.spec)
-        job = find_job(arm(specs[d.spec], d.perturbed), d.scenario, d.seed, d.strategy)
-        now = trace_digest(job)
+        if not d.spec:
+            now = run_digest(d.scenario, seed=None if d.seed < 0 else d.seed, strategy=d.strategy, root=root).sha256
+        else:
+            if d.spec not in specs:
+                specs[d.spec] = load_spec(root / d.spec)
+            now = trace_digest(find_job(arm(specs[d.spec], d.perturbed), d.scenario, d.seed, d.strategy))
         if now != d.sha256:
-            changed.append(f"{Path(d.scenario).stem} seed {d.seed} {d.strategy} "
-                           f"({'perturbed' if d.perturbed else 'control'}): {d.sha256[:12]} → {now[:12]}")
+            where = "tasker run" if not d.spec else "perturbed" if d.perturbed else "control"
+            changed.append(f"{Path(d.scenario).stem} seed {d.seed} {d.strategy or 'its own settings'} "
+                           f"({where}): {d.sha256[:12]} → {now[:12]}")
     return changed
 
 

@@ -125,6 +125,7 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
     scenario_list = top.array("scenarios", nonempty=True)
     at = top.at("scenarios", {})
     sources: dict[str, str] = {}
+    files: dict[Path, str] = {}  # the file each scenario is, so one file under two spellings is seen
     for i, sc in enumerate(scenario_list):
         if not isinstance(sc, str) or not sc:
             raise at.error(i, f"expected a scenario file or a shipped scenario name, got {sc!r}")
@@ -135,11 +136,16 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
             if not file.is_file():
                 raise at.error(i, f"no such file: {file} (scenario paths are relative to the spec file)")
             sources[sc] = str(file.resolve())
+            resolved = file.resolve()
         else:
             try:  # a shipped scenario's name is passed on as it is: every worker has the package
-                scenarios.resolve(sc)
+                resolved = scenarios.resolve(sc).resolve()
             except reader.InputError as exc:
                 raise at.error(i, exc.message) from None
+        if resolved in files:  # its runs would be counted twice, as two scenarios
+            raise at.error(i, f"{sc!r} is the scenario {files[resolved]!r} again (both are {resolved}): each "
+                              "scenario once")
+        files[resolved] = sc
     paths = _paths(top, p.parent)
     start = int(top.number("seed_start", 0, integer=True, min=0, max=reader.MAX_SEED))
     seeds_raw = top.raw("seeds")
@@ -344,6 +350,9 @@ def _variants(t: reader.Table, scenario_list: Sequence[str], sources: Mapping[st
         step = float(times.number("step", positive=True))
         times.done()
         vt.done()
+        if not (stop - start) / step <= MAX_JOBS:  # inf too: ceil() of it raised in every job
+            raise times.error("step", f"{(stop - start) / step:.3g} strata of {step:g} s in [{start:g}, {stop:g}), "
+                                      f"more than the {MAX_JOBS} a sweep may have jobs: a larger step")
         try:
             out[sc] = InterruptionGrid(interrupt, start, stop, step)
         except ValueError as exc:
@@ -361,12 +370,16 @@ def _check_interrupt(t: reader.Table, vt: reader.Table, sc: str, source: str, gr
         top = reader.load(scenarios.resolve(source), scenarios.ScenarioError)
         kind = top.raw("kind", "synthetic")
         requests = top.raw("requests", [])
+        horizon = top.table("settings", {}).raw("horizon", 1800.0)
     except reader.InputError:
         return  # the scenario's own fault: its loader names it (sweep.precheck, before any job runs)
     if kind != "robot":
         raise t.error(sc, f"{sc!r} is a {kind} scenario: only robot scenarios are randomised, so variants "
                           f"would be ignored")
     n = len(requests) if isinstance(requests, list) else 0
+    if isinstance(horizon, int | float) and not isinstance(horizon, bool) and grid.start >= horizon:
+        raise vt.error("times", f"start = {grid.start:g} s is not before {sc!r}'s horizon ({horizon:g} s): the "
+                                "interruption would come after every run ended")
     if grid.index >= n:
         raise vt.error("interrupt", f"no {grid.interrupt} in {sc!r}: it has {n} requests"
                                     + (f", requests[0]..requests[{n - 1}]" if n else ""))

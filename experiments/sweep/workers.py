@@ -148,8 +148,9 @@ def _execute_marked(run_fn: RunFn, job: Job, mark: str) -> Outcome:
     return execute(run_fn, job)
 
 
-def _died(exitcode: int | None) -> str:
-    """The message of a job whose worker process died while running it alone."""
+def _died(exitcode: int | None, hook: str | None = None) -> str:
+    """The message of a job whose worker process died while running it alone (in ``hook``, a
+    ``task.py`` hook named with its folder, when one was running)."""
     if exitcode is None:
         how = "exit code unknown"
     elif exitcode < 0:
@@ -160,13 +161,20 @@ def _died(exitcode: int | None) -> str:
         how = f"killed by {name}, exit code {exitcode}"
     else:
         how = f"exit code {exitcode}"
+    if hook is not None:
+        return (f"worker process died ({how}) while running this job alone, in the task.py hook {hook} "
+                "(a hook that calls os._exit or kills its process ends the run it is in)")
     return (f"worker process died ({how}) while running this job alone "
             "(a crash in native code, os._exit, or the OOM killer)")
 
 
-def _alone_child(conn: Any, run_fn: RunFn, job: Job, driver: int) -> None:
-    """The body of the process that runs one job alone: send its outcome back, or die trying."""
+def _alone_child(conn: Any, run_fn: RunFn, job: Job, driver: int, mark: str) -> None:
+    """The body of the process that runs one job alone: send its outcome back, or die trying
+    (leaving in ``mark`` the task.py hook that was running, :mod:`tasker.support.hookmark`)."""
+    from tasker.support import hookmark
+
     die_with_parent(driver)
+    hookmark.use(mark)
     out = execute(run_fn, job)
     try:
         conn.send(out)
@@ -177,26 +185,33 @@ def _alone_child(conn: Any, run_fn: RunFn, job: Job, driver: int) -> None:
 
 
 def _alone(run_fn: RunFn, job: Job, ctx: Any) -> Outcome:  # a multiprocessing context (spawn or forkserver)
-    """Run one job alone in a fresh worker process; if the process dies, an ``error`` outcome that says so."""
+    """Run one job alone in a fresh worker process; if the process dies, an ``error`` outcome that says
+    so, naming the ``task.py`` hook (and its folder) that was running if one was."""
+    from tasker.support import hookmark
+
     start = time.perf_counter()
-    receiver, sender = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_alone_child, args=(sender, run_fn, job, os.getpid()),
-                       name=f"tasker-sweep-alone-{job.seed}")
-    proc.start()
-    sender.close()  # so that receiving ends (EOFError) when the process dies without sending
-    out: Outcome | None = None
-    try:
-        out = receiver.recv()
-    except EOFError:  # it died without sending: wait for its exit code
-        proc.join(timeout=30)
-    finally:
-        receiver.close()
-        if proc.is_alive():  # interrupted (Ctrl-C), or it closed the pipe and kept going
-            proc.terminate()
-        proc.join()
+    with tempfile.TemporaryDirectory(prefix="tasker-alone-") as tmp:
+        mark = hookmark.create(Path(tmp) / "hook")
+        receiver, sender = ctx.Pipe(duplex=False)
+        proc = ctx.Process(target=_alone_child, args=(sender, run_fn, job, os.getpid(), str(mark)),
+                           name=f"tasker-sweep-alone-{job.seed}")
+        proc.start()
+        sender.close()  # so that receiving ends (EOFError) when the process dies without sending
+        out: Outcome | None = None
+        try:
+            out = receiver.recv()
+        except EOFError:  # it died without sending: wait for its exit code
+            proc.join(timeout=30)
+        finally:
+            receiver.close()
+            if proc.is_alive():  # interrupted (Ctrl-C), or it closed the pipe and kept going
+                proc.terminate()
+            proc.join()
+        hook = hookmark.read(mark)
     if out is not None:
         return out
-    return _failed(job, _died(proc.exitcode), time.perf_counter() - start, f"{socket.gethostname()}:{proc.pid}")
+    return _failed(job, _died(proc.exitcode, hook), time.perf_counter() - start,
+                   f"{socket.gethostname()}:{proc.pid}")
 
 
 def _pool_pass(run_fn: RunFn, queue: deque[Job], workers: int, ctx: multiprocessing.context.BaseContext,

@@ -5,7 +5,10 @@ every fault is an :class:`InputError` that names the file, the line (when the fi
 one for the key), the dotted field and what was expected — with a "did you mean" for
 misspelled names.  Reading is strict by default:
 
-* the file must be UTF-8 text (a binary file or a stray byte is an error naming the line);
+* the file must be UTF-8 text (a binary file or a stray byte is an error naming the line), a
+  regular file (not ``/dev/zero``) of at most :data:`MAX_FILE_BYTES`;
+* arrays and tables nest at most :data:`MAX_DEPTH` deep, integers fit in 64 bits (TOML's rule);
+  :func:`parse_json` holds JSON (run records, results, traces) to the same limits;
 * a number must be finite (TOML's ``nan`` and ``inf`` are refused) and of the right type
   (``true`` is not a number; an integer is accepted where a float is expected);
 * :meth:`Table.done` refuses keys nobody asked for, listing the valid ones, so
@@ -26,7 +29,9 @@ from __future__ import annotations
 import difflib
 import json
 import math
+import os
 import re
+import stat
 import tomllib
 import warnings
 from collections.abc import Iterable, Sequence
@@ -310,6 +315,8 @@ def check_number(t: Table, key: str | int, value: Any, *, min: float | None = No
         raise t.error(key, f"expected {'an integer' if integer else 'a number'}, got {_show(value)}")
     if integer and not isinstance(value, int):
         raise t.error(key, f"expected an integer, got {value!r}")
+    if isinstance(value, int) and not -MAX_INT - 1 <= value <= MAX_INT:
+        raise t.error(key, f"expected a 64-bit integer, got one of {len(str(abs(value)))} digits")
     if not math.isfinite(value):
         raise t.error(key, f"expected a finite number, got {value!r}")
     if positive and value <= 0:
@@ -357,30 +364,132 @@ def _show(value: Any) -> str:
     return f"{_kind(value)} {value!r}"
 
 
-def read_text(path: str | Path, error_class: type[InputError] = InputError) -> str:
-    """A user's file as text: missing, binary and non-UTF-8 files are clean errors.  A UTF-8
-    byte-order mark (Windows editors write one) is dropped: TOML parsers would call it a syntax error."""
+# -- reading within limits ---------------------------------------------------------------
+
+MAX_FILE_BYTES = 64 * 2**20
+"""The largest file a reader takes whole (64 MiB): far above any scenario, world, task folder,
+protocol, spec or run record; a mistaken path (a disk image, ``/dev/zero``) fails at once."""
+
+MAX_DEPTH = 64
+"""Arrays and tables (JSON objects) within each other at most this deep: no file of tasker's
+needs a tenth of it, and readers of deeper ones would run out of Python's recursion."""
+
+MAX_SECONDS = 7 * 24 * 3600.0
+"""The longest simulated time an input may name (a week): a horizon, a request's time, a duration,
+a budget.  A run steps its clock up to the times it is given, so ``t = 1e300`` never ended."""
+
+MAX_INT = 2**63 - 1
+"""Integers are 64-bit (TOML's rule, and SQLite's): a longer one is refused where it is read,
+never turned into an ``OverflowError`` by the first ``float()`` downstream."""
+
+
+def _size(n: int) -> str:
+    return f"{n / 2**20:g} MiB" if n >= 2**20 else f"{n} bytes"
+
+
+def read_bytes(path: str | Path, error_class: type[InputError] = InputError, *,
+               limit: int = MAX_FILE_BYTES) -> bytes:
+    """A file's bytes, at most ``limit`` of them: a missing file, a folder, a device (``/dev/zero``
+    never ends) or a file larger than ``limit`` is a clean ``error_class`` naming it.  A pipe is
+    read up to the limit; one that no program writes to reads as empty (it never blocks)."""
     p = Path(path)
+    if "\x00" in str(path):
+        raise error_class(repr(str(path)), "is not a valid file name (it holds a NUL character)")
     try:
-        data = p.read_bytes()
+        mode = p.stat().st_mode
+        if stat.S_ISDIR(mode):
+            raise IsADirectoryError
+        if not (stat.S_ISREG(mode) or stat.S_ISFIFO(mode)):
+            raise error_class(p, "is not a regular file (a device or a socket), expected a file")
+        # a pipe is opened without waiting for a writer (none: it reads as empty), then read as a file
+        fd = os.open(p, os.O_RDONLY | os.O_NONBLOCK)
+        os.set_blocking(fd, True)
+        with os.fdopen(fd, "rb") as f:
+            data = f.read(limit + 1)
     except FileNotFoundError:
         raise error_class(p, "no such file") from None
     except IsADirectoryError:
         raise error_class(p, "is a directory, expected a file") from None
     except OSError as exc:
         raise error_class(p, f"cannot read: {exc.strerror or exc}") from None
-    if b"\x00" in data:
-        raise error_class(p, "is a binary file, expected UTF-8 text")
+    if len(data) > limit:
+        raise error_class(p, f"is larger than {_size(limit)}, the most a file read here may have")
+    return data
+
+
+def decode(data: bytes, file: str | Path, error_class: type[InputError] = InputError) -> str:
+    """UTF-8 text (a byte-order mark dropped); a NUL or a byte that is no UTF-8 names its line."""
+    nul = data.find(b"\x00")
+    if nul >= 0:
+        raise error_class(file, "is a binary file, expected UTF-8 text", line=data[:nul].count(b"\n") + 1)
     data = data.removeprefix(b"\xef\xbb\xbf")
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
-        raise error_class(p, f"is not UTF-8 text (byte {data[exc.start]:#04x})", line=line) from None
+        raise error_class(file, f"is not UTF-8 text (byte {data[exc.start]:#04x})", line=line) from None
+
+
+def read_text(path: str | Path, error_class: type[InputError] = InputError, *, limit: int = MAX_FILE_BYTES) -> str:
+    """A user's file as text (:func:`read_bytes`, :func:`decode`): missing, special, too large,
+    binary and non-UTF-8 files are clean errors.  A UTF-8 byte-order mark (Windows editors write
+    one) is dropped: TOML parsers would call it a syntax error."""
+    return decode(read_bytes(path, error_class, limit=limit), path, error_class)
+
+
+def _field(path: Sequence[str | int]) -> str:
+    out = ""
+    for p in path[:6]:
+        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
+    return out + ("…" if len(path) > 6 else "")
+
+
+def tree_problem(data: Any) -> tuple[tuple[str | int, ...], str] | None:
+    """``(path, why)`` when decoded data nests deeper than :data:`MAX_DEPTH` or holds an integer
+    outside 64 bits; else ``None``.  Iterative, so it never recurses itself."""
+    stack: list[tuple[Any, tuple[str | int, ...]]] = [(data, ())]
+    while stack:
+        value, path = stack.pop()
+        if isinstance(value, int) and not isinstance(value, bool):
+            if not -MAX_INT - 1 <= value <= MAX_INT:
+                return path, f"expected a 64-bit integer, got one of {len(str(abs(value)))} digits"
+        elif isinstance(value, dict | list):
+            if len(path) >= MAX_DEPTH:
+                return path, f"nested more than {MAX_DEPTH} deep"
+            items = value.items() if isinstance(value, dict) else enumerate(value)
+            stack.extend((v, (*path, k)) for k, v in items)
+    return None
+
+
+def _long_number_line(text: str) -> int | None:
+    m = re.search(r"\d{4000}", text)
+    return text.count("\n", 0, m.start()) + 1 if m else None
+
+
+def parse_json(text: str, file: str | Path = "<string>", error_class: type[InputError] = InputError, *,
+               line: int | None = None) -> Any:
+    """Decoded JSON within the limits (:data:`MAX_DEPTH`, 64-bit integers); ``line`` is where
+    ``text`` starts in ``file`` (a line of a ``.jsonl``).  Faults are ``error_class`` errors."""
+    at = (line or 1) - 1
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise error_class(file, f"not valid JSON: {exc.msg}", line=at + exc.lineno) from None
+    except RecursionError:
+        raise error_class(file, f"not readable JSON: nested more than {MAX_DEPTH} deep", line=line) from None
+    except ValueError:  # Python refuses integers of more than 4300 digits
+        raise error_class(file, "not readable JSON: a number of thousands of digits",
+                          line=at + (_long_number_line(text) or 1)) from None
+    problem = tree_problem(data)
+    if problem is not None:
+        path, why = problem
+        raise error_class(file, why, line=line, field=_field(path))
+    return data
 
 
 def loads(text: str, file: str | Path = "<string>", error_class: type[InputError] = InputError) -> Table:
-    """Parse TOML text into a strict :class:`Table` (syntax errors name the line)."""
+    """Parse TOML text into a strict :class:`Table` (syntax errors name the line; nesting deeper
+    than :data:`MAX_DEPTH` and integers beyond 64 bits are refused, as TOML says)."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -388,7 +497,17 @@ def loads(text: str, file: str | Path = "<string>", error_class: type[InputError
         msg = _TOML_POS.sub("", str(exc)).strip()
         line = int(m.group(1)) if m else (text.count("\n") + 1 if "end of document" in msg else None)
         raise error_class(file, f"not valid TOML: {msg}", line=line) from None
-    return Table(file, data, (), _LineIndex(text), error_class)
+    except RecursionError:
+        raise error_class(file, f"not readable TOML: arrays or tables nested more than {MAX_DEPTH} deep") from None
+    except ValueError:  # Python refuses integers of more than 4300 digits
+        raise error_class(file, "not valid TOML: expected a 64-bit integer, got one of thousands of digits",
+                          line=_long_number_line(text)) from None
+    index = _LineIndex(text)
+    problem = tree_problem(data)
+    if problem is not None:
+        path, why = problem
+        raise error_class(file, why, line=index.line(path), field=_field(path))
+    return Table(file, data, (), index, error_class)
 
 
 def load(path: str | Path, error_class: type[InputError] = InputError) -> Table:
@@ -398,9 +517,5 @@ def load(path: str | Path, error_class: type[InputError] = InputError) -> Table:
     """
     text = read_text(path, error_class)
     if str(path).endswith(".json"):
-        try:
-            data = json.loads(text, parse_constant=lambda c: float(c))
-        except json.JSONDecodeError as exc:
-            raise error_class(path, f"not valid JSON: {exc.msg}", line=exc.lineno) from None
-        return Table(path, data, (), None, error_class)
+        return Table(path, parse_json(text, path, error_class), (), None, error_class)
     return loads(text, path, error_class)

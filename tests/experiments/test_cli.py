@@ -72,6 +72,9 @@ BAD: list[tuple[list[str], str]] = [
     (["plan", "{domain}", "{domain}", "--timeout", "nan"], "--timeout"),
     (["plan", "{domain}", "{domain}", "--planner", "fast-downwrd"], "did you mean 'fast-downward'"),
     (["domains", "--path", "{missing}"], "--path"),
+    (["paper", "--variants", "-1"], "--variants"),
+    (["paper", "--variants", "0", "--out", "{missing}"], "--out"),
+    (["paper", "--scenario", "papr"], "did you mean 'paper'"),
     (["fsm", "guide_humn"], "did you mean 'guide_human'"),
     (["fsm", "cook", "--purpose", "genSusp", "--after", "-1"], "--after"),
     (["fsm", "cook", "--purpose", "genSusp", "--after", "99"], "--after"),
@@ -371,7 +374,7 @@ def test_day_stopped_by_ctrl_c_says_how_to_go_on(monkeypatch: pytest.MonkeyPatch
     out.mkdir()
     assert main(["day", "--protocol", "tabsa", "--days", "1", "--out", str(out)]) == 130
     err = capsys.readouterr().err
-    assert f"the days that ended are in {out / 'days.db'}: run the same command with --resume" in err
+    assert f"the days that ended are in {out / 'days.db'}: run the same command again to go on" in err
 
 
 def test_strategy_options_on_a_synthetic_scenario_warn(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -179,8 +179,8 @@ def test_strategies_are_compared_under_each_scheduler() -> None:
          for s in (1, 2, 3)]
     text = day_table.report(a + b, title="t")
     assert "## t, strategy `suspension=static`" in text and "## t, strategy `suspension=planned`" in text
-    assert "| travel distance (m) | `suspension=planned`, lookahead | 1.00 ± 0.00 |" in text
-    assert "| travel distance (m) | `suspension=planned`, alg2 | 1.00 ± 0.00 |" in text
+    assert "| travel distance (m) | `suspension=planned`, lookahead | 3 | 1.00 ± 0.00 | 0 / 0 / 3 |" in text
+    assert "| travel distance (m) | `suspension=planned`, alg2 | 3 | 1.00 ± 0.00 | 0 / 0 / 3 |" in text
     assert "| time suspending (s, ours) | `suspension=planned`, alg2 |" in text  # what strategies differ in
 
 
@@ -276,11 +276,11 @@ def test_resuming_with_a_changed_protocol_is_refused_and_keeps_the_stored_days(
     capsys.readouterr()
     assert _day_main([*args, "--days", "3"]) == 2
     err = capsys.readouterr().err
-    assert f"argument --resume: {out / 'days.db'} holds days of {proto} as it was when they ran" in err
-    assert "run without --resume to start afresh" in err and "Traceback" not in err
+    assert f"argument --out: {out / 'days.db'} holds days of {proto} as it was when they ran" in err
+    assert "give --overwrite to delete them and start afresh" in err and "Traceback" not in err
     with ResultStore(out / "days.db", readonly=True) as store:
         assert sorted(r.seed for r in store.rows()) == [1, 2]
-    assert _day_main([a for a in args if a != "--resume"] + ["--days", "1"]) == 0  # afresh
+    assert _day_main([a for a in args if a != "--resume"] + ["--days", "1", "--overwrite"]) == 0  # afresh
 
 
 def test_a_folder_given_as_the_protocol_is_named_a_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -13,6 +13,7 @@ from typing import Any
 
 import pytest
 
+from experiments.days import draw as day_draw
 from experiments.days import pipeline as days
 from experiments.days import protocol
 from experiments.days import runner as day_runner
@@ -59,7 +60,7 @@ def test_the_rush_is_the_full_day_called_in_half_an_hour() -> None:
     assert (rush.last_call_s, rush.length_s) == (1800.0, 7200.0)
     same = ("step_s", "robot_speed", "start_site", "planning_time_s", "sites", "tasks", "robot")
     assert all(getattr(rush, f) == getattr(full, f) for f in same)
-    calls = [r.t for r in protocol.draw(rush, 3)]
+    calls = [r.t for r in day_draw.draw(rush, 3)]
     assert len(calls) == 36 and max(calls) < 1800.0
     assert days.make("tabsa-rush", 3, backend="robot").scenario.horizon == 7200.0
 

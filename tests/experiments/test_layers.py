@@ -122,4 +122,4 @@ def test_argparse_lives_only_in_cli() -> None:
                    and any(isinstance(x, ast.Import | ast.ImportFrom) and "argparse" in
                            ([a.name for a in x.names] if isinstance(x, ast.Import) else [x.module or ""])
                            for x in ast.walk(ast.parse(p.read_text(encoding="utf-8")))))
-    assert users == ["experiments.paper.report"], users  # issue 27 replaces it
+    assert users == [], users

@@ -1,8 +1,9 @@
 """End to end: ``tasker run paper`` writes its outputs, is reproducible, and reproduces the
 steps of Appendix B that follow from the costs — with the paper's rule (hysteresis 1.0) and
 the ROS code's 0.9 — plus the counterfactuals that show the causes (John stands still;
-Peter stays down).  The 50-variant reproduction rate is ``python -m experiments.paper.report``
-(``docs/paper.md``), not a test."""
+Peter stays down); ``paper-2019`` is the reconstruction of ``experiments.paper.reconstruction``
+and reproduces the steps its layout gives.  The 50-variant reproduction rates are
+``tasker paper`` (``docs/paper.md``), not a test."""
 
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ import pytest
 from experiments.cli import main
 from experiments.inputs import scenario as scenarios
 from experiments.paper import appendix_b
-from experiments.paper.report import run_one
+from experiments.paper.report import Config, run_one
 from experiments.run.runner import run_scenario
 from tasker.trace import read
 
@@ -39,7 +40,7 @@ def checked(paper_run: Path) -> dict[float, list[dict[str, Any]]]:
     shipped = appendix_b.check(read(paper_run / "trace.jsonl"))
     as_dicts = [{"ok": s.ok, "t": s.t, "c_switch": s.c_switch, "c_wait": s.c_wait, "detail": s.detail,
                  "name": s.name} for s in shipped]
-    return {0.9: as_dicts, 1.0: run_one((1.0, None, "paper"))["steps"]}
+    return {0.9: as_dicts, 1.0: run_one(("paper", Config("seconds", 1.0), None))["steps"]}
 
 
 def _events(change: Callable[[scenarios.RobotScenario], scenarios.RobotScenario]) -> list[dict[str, Any]]:
@@ -136,3 +137,95 @@ def test_the_report_replaces_only_its_block() -> None:
     out = splice(text, f"{BEGIN}\nnew\n{END}\n")
     assert out == f"# title\n\nprose\n\n{BEGIN}\nnew\n{END}\n\nmore prose\n"
     assert splice("no markers\n", f"{BEGIN}\nx\n{END}\n").endswith(f"\n\n{BEGIN}\nx\n{END}\n")
+
+
+# -- paper-2019: the layout reconstructed from the original verification's record -------------
+
+def test_the_paper_2019_files_hold_the_reconstruction() -> None:
+    """Every coordinate of the world and the scenario is reconstruction.derive()'s, shifted into the room."""
+    import math
+
+    from experiments.paper import reconstruction
+    from robot.spec import load_world
+
+    lay = reconstruction.derive()
+    scn = scenarios.load(scenarios.resolve("paper-2019"))
+    world = load_world(scn.world)
+    shift = (2.5, 2.0)
+
+    def at(p: tuple[float, float]) -> tuple[float, float]:
+        return (round(p[0] + shift[0], 2), round(p[1] + shift[1], 2))
+
+    def xy(pose: tuple[float, ...] | list[float]) -> tuple[float, float]:
+        return (round(float(pose[0]), 2), round(float(pose[1]), 2))
+
+    assert xy(world.places["alice_destination"]) == at(lay.alice_dest)
+    assert xy(world.places["john_destination"]) == at(lay.john_dest)
+    assert xy(world.people["alice"].pose) == at(lay.alice)
+    assert xy(world.people["peter"].pose) == at(lay.peter)
+    assert xy(world.robot.pose) == at(lay.robot)
+    assert xy(world.people["john"].pose) == at(lay.john_walk[0][1])
+    walk = [(round(t, 1), round(x, 2), round(y, 2)) for t, x, y in scn.people["john"]["walk"]]
+    assert walk == [(round(t - 2507.6, 1), *at(p)) for t, p in lay.john_walk]
+    assert xy(scn.people["sara"]["walk"][-1][1:]) == at(lay.sara)
+    fastest = max(math.dist(a[1], b[1]) / (b[0] - a[0]) for a, b in zip(lay.john_walk, lay.john_walk[1:], strict=False))
+    assert world.people["john"].speed == pytest.approx(fastest, abs=0.05)
+    # the derivation reproduces the recorded distances it was made from
+    assert all(abs(rec - got) < 1e-6 for _, what, rec, got in reconstruction.residuals(lay) if "guided" not in what)
+    assert lay.fit_rms < 0.15
+
+
+@pytest.fixture(scope="module")
+def paper_2019() -> list[dict[str, Any]]:
+    return run_one(("paper-2019", Config("seconds", 0.9), None))["steps"]
+
+
+def test_paper_2019_reproduces_steps_1_2_and_7_and_step_2_by_a_clear_margin(paper_2019: list[dict[str, Any]]) -> None:
+    steps = paper_2019
+    assert [steps[k]["ok"] for k in (0, 1, 6)] == [True, True, True], [steps[k]["detail"] for k in (0, 1, 6)]
+    assert steps[1]["c_switch"] < (0.9 - KNIFE_EDGE) * steps[1]["c_wait"], steps[1]["detail"]
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "In paper-2019 our robot (0.5 m/s) reaches Alice, greets her and asks her to follow before John arrives "
+    "where the record has him at 2521.1 (t = 13.5); the record's robot was still 1.2 m from her. Her task is "
+    "then the shorter and step 3 misses (docs/paper.md: the closest comparison and its margin)."))
+def test_paper_2019_reproduces_step_3(paper_2019: list[dict[str, Any]]) -> None:
+    assert paper_2019[2]["ok"], paper_2019[2]["detail"]
+
+
+def test_the_original_model_is_chosen_per_request_with_each_persons_factors() -> None:
+    from experiments.paper.report import scenario_for
+
+    scn = scenario_for(("paper-2019", Config("taskER-2019", 0.9), None))
+    args = {a.fields["args"]["person"]: a.fields["args"] for a in scn.actions if a.kind == "request"}
+    assert args["john"] == {"person": "john", "destination": "john_destination", "cost_model": "taskER-2019",
+                            "f_walk": 0.15, "f_stand": 0.15, "f_sit": 0.3}
+    assert args["alice"]["f_walk"] == 0.2 and args["peter"] == {"person": "peter", "cost_model": "taskER-2019"}
+    assert scn.scheduler_options["hysteresis"] == 0.9
+    ours = scenario_for(("paper", Config("seconds", 1.0), 3))
+    assert all("cost_model" not in a.fields["args"] for a in ours.actions if a.kind == "request")
+    assert ours.scheduler_options["hysteresis"] == 1.0 and ours.seed == 3
+
+
+def test_tasker_paper_writes_the_block_with_its_command_and_commit(tmp_path: Path,
+                                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    from experiments.paper import report
+
+    def fake(todo: list[report.Job], workers: int, done: Any = None) -> dict[report.Job, report.Run]:
+        step = {"name": "s", "ok": True, "t": 1.0, "c_switch": 1.0, "c_wait": 2.0, "margin": 0.5, "detail": "d"}
+        miss = {**step, "ok": False, "t": None, "c_switch": 3.0, "margin": -0.5}
+        return {job: {"steps": [step, miss if job[2] == 1 else step],
+                      "predictions": [{"agent": "d1", "t": 0.0, "predicted_s": 10.0, "realised_s": 11.0,
+                                       "ended": True}]} for job in todo}
+
+    monkeypatch.setattr(report, "run_all", fake)
+    doc = tmp_path / "paper.md"
+    doc.write_text(f"# prose\n\n{report.BEGIN}\nold\n{report.END}\n\nmore prose\n")
+    assert main(["paper", "--variants", "2", "--out", str(doc), "--scenario", "paper-2019"]) == 0
+    text = doc.read_text()
+    assert text.startswith("# prose\n\n") and text.endswith("\n\nmore prose\n") and "\nold\n" not in text
+    assert "`tasker paper --variants 2 --scenario paper-2019 --out " in text and "at commit `" in text
+    assert "| 2 | s | yes +50.0 %; 1/2 |" in text  # the shipped run holds; variant 1 of 2 misses
+    assert "taskER-2019, h = 0.9" in text and "`paper-2019`" in text and "`paper`:" not in text
+    assert "| 2521.1 | taskER-2019 | 2.248 | 2.861 | +21.4 % | yes | yes | 2.248 | 2.861 |" in text

@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 from experiments.analysis import stats
+from experiments.days import draw as day_draw
 from experiments.days import pipeline as day_pipeline
 from experiments.days import protocol
 from experiments.days import runner as day_runner
@@ -32,7 +33,7 @@ def test_the_shipped_protocol_reads(tabsa: protocol.Protocol) -> None:
 
 
 def test_a_day_is_reproducible_per_seed(tabsa: protocol.Protocol) -> None:
-    a, b, c = protocol.generate(tabsa, 7), protocol.generate(tabsa, 7), protocol.generate(tabsa, 8)
+    a, b, c = day_draw.generate(tabsa, 7), day_draw.generate(tabsa, 7), day_draw.generate(tabsa, 8)
     assert a.actions == b.actions and a.actions != c.actions
     assert len(a.actions) == 36
     falls = [x.fields["args"] for x in a.actions if x.fields["task"] == "fall"]
@@ -97,7 +98,7 @@ def test_a_day_of_no_requests_is_refused_and_a_day_of_one_type_runs(tmp_path: Pa
         protocol.load(write(tmp_path, text.replace("count = 12", "count = 0")))
     falls = protocol.load(write(tmp_path, text.replace("count = 12", "count = 0").replace(
         "count = 0\npriority = 3", "count = 1\npriority = 3")))
-    assert [r.kind for r in protocol.draw(falls, 1)] == ["fall"]
+    assert [r.kind for r in day_draw.draw(falls, 1)] == ["fall"]
 
 
 def test_a_failed_fall_is_requested_again_until_its_death_at(tabsa: protocol.Protocol) -> None:
@@ -227,8 +228,9 @@ def test_holm_adjustment() -> None:
 def test_table_has_every_scheduler_and_the_paired_tests(tabsa: protocol.Protocol) -> None:
     results = day_runner.run_days(TABSA, 3, ["lookahead", "simple2"], workers=1)
     text = day_table.table(results)
-    assert "| metric | lookahead | simple2 |" in text
-    assert "| dead falls | simple2 |" in text and "Holm" in text
+    assert "| metric | lookahead | simple2 (ours) |" in text  # our priority-first reading of TaBSA's agent
+    assert "| dead falls | simple2 (ours) | 3 |" in text and "Holm" in text
+    assert "too few days (< 8)" in text  # 8 tests: 2^(1-n) * 8 < 0.05 needs n >= 8
 
 
 def test_a_failed_tasks_own_safe_suspension_is_not_an_interruption() -> None:

@@ -216,3 +216,12 @@ def test_host_dependent_metrics_are_reported_without_a_verdict(tmp_path: Path, r
     page = files.html.read_text()
     assert "<table>" in page and "host-dependent: no verdict" in page and 'id="metric-0"' in page
     assert "<script src" not in page
+
+
+def test_a_sweep_with_planner_fallbacks_says_so(rows: list[RunRow]) -> None:
+    assert "fallback" not in report_tables.markdown(analyse(rows))
+    fell = [RunRow(r.scenario, r.seed, r.strategy, r.status, r.record,
+                   {**r.metrics, "totals": {**r.metrics["totals"], "static_fallbacks": 1}})
+            if (r.scenario, r.seed, r.strategy) == ("a", 2, PLANNED) else r for r in rows]
+    md = report_tables.markdown(analyse(fell))
+    assert "**1 runs had a planner fallback to static**" in md and f"a {PLANNED}" in md

@@ -186,3 +186,16 @@ def test_margins_and_flips_are_summed_per_cell() -> None:
     line = next(s for s in text.splitlines() if s.startswith("| hh | static | 6 |"))
     assert line.split("|")[4].strip() == "3" and "-0.1:3 +0.2:3" in line  # |margin| < 0.1: the -0.1 bin
     assert line.rstrip(" |").endswith("3 | 0 | 0 | 3")
+
+
+def test_a_plain_run_is_vouched_for_by_its_scenario(monkeypatch: pytest.MonkeyPatch) -> None:
+    calls: list[tuple[str, object, str]] = []
+
+    def fake(scenario: str, *, seed: int | None = None, strategy: str = "", root: Path = ROOT) -> pv.Digest:
+        calls.append((scenario, seed, strategy))
+        return pv.Digest("", False, scenario, -1, strategy, "c" * 64)
+
+    monkeypatch.setattr(pv, "run_digest", fake)
+    prov = pv.Provenance("c", (pv.Digest("", False, "paper", -1, "", "c" * 64),))
+    assert pv.verify(prov) == [] and calls == [("paper", None, "")]
+    assert "| paper | tasker run | its own | its own settings |" in "\n".join(pv.render(prov))

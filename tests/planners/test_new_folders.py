@@ -333,7 +333,9 @@ def test_a_folder_reached_twice_is_one_task_type_and_a_real_clash_names_both(
     folder = _new(tmp_path)
     monkeypatch.setenv(ENV_VAR, str(folder))
     assert [t.name for t in task_types([tmp_path, f"{folder}/"])].count("fetch") == 1
-    other = _new(tmp_path / "more", "guide_human")
+    other = _new(tmp_path / "more", "guide_humans")  # tasker new refuses a bundled name: made by hand
+    toml = other / "task.toml"
+    toml.write_text(toml.read_text().replace('name = "guide_humans"', 'name = "guide_human"'))
     with pytest.raises(ConfigError) as info:
         task_types([other])
     bundled = (BUNDLED / "guide_human" / "task.toml").resolve()
@@ -386,11 +388,13 @@ def test_a_binding_of_the_wrong_kind_for_the_world_is_a_warning(tmp_path: Path) 
     from tasker.support.reader import InputWarning
 
     folder = _new(tmp_path)
+    for name in ("task.toml", "domain.pddl"):  # a predicate of its own: 'holding' is bound as held by bundled
+        (folder / name).write_text((folder / name).read_text().replace("holding", "carrying"))  # folders too
     _edit(folder / "task.toml", 'kind = "held"', 'kind = "device"')
     with pytest.warns(InputWarning) as caught:
         scn = scenarios.load(folder / "scenario.toml", task_paths=[str(folder)])
-    message = "task type 'fetch': its device binding of ['holding', '?r', '?i'] covers vase here, and none is a " \
-              "device thing of world 'flat', so the fact stays symbolic (kind = 'held'?)"
+    message = "task type 'fetch': its device binding of ['carrying', '?r', '?i'] covers vase here, and none is " \
+              "a device thing of world 'flat', so the fact stays symbolic (kind = 'held'?)"
     assert any(message in str(w.message) for w in caught) and any(message in w for w in scn.warnings)
     _edit(folder / "task.toml", 'kind = "device"', 'kind = "held"')
     assert scenarios.load(folder / "scenario.toml", task_paths=[str(folder)]).warnings == ()

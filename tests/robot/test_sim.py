@@ -235,12 +235,14 @@ def test_equal_facts_keys_mean_equal_facts(paper) -> None:
     sim.bind([Binding("follower", ("following", "?h"), "?h", ("person",))])
     seen: dict[object, frozenset] = {}
     keys = 0
+    poses: dict[object, set[tuple[float, float]]] = {}
 
     def look() -> None:
         nonlocal keys
         key, facts = sim.facts_key(), sim.snapshot().facts
         keys += key not in seen
         assert seen.setdefault(key, facts) == facts
+        poses.setdefault(key, set()).add(sim.robot_pose()[:2])
 
     stage = nav("john", add=[["met", "robot", "john"]])
     sim.begin("d1", stage, 0.0)
@@ -257,4 +259,53 @@ def test_equal_facts_keys_mean_equal_facts(paper) -> None:
         t = round(t + 0.5, 6)
         sim.advance(t)
         look()
-    assert keys > 10  # the key did change along the way
+    assert keys >= 4  # the key did change along the way (places reached, a follower, a posture)
+    # and it is made of places, not poses: the robot driving within one place keeps it
+    assert max(len(p) for p in poses.values()) > 5
+
+
+def test_people_not_stepped_while_still_are_where_stepping_them_puts_them(paper, monkeypatch) -> None:
+    """Still people are not stepped (``Person._idle_after``), the world syncs and re-examines
+    only people touched since it last looked: the same samples as stepping, syncing and
+    re-examining everyone at every tick.  John walks his script (before its start, walking,
+    after its end); in the bedroom p falls, q steps aside and r, in a dead end, stays
+    (``test_bystanders_make_room_for_help``), John walks up to p later and makes room too, p
+    gets up and they go back; w, standing in the living/hall doorway, is told to wait (steps
+    aside first), then follows the robot."""
+    import dataclasses
+
+    from robot.people import Person
+    from robot.spec import PersonSpec
+
+    def person(name: str, x: float, y: float, events=()) -> PersonSpec:
+        return PersonSpec(name, (x, y, 0.0), "standing", 0.5, ((0.0, x, y), (100.0, x, y)), tuple(events))
+
+    world = dataclasses.replace(paper, people={
+        "john": paper.people["john"], "p": person("p", 10.5, 4.6, [(1.0, "fallen"), (175.0, "standing")]),
+        "q": person("q", 9.6, 4.6), "r": person("r", 11.4, 4.6), "w": person("w", 5.0, 2.0)})
+
+    def day() -> list[str]:
+        sim = Simulation(world)
+        sim.bind([Binding("follower", ("following", "?h"), "?h", ("person",)),
+                  Binding("waiting", ("told_to_wait", "?h"), "?h", ("person",))])
+        sim.advance(5.0)
+        sim.apply(add=[["told_to_wait", "w"]])
+        run(sim, nav("living"), 5.0, limit=60.0)
+        sim.apply(delete=[["told_to_wait", "w"]], add=[["following", "w"]])
+        run(sim, nav("kitchen"), 60.0, limit=120.0)
+        sim.people["john"].go_to(120.0, 9.0, 5.4)  # to p, lying in the bedroom: he makes room
+        sim.apply(delete=[["following", "w"]])
+        sim.advance(190.0)
+        return sim.recording.lines()
+
+    fast = day()
+    monkeypatch.setattr(Person, "_idle_after", lambda self, t: -math.inf)
+    def everyone_every_tick(self: Simulation) -> None:
+        self._doors_seen = -1  # as if a door had moved: _give_room looks at everyone
+        self._give_room()
+        self._sync_people()
+
+    monkeypatch.setattr(Simulation, "_people_react", everyone_every_tick)
+    everyone = day()
+    assert fast == everyone
+    assert len({line.split('"robot"')[0] for line in fast}) > 100  # people did move
