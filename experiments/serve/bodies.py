@@ -87,8 +87,10 @@ def _checked(scn: RobotScenario, key: str, entry: dict[str, Any], t: float, wher
              tasks: Iterable[TaskType]) -> tuple[TimedAction, list[str]]:
     """``entry`` as the one ``[[key]]`` of a scenario like ``scn``, read and cross-checked; its warnings."""
     data: dict[str, Any] = {key: [{"t": t, **entry}]}
-    if scn.objects:  # the scenario's own objects: a request may name them
+    if scn.objects:  # the scenario's own objects and devices: a request or an event may name them
         data["objects"] = {n: dict(o) for n, o in scn.objects.items()}
+    if scn.devices:
+        data["devices"] = {n: dict(d) for n, d in scn.devices.items()}
     top = Table(where, data, error_class=ScenarioError)
     try:
         actions = read_actions(top, world_events=True)

@@ -3,7 +3,7 @@
 :class:`Record` keeps every action of the session in the order the session scheduled it: the
 served scenario's own (as ``build_robot_actions`` scheduled them) and each one that arrived
 over HTTP, at the time it was injected.  :meth:`Record.write` writes ``session.toml``: the
-world, the seed, the settings, the people and objects of the served scenario, and every
+world, the seed, the settings, the people, objects and devices of the served scenario, and every
 action at its simulated time.  A scenario names its requests ``d1``, ``d2``, … in the order
 of its file; a live session numbered the served scenario's first and the arrivals after
 them, so every reference (a termination's or change's ``agent``, a world event's ``after``)
@@ -14,6 +14,7 @@ and must give the same actions, or the session is not saved as replayable (a bug
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +23,7 @@ import tomli_w
 from experiments.inputs import scenario as scenarios
 from experiments.inputs.actions import TABLES, TimedAction
 from experiments.inputs.robot_scenario import RobotScenario
+from tasker.support.reader import InputWarning
 
 KEYS = {kind: key for key, kind in TABLES}
 """The array-of-tables key of each action kind (``request`` -> ``requests``)."""
@@ -37,10 +39,11 @@ class Entry:
 
 
 class Record:
-    """The actions of a session (see the module docstring) and the scenario they are played in."""
+    """The actions of a session (see the module docstring) and the scenario they are played in;
+    ``task_paths``: the task folders it loaded besides the bundled ones (``--path``), to read it back."""
 
-    def __init__(self, base: RobotScenario) -> None:
-        self.base = base
+    def __init__(self, base: RobotScenario, task_paths: tuple[str, ...] = ()) -> None:
+        self.base, self.task_paths = base, task_paths
         self.entries: list[Entry] = []
 
     def add(self, action: TimedAction, sid: str | None) -> None:
@@ -70,6 +73,9 @@ class Record:
         if b.objects:
             out["objects"] = {n: {"type": o["type"], "place": o["place"], "facts": [list(f) for f in o["facts"]]}
                               for n, o in b.objects.items()}
+        if b.devices:
+            out["devices"] = {n: {"type": d["type"], "place": d["place"], "state": d["state"]}
+                              for n, d in b.devices.items()}
         ids = self.renumbering()
         for e in sorted(self.entries, key=lambda e: (e.action.t, e.order)):
             out.setdefault(KEYS[e.action.kind], []).append(_entry(e.action, ids))
@@ -80,7 +86,9 @@ class Record:
         text = tomli_w.dumps(self.data(horizon))
         comment = "".join(f"# {line}\n" if line else "#\n" for line in header.splitlines())
         path.write_text(comment + "\n" + text, encoding="utf-8")
-        loaded = scenarios.load(path)
+        with warnings.catch_warnings():  # actions after the stop are kept on purpose (docs/serve.md)
+            warnings.simplefilter("ignore", InputWarning)
+            loaded = scenarios.load(path, task_paths=self.task_paths)
         ids, table = self.renumbering(), {kind: i for i, (_, kind) in enumerate(TABLES)}
         # the reader's order: by time, then by table, then by place in the file
         wanted = [_renamed(e.action, ids) for e in sorted(self.entries, key=lambda e: (e.action.t,

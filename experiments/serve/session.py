@@ -132,7 +132,7 @@ class Session:
             self._refuse_waiting("the session has stopped")
 
     def _drive(self, loop: SimulationLoop, sim: Any, actions: Actions) -> RobotScenario:
-        record = Record(self.scenario)
+        record = Record(self.scenario, self.task_paths)
         count = 0
         for a in sorted(self.scenario.actions, key=lambda a: a.t):  # as build_robot_actions numbered them
             count += a.kind == "request"

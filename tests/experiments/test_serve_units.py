@@ -184,6 +184,38 @@ def test_the_saved_session_renumbers_requests_in_file_order_and_reads_back(tmp_p
         {"agent": "d2", "reason": "terminated by the user"}, {"agent": "d3", "args": {"priority": 2}}]
 
 
+def test_a_served_scenarios_devices_objects_and_settings_are_saved(tmp_path: Path) -> None:
+    """water_plants adds a device (its tap) and objects to the paper world, and a task folder:
+    the saved session keeps them, or its replay would run in another world."""
+    root = Path(__file__).resolve().parents[2] / "experiments" / "sweep" / "specs"
+    paths = (str(root / "tasks"),)
+    scn = scenarios.load(root / "scenarios" / "water_plants.toml", task_paths=paths)
+    base = dataclasses.replace(scn, name="water_plants-session", request_fields=True)
+    record = Record(base, paths)
+    for k, a in enumerate(sorted(base.actions, key=lambda a: a.t)):
+        record.add(a, f"d{k + 1}" if a.kind == "request" else None)
+    loaded = record.write(tmp_path / "session.toml", 50.001, "a test session")  # read back with the checks
+    assert loaded.devices == scn.devices == {"tap": {"type": "tap", "place": "bathroom", "state": "off"}}
+    assert (loaded.objects, loaded.scheduler_options) == (scn.objects, scn.scheduler_options)
+    assert loaded.actions == tuple(a for a in scn.actions)  # the same actions, pending ones after 50 s too
+
+
+def test_a_world_event_may_name_a_device_the_served_scenario_adds() -> None:
+    """``{"device": ["tap", "on"]}`` in water_plants, whose ``[devices.tap]`` the world lacks, was
+    a KeyError in the check that stopped the session."""
+    from experiments.inputs.request_fields import with_request_fields
+    from planners.bundled import task_types
+
+    root = Path(__file__).resolve().parents[2] / "experiments" / "sweep" / "specs"
+    paths = [str(root / "tasks")]
+    scn = scenarios.load(root / "scenarios" / "water_plants.toml", task_paths=paths)
+    tasks = [with_request_fields(t) for t in task_types(paths)]
+    a, _ = bodies.read_world({"device": ["tap", "on"]}, t=3.0, scn=scn, tasks=tasks)
+    assert (a.fields["what"], a.fields["value"]) == ("device", ["tap", "on"])
+    err = _refused(bodies.read_world, {"device": ["tab", "on"]}, t=3.0, scn=scn, tasks=tasks)
+    assert err.field == "device" and "did you mean 'tap'?" in err.message
+
+
 SESSION = """
 kind = "robot"
 world = "paper"
