@@ -92,6 +92,9 @@ def create_app(session: Session, *, page: Callable[[], str], token: str | None =
         except TimeoutError:
             return JSONResponse({"detail": f"{ask.kind}: the session did not answer within {REPLY_S:g} s"},
                                 status_code=504)
+        except Exception as exc:  # a bug, not the body: say so, the session goes on
+            return JSONResponse({"detail": f"{ask.kind}: internal error, not a fault of the request "
+                                           f"({type(exc).__name__}: {exc}); the session goes on"}, status_code=500)
         return JSONResponse(result, status_code=status)
 
     async def read(request: Request, where: str) -> Any:

@@ -261,3 +261,51 @@ def test_the_live_page_is_offline_and_holds_the_world_figure_and_the_queue() -> 
     assert all(f"<th>{c}</th>" in text for c in COLUMNS if c and "[" not in c)
     doors = {name: len(world.obstacles) + k for k, name in enumerate(world.doors)}
     assert f"const DOORS = {json.dumps(doors)};" in text
+
+
+def _asgi(app: object, method: str, path: str, body: bytes = b"") -> tuple[int, dict]:
+    """One HTTP call to an ASGI app, in this process (no server, no client library)."""
+    import asyncio
+
+    sent: list[dict] = []
+
+    async def receive() -> dict:
+        return {"type": "http.request", "body": body, "more_body": False}
+
+    async def send(message: dict) -> None:
+        sent.append(message)
+
+    scope = {"type": "http", "asgi": {"version": "3.0"}, "http_version": "1.1", "method": method, "path": path,
+             "raw_path": path.encode(), "query_string": b"", "root_path": "", "scheme": "http",
+             "headers": [(b"content-type", b"application/json")], "client": ("127.0.0.1", 1),
+             "server": ("127.0.0.1", 80)}
+    asyncio.run(app(scope, receive, send))  # type: ignore[operator]
+    status = next(m["status"] for m in sent if m["type"] == "http.response.start")
+    return status, json.loads(b"".join(m.get("body", b"") for m in sent if m["type"] == "http.response.body"))
+
+
+def test_a_bug_in_reading_one_request_fails_that_request_not_the_session(
+        tmp_path: Path, paper: scenarios.RobotScenario, monkeypatch: pytest.MonkeyPatch) -> None:
+    from experiments.serve.app import create_app
+    from experiments.serve.session import Ask, Session
+
+    def broken(*_: object, **__: object) -> None:
+        raise RuntimeError("a bug")
+
+    monkeypatch.setattr(bodies, "read_request", broken)
+    session = Session(paper, speed=1.0, out=tmp_path, served="test")
+    loop = make_loop([guide()])
+    ask = Ask("request", {"task": "guide"})
+    assert session._take(ask, loop, None, None, Record(paper), []) == loop.now  # nothing scheduled, no raise
+    assert isinstance(ask.reply.exception(), RuntimeError)
+
+    class Failing:
+        def ask(self, ask: Ask) -> object:
+            ask.reply.set_exception(RuntimeError("a bug"))
+            return ask.reply
+
+    status, said = _asgi(create_app(Failing(), page=lambda: ""), "POST", "/requests",  # type: ignore[arg-type]
+                         b'{"task": "guide"}')
+    assert status == 500 and "internal error, not a fault of the request (RuntimeError: a bug)" in said["detail"]
+    status, said = _asgi(create_app(Failing(), page=lambda: ""), "POST", "/requests", b'{"task": ')  # type: ignore
+    assert status == 400 and "not valid JSON" in said["detail"]
