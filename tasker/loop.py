@@ -118,6 +118,19 @@ class SimulationLoop:
         self._pending_events += 1
         self._push(self._to_tick(t), _EVENT, action)
 
+    def next_free(self, t: float) -> float:
+        """The first tick's time at or after ``t`` (and after now) at which no :meth:`at` action is due.
+
+        An action added there with :meth:`at` runs alone in its tick, before anything added later
+        for that tick: its order among the tick's actions cannot depend on when it was added.  A
+        live controller injects what arrives there, so that a scenario holding the same action at
+        that time replays the run byte for byte (``tasker serve``)."""
+        due = {tick for tick, phase, _, _ in self._heap if phase == _EVENT}
+        tick = max(self._to_tick(t), self._tick + 1)
+        while tick in due:
+            tick += 1
+        return round(tick * self.resolution, 9)  # a time that reads as this tick, written without float noise
+
     def request(self, t: float, task_type: str, args: Mapping[str, Any] | None = None,
                 requester: str = "user") -> Request:
         """Schedule a task request at ``t``.  Type and arguments are checked now, before the run."""

@@ -33,6 +33,7 @@ SUBCOMMAND_MODULES = (
     "experiments.cli.docs",   # docs
     "experiments.cli.results",  # results
     "experiments.cli.paper",  # paper
+    "experiments.cli.serve",  # serve
     # Add a subcommand here: a module with ``register(subparsers)`` (e.g. explain, an HTML report).
 )
 """Modules that add subcommands, in the order ``tasker --help`` lists them."""

@@ -44,6 +44,9 @@ class RobotScenario:
     secure_over_higher: bool = False
     """Hazard-aware waiting may preempt a task of a higher priority class to secure a hazard (off: the
     safety rule of ``docs/model.md``)."""
+    request_fields: bool = False
+    """Every task type takes the request fields ``deadline``, ``priority`` and ``death_at``
+    (:mod:`experiments.inputs.request_fields`), as when a request gives one; ``tasker serve`` sessions set it."""
     warnings: tuple[str, ...] = field(default=(), compare=False)
 
     def to_json(self) -> dict[str, Any]:

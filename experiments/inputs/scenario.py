@@ -159,6 +159,7 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
         horizon=float(s.number("horizon", 1800.0, positive=True, max=reader.MAX_SECONDS)),
         people=people, objects=objects, devices=devices, policy=str(s.string("policy", "strict", choices=POLICIES)),
         secure_over_higher=bool(s.boolean("secure_over_higher", False)),
+        request_fields=bool(s.boolean("request_fields", False)),
     )
     s.done()
     top.done(SCENARIO_KEYS)

@@ -57,19 +57,27 @@ class RunResult:
     trajectory: tuple[tuple[float, float, float, float], ...] = ()
 
 
-def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None = None,
-                suspension: str | None = None, scheduler: str | None = None,
-                trace: Trace | None = None, task_paths: tuple[str, ...] = (), policy: str | None = None,
-                hazard_waiting: bool = False, request_fields: bool = False,
-                task_wrapper: Callable[[TaskType], TaskType] | None = None) -> tuple[SimulationLoop, Any]:
-    """The loop and the simulation for a robot scenario, with every request and event scheduled.
+def build_robot(scn: scenarios.RobotScenario, *, seed: int, **options: Any) -> tuple[SimulationLoop, Any]:
+    """The loop and the simulation for a robot scenario, with every request and event scheduled
+    (:func:`build_robot_actions`, whose keywords it takes)."""
+    loop, sim, _ = build_robot_actions(scn, seed=seed, **options)
+    return loop, sim
+
+
+def build_robot_actions(scn: scenarios.RobotScenario, *, seed: int, update: str | None = None,
+                        suspension: str | None = None, scheduler: str | None = None,
+                        trace: Trace | None = None, task_paths: tuple[str, ...] = (), policy: str | None = None,
+                        hazard_waiting: bool = False, request_fields: bool = False,
+                        task_wrapper: Callable[[TaskType], TaskType] | None = None
+                        ) -> tuple[SimulationLoop, Any, Actions]:
+    """The loop, the simulation and the :class:`Actions` of a robot scenario, every action scheduled.
 
     ``task_paths`` are task folders loaded besides the bundled ones and ``$TASKER_TASKS``.
     ``policy`` (default: the scenario's) reaches every task's :class:`Strategy`;
     ``hazard_waiting`` is passed to the loop; ``request_fields`` lets every task type take
     the requests' ``deadline`` and ``priority`` (:mod:`experiments.inputs.request_fields`); it is on
-    whenever the scenario's requests give one.  ``task_wrapper`` is applied to every task type
-    after that (a day's drawn work: :mod:`experiments.days.robot_work`).
+    whenever the scenario's requests give one or its ``settings.request_fields`` is true.  ``task_wrapper``
+    is applied to every task type after that (a day's drawn work: :mod:`experiments.days.robot_work`).
     A ``people`` entry may set a person's ``pose``, ``walk`` and walking ``speed``."""
     from planners.bundled import task_types
     from robot.sim import Simulation
@@ -95,7 +103,7 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
     spec, from_world = _world_file_events(spec, str(scn.world))
     sim = Simulation(spec, seed=seed)
     loaded = task_types(task_paths)
-    if request_fields or asked_for(scn.actions):
+    if request_fields or scn.request_fields or asked_for(scn.actions):
         from experiments.inputs.request_fields import with_request_fields
 
         loaded = [with_request_fields(t) for t in loaded]
@@ -122,14 +130,34 @@ def build_robot(scn: scenarios.RobotScenario, *, seed: int, update: str | None =
                       version=sim.facts_key)
     loop.observers.append(monitor.observe)
     loop.harmoniser.hazards = monitor.active  # hazard-aware waiting learns of hazards from the monitor
-    made = _Made(loop, Requester(store, loop.harmoniser, "scenario"))
-    requests = 0  # the K-th request is the scenario's dK
+    actions = Actions(loop, sim, _Made(loop, Requester(store, loop.harmoniser, "scenario")))
     for a in sorted([*from_world, *scn.actions], key=lambda a: a.t):  # stable: the world file's first at a tie
         if a.kind == "request":
-            requests += 1
             store.validate(a.fields["task"], a.fields["args"])  # bad requests fail before the run
-        loop.at(a.t, _action(loop, sim, made, a, f"d{requests}"))
-    return loop, sim
+        actions.schedule(a)
+    return loop, sim, actions
+
+
+class Actions:
+    """Schedules a scenario's timed actions on its built loop: :func:`build_robot` every action of
+    the scenario before the run, a live controller (:mod:`experiments.serve`) each action as it
+    arrives.  The K-th request scheduled is the scenario's ``dK`` (what ``terminate``, ``change``
+    and ``after`` name); :meth:`agents` says which agents were made for it."""
+
+    def __init__(self, loop: SimulationLoop, sim: Any, made: _Made) -> None:
+        self.loop, self.sim, self._made = loop, sim, made
+        self.requests = 0
+
+    def schedule(self, a: TimedAction) -> str | None:
+        """Run ``a`` at ``a.t`` through the same path as a scenario's; a request's scenario id."""
+        if a.kind == "request":
+            self.requests += 1
+        self.loop.at(a.t, _action(self.loop, self.sim, self._made, a, f"d{self.requests}"))
+        return f"d{self.requests}" if a.kind == "request" else None
+
+    def agents(self, sid: str) -> tuple[str, ...]:
+        """The agents made for the scenario's request ``sid`` so far (renewals after the first)."""
+        return tuple(self._made.agents.get(sid, ()))
 
 
 def _world_file_events(spec: Any, world: str) -> tuple[Any, list[TimedAction]]:
@@ -278,7 +306,8 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
                  policy: str | None = None, hazard_waiting: bool | None = None,
                  interruption: scenarios.InterruptionGrid | None = None,
                  perturbation: Perturbation | None = None, request_fields: bool = False,
-                 task_wrapper: Callable[[TaskType], TaskType] | None = None) -> RunResult:
+                 task_wrapper: Callable[[TaskType], TaskType] | None = None,
+                 live: Callable[[SimulationLoop, Any, Actions], scenarios.RobotScenario] | None = None) -> RunResult:
     """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced.
 
     ``task_paths``: task folders to load besides the bundled ones (``tasker run --path``).
@@ -286,7 +315,10 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
     hazard-aware waiting on; ``interruption`` (with ``randomize``) places the interrupting request
     in the seed's stratum (:class:`experiments.inputs.scenario.InterruptionGrid`) and ``perturbation``
     draws exogenous world events around it (:mod:`experiments.inputs.perturbation`);
-    ``request_fields`` and ``task_wrapper``: see :func:`build_robot`."""
+    ``request_fields`` and ``task_wrapper``: see :func:`build_robot_actions`.  ``live`` drives a robot
+    scenario's loop instead of running it to its end (``tasker serve``, :mod:`experiments.serve`): it gets
+    the loop, the simulation and their :class:`Actions`, and returns the scenario that replays what it ran
+    (the scenario ``run.json`` records)."""
     if isinstance(source, scenarios.RobotScenario):
         kind, scn_path = "robot", Path(source.source)
     else:
@@ -294,6 +326,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         kind = scenarios.kind_of(scn_path)
     t0 = time.perf_counter()
     trajectory: tuple[tuple[float, float, float, float], ...] = ()
+    actions: Actions | None = None
     if kind == "synthetic":
         syn = synthetic.load(scn_path)
         run_seed = syn.seed if seed is None else seed
@@ -307,16 +340,20 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
             scn = scenarios.randomize(scn, run_seed, interruption=interruption, perturbation=perturbation)
         if mode is not None:
             scn = dataclasses.replace(scn, mode=mode)
-        loop, sim = build_robot(scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler,
-                                task_paths=task_paths, policy=policy, hazard_waiting=bool(hazard_waiting),
-                                request_fields=request_fields, task_wrapper=task_wrapper)
+        loop, sim, actions = build_robot_actions(
+            scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler, task_paths=task_paths,
+            policy=policy, hazard_waiting=bool(hazard_waiting), request_fields=request_fields,
+            task_wrapper=task_wrapper)
         spec_json = {"kind": "robot", **scn.to_json()}
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")
     error: BaseException | None = None
     with _journal(kind) as journal:  # the PDDL of every planning call, for problems/
         try:
-            _run(loop, progress)
+            if live is not None and actions is not None:
+                spec_json = {"kind": "robot", **live(loop, sim, actions).to_json()}
+            else:
+                _run(loop, progress)
         except Exception as exc:  # the trace so far, run.json and metrics.json are still written, then it propagates
             error = exc
         except KeyboardInterrupt as exc:  # the user stopped it: keep what ran, closed like a run cut by its horizon

@@ -95,6 +95,13 @@ BAD: list[tuple[list[str], str]] = [
     (["day", "--days", "0", "--out", "{tmp}/day"], "--days"),
     (["docs", "--root", "{missing}"], "no docs/ folder"),
     (["results", "--replay", "nowhere", "1", "derived", "--out", "{tmp}"], "no scenario 'nowhere'"),
+    (["serve", "papr"], "did you mean 'paper'"),
+    (["serve", "{file}"], "a_file"),
+    (["serve", SYNTHETIC], "a synthetic scenario has no robot to serve"),
+    (["serve", "paper", "--speed", "0"], "--speed"),
+    (["serve", "paper", "--port", "70000"], "--port"),
+    (["serve", "paper", "--token", ""], "--token"),
+    (["serve", "paper", "--out", "{under_file}"], "--out"),
 ]
 
 

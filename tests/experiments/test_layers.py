@@ -14,7 +14,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 LAYERS = {"inputs": 0, "trace": 1, "metrics": 2, "analysis": 3, "report": 4, "run": 5, "sweep": 6,
-          "days": 7, "paper": 7, "cli": 9}
+          "days": 7, "paper": 7, "serve": 7, "cli": 9}
 FACADE = 8
 PACKAGES = ("tasker", "planners", "robot", "experiments", "domains")
 
