@@ -200,21 +200,9 @@ class _Checker:
             check_name(st, task, task, names, "task type", TASKS_HINT)
 
     def scenario_objects(self) -> None:
-        from robot.spec import name_problem
-
         ot = self.top.table("objects", {})
         for name, entry in self.scn.objects.items():
-            t = ot.at(name, ot.data[name])
-            if name in self.objects:
-                raise ot.error(name, f"the name {name!r} is already a {self.objects[name]} of world "
-                                     f"{self.world.name!r}; expected a new name")
-            bad = name_problem(name)
-            if bad:
-                raise ot.error(name, bad)
-            if self.types:
-                check_name(t, "type", entry["type"], self.types, "object type")
-            check_name(t, "place", entry["place"], self.world.places, f"place of world {self.world.name!r}")
-            self.objects[name] = entry["type"]
+            self._new_thing(ot, name, entry, "object", "")
         self.scenario_devices()
         for name, entry in self.scn.objects.items():
             t = ot.at(name, ot.data[name])
@@ -223,21 +211,26 @@ class _Checker:
 
     def scenario_devices(self) -> None:
         """``[devices.NAME]``: a new name, a type of the task types' domains, a place of the world."""
-        from robot.spec import name_problem
-
         dt = self.top.table("devices", {})
         for name, entry in self.scn.devices.items():
-            t = dt.at(name, dt.data[name])
-            if name in self.objects:
-                raise dt.error(name, f"the name {name!r} is already a {self.objects[name]} of world "
-                                     f"{self.world.name!r} or of this scenario's [objects]; expected a new name")
-            bad = name_problem(name)
-            if bad:
-                raise dt.error(name, bad)
-            if self.types:
-                check_name(t, "type", entry["type"], self.types, "device type")
-            check_name(t, "place", entry["place"], self.world.places, f"place of world {self.world.name!r}")
-            self.objects[name] = entry["type"]
+            self._new_thing(dt, name, entry, "device", " or of this scenario's [objects]")
+
+    def _new_thing(self, table: Table, name: str, entry: Mapping[str, Any], kind: str, also: str) -> None:
+        """One ``[objects.NAME]`` or ``[devices.NAME]``: a new name, a type of the task types'
+        domains, a place of the world; recorded in :attr:`objects`."""
+        from robot.spec import name_problem
+
+        t = table.at(name, table.data[name])
+        if name in self.objects:
+            raise table.error(name, f"the name {name!r} is already a {self.objects[name]} of world "
+                                    f"{self.world.name!r}{also}; expected a new name")
+        bad = name_problem(name)
+        if bad:
+            raise table.error(name, bad)
+        if self.types:
+            check_name(t, "type", entry["type"], self.types, f"{kind} type")
+        check_name(t, "place", entry["place"], self.world.places, f"place of world {self.world.name!r}")
+        self.objects[name] = entry["type"]
 
     def fact(self, t: Table, key: str | int, fact: Sequence[str]) -> None:
         """A fact names a known predicate with its arity, over objects of the world."""
