@@ -97,8 +97,13 @@ def create_app(session: Session, *, page: Callable[[], str], token: str | None =
                                            f"({type(exc).__name__}: {exc}); the session goes on"}, status_code=500)
         return JSONResponse(result, status_code=status)
 
-    async def read(request: Request, where: str) -> Any:
-        return bodies.parse_json(await request.body(), where)
+    async def with_body(request: Request, where: str, kind: str, status: int, agent: str | None = None) -> Response:
+        """Read the JSON body (a malformed one is refused here), then ask the session."""
+        try:
+            body = bodies.parse_json(await request.body(), where)
+        except Refused as exc:
+            return JSONResponse(exc.to_json(), status_code=exc.status)
+        return await answer(Ask(kind, body, agent=agent), status)
 
     @app.get("/", response_class=HTMLResponse, summary="The live page: the apartment, the robot, the queue")
     async def live_page() -> HTMLResponse:
@@ -112,11 +117,7 @@ def create_app(session: Session, *, page: Callable[[], str], token: str | None =
     @app.post("/requests", status_code=201, summary="Request a task; 201 {id, t, warnings}",
               openapi_extra=_body(REQUEST_SCHEMA), responses={400: _REFUSED, 422: _REFUSED})
     async def post_request(request: Request) -> Response:
-        try:
-            body = await read(request, "POST /requests")
-        except Refused as exc:
-            return JSONResponse(exc.to_json(), status_code=exc.status)
-        return await answer(Ask("request", body), 201)
+        return await with_body(request, "POST /requests", "request", 201)
 
     @app.delete("/requests/{agent}", status_code=202, summary="Terminate a task (term: it suspends safely first)",
                 responses={404: _REFUSED, 409: _REFUSED})
@@ -126,21 +127,12 @@ def create_app(session: Session, *, page: Callable[[], str], token: str | None =
     @app.patch("/requests/{agent}", status_code=202, summary="Change a task's priority, deadline or arguments (R2)",
                openapi_extra=_body(CHANGE_SCHEMA), responses={404: _REFUSED, 409: _REFUSED, 422: _REFUSED})
     async def patch_request(agent: str, request: Request) -> Response:
-        where = f"PATCH /requests/{agent}"
-        try:
-            body = await read(request, where)
-        except Refused as exc:
-            return JSONResponse(exc.to_json(), status_code=exc.status)
-        return await answer(Ask("change", body, agent=agent), 202)
+        return await with_body(request, f"PATCH /requests/{agent}", "change", 202, agent=agent)
 
     @app.post("/world", status_code=202, summary="An event of the world's vocabulary (someone falls, a door closes)",
               openapi_extra=_body(WORLD_SCHEMA), responses={400: _REFUSED, 422: _REFUSED})
     async def post_world(request: Request) -> Response:
-        try:
-            body = await read(request, "POST /world")
-        except Refused as exc:
-            return JSONResponse(exc.to_json(), status_code=exc.status)
-        return await answer(Ask("world", body), 202)
+        return await with_body(request, "POST /world", "world", 202)
 
     @app.post("/stop", status_code=202, summary="Stop: write the run folder and session.toml, then exit")
     async def stop() -> Response:
