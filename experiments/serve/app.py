@@ -34,8 +34,8 @@ REQUEST_SCHEMA = {
     "type": "object", "required": ["task"], "additionalProperties": False,
     "properties": {"task": {"type": "string", "description": "a task type of the session"}, "args": _ARGS,
                    "priority": {"type": "integer", "description": "static priority, higher is more urgent"},
-                   "deadline": {"type": "number", "description": "absolute simulated time to be done by [s]"}},
-    "example": {"task": "guide_human", "args": {"person": "john", "destination": "john_destination"}}}
+                   "deadline": {"type": "number", "description": "absolute simulated time to be done by [s]"}}}
+"""A request's body; its ``example`` is the served scenario's first request (:func:`create_app`)."""
 CHANGE_SCHEMA = {
     "type": "object", "additionalProperties": False,
     "properties": {"priority": REQUEST_SCHEMA["properties"]["priority"],  # type: ignore[index]
@@ -61,6 +61,12 @@ _REFUSED = {"description": "refused: the body's field and what was expected",
 
 def _body(schema: dict[str, Any]) -> dict[str, Any]:
     return {"requestBody": {"required": True, "content": {"application/json": {"schema": schema}}}}
+
+
+def _with_example(schema: dict[str, Any], session: Session) -> dict[str, Any]:
+    """``schema`` with the served scenario's first request as its example (a world alone has none)."""
+    first = next((a.fields for a in session.scenario.actions if a.kind == "request"), None)
+    return schema if first is None else {**schema, "example": {"task": first["task"], "args": first["args"]}}
 
 
 def create_app(session: Session, *, page: Callable[[], str], token: str | None = None) -> FastAPI:
@@ -115,7 +121,7 @@ def create_app(session: Session, *, page: Callable[[], str], token: str | None =
         return Response(session.state_json(), media_type="application/json")
 
     @app.post("/requests", status_code=201, summary="Request a task; 201 {id, t, warnings}",
-              openapi_extra=_body(REQUEST_SCHEMA), responses={400: _REFUSED, 422: _REFUSED})
+              openapi_extra=_body(_with_example(REQUEST_SCHEMA, session)), responses={400: _REFUSED, 422: _REFUSED})
     async def post_request(request: Request) -> Response:
         return await with_body(request, "POST /requests", "request", 201)
 

@@ -300,6 +300,8 @@ def test_a_bug_in_reading_one_request_fails_that_request_not_the_session(
     assert isinstance(ask.reply.exception(), RuntimeError)
 
     class Failing:
+        scenario = paper  # create_app reads the served scenario's first request for the schema's example
+
         def ask(self, ask: Ask) -> object:
             ask.reply.set_exception(RuntimeError("a bug"))
             return ask.reply
@@ -308,4 +310,8 @@ def test_a_bug_in_reading_one_request_fails_that_request_not_the_session(
                          b'{"task": "guide"}')
     assert status == 500 and "internal error, not a fault of the request (RuntimeError: a bug)" in said["detail"]
     status, said = _asgi(create_app(Failing(), page=lambda: ""), "POST", "/requests", b'{"task": ')  # type: ignore
+    schema = create_app(Failing(), page=lambda: "").openapi()  # type: ignore[arg-type]
+    body = schema["paths"]["/requests"]["post"]["requestBody"]["content"]["application/json"]["schema"]
+    first = next(a.fields for a in paper.actions if a.kind == "request")
+    assert body["example"] == {"task": first["task"], "args": first["args"]}  # the served scenario's first request
     assert status == 400 and "not valid JSON" in said["detail"]
