@@ -11,6 +11,7 @@ Each generated part sits between two markers (``<!-- generated: NAME ... -->`` a
 
 from __future__ import annotations
 
+import ast
 import dataclasses
 from collections.abc import Callable
 from pathlib import Path
@@ -19,10 +20,32 @@ from experiments.analysis.tables import markdown_table
 from experiments.metrics.registry import METRICS, Direction
 from tasker import events as ev
 
+ROOT = Path(__file__).resolve().parents[2]
+SOURCES = ("tasker", "planners", "robot", "experiments")
+"""The packages whose code may emit trace events."""
+
+
+def emitters(root: Path = ROOT) -> dict[str, list[str]]:
+    """Per event type (class name), the modules that construct it (``ev.Decision(...)``), found in
+    the source: what emits each documented event, and a test that none is documented but never made."""
+    names = {cls.__name__ for cls in ev.TYPES}
+    out: dict[str, set[str]] = {n: set() for n in names}
+    for pkg in SOURCES:
+        for path in sorted((root / pkg).rglob("*.py")):
+            if path == root / "tasker" / "events.py":
+                continue
+            for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+                if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr in names \
+                        and isinstance(node.func.value, ast.Name) and node.func.value.id in ("ev", "events"):
+                    out[node.func.attr].add(path.relative_to(root).as_posix())
+    return {n: sorted(m) for n, m in out.items()}
+
 
 def events_markdown() -> str:
-    """One table per event type: its JSON fields in written order, their types, and what they mean."""
+    """One table per event type: its JSON fields in written order, their types, what they mean, and
+    the modules that emit it (:func:`emitters`)."""
     out = []
+    made = emitters()
     for cls in ev.TYPES:
         rows: list[tuple[str, str, str]] = [("`t`", "float", "simulated seconds since the start")]
         if cls is ev.Decision:
@@ -34,7 +57,9 @@ def events_markdown() -> str:
                 f = fields[attr]
                 kind = str(f.type).replace(" | None", "") + (" (optional)" if optional else "")
                 rows.append((f"`{name}`", kind.replace("|", "∣"), f.metadata.get("doc", "")))
+        by = ", ".join(f"`{m}`" for m in made[cls.__name__]) or "nothing (reserved)"
         out += [f"#### `{cls.KIND}`: {cls.__name__}", "", (cls.__doc__ or "").strip().split("\n\n")[0], "",
+                f"Emitted by {by}, as `Trace.emit(ev.{cls.__name__}(...))`.", "",
                 *markdown_table(["field", "type", "meaning"], rows), ""]
     return "\n".join(out)
 
