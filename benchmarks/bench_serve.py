@@ -33,7 +33,9 @@ import threading
 import time
 import urllib.error
 import urllib.request
+from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -70,6 +72,19 @@ def bodies(n: int) -> list[tuple[Any, bytes | None]]:
             out.append(({"task": "guide_human", "args": {"person": person, "destination": f"{person}_destination"
                                                           if person in ("john", "alice") else "kitchen"}}, None))
     return out
+
+
+@contextmanager
+def sampling(url: str, out: list[float]) -> Iterator[None]:
+    """GET /state latencies into ``out`` from a thread of its own while the block runs."""
+    stop = threading.Event()
+    sampler = threading.Thread(target=sample, args=(url, stop, out))
+    sampler.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        sampler.join()
 
 
 def sample(url: str, until: threading.Event, out: list[float]) -> None:
@@ -130,29 +145,18 @@ def main(argv: list[str]) -> int:
             while call(url + "state")[1].get("status") != "running":
                 time.sleep(0.1)
             idle: list[float] = []
-            stop = threading.Event()
-            sampler = threading.Thread(target=sample, args=(url, stop, idle))
-            sampler.start()
-            time.sleep(2.0)
-            stop.set()
-            sampler.join()
+            with sampling(url, idle):
+                time.sleep(2.0)
             busy: list[float] = []
-            stop = threading.Event()
-            sampler = threading.Thread(target=sample, args=(url, stop, busy))
-            sampler.start()
-            t0 = time.perf_counter()
-            with ThreadPoolExecutor(max_workers=32) as pool:
-                answers = list(pool.map(lambda b: call(url + "requests", "POST", b[0], b[1]), bodies(args.requests)))
-            burst_s = time.perf_counter() - t0
-            stop.set()
-            sampler.join()
+            with sampling(url, busy):
+                t0 = time.perf_counter()
+                with ThreadPoolExecutor(max_workers=32) as pool:
+                    answers = list(pool.map(lambda b: call(url + "requests", "POST", b[0], b[1]),
+                                            bodies(args.requests)))
+                burst_s = time.perf_counter() - t0
             after: list[float] = []
-            stop = threading.Event()
-            sampler = threading.Thread(target=sample, args=(url, stop, after))
-            sampler.start()
-            time.sleep(args.after)
-            stop.set()
-            sampler.join()
+            with sampling(url, after):
+                time.sleep(args.after)
             last = call(url + "state")[1]
             call(url + "stop", "POST")
             proc.communicate(timeout=600)
