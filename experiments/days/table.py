@@ -27,6 +27,7 @@ import numpy as np
 from scipy import stats
 
 from experiments.analysis.stats import ALPHA, estimate, holm
+from experiments.analysis.tables import markdown_table
 from experiments.metrics.day import ENDINGS, TABSA_ENDINGS
 from experiments.metrics.registry import Direction, direction
 
@@ -127,27 +128,27 @@ def table(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead",
     days = len(by[names[0]]) if names else 0
     heads = [_header(n) for n in names]
     out = [f"## {title}" if title else "", f"{days} days per scheduler; mean ± half-width of the 95 % CI over days.",
-           "", "| metric | " + " | ".join(heads) + " |", "|---|" + "---|" * len(names)]
+           ""]
+    metric_rows = []
     for label, _, get in rows:
         cells = []
         for n in names:
             vals = [v for v in (get(r) for r in by[n]) if v is not None]
             cells.append(_fmt(*_ci(vals)) if vals else "–")
         if any(c != "–" for c in cells):  # e.g. path metrics exist only on the robot backend
-            out.append(f"| {label} | " + " | ".join(cells) + " |")
+            metric_rows.append([label, *cells])
+    out += markdown_table(["metric", *heads], metric_rows)
     if any("tabsa_ending" in r for r in results):  # days stored before TaBSA's rule was read have none
         out += ["", "How the days end by TaBSA's rule (`test_planner.py` stops its day at the first of these; "
                 "its oscillation: the task of a step with more than 2 gaps in 180 s; the day is run to its end "
                 "here, so the rows above count the whole day):", "",
-                "| ending (TaBSA) | " + " | ".join(heads) + " |", "|---|" + "---|" * len(names)]
-        for ending in TABSA_ENDINGS:
-            out.append(f"| {ending} | " + " | ".join(
-                str(sum(1 for r in by[n] if r.get("tabsa_ending") == ending)) for n in names) + " |")
+                *markdown_table(["ending (TaBSA)", *heads],
+                                [[ending, *(sum(1 for r in by[n] if r.get("tabsa_ending") == ending) for n in names)]
+                                 for ending in TABSA_ENDINGS])]
     out += ["", "How the days ended by our rule (our oscillation: a task's third start within 180 s):", "",
-            "| ending (ours) | " + " | ".join(heads) + " |", "|---|" + "---|" * len(names)]
-    for ending in ENDINGS:
-        out.append(f"| {ending} | " + " | ".join(str(sum(1 for r in by[n] if r["ending"] == ending)) for n in names)
-                   + " |")
+            *markdown_table(["ending (ours)", *heads],
+                            [[ending, *(sum(1 for r in by[n] if r["ending"] == ending) for n in names)]
+                             for ending in ENDINGS])]
     if reference in by and len(names) > 1:
         out += ["", *_paired_intro(f"{reference} − baseline")]
         out += _paired(rows, [(n, by[reference], by[n]) for n in names if n != reference])
@@ -158,9 +159,11 @@ def _paired_intro(what: str) -> list[str]:
     return [f"Paired over days: {what}.  Effect: the mean difference with its 95 % t interval (negative: "
             "fewer/earlier), and the days it was lower / tied / higher.  p: Wilcoxon signed-rank, Holm-corrected "
             "over every test of this table; verdict from the metric's registered direction, none below the "
-            "minimum number of days (see docs/benchmark.md).", "",
-            "| metric | compared with | days | difference (95 % CI) | lower / tied / higher | p (Holm) | verdict |",
-            "|---|---|---|---|---|---|---|"]
+            "minimum number of days (see docs/benchmark.md).", ""]
+
+
+PAIRED_HEADER = ("metric", "compared with", "days", "difference (95 % CI)", "lower / tied / higher", "p (Holm)",
+                 "verdict")
 
 
 def _verdict(key: str, mean: float, p: float, n: int, least: int) -> str:
@@ -177,8 +180,9 @@ def _verdict(key: str, mean: float, p: float, n: int, least: int) -> str:
 def _paired(rows: Sequence[tuple[str, str, Any]],
             groups: Sequence[tuple[str, Sequence[Mapping[str, Any]], Sequence[Mapping[str, Any]]]],
             keys: Sequence[str] = PAIRED) -> list[str]:
-    """Table lines (see :func:`_paired_intro`) for each metric of ``keys`` and each ``(name, a days,
-    b days)``, ``a − b`` paired by seed; Holm over every line, verdicts from :data:`REGISTERED`."""
+    """A table (:data:`PAIRED_HEADER`, after :func:`_paired_intro`) with a line for each metric of ``keys``
+    and each ``(name, a days, b days)``, ``a − b`` paired by seed; Holm over every line, verdicts from
+    :data:`REGISTERED`."""
     tests = []
     getters = {key: (label, get) for label, key, get in rows}
     for key in keys:
@@ -196,9 +200,9 @@ def _paired(rows: Sequence[tuple[str, str, Any]],
     for (key, label, n, diff, _), p in zip(tests, adjusted, strict=True):
         mean, half = _ci(list(diff))
         counts = f"{int(np.sum(diff < 0))} / {int(np.sum(diff == 0))} / {int(np.sum(diff > 0))}"
-        out.append(f"| {label} | {_header(n)} | {len(diff)} | {_fmt(mean, half)} | {counts} | {p:.3g} | "
-                   f"{_verdict(key, mean, p, len(diff), least)} |")
-    return out
+        out.append([label, _header(n), len(diff), _fmt(mean, half), counts, f"{p:.3g}",
+                    _verdict(key, mean, p, len(diff), least)])
+    return markdown_table(PAIRED_HEADER, out)
 
 
 def report(results: Sequence[Mapping[str, Any]], *, reference: str = "lookahead", title: str = "") -> str:
