@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from experiments.cli.args import EXIT_FAILED, EXIT_OK, UsageError, note, positive_int, show_progress, writable_file
+from experiments.sweep import experiment_paths
 
 if TYPE_CHECKING:
     from experiments.sweep.experiment import Plan
@@ -32,8 +33,7 @@ examples:
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    from experiments.sweep import experiment as ex
-
+    ex = experiment_paths  # only its constants: the help must not load the experiment
     p = sub.add_parser("results", help="run the suspension-strategy experiment; regenerate docs/results.md",
                        description="Run the experiment declared in docs/results.md (static, planned and derived "
                                    "suspension over randomised, perturbed variants; a pilot fixes n) and write the "
@@ -67,8 +67,9 @@ def _results(args: argparse.Namespace) -> int:
         return _check(args)
     if args.replay is not None:
         return _replay(args, spec)
-    if args.partial and Path(args.markdown).resolve() == (ex.ROOT / ex.MARKDOWN).resolve():
-        raise UsageError("--partial", f"an interim document may not replace {ex.MARKDOWN}: give --markdown PATH")
+    if args.partial and Path(args.markdown).resolve() == (ex.ROOT / experiment_paths.MARKDOWN).resolve():
+        raise UsageError("--partial", f"an interim document may not replace {experiment_paths.MARKDOWN}: "
+                                      "give --markdown PATH")
     writable_file(args.db, "--db")
     writable_file(args.control_db, "--control-db")
     if args.no_run:

@@ -27,14 +27,12 @@ from pathlib import Path
 from experiments.analysis.family import BINARY, SECONDS, Contrast, Outcome, Size, pilot_sizes
 from experiments.metrics.store import ResultStore, RunRow
 from experiments.sweep.driver import SweepSummary, run_sweep
+from experiments.sweep.experiment_paths import CONTROL_DB, DB
 from experiments.sweep.provenance import arm
 from experiments.sweep.spec import Job, SweepSpec, load_spec
 
 ROOT = Path(__file__).resolve().parents[2]
 SPEC = "experiments/sweep/specs/strategies.toml"
-DB = "out/strategies.db"
-CONTROL_DB = "out/strategies-control.db"
-MARKDOWN = "docs/results.md"
 
 PILOT_SEEDS = 20
 CONTROL_SEEDS = 30
