@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import math
 import re
+import threading
+from collections import OrderedDict
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -24,6 +26,8 @@ TRAVEL_FUNCTION = "travel-time"
 CONNECTED = "connected"
 UNREACHABLE_COST = 1_000_000
 """``travel-time`` written for a pair that is not connected (it can never be used)."""
+RENDERED = 512
+"""How many rendered problems each domain remembers (:func:`render_problem`)."""
 
 
 class DomainModel:
@@ -45,6 +49,9 @@ class DomainModel:
         self.functions = set(schema.functions)
         self.constants: dict[str, str] = dict(schema.constants)
         self.actions = {a.name: a for a in schema.actions}
+        # render_problem's answers by everything they are made of (a pure function of these)
+        self.rendered: OrderedDict[tuple[Any, ...], tuple[str, frozenset[Fact]]] = OrderedDict()
+        self.rendered_lock = threading.Lock()
 
     def has_type(self, obj_type: str, wanted: str) -> bool:
         return wanted == "" or wanted in self.types.get(obj_type, ())
@@ -194,7 +201,28 @@ def render_problem(
     declare, are left out: the world holds facts for every task.  A fact with the right
     predicate but the wrong arity is an error.  The domain's constants are objects too
     (declared by the domain, so a world object of the same name is not declared again).
+
+    Remembered per domain (the last ``RENDERED`` answers): the same facts, objects, goal,
+    travel times and name give the same text, so a repeat costs building the key.
     """
+    extra = tuple(extra_facts)
+    key = (world.facts, tuple(world.objects.items()), tuple(map(tuple, goal)), tuple(map(tuple, extra)),
+           None if travel is None else tuple(travel.items()), name)
+    with domain.rendered_lock:
+        done = domain.rendered.get(key)
+        if done is not None:
+            domain.rendered.move_to_end(key)
+            return done
+    done = _render_problem(domain, world, goal, extra, travel, name)
+    with domain.rendered_lock:
+        domain.rendered[key] = done
+        while len(domain.rendered) > RENDERED:
+            domain.rendered.popitem(last=False)
+    return done
+
+
+def _render_problem(domain: DomainModel, world: WorldState, goal: Sequence[Sequence[str]], extra_facts: Iterable[Fact],
+                    travel: Mapping[tuple[str, str], float] | None, name: str) -> tuple[str, frozenset[Fact]]:
     known = {**domain.constants, **{n: t for n, t in sorted(world.objects.items()) if t in domain.types}}
     objects = {n: t for n, t in known.items() if n not in domain.constants}
     init: set[Fact] = set()
