@@ -238,6 +238,7 @@ class Monitor:
         self._facts = facts
         self._robot = robot
         self._last: tuple[frozenset[Fact], tuple[tuple[str, bool], ...]] | None = None
+        self._alive_memo: tuple[list[Any], list[int], tuple[tuple[str, bool], ...]] | None = None
         self.hazards: dict[tuple[str | None, str, Fact], Hazard] = {}
         self._since: dict[tuple[str | None, str, Fact], float] = {}  # when each active hazard went on
         self.roles: dict[tuple[str, str], str] = {}
@@ -252,7 +253,7 @@ class Monitor:
     def observe(self, now: float) -> None:
         made_by, self._done_in_tick = self._done_in_tick, []
         agents = list(self._agents())
-        alive = tuple((a.id, bool(a.ended)) for a in agents)
+        alive = self._alive(agents)
         if self._version is not None:  # the world says whether its facts can have changed
             seen = (self._version(), alive)
             if seen == self._seen:
@@ -267,6 +268,17 @@ class Monitor:
         robot = self._robot()
         self._hazards(now, facts, agents, robot, made_by)
         self._people(now, facts, agents, robot)
+
+    def _alive(self, agents: list[Any]) -> tuple[tuple[str, bool], ...]:
+        """``(id, ended)`` of every agent: the last answer again when the list holds the same
+        agents and none of those live then has ended since (an ended agent never lives again),
+        so a tick costs a look at the live agents, not at every agent of the run."""
+        memo = self._alive_memo
+        if memo is not None and agents == memo[0] and not any(agents[i].ended for i in memo[1]):
+            return memo[2]
+        alive = tuple((a.id, bool(a.ended)) for a in agents)
+        self._alive_memo = (agents, [i for i, (_, ended) in enumerate(alive) if not ended], alive)
+        return alive
 
     def _hazards(self, now: float, facts: frozenset[Fact], agents: list[Any], robot: str, made_by: list[str]) -> None:
         found: dict[tuple[str | None, str, Fact], Hazard] = {}

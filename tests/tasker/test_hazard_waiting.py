@@ -9,6 +9,7 @@ The hazard metric is the project's own (``experiments.metrics.run``, ``safety.bu
 
 from __future__ import annotations
 
+import random
 from collections.abc import Sequence
 from typing import Any
 
@@ -336,3 +337,29 @@ def test_the_safety_rule_does_not_hold_back_securing_against_a_lower_class() -> 
     """The stew outranks the chore here: securing goes ahead, as before."""
     events, _ = run("alg2", hazard_waiting=True, secure_over_higher=False, classes=[["stew"], ["chore"]])
     assert not any(e["event"] == "decision" and e.get("rule") == "secure held" for e in events)
+
+
+def test_the_monitor_sees_every_agent_that_ends_or_arrives() -> None:
+    """Monitor._alive answers from its memo only while the same agents are there and none of
+    the live ones has ended: an end, a new agent or another list is always seen."""
+    from types import SimpleNamespace
+
+    from tasker.trace import Trace
+
+    agents = [SimpleNamespace(id=f"d{i}", ended=False) for i in range(4)]
+    m = Monitor(Trace(), lambda: agents, lambda name: Meaning(), lambda: frozenset())
+
+    def truth(xs: list[Any]) -> tuple[tuple[str, bool], ...]:
+        return tuple((a.id, a.ended) for a in xs)
+
+    rng = random.Random(5)
+    for _ in range(200):
+        move = rng.random()
+        if move < 0.3:
+            rng.choice(agents).ended = True
+        elif move < 0.5:
+            agents.append(SimpleNamespace(id=f"d{len(agents)}", ended=rng.random() < 0.2))
+        elif move < 0.55:
+            agents = [SimpleNamespace(id=a.id, ended=a.ended) for a in agents]  # the same ids, other agents
+            agents[rng.randrange(len(agents))].ended = False
+        assert m._alive(list(agents)) == truth(agents)
