@@ -101,3 +101,17 @@ def test_a_sample_line_is_what_the_json_encoder_writes() -> None:
         people = tuple(PersonState(n, v(), v(), v(), rng.choice(["standing", "sitting", "fallen"])) for n in names)
         s = Sample(round(rng.uniform(0, 4000), 2), (v(), v(), v()), people)
         assert s.line() == json.dumps(s.to_json(), sort_keys=True)
+
+
+def test_a_remembered_person_keeps_the_sign_of_zero() -> None:
+    """Sample.line remembers each person's text; 0.0 == -0.0 must not hand one the other's."""
+    import itertools
+    import json
+
+    from robot.recording import PersonState, Sample
+
+    for x, y, yaw in itertools.product([0.0, -0.0, 1.5], repeat=3):
+        for xs in ([x, -x], [-x, x]):
+            for value in xs:
+                s = Sample(1.0, (0.0, 0.0, 0.0), (PersonState("ann", value, y, yaw, "standing"),))
+                assert s.line() == json.dumps(s.to_json(), sort_keys=True)
