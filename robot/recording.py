@@ -45,6 +45,14 @@ class Sample:
         return {"t": round(self.t, 4), "robot": [round(v, 4) for v in self.robot],
                 "people": {p.name: [round(p.x, 4), round(p.y, 4), round(p.yaw, 4), p.posture] for p in self.people}}
 
+    def as_written(self) -> Sample:
+        """This sample as :func:`read_trajectory` reads it back from the file: numbers rounded
+        to 4 places (the file's ``repr`` of them reads back as the same float), people by name."""
+        x, y, yaw = (round(float(v), 4) for v in self.robot)
+        return Sample(round(float(self.t), 4), (x, y, yaw), tuple(
+            PersonState(p.name, round(float(p.x), 4), round(float(p.y), 4), round(float(p.yaw), 4), p.posture)
+            for p in sorted(self.people, key=lambda p: p.name)))
+
     def line(self) -> str:
         """``json.dumps(self.to_json(), sort_keys=True)``, written out directly: a day has tens
         of thousands of samples and the general encoder cost a second of it.  Numbers are
@@ -122,6 +130,12 @@ class Recorder:
         return [json.dumps(head, sort_keys=True)] + [
             self.samples[k].line() if kind == 0 else json.dumps(self.marks[k].to_json(), sort_keys=True)
             for _, kind, k in rows]
+
+    def samples_as_read(self) -> list[Sample]:
+        """The samples :func:`read_trajectory` would read from :meth:`write`'s file, without
+        the file: what a day needs of its run, kept in memory (``tests/robot/test_recording.py``
+        holds the two equal)."""
+        return [s.as_written() for s in sorted(self.samples, key=lambda s: s.t)]
 
     def write(self, path: str | Path) -> Path:
         out = Path(path)

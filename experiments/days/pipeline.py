@@ -27,7 +27,6 @@ robot backend, the recorded trajectory (``trajectory.jsonl``).
 from __future__ import annotations
 
 import math
-import tempfile
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -314,14 +313,11 @@ class Day:
                 trace.write(Path(out) / "trace.jsonl")
             return DayRun(list(trace.events))
         from experiments.run.runner import run_scenario
-        from robot.recording import read_trajectory
 
-        with tempfile.TemporaryDirectory(prefix="tasker-day-") as tmp:
-            where = Path(out) if out is not None else Path(tmp)
-            result = run_scenario(self.scenario, seed=self.seed, out=where, pictures=False, request_fields=True,
-                                  task_wrapper=wrapper_for(robot_work(self.protocol)), **settings)
-            _, samples, _ = read_trajectory(where / "trajectory.jsonl")
-        return DayRun(list(result.trace.events), tuple(samples), result.record)
+        # the samples from memory, as the file would give them back: no write-and-read round trip
+        result = run_scenario(self.scenario, seed=self.seed, out=None if out is None else Path(out), pictures=False,
+                              request_fields=True, task_wrapper=wrapper_for(robot_work(self.protocol)), **settings)
+        return DayRun(list(result.trace.events), tuple(result.recording.samples_as_read()), result.record)
 
     def build(self) -> Any:
         """The synthetic backend's ready loop (the robot at the start site)."""

@@ -55,6 +55,8 @@ class RunResult:
     metrics: dict[str, Any]
     trace: Trace
     trajectory: tuple[tuple[float, float, float, float], ...] = ()
+    recording: Any = None
+    """A robot run's :class:`robot.recording.Recorder` (``trajectory.jsonl`` is written from it); None if synthetic."""
 
 
 def build_robot(scn: scenarios.RobotScenario, *, seed: int, **options: Any) -> tuple[SimulationLoop, Any]:
@@ -398,7 +400,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
             metrics = {"error": f"metrics failed on the partial trace: {type(exc).__name__}: {exc}"}
     if out is not None:
         _save(Path(out), record, metrics, trace, trajectory, world_spec, pictures and error is None, sim, journal)
-    result = RunResult(record, metrics, trace, trajectory)
+    result = RunResult(record, metrics, trace, trajectory, None if sim is None else sim.recording)
     if isinstance(error, KeyboardInterrupt):
         raise RunInterrupted(reason, result) from error
     if error is not None:

@@ -115,3 +115,25 @@ def test_a_remembered_person_keeps_the_sign_of_zero() -> None:
             for value in xs:
                 s = Sample(1.0, (0.0, 0.0, 0.0), (PersonState("ann", value, y, yaw, "standing"),))
                 assert s.line() == json.dumps(s.to_json(), sort_keys=True)
+
+
+def test_samples_kept_in_memory_are_the_samples_read_from_the_file(paper, tmp_path) -> None:
+    """A day takes its samples from memory (Recorder.samples_as_read) instead of writing the
+    file and reading it back: the two must be the same samples, value for value."""
+    import random
+
+    from robot.recording import PersonState, Sample
+
+    sim = Simulation(paper)
+    sim.advance(_drive(sim, "kitchen", 60.0) + 2.0)  # people walk, Peter falls on the way
+    rec = sim.recording
+    rng = random.Random(2)  # and awkward numbers: signed zeros, halves at the 4th place, big ones
+    for k in range(200):
+        v = [rng.choice([0.0, -0.0, 1.23455, -2.00005, 1e16, rng.uniform(-9, 9)]) for _ in range(9)]
+        rec.samples.append(Sample(200.0 + k / 7, (v[0], v[1], v[2]),
+                                  (PersonState("zed", v[3], v[4], v[5], "sitting"),
+                                   PersonState("amy", v[6], v[7], v[8], "standing"))))
+    _, samples, _ = read_trajectory(sim.write_trajectory(tmp_path / "t.jsonl"))
+    assert rec.samples_as_read() == samples
+    assert [tuple(map(repr, (s.t, *s.robot))) for s in rec.samples_as_read()] == \
+        [tuple(map(repr, (s.t, *s.robot))) for s in samples]  # -0.0 stays -0.0
