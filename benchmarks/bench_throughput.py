@@ -168,6 +168,7 @@ def profile() -> int:
         child, cpu = _children_cpu(), time.process_time()
         run_scenario(DAY, out=Path(tmp) / "day", pictures=False)
         child, cpu = _children_cpu() - child, time.process_time() - cpu
+        last = (Path(tmp) / "day" / "trace.jsonl").read_text().splitlines()[-1]
     totals["the loop, harmoniser, agents and the rest"] = cpu - sum(totals.values())
     totals["Fast Downward's search (child processes)"] = child
     whole = cpu + child
@@ -180,6 +181,12 @@ def profile() -> int:
 
     print(f"\nphysics ticks: {calls.get(ENTRY_POINTS[0][0], 0)}, each {round(CONTROL_DT / TIMESTEP)} MuJoCo steps "
           f"of {TIMESTEP * 1000:g} ms; CPU s of this process {cpu:.2f}, of child processes {child:.2f}")
+    # what the target leaves: at 500x the hour may cost sim / 500 CPU-s in all, imports included
+    sim = float(json.loads(last)["t"])
+    physics = totals.get(ENTRY_POINTS[0][0], 0.0)
+    if sim:
+        print(f"500x leaves {sim / 500:.2f} CPU-s for the {sim:.0f} s simulated; MuJoCo's steps alone took "
+              f"{physics:.2f} ({physics / (sim / 500):.0%} of it), everything else {whole - physics:.2f}")
     return 0
 
 
