@@ -50,7 +50,7 @@ class Sample:
         to 4 places (the file's ``repr`` of them reads back as the same float), people by name."""
         x, y, yaw = (round(float(v), 4) for v in self.robot)
         return Sample(round(float(self.t), 4), (x, y, yaw), tuple(
-            PersonState(p.name, round(float(p.x), 4), round(float(p.y), 4), round(float(p.yaw), 4), p.posture)
+            _rounded(p) if p.x and p.y and p.yaw else _rounded.__wrapped__(p)
             for p in sorted(self.people, key=lambda p: p.name)))
 
     def line(self) -> str:
@@ -62,6 +62,13 @@ class Sample:
                           _person.__wrapped__(p.name, p.x, p.y, p.yaw, p.posture) for p in people)
         x, y, yaw = (round(float(v), 4) for v in self.robot)
         return f'{{"people": {{{inner}}}, "robot": [{x!r}, {y!r}, {yaw!r}], "t": {round(float(self.t), 4)!r}}}'
+
+
+@functools.lru_cache(maxsize=4096)
+def _rounded(p: PersonState) -> PersonState:
+    """``p`` as the file gives it back (:meth:`Sample.as_written`), remembered like :func:`_person`
+    (and, like it, called through the memo only with no coordinate zero)."""
+    return PersonState(p.name, round(float(p.x), 4), round(float(p.y), 4), round(float(p.yaw), 4), p.posture)
 
 
 def _str(s: str) -> str:

@@ -101,6 +101,7 @@ class Simulation:
         self.trajectory: list[tuple[float, float, float, float]] = []  # (t, x, y, yaw) at RECORD_HZ
         self._ticks = 0
         self._last_cmd = STOP
+        self._blocker: Person | None = None  # the person who kept the last fast-forward from happening
         self._synced: dict[str, tuple[float, float, float, str]] = {}
         self.places = Places(self.spec, self.scene)
         self._fallen: tuple[str, ...] = ()  # who lay fallen at the last look (Simulation._give_room)
@@ -197,10 +198,15 @@ class Simulation:
         meanwhile are recorded."""
         if self._last_cmd != STOP or not self.mj.at_rest():
             return False
+        # whoever kept the last look from skipping usually keeps this one too: asked first (a
+        # pure question, so the order changes nothing but how soon the answer is known)
+        if self._blocker is not None and self._still_until(self._blocker) <= self.time:
+            return False
         horizon = min(now + 1e-9, self.skill.quiet_until() if self.skill is not None else math.inf)
         for p in self.people:
             horizon = min(horizon, self._still_until(p))
             if horizon <= self.time:
+                self._blocker = p
                 return False
         if not math.isfinite(horizon):
             return False

@@ -135,5 +135,7 @@ def test_samples_kept_in_memory_are_the_samples_read_from_the_file(paper, tmp_pa
                                    PersonState("amy", v[6], v[7], v[8], "standing"))))
     _, samples, _ = read_trajectory(sim.write_trajectory(tmp_path / "t.jsonl"))
     assert rec.samples_as_read() == samples
-    assert [tuple(map(repr, (s.t, *s.robot))) for s in rec.samples_as_read()] == \
-        [tuple(map(repr, (s.t, *s.robot))) for s in samples]  # -0.0 stays -0.0
+    def reprs(s: Sample) -> tuple[str, ...]:  # -0.0 stays -0.0
+        return tuple(map(repr, (s.t, *s.robot, *(v for p in s.people for v in (p.x, p.y, p.yaw)))))
+
+    assert [reprs(s) for s in rec.samples_as_read()] == [reprs(s) for s in samples]
