@@ -23,7 +23,7 @@ import traceback
 import warnings
 from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any, NoReturn, TypeVar
 
 from experiments.inputs.fields import TASKS_HINT
 from tasker.errors import TaskerError, UnknownName, UsageError
@@ -94,12 +94,20 @@ def seed(text: str) -> int:
     return value
 
 
+_T = TypeVar("_T")
+
+
+def _read(text: str, cast: Callable[[str], _T], expected: str, got: str | None = None) -> _T:
+    """``cast(text)``, or the ``type=`` error "expected EXPECTED, got ``got`` (the text's repr)"."""
+    try:
+        return cast(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected {expected}, got {repr(text) if got is None else got}") from None
+
+
 def positive_seconds(text: str) -> float:
     """``type=`` for time-outs: a finite number of seconds greater than zero."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
+    value = _read(text, float, "a number of seconds")
     if not (math.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"expected a finite number of seconds > 0, got {text!r}")
     if value > MAX_TIMEOUT_S:
@@ -109,21 +117,31 @@ def positive_seconds(text: str) -> float:
 
 def non_negative_seconds(text: str) -> float:
     """``type=`` for simulated times such as ``--at``: a finite number of seconds >= 0."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
+    value = _read(text, float, "a number of seconds")
     if not (math.isfinite(value) and value >= 0):
         raise argparse.ArgumentTypeError(f"expected a finite number of seconds >= 0, got {text!r}")
     return value
 
 
+def speed(text: str) -> float:
+    """``type=`` for ``tasker serve --speed``: simulated seconds per wall second, finite and > 0."""
+    value = _read(text, float, "a number of simulated seconds per second")
+    if not 0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a speed > 0 (simulated seconds per wall second), got {text!r}")
+    return value
+
+
+def port(text: str) -> int:
+    """``type=`` for ``--port``: 0 (any free one) to 65535."""
+    value = _read(text, int, "a port number")
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a port 0..65535 (0: any free one), got {value}")
+    return value
+
+
 def positive_int(text: str) -> int:
     """``type=`` for counts such as ``--days``: an integer >= 1."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {shown(repr(text))}") from None
+    value = _read(text, int, "a positive integer", shown(repr(text)))
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {shown(value)}")
     return value
@@ -139,10 +157,7 @@ def workers(text: str) -> int:
 
 def non_negative_int(text: str) -> int:
     """``type=`` for indices such as ``--after``: an integer >= 0."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}") from None
+    value = _read(text, int, "an integer >= 0")
     if value < 0:
         raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {shown(value)}")
     return value

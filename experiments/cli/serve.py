@@ -11,7 +11,7 @@ import secrets
 import sys
 from pathlib import Path
 
-from experiments.cli.args import EXIT_FAILED, EXIT_OK, UsageError, note, seed, writable_dir
+from experiments.cli.args import EXIT_FAILED, EXIT_OK, UsageError, note, port, seed, speed, writable_dir
 from experiments.cli.run import add_path_option, task_paths
 
 EXAMPLES = """\
@@ -21,26 +21,6 @@ examples:
        -d '{"task": "guide_human", "args": {"person": "john", "destination": "john_destination"}}'
   tasker serve experiments/inputs/scenarios/paper.toml --out out/live   # its requests come at their times
   tasker run out/live/session.toml                 # replays the session: the same trace.jsonl"""
-
-
-def _speed(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number of simulated seconds per second, got {text!r}") from None
-    if not 0 < value < float("inf"):
-        raise argparse.ArgumentTypeError(f"expected a speed > 0 (simulated seconds per wall second), got {text!r}")
-    return value
-
-
-def _port(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a port number, got {text!r}") from None
-    if not 0 <= value <= 65535:
-        raise argparse.ArgumentTypeError(f"expected a port 0..65535 (0: any free one), got {value}")
-    return value
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -56,8 +36,8 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p.add_argument("source", metavar="WORLD|SCENARIO",
                    help="a shipped world (paper, flat), a world file, or a robot scenario (its requests then come "
                         "at their times)")
-    p.add_argument("--speed", type=_speed, default=1.0, help="simulated seconds per wall second (default 1)")
-    p.add_argument("--port", type=_port, default=8765, help="port to listen on (default 8765; 0: any free one)")
+    p.add_argument("--speed", type=speed, default=1.0, help="simulated seconds per wall second (default 1)")
+    p.add_argument("--port", type=port, default=8765, help="port to listen on (default 8765; 0: any free one)")
     p.add_argument("--host", default="127.0.0.1",
                    help="address to listen on (default 127.0.0.1; another one exposes the robot: a token is then "
                         "required)")
