@@ -12,11 +12,14 @@ from __future__ import annotations
 
 import functools
 import json
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 from tasker.world import Pose
+
+_T = TypeVar("_T")
 
 RECORD_HZ = 10.0  # samples per simulated second
 FORMAT = "tasker-trajectory/1"
@@ -50,38 +53,39 @@ class Sample:
         to 4 places (the file's ``repr`` of them reads back as the same float), people by name."""
         x, y, yaw = (round(float(v), 4) for v in self.robot)
         return Sample(round(float(self.t), 4), (x, y, yaw), tuple(
-            _rounded(p) if p.x and p.y and p.yaw else _rounded.__wrapped__(p)
-            for p in sorted(self.people, key=lambda p: p.name)))
+            _remembered(_rounded, p) for p in sorted(self.people, key=lambda p: p.name)))
 
     def line(self) -> str:
         """``json.dumps(self.to_json(), sort_keys=True)``, written out directly: a day has tens
         of thousands of samples and the general encoder cost a second of it.  Numbers are
         ``repr`` of the rounded float, as the encoder writes them; strings go through it."""
         people = sorted(self.people, key=lambda p: p.name)
-        inner = ", ".join(_person(p.name, p.x, p.y, p.yaw, p.posture) if p.x and p.y and p.yaw else
-                          _person.__wrapped__(p.name, p.x, p.y, p.yaw, p.posture) for p in people)
+        inner = ", ".join(_remembered(_person, p) for p in people)
         x, y, yaw = (round(float(v), 4) for v in self.robot)
         return f'{{"people": {{{inner}}}, "robot": [{x!r}, {y!r}, {yaw!r}], "t": {round(float(self.t), 4)!r}}}'
 
 
+def _remembered(fn: Callable[[PersonState], _T], p: PersonState) -> _T:
+    """``fn(p)`` through ``fn``'s memo (most people stand still most of a day), except when a
+    coordinate is zero: ``0.0 == -0.0``, so the memo would hand one of them the other's answer."""
+    return fn(p) if p.x and p.y and p.yaw else fn.__wrapped__(p)  # type: ignore[attr-defined]
+
+
 @functools.lru_cache(maxsize=4096)
 def _rounded(p: PersonState) -> PersonState:
-    """``p`` as the file gives it back (:meth:`Sample.as_written`), remembered like :func:`_person`
-    (and, like it, called through the memo only with no coordinate zero)."""
+    """``p`` as the file gives it back (:meth:`Sample.as_written`)."""
     return PersonState(p.name, round(float(p.x), 4), round(float(p.y), 4), round(float(p.yaw), 4), p.posture)
+
+
+@functools.lru_cache(maxsize=4096)
+def _person(p: PersonState) -> str:
+    """``p``'s part of :meth:`Sample.line`."""
+    return f"{_str(p.name)}: [{round(float(p.x), 4)!r}, {round(float(p.y), 4)!r}, {round(float(p.yaw), 4)!r}, " \
+           f"{_str(p.posture)}]"
 
 
 def _str(s: str) -> str:
     return json.dumps(s)
-
-
-@functools.lru_cache(maxsize=4096)
-def _person(name: str, x: float, y: float, yaw: float, posture: str) -> str:
-    """One person's part of :meth:`Sample.line`, remembered: most people stand still most of a day.
-
-    Called through the memo only with no coordinate zero: ``0.0 == -0.0`` would hand one
-    of them the other's text."""
-    return f"{_str(name)}: [{round(float(x), 4)!r}, {round(float(y), 4)!r}, {round(float(yaw), 4)!r}, {_str(posture)}]"
 
 
 @dataclass(frozen=True, slots=True)
