@@ -10,10 +10,13 @@ trace dicts.  So what a state, a suspension or a hazard episode *is* is decided 
   events) and **person role spans** (the task folders' declared roles, ``role`` events);
 * **stage runs**: each stage from ``begin`` to its closing event;
 * **suspension episodes**: from entering ``genSusp`` (by ``suspend``, ``stage_failed`` or
-  ``secure``) to entering ``wait`` or ``end``, with the ``exeSusp`` plan and the stages run;
+  ``secure``) to entering ``wait`` or ``end``, with the ``exeSusp`` plan (and any made again
+  when the ``fallback`` strategy planned around a stage of it), the stages run, and the check
+  of its goal as it ended (the ``goal`` event);
 * **interruptions**: from a ``susp`` command to the agent's next ``start`` (a ``start`` with
   ``secure`` does not end one), with the expected and realised lengths;
-* **hazard episodes** with their owner (``null``: nobody's), from ``on`` to ``off``.
+* **hazard episodes** with their owner (``null``: nobody's), from ``on`` to ``off``, and whether
+  the robot carries the thing (``carried``).
 
 A span still open when the trace ends is closed at the trace's last time with
 ``closed=False``.  Times are the trace's simulated seconds.  The names of states and
@@ -106,7 +109,9 @@ class Suspension:
     ``trigger``: ``suspend`` (a ``susp`` or ``term`` command, or the task's own ``ic_term``),
     ``stage_failed`` (a failed stage, before the task ends) or ``secure`` (hazard-aware
     waiting, from ``wait``).  ``outcome``: ``wait``, ``end`` or ``open`` (the trace ended).
-    ``ready`` is when ``exeSusp`` began (its plan was ready), if it did."""
+    ``ready`` is when ``exeSusp`` began (its plan was ready), if it did.  ``replans`` are the plans
+    made again within the episode (``fallback`` planning around a stage that could not run);
+    ``goal`` is the check of the goal its ``exeSusp`` aimed for as it ended, if the task type said one."""
 
     agent: str
     start: float
@@ -116,6 +121,13 @@ class Suspension:
     ready: float | None
     end: float
     outcome: str
+    replans: tuple[ev.PlanMade, ...] = ()
+    goal: ev.GoalChecked | None = None
+
+    @property
+    def last_plan(self) -> ev.PlanMade | None:
+        """The plan ``exeSusp`` last ran (the first, unless it was planned again)."""
+        return self.replans[-1] if self.replans else self.plan
 
     @property
     def duration(self) -> float:
@@ -148,6 +160,7 @@ class HazardEpisode:
     severity: float
     start: float
     end: float | None
+    carried: bool = False
 
     @property
     def label(self) -> str:
@@ -235,6 +248,7 @@ class Timeline:
         self.commands: list[ev.CommandSent] = []
         self.hazards: list[HazardEpisode] = []
         self.needs: dict[str, str] = {}
+        self.goals: list[ev.GoalChecked] = []
         self._role_times: list[float] | None = None
         self.people_order: list[str] = []
         """Agents in the order their first person-role edge came (the order of ``people`` metrics)."""
@@ -351,13 +365,11 @@ class _Reading:
             self.state[e.agent] = (e.target, e.t, e.trigger)
         if e.source == S.WAIT.value and e.target == S.UP_TSK.value:
             self.resuming[e.agent] = e.t
-        if e.target == S.GEN_SUSP.value:
+        if e.target == S.GEN_SUSP.value and not (e.source == S.EXE_SUSP.value and a.id in self.susp_open):
             self.susp_open[a.id] = {"agent": a.id, "start": e.t, "trigger": e.trigger, "plan": None, "stages": [],
-                                    "ready": None}
+                                    "ready": None, "replans": [], "goal": None}
         elif e.source in SUSPENDING and e.target not in SUSPENDING and a.id in self.susp_open:
-            opened = self.susp_open.pop(a.id)
-            opened["stages"] = tuple(opened["stages"])
-            a.suspensions.append(Suspension(**opened, end=e.t, outcome=e.target))
+            a.suspensions.append(_suspension(self.susp_open.pop(a.id), e.t, e.target))
         if e.target == S.WAIT.value and a.id in self.inter_open and self.inter_open[a.id]["wait_t"] is None:
             self.inter_open[a.id]["wait_t"] = e.t
 
@@ -386,8 +398,17 @@ class _Reading:
         if a is None:
             return
         a.plans.append(e)
-        if e.purpose == S.GEN_SUSP.value and e.agent in self.susp_open:
-            self.susp_open[e.agent]["plan"] = e
+        opened = self.susp_open.get(e.agent)
+        if e.purpose == S.GEN_SUSP.value and opened is not None:
+            if opened["plan"] is None:
+                opened["plan"] = e
+            else:
+                opened["replans"].append(e)
+
+    def goal(self, e: ev.GoalChecked) -> None:
+        self.tl.goals.append(e)
+        if e.agent in self.susp_open:
+            self.susp_open[e.agent]["goal"] = e
 
     def command(self, e: ev.CommandSent) -> None:
         self.tl.commands.append(e)
@@ -464,8 +485,7 @@ class _Reading:
             if run.fsm == S.EXE_SUSP.value and agent in self.susp_open:
                 self.susp_open[agent]["stages"].append(run)
         for agent, opened in self.susp_open.items():
-            opened["stages"] = tuple(opened["stages"])
-            tl.agents[agent].suspensions.append(Suspension(**opened, end=t_end, outcome="open"))
+            tl.agents[agent].suspensions.append(_suspension(opened, t_end, "open"))
         for agent, opened in self.inter_open.items():
             tl.agents[agent].interruptions.append(Interruption(**opened, resume_t=None,
                                                                outcome="open at the end of the run"))
@@ -493,14 +513,19 @@ _HANDLERS: dict[type[ev.Event], Callable[[_Reading, Any], None]] = {
     ev.RolesChanged: _Reading.roles, ev.RoleChanged: _Reading.role, ev.HazardChanged: _Reading.hazard,
     ev.Decision: _appender("decisions"), ev.WorldChanged: _appender("world"), ev.ModeChanged: _appender("modes"),
     ev.ArgsChanged: _appender("changes"), ev.SecureChanged: _appender("secures"),
-    ev.RunStarted: _Reading.run, ev.RunStopped: _Reading.stopped,
+    ev.RunStarted: _Reading.run, ev.RunStopped: _Reading.stopped, ev.GoalChecked: _Reading.goal,
 }
 """How each event type is read; a type not listed (none today) is skipped."""
 
 
 def _episode(on: ev.HazardChanged, end: float | None) -> HazardEpisode:
     return HazardEpisode(on.agent, on.hazard, tuple(str(x) for x in on.args), tuple(str(x) for x in on.fact),
-                         float(on.budget_s), float(on.severity), on.t, end)
+                         float(on.budget_s), float(on.severity), on.t, end, bool(on.carried))
+
+
+def _suspension(opened: dict[str, Any], end: float, outcome: str) -> Suspension:
+    return Suspension(opened["agent"], opened["start"], opened["trigger"], opened["plan"], tuple(opened["stages"]),
+                      opened["ready"], end, outcome, tuple(opened["replans"]), opened["goal"])
 
 
 def timeline(source: Timeline | Iterable[ev.Event | Mapping[str, Any]] | str | Path) -> Timeline:
