@@ -83,3 +83,15 @@ def test_a_report_that_fails_is_a_problem_of_its_folder(monkeypatch: pytest.Monk
     assert main(["check", str(HOT_POT)]) == 1
     out = capsys.readouterr().out
     assert f"error  {HOT_POT}: its suspension tree cannot be read: " in out and "extra_facts gave 'x'" in out
+
+
+def test_the_report_docs_domains_md_shows_is_what_check_prints(monkeypatch: pytest.MonkeyPatch,
+                                                               capsys: pytest.CaptureFixture[str]) -> None:
+    doc = (ROOT / "docs" / "domains.md").read_text()
+    marker = "<!-- pasted from `tasker check experiments/sweep/specs/tasks/water_plants` on commit "
+    block = doc[doc.index(marker):].split("```")[1].strip("\n").splitlines()
+    monkeypatch.chdir(ROOT)
+    assert main(["check", "experiments/sweep/specs/tasks/water_plants"]) == 0
+    out, err = capsys.readouterr()
+    assert [line for line in block if line.startswith(("tree", "ok", "1 checks"))] == out.splitlines()
+    assert [line for line in block if line.startswith("tasker check: warning:")] == err.splitlines()
