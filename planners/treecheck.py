@@ -61,8 +61,9 @@ class Maker(enum.Enum):
     TASK_PY = "only task.py's extra_facts makes it"
     REQUEST = "only the request's [problem] facts (or Alg. 3's suspended_facts) make it"
     PLANNER = "only the problem builder makes it (for the planner, from the motion model)"
-    NOTHING = ("nothing makes it: no action of the domain adds it, no [[bindings]] entry reads it off the "
-               "world, and neither the [example] nor a known world or scenario holds it")
+    NOTHING = ("nothing makes it: no action of this domain (nor of a task type checked with it) adds it, no "
+               "[[bindings]] entry reads it off the world, and neither the [example] nor a known world or scenario "
+               "holds it")
 
 
 @dataclass(frozen=True, slots=True)
@@ -250,24 +251,26 @@ class TreeReport:
 # -- conditions the tree never sees ------------------------------------------------------------
 
 
-def _world_predicates(task: PddlTaskType, world_facts: Iterable[Fact]) -> set[str]:
+def _world_predicates(task: PddlTaskType, world_facts: Iterable[Fact], others: Iterable[PddlTaskType]) -> set[str]:
     """Predicates the world can hold at interruption (module docstring): ``at`` (from poses), what a
     binding reads off physics, what a stage's unconditional effect adds (the executor applies only
-    those), and what the ``[example]`` and the caller's known worlds and scenarios state."""
+    those; ``others``' stages act on the same world), and what the ``[example]`` and the caller's
+    known worlds and scenarios state."""
     out = {LOCATION, *(b.fact[0] for b in task.spec.bindings), *(f[0] for f in world_facts if f)}
-    out |= {e.fluent for a in task.domain.actions.values() for e in a.effects if e.positive}
+    out |= {e.fluent for t in (task, *others) for a in t.domain.actions.values() for e in a.effects if e.positive}
     if task.spec.example is not None:
         out |= {f[0] for f in task.spec.example.facts}
     return out
 
 
-def unseen_conditions(task: PddlTaskType, world_facts: Iterable[Fact] = (),
-                      hook_facts: Iterable[Fact] = ()) -> tuple[UnseenCondition, ...]:
+def unseen_conditions(task: PddlTaskType, world_facts: Iterable[Fact] = (), hook_facts: Iterable[Fact] = (),
+                      others: Iterable[PddlTaskType] = ()) -> tuple[UnseenCondition, ...]:
     """The ``when`` literals over a predicate the world never holds, and what makes it instead.
 
     ``world_facts``: facts of worlds and scenarios the task may run in, besides its ``[example]``;
-    ``hook_facts``: what ``task.py``'s ``extra_facts`` made on the example's states."""
-    visible = _world_predicates(task, world_facts)
+    ``hook_facts``: what ``task.py``'s ``extra_facts`` made on the example's states; ``others``:
+    task types that may run beside it (their stages' effects reach the same world)."""
+    visible = _world_predicates(task, world_facts, others)
     by_hook: dict[str, Fact] = {}
     for f in hook_facts:
         by_hook.setdefault(f[0], f)
@@ -396,15 +399,17 @@ def _run(task: PddlTaskType, ctx: TaskContext, state: _State, policy: str, inter
                      tuple(h for h in on if h not in ok), tuple(ok))
 
 
-def report(task: PddlTaskType, *, world_facts: Iterable[Fact] = ()) -> TreeReport:
-    """The tree report of ``task`` on its ``[example]`` (module docstring); ``world_facts``: facts of the
-    worlds and scenarios the task may run in, for :func:`unseen_conditions`."""
-    world_facts = tuple(world_facts)
+def report(task: PddlTaskType, *, world_facts: Iterable[Fact] = (), others: Iterable[PddlTaskType] = ()) -> TreeReport:
+    """The tree report of ``task`` on its ``[example]`` (module docstring); ``world_facts`` (facts of the
+    worlds and scenarios the task may run in) and ``others`` (task types that may run beside it) are
+    for :func:`unseen_conditions`."""
+    world_facts, others = tuple(world_facts), tuple(others)
     notes: list[str] = []
     ctx = example_context(task)
     if ctx is None:
         notes.append("no [example]: completeness is not checked (add one: a world and a request)")
-        return TreeReport(task.name, task.spec.suspension, (), (), unseen_conditions(task, world_facts), tuple(notes))
+        unseen = unseen_conditions(task, world_facts, others=others)
+        return TreeReport(task.name, task.spec.suspension, (), (), unseen, tuple(notes))
     exes = _exes(task, ctx, notes)
     states = _states(task, ctx, exes, notes)
     made: list[Fact] = []
@@ -423,5 +428,5 @@ def report(task: PddlTaskType, *, world_facts: Iterable[Fact] = ()) -> TreeRepor
             if run.branch >= 0 and task.spec.suspension[run.branch].policy == "conditional":
                 runs.append(run)
     return TreeReport(task.name, task.spec.suspension, tuple((exe, len(st)) for exe, st in exes), tuple(runs),
-                      unseen_conditions(task, world_facts, made), tuple(notes))
+                      unseen_conditions(task, world_facts, made, others), tuple(notes))
 

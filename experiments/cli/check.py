@@ -13,7 +13,8 @@ Each task folder that loads also gets its suspension tree read (:mod:`planners.t
 per branch, at each ``exeTsk`` stage of its ``[example]``, whether the branch the tree chooses
 there reaches its goal and leaves every declared hazard off, and which ``when`` conditions name
 a fact the world never has (the worlds shipped, and those of the worlds and scenarios checked
-in the same call, count as worlds it may have).  Printed as ``tree`` lines; what fails is a
+in the same call, count as worlds it may have; the other task folders checked, as tasks that
+may act on the same world).  Printed as ``tree`` lines; what fails is a
 warning, not a problem (the exit status stays 0).
 """
 
@@ -236,8 +237,9 @@ class Checker:
         known = [*self.world_facts, *(f for name in shipped_worlds() for f in world_facts(load_world(name)))]
         out: list[tuple[str, str]] = []
         for shown, task in self.tasks.values():
+            others = [t for _, t in self.tasks.values() if t is not task]
             try:
-                report = treecheck.report(task, world_facts=known)
+                report = treecheck.report(task, world_facts=known, others=others)
             except (TaskerError, ValueError) as exc:
                 self.problems.append((str(shown), f"its suspension tree cannot be read: {error_text(exc)}"))
                 continue

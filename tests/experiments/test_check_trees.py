@@ -95,3 +95,14 @@ def test_the_report_docs_domains_md_shows_is_what_check_prints(monkeypatch: pyte
     out, err = capsys.readouterr()
     assert [line for line in block if line.startswith(("tree", "ok", "1 checks"))] == out.splitlines()
     assert [line for line in block if line.startswith("tasker check: warning:")] == err.splitlines()
+
+
+def test_a_fact_another_folder_checked_with_it_makes_is_seen(tmp_path: Path,
+                                                            capsys: pytest.CaptureFixture[str]) -> None:
+    from tests.planners.test_treecheck import urgent_pair
+
+    reader, maker = urgent_pair(tmp_path)
+    assert main(["check", str(reader)]) == 0
+    assert "`when` ['urgent', '$pot'] names a fact the world never has" in capsys.readouterr().err
+    assert main(["check", str(reader), str(maker)]) == 0
+    assert "never has" not in capsys.readouterr().err

@@ -291,3 +291,31 @@ def test_the_shipped_trees_see_every_fact_given_the_shipped_worlds() -> None:
 def test_post_init_checks_fire(build: object, fragment: str) -> None:
     with pytest.raises(ValueError, match=re.escape(fragment)):
         build()  # type: ignore[operator]
+
+
+def urgent_pair(tmp_path: Path) -> tuple[Path, Path]:
+    """Two hot_pot folders: one whose tree reads ``(urgent pot)`` but never makes it, and one (``hot_pot_b``)
+    with an action that does: the world the two share can hold it."""
+    urgent = "(clear ?p - place))", "(clear ?p - place)\n    (urgent ?x - pot))"
+    reader = _folder(tmp_path / "a", COUNTER.replace('when = [["holding", "$robot", "$pot"]]',
+                                                     'when = [["holding", "$robot", "$pot"], ["urgent", "$pot"]]'))
+    maker = _folder(tmp_path / "b", edit={'name = "hot_pot"': 'name = "hot_pot_b"',
+                                          "[actions.put_pot]": '[actions.mark]\nskill = "say"\n\n[actions.put_pot]'})
+    for folder in (reader, maker):
+        domain = folder / "domain.pddl"
+        domain.write_text(domain.read_text().replace(*urgent))
+    domain = maker / "domain.pddl"
+    domain.write_text(domain.read_text().rstrip().removesuffix(")") + """
+  (:action mark
+    :parameters (?x - pot)
+    :effect (and (urgent ?x) (increase (total-cost) 1)))
+)
+""")
+    return reader, maker
+
+
+def test_a_fact_another_task_type_makes_is_seen(tmp_path: Path) -> None:
+    reader, maker = urgent_pair(tmp_path)
+    task = _load(reader)
+    assert [(u.literal, u.maker) for u in unseen_conditions(task)] == [(("urgent", "$pot"), Maker.NOTHING)]
+    assert unseen_conditions(task, others=[_load(maker)]) == ()
