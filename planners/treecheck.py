@@ -21,6 +21,7 @@ Two things are reported (``docs/domains.md``, "What `tasker check` says about a 
   ``conditional`` policy, a conditional branch is run with the longest interruption it
   accepts, and a hazard whose ``budget_s`` covers it may stay on.
 
+Every tree of the folder is read (``[[suspension]]`` and each ``[[trees.NAME]]``: one report a tree).
 Where a branch is not complete, or a condition can never be seen, :meth:`TreeReport.warn`
 gives an :class:`~tasker.support.reader.InputWarning` at the branch's line of ``task.toml``,
 naming the branch, the state, the hazard or the fact: a warning, not an error (the run is
@@ -42,7 +43,7 @@ from planners.examples import example_context
 from planners.problem import CONNECTED
 from planners.problem import holds as holds_all
 from planners.stagecheck import LOCATION
-from planners.taskspec import Branch, Literal
+from planners.taskspec import DEFAULT_TREE, Branch, Literal
 from tasker.errors import PlanningFailed
 from tasker.stage import Stage
 from tasker.task import POLICIES, Strategy, TaskContext
@@ -196,6 +197,13 @@ class TreeReport:
     unseen: tuple[UnseenCondition, ...]
     notes: tuple[str, ...] = ()
     """Why part of the report is missing (no ``[example]``, an unsolvable one, a failing hook)."""
+    tree: str = DEFAULT_TREE
+    """Which tree: ``default`` (``[[suspension]]``) or the name of a ``[[trees.NAME]]``."""
+
+    @property
+    def where(self) -> str:
+        """Where the tree is written in ``task.toml``: ``suspension`` or ``trees.NAME``."""
+        return "suspension" if self.tree == DEFAULT_TREE else f"trees.{self.tree}"
 
     def runs_of(self, branch: int) -> tuple[BranchRun, ...]:
         return tuple(r for r in self.runs if r.branch == branch)
@@ -212,11 +220,12 @@ class TreeReport:
         """The report, one line each (``tasker check`` prints them)."""
         walked = ", ".join(f"{exe} {n} stage(s)" for exe, n in self.walked) or "none"
         points = len({r.point for r in self.runs})
-        out = [f"suspension tree of {self.task!r} at {points} interruption point(s) of the [example]'s exeTsk "
+        which = "suspension tree" if self.tree == DEFAULT_TREE else f"suspension tree {self.tree!r}"
+        out = [f"{which} of {self.task!r} at {points} interruption point(s) of the [example]'s exeTsk "
                f"(walked: {walked})"]
         out += [f"  {note}" for note in self.notes]
         for k, b in enumerate(self.branches):
-            name = f"suspension[{k}] {b.label or '(no label)'!r}"
+            name = f"{self.where}[{k}] {b.label or '(no label)'!r}"
             runs = self.runs_of(k)
             bad = [r for r in runs if not r.complete]
             if not runs:
@@ -227,7 +236,7 @@ class TreeReport:
                 out.append(f"  {name}: NOT complete at {len(bad)} of {len(runs)} point(s)")
                 out += [f"    {r.describe()}" for r in bad]
         out += [f"  {r.describe()}" for r in self.runs_of(-1)]
-        out += [f"  suspension[{u.branch}]: `when` {list(u.literal)}: the world never has it ({u.maker.value})"
+        out += [f"  {self.where}[{u.branch}]: `when` {list(u.literal)}: the world never has it ({u.maker.value})"
                 for u in self.unseen]
         return out
 
@@ -235,14 +244,14 @@ class TreeReport:
         """One :class:`~tasker.support.reader.InputWarning` per branch that is not complete, and per
         condition the tree never sees, at the branch's line of ``task.toml``."""
         for u in self.unseen:
-            task.spec.warn(f"suspension[{u.branch}]", u.message())
+            task.spec.warn(f"{self.where}[{u.branch}]", u.message())
         for k in sorted({r.branch for r in self.failing()}):
             bad = [r for r in self.failing() if r.branch == k]
             more = f" (and at {len(bad) - 1} more point(s), listed in the tree report)" if len(bad) > 1 else ""
             if k < 0:  # genSusp fails there, whatever the strategy
-                task.spec.warn("suspension", f"the tree cannot be read on the [example]: {bad[0].describe()}{more}")
+                task.spec.warn(self.where, f"the tree cannot be read on the [example]: {bad[0].describe()}{more}")
                 continue
-            task.spec.warn(f"suspension[{k}]", f"branch {bad[0].label!r} is not complete on the [example]: "
+            task.spec.warn(f"{self.where}[{k}]", f"branch {bad[0].label!r} is not complete on the [example]: "
                                                f"{bad[0].describe()}{more}; the static strategy leaves it so (give "
                                                "the state its own branch, or state what the branch assumes in its "
                                                "`when`)")
@@ -264,7 +273,7 @@ def _world_predicates(task: PddlTaskType, world_facts: Iterable[Fact], others: I
 
 
 def unseen_conditions(task: PddlTaskType, world_facts: Iterable[Fact] = (), hook_facts: Iterable[Fact] = (),
-                      others: Iterable[PddlTaskType] = ()) -> tuple[UnseenCondition, ...]:
+                      others: Iterable[PddlTaskType] = (), tree: str | None = None) -> tuple[UnseenCondition, ...]:
     """The ``when`` literals over a predicate the world never holds, and what makes it instead.
 
     ``world_facts``: facts of worlds and scenarios the task may run in, besides its ``[example]``;
@@ -276,7 +285,7 @@ def unseen_conditions(task: PddlTaskType, world_facts: Iterable[Fact] = (), hook
         by_hook.setdefault(f[0], f)
     requested = {lit[0] for lit in (*task.spec.facts, *task.spec.suspended_facts) if lit and lit[0] != "not"}
     out = []
-    for k, b in enumerate(task.spec.suspension):
+    for k, b in enumerate(task.spec.tree(tree)):
         for lit in b.when:
             pred = lit[1] if lit[0] == "not" else lit[0]
             if pred in visible:
@@ -357,16 +366,17 @@ def _states(task: PddlTaskType, ctx: TaskContext, exes: Sequence[tuple[str, tupl
 # -- running a branch ----------------------------------------------------------------------------
 
 
-def _run(task: PddlTaskType, ctx: TaskContext, state: _State, policy: str, interruption: float | None) -> BranchRun:
-    """The branch the tree chooses in ``state`` under ``policy``, run stage by stage."""
+def _run(task: PddlTaskType, ctx: TaskContext, state: _State, policy: str, interruption: float | None,
+         tree: str | None = None) -> BranchRun:
+    """The branch tree ``tree`` chooses in ``state`` under ``policy``, run stage by stage."""
     memory = {} if interruption is None else {INTERRUPTION_KEY: interruption}
-    c = replace(ctx, world=state.world, strategy=Strategy("planned", "static", policy), done=list(state.done),
+    c = replace(ctx, world=state.world, strategy=Strategy("planned", "static", policy, tree), done=list(state.done),
                 interrupted=None, suspended=True, memory=memory)
     try:
         branch, b = task.branch(c, state.world)
     except PlanningFailed as exc:
         return BranchRun(state.point, -1, "", policy, interruption, blocked=f"the tree cannot be read: {exc}")
-    k = next(i for i, x in enumerate(task.spec.suspension) if x is branch)
+    k = next(i for i, x in enumerate(task.spec.tree(tree)) if x is branch)
     label = branch.label or f"suspension[{k}]"
     world, blocked = state.world, None
     ran: list[Stage] = []
@@ -399,17 +409,20 @@ def _run(task: PddlTaskType, ctx: TaskContext, state: _State, policy: str, inter
                      tuple(h for h in on if h not in ok), tuple(ok))
 
 
-def report(task: PddlTaskType, *, world_facts: Iterable[Fact] = (), others: Iterable[PddlTaskType] = ()) -> TreeReport:
-    """The tree report of ``task`` on its ``[example]`` (module docstring); ``world_facts`` (facts of the
-    worlds and scenarios the task may run in) and ``others`` (task types that may run beside it) are
-    for :func:`unseen_conditions`."""
+def report(task: PddlTaskType, *, world_facts: Iterable[Fact] = (), others: Iterable[PddlTaskType] = (),
+           tree: str | None = None) -> TreeReport:
+    """The report of ``task``'s tree ``tree`` (None: ``[[suspension]]``) on its ``[example]`` (module
+    docstring); ``world_facts`` (facts of the worlds and scenarios the task may run in) and ``others``
+    (task types that may run beside it) are for :func:`unseen_conditions`."""
     world_facts, others = tuple(world_facts), tuple(others)
+    name = tree or DEFAULT_TREE
+    branches = task.spec.tree(tree)
     notes: list[str] = []
     ctx = example_context(task)
     if ctx is None:
         notes.append("no [example]: completeness is not checked (add one: a world and a request)")
-        unseen = unseen_conditions(task, world_facts, others=others)
-        return TreeReport(task.name, task.spec.suspension, (), (), unseen, tuple(notes))
+        unseen = unseen_conditions(task, world_facts, others=others, tree=tree)
+        return TreeReport(task.name, branches, (), (), unseen, tuple(notes), name)
     exes = _exes(task, ctx, notes)
     states = _states(task, ctx, exes, notes)
     made: list[Fact] = []
@@ -418,15 +431,22 @@ def report(task: PddlTaskType, *, world_facts: Iterable[Fact] = (), others: Iter
             made += task.hook_facts(replace(ctx, world=s.world), s.world)
         except Exception:  # noqa: BLE001 - task.py's hooks: the load check has warned already
             break
-    limits = sorted({b.max_interruption_s for b in task.spec.suspension
+    limits = sorted({b.max_interruption_s for b in branches
                      if b.policy == "conditional" and b.max_interruption_s is not None})
     runs: list[BranchRun] = []
     for s in states:
-        runs.append(_run(task, ctx, s, "strict", None))
+        runs.append(_run(task, ctx, s, "strict", None, tree))
         for limit in limits:  # a conditional branch, at the longest interruption it accepts
-            run = _run(task, ctx, s, "conditional", limit)
-            if run.branch >= 0 and task.spec.suspension[run.branch].policy == "conditional":
+            run = _run(task, ctx, s, "conditional", limit, tree)
+            if run.branch >= 0 and branches[run.branch].policy == "conditional":
                 runs.append(run)
-    return TreeReport(task.name, task.spec.suspension, tuple((exe, len(st)) for exe, st in exes), tuple(runs),
-                      unseen_conditions(task, world_facts, made, others), tuple(notes))
+    return TreeReport(task.name, branches, tuple((exe, len(st)) for exe, st in exes), tuple(runs),
+                      unseen_conditions(task, world_facts, made, others, tree), tuple(notes), name)
+
+
+def reports(task: PddlTaskType, *, world_facts: Iterable[Fact] = (),
+            others: Iterable[PddlTaskType] = ()) -> list[TreeReport]:
+    """One :func:`report` for each of ``task``'s trees, ``[[suspension]]`` first."""
+    world_facts, others = tuple(world_facts), tuple(others)
+    return [report(task, world_facts=world_facts, others=others, tree=name) for name in task.spec.tree_names]
 

@@ -239,12 +239,13 @@ class Checker:
         for shown, task in self.tasks.values():
             others = [t for _, t in self.tasks.values() if t is not task]
             try:
-                report = treecheck.report(task, world_facts=known, others=others)
+                reports = treecheck.reports(task, world_facts=known, others=others)
             except (TaskerError, ValueError) as exc:
                 self.problems.append((str(shown), f"its suspension tree cannot be read: {error_text(exc)}"))
                 continue
-            report.warn(task)
-            out += [(str(shown), line) for line in report.lines()]
+            for report in reports:
+                report.warn(task)
+                out += [(str(shown), line) for line in report.lines()]
         return out
 
 
@@ -252,7 +253,7 @@ def world_facts(world: Any) -> list[Fact]:
     """What a world (:class:`robot.spec.WorldSpec`) can hold, as :class:`robot.sim.Simulation` reads it
     off: its facts, its devices at their places in their states, and its people's postures — any of
     whom may fall (a script or a world event), which the simulation says as ``(fallen name)``."""
-    out = [tuple(f) for f in world.facts]
+    out = [tuple(f) for f in world.facts] + [("clear", p) for p in world.places]  # the world derives clear
     for d in world.devices.values():
         out += [("at", d.name, d.place), ("state", d.name, d.state)]
     for person in world.people.values():

@@ -269,8 +269,9 @@ def test_the_shipped_trees_see_every_fact_given_the_shipped_worlds() -> None:
     known = [f for name in shipped_worlds() for f in load_world(name).facts]
     for name in ("carry_object", "cook", "guide_human", "human_fell"):
         assert unseen_conditions(_load(DOMAINS / name), world_facts=known) == (), name
-    # the doors' branch reads door_at, which only a world with doors (flat) states
-    assert [u.literal for u in unseen_conditions(_load(DOMAINS / "cook"))] == [("door_at", "?d", "?p")]
+    # cook's trees read nothing its own example does not state (its door branch, reading door_at, is gone);
+    # a tree that reads what no world states is flagged (test_what_makes_an_unseen_fact_is_named)
+    assert unseen_conditions(_load(DOMAINS / "cook")) == ()
 
 
 # -- the report's types ---------------------------------------------------------------------------
@@ -319,3 +320,13 @@ def test_a_fact_another_task_type_makes_is_seen(tmp_path: Path) -> None:
     task = _load(reader)
     assert [(u.literal, u.maker) for u in unseen_conditions(task)] == [(("urgent", "$pot"), Maker.NOTHING)]
     assert unseen_conditions(task, others=[_load(maker)]) == ()
+
+
+def test_every_tree_of_a_folder_gets_its_report_named_where_it_is_written() -> None:
+    from planners.treecheck import reports
+
+    got = reports(_load(DOMAINS / "cook"))
+    assert [(r.tree, r.where) for r in got] == [("default", "suspension"), ("cooker", "trees.cooker")]
+    assert all(r.complete for r in got), [r.lines() for r in got]
+    assert any("trees.cooker[1] 'hot pan held, cooker on: back on the cooker, cooker off'" in line
+               for line in got[1].lines())
