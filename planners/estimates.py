@@ -450,6 +450,18 @@ _estimators: weakref.WeakKeyDictionary[Any, Estimator] = weakref.WeakKeyDictiona
 _estimators_lock = threading.Lock()
 
 
+def forget_estimates() -> None:
+    """Every task type's estimates and rendered problems forgotten: the next ones are made cold."""
+    with _estimators_lock:
+        estimators = list(_estimators.items())
+    for task, est in estimators:
+        est.clear()
+        domain = getattr(task, "domain", None)
+        if domain is not None:
+            with domain.rendered_lock:
+                domain.rendered.clear()
+
+
 def estimator_for(task: EstimatedTask) -> Estimator:
     """The :class:`Estimator` of a task type (one per instance, so its agents share the cache)."""
     with _estimators_lock:

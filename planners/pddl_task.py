@@ -44,7 +44,7 @@ from typing import Any
 from planners import derived, fallback, original_costs, stagecheck
 from planners.checks import DefinitionError
 from planners.derived import INTERRUPTION_KEY
-from planners.estimates import estimator_for, executing
+from planners.estimates import estimator_for, executing, forget_estimates
 from planners.planner import PddlText, Planner
 from planners.problem import (
     PLACE_TYPE,
@@ -110,6 +110,15 @@ def planning_journal() -> Iterator[list[PlanningRecord]]:
         yield records
     finally:
         _journal.reset(token)
+
+
+def forget_caches() -> None:
+    """Forget what planning remembered in this process — the shared planner's answers, every task type's
+    estimates and rendered problems — so the next run plans as a first run does (cold caches: how
+    ``tasker results`` measures genSusp's wall time).  Answers are exact, so runs are unchanged."""
+    if _shared_planner is not None:
+        _shared_planner.clear_cache()
+    forget_estimates()
 
 
 def default_planner() -> Planner:

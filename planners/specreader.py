@@ -14,7 +14,7 @@ from typing import Any
 
 from planners.checks import DefinitionError
 from tasker.support import reader
-from tasker.task import POLICIES
+from tasker.task import DEFAULT_TREE, POLICIES
 
 Literal = tuple[str, ...]
 
@@ -46,8 +46,6 @@ class Branch:
     max_interruption_s: float | None = None
 
 
-DEFAULT_TREE = "default"
-"""The name of the decision tree written as ``[[suspension]]``."""
 
 
 def object_token(token: str) -> str:

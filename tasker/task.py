@@ -85,6 +85,8 @@ class Effects:
         return bool(self.add or self.delete)
 
 
+DEFAULT_TREE = "default"
+"""The name of a task's default decision tree (a task folder's ``[[suspension]]``; :attr:`Strategy.tree` None)."""
 POLICIES = ("strict", "conditional")
 UPDATES = ("planned", "static")
 """How upTsk builds exeTsk: plan from the world as it is, or the template (Alg. 3)."""

@@ -20,24 +20,25 @@ from experiments.sweep import experiment_paths
 
 if TYPE_CHECKING:
     from experiments.sweep.experiment import Plan
-    from experiments.sweep.spec import Job, SweepSpec
+    from experiments.sweep.spec import SweepSpec
 
 EXAMPLES = """\
 examples:
-  tasker results --workers 2                  # run what is missing (pilot, n seeds, control), write docs/results.md
+  tasker results --workers 2                  # run what is missing (pilot, n seeds, three arms), write docs/results.md
   tasker results --pilot                      # only the pilot's 20 seeds; print the n it fixes
   tasker results --limit 60                   # 60 more runs, then say how long the rest takes
   tasker results --no-run --partial --markdown /tmp/interim.md   # an interim document from what is stored
-  tasker results --replay carry 7 derived --out out/replay        # one run again, every output of tasker run
+  tasker results --replay household 7 fallback --tree cook:cooker --out out/replay   # one run again, every output
   tasker results --check                      # do docs/results.md's vouched-for traces still come out?"""
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     ex = experiment_paths  # only its constants: the help must not load the experiment
     p = sub.add_parser("results", help="run the suspension-strategy experiment; regenerate docs/results.md",
-                       description="Run the experiment declared in docs/results.md (static, planned and derived "
-                                   "suspension over randomised, perturbed variants; a pilot fixes n) and write the "
-                                   "document from the stored runs. Resumable: only missing runs are run.",
+                       description="Run the experiment declared in docs/results.md (static, planned, derived and "
+                                   "fallback suspension over randomised variants, in a targeted, an untargeted and "
+                                   "a control arm; a pilot fixes n) and write the document from the stored runs. "
+                                   "Resumable: only missing runs are run.",
                        epilog=EXAMPLES)
     p.add_argument("--workers", type=positive_int, default=1, help="local worker processes (default 1)")
     p.add_argument("--limit", type=positive_int, default=None, metavar="N", help="start at most N runs in this call")
@@ -46,13 +47,14 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p.add_argument("--partial", action="store_true",
                    help="write the document even if the design is not complete (needs --markdown other than "
                         f"{ex.MARKDOWN}: the committed document is only replaced by a complete one)")
-    p.add_argument("--db", default=ex.DB, help=f"perturbed arm's results database (default {ex.DB})")
-    p.add_argument("--control-db", default=ex.CONTROL_DB, help=f"control arm's database (default {ex.CONTROL_DB})")
+    p.add_argument("--results", default=ex.RESULTS, metavar="DIR",
+                   help=f"the folder of the arms' results databases, ARM.db (default {ex.RESULTS})")
     p.add_argument("--markdown", default=ex.MARKDOWN, help=f"the document to write (default {ex.MARKDOWN})")
     p.add_argument("--replay", nargs=3, metavar=("SCENARIO", "SEED", "SUSPENSION"), default=None,
-                   help="run one job of the perturbed arm again (with --control: of the control arm) with every "
-                        "output into --out; SCENARIO as in the document (e.g. compound)")
-    p.add_argument("--control", action="store_true", help="with --replay: the control arm's job")
+                   help="run one job again with every output into --out; SCENARIO as in the document (e.g. compound)")
+    p.add_argument("--arm", choices=("targeted", "untargeted", "control"), default="targeted",
+                   help="with --replay: the arm of the job (default targeted)")
+    p.add_argument("--tree", default="default", help="with --replay: the cell's tree (default: default)")
     p.add_argument("--out", default=None, metavar="DIR", help="with --replay: where to write the run")
     p.add_argument("--check", action="store_true",
                    help="re-run the runs the document's provenance block vouches for; exit 1 if a trace changed")
@@ -70,77 +72,74 @@ def _results(args: argparse.Namespace) -> int:
     if args.partial and Path(args.markdown).resolve() == (ex.ROOT / experiment_paths.MARKDOWN).resolve():
         raise UsageError("--partial", f"an interim document may not replace {experiment_paths.MARKDOWN}: "
                                       "give --markdown PATH")
-    writable_file(args.db, "--db")
-    writable_file(args.control_db, "--control-db")
+    root = Path(args.results)
+    for arm in ex.ARMS:
+        writable_file(str(ex.db_of(arm, root)), "--results")
     if args.no_run:
-        plan = ex.size(spec, args.db)
+        plan = ex.size(spec, ex.db_of("targeted", root))
     else:
-        plan, prog = ex.run(spec, db=args.db, control_db=args.control_db, workers=args.workers, limit=args.limit,
-                            pilot_only=args.pilot, progress=show_progress(args))
-        for name, s in (("pilot", prog.pilot), ("perturbed arm", prog.perturbed), ("control arm", prog.control)):
+        plan, prog = ex.run(spec, results=root, workers=args.workers, limit=args.limit, pilot_only=args.pilot,
+                            progress=show_progress(args))
+        for name, s in (("pilot", prog.pilot), *((f"{a} arm", prog.arms[a]) for a in ex.ARMS)):
             if s is not None:
                 note(args, f"{name}: {s.ran} run ({s.ok} ok, {s.errors} errors), {s.skipped} already stored")
     print("n per scenario (from the pilot): " + ", ".join(f"{Path(sc).stem} {n}" for sc, n in plan.n.items()))
-    missing = _missing(spec, plan, args)
+    missing = _missing(spec, plan, root)
     if args.pilot:
         for size in plan.sizes:
-            print(f"  {Path(size.scenario).stem:12} {size.contrast.name:18} {size.outcome.label:45} "
-                  f"pilot pairs {size.pairs:3}  needs {'-' if size.required is None else size.required}")
+            print(f"  {size.scenario:40} {size.contrast.name:20} pilot pairs {size.pairs:3}  "
+                  f"needs {'-' if size.required is None else size.required}")
         return EXIT_OK
     if missing and not args.partial:
-        print(f"{missing} runs of the declared design are missing; {_eta(args, missing)}. {args.markdown} is written "
-              "once they are in (run the same command again; --partial --markdown PATH for an interim document).")
+        print(f"{missing} runs of the declared design are missing; {_eta(args, missing, root)}. {args.markdown} is "
+              "written once they are in (run the same command again; --partial --markdown PATH for an interim "
+              "document).")
         return EXIT_OK
-    return _write(args, spec, plan, complete=not missing)
+    return _write(args, spec, plan, root, complete=not missing)
 
 
-def _missing(spec: SweepSpec, plan: Plan, args: argparse.Namespace) -> int:
+def _missing(spec: SweepSpec, plan: Plan, root: Path) -> int:
     from experiments.sweep import experiment as ex
 
-    want = [*ex.perturbed_jobs(spec, plan.n), *ex.pilot_jobs(spec)]
-    have = {r.key for r in ex.rows_of(args.db, want)}
-    control = ex.control_jobs(spec)
-    have_c = {r.key for r in ex.rows_of(args.control_db, control)}
-    return len({j.key for j in want} - have) + len({j.key for j in control} - have_c)
+    out = 0
+    for arm in ex.ARMS:
+        want = ex.arm_jobs(spec, arm, plan.n) + (ex.pilot_jobs(spec) if arm == "targeted" else [])
+        have = {r.key for r in ex.rows_of(ex.db_of(arm, root), want)}
+        out += len({j.key for j in want} - have)
+    return out
 
 
-def _eta(args: argparse.Namespace, missing: int) -> str:
+def _eta(args: argparse.Namespace, missing: int, root: Path) -> str:
     from experiments.sweep import experiment as ex
 
-    walls = [r.wall for db in (args.db, args.control_db) if Path(db).is_file()
-             for r in ex.rows_of(db, _all_jobs()) if r.wall]
+    spec = ex.load()
+    walls = [r.wall for arm in ex.ARMS for r in ex.rows_of(ex.db_of(arm, root), ex.arm_jobs(spec, arm, None))
+             if r.wall]
     if not walls:
         return "no run time known yet to estimate them"
     per = sum(walls) / len(walls)
     return f"at {per:.1f} s a run on {args.workers} worker(s), about {per * missing / args.workers / 3600:.1f} h"
 
 
-def _all_jobs() -> list[Job]:
-    from experiments.sweep import experiment as ex
-
-    spec = ex.load()
-    return [*spec.jobs(), *ex.control_jobs(spec)]
-
-
-def _write(args: argparse.Namespace, spec: SweepSpec, plan: Plan, *, complete: bool) -> int:
+def _write(args: argparse.Namespace, spec: SweepSpec, plan: Plan, root: Path, *, complete: bool) -> int:
     from experiments.sweep import experiment as ex
     from experiments.sweep import provenance as pv
     from experiments.sweep.results_doc import render
 
-    perturbed = ex.rows_of(args.db, ex.perturbed_jobs(spec, plan.n))
-    control = ex.rows_of(args.control_db, ex.control_jobs(spec))
-    picks = [(j, True) for j in pv.pick(ex.perturbed_jobs(spec, plan.n))]
-    picks += [(j, False) for j in pv.pick(ex.control_jobs(spec))[:1]]
+    arms = {arm: ex.by_cell(ex.rows_of(ex.db_of(arm, root), ex.arm_jobs(spec, arm, plan.n))) for arm in ex.ARMS}
+    commit = pv.commit()
+    picks = [(j, arm) for arm in ex.ARMS for j in pv.pick(ex.arm_jobs(spec, arm, plan.n), seed=f"{commit}|{arm}")
+             if arm == "targeted" or j.scenario == spec.scenarios[0]]
     note(args, f"vouching for {len(picks)} runs (running them again for their trace digests)")
-    digests = tuple(pv.digest(ex.SPEC, j, perturbed=p) for j, p in picks)
+    digests = tuple(pv.digest(ex.SPEC, j, arm) for j, arm in picks)
     command = "tasker results" + (f" --workers {args.workers}" if args.workers != 1 else "")
-    text = render(perturbed, control, plan, spec.scenarios, command, pv.Provenance(pv.commit(), digests))
+    text = render(arms, plan, ex.cells(spec), command, pv.Provenance(commit, digests))
     if not complete:
         text = ("> **Interim**: the declared design is not complete; these numbers are not the experiment's "
                 "answer.\n\n" + text)
     Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
     Path(args.markdown).write_text(text, encoding="utf-8")
-    print(f"wrote {args.markdown} ({len(perturbed)} perturbed and {len(control)} control runs)")
+    print(f"wrote {args.markdown} (" + ", ".join(f"{len(arms[a])} {a}" for a in ex.ARMS) + " runs)")
     return EXIT_OK
 
 
@@ -151,22 +150,22 @@ def _replay(args: argparse.Namespace, spec: SweepSpec) -> int:
     if args.out is None:
         raise UsageError("--out", "--replay needs --out DIR (where the run's outputs go)")
     scenario, seed_text, suspension = args.replay
-    jobs = ex.control_jobs(spec) if args.control else spec.jobs()
+    jobs = ex.arm_spec(spec, args.arm).jobs()
     by_name = {Path(sc).stem: sc for sc in spec.scenarios}
     if scenario not in by_name:
         raise UsageError("--replay", f"no scenario {scenario!r} (scenarios: {', '.join(sorted(by_name))})")
+    tree = None if args.tree == "default" else args.tree
     match = [j for j in jobs if j.scenario == by_name[scenario] and str(j.seed) == seed_text
-             and j.strategy.suspension == suspension]
+             and j.strategy.suspension == suspension and j.strategy.tree == tree]
     if not match:
-        raise UsageError("--replay", f"no job {scenario} seed {seed_text} suspension {suspension!r} in the "
-                                     f"{'control' if args.control else 'perturbed'} arm (seeds "
-                                     f"{min(j.seed for j in jobs)}..{max(j.seed for j in jobs)}; suspension static, "
-                                     "planned or derived)")
+        trees = sorted({j.strategy.tree or "default" for j in jobs if j.scenario == by_name[scenario]})
+        raise UsageError("--replay", f"no job {scenario} seed {seed_text} suspension {suspension!r} tree "
+                                     f"{args.tree!r} in the {args.arm} arm (seeds {min(j.seed for j in jobs)}.."
+                                     f"{max(j.seed for j in jobs)}; suspension static, planned, derived or fallback; "
+                                     f"its trees: {', '.join(trees)})")
     job = match[0]
-    st = job.strategy
     run_scenario(job.source, job.options(), out=Path(args.out))
-    print(f"wrote {args.out}/ ({scenario}, seed {seed_text}, {st.label}"
-          f"{', control arm' if args.control else ''})")
+    print(f"wrote {args.out}/ ({scenario}, seed {seed_text}, {job.strategy.label}, {args.arm} arm)")
     return EXIT_OK
 
 

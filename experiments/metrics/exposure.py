@@ -59,12 +59,12 @@ def stretches(tl: Timeline) -> list[Stretch]:
     out: list[Stretch] = []
     for h in tl.hazards:
         end = h.end if h.end is not None else tl.t_end
-        owner = tl.agents.get(h.owner) if h.owner is not None else None
-        if owner is None:
+        if h.owner is None:
             out.append(Stretch(None, h.label, h.start, end, "nobody's", unowned_reason(tl, h)))
             continue
+        owner = tl.agents.get(h.owner)  # an owner the trace never requested never held the robot
         cursor = h.start
-        for lo, hi in _cmd_spans(owner, h.start, end) + [(end, end)]:
+        for lo, hi in (_cmd_spans(owner, h.start, end) if owner is not None else []) + [(end, end)]:
             if lo > cursor:  # unattended from cursor to lo: the first budget_s of it within budget
                 edge = min(lo, cursor + h.budget_s)
                 if edge > cursor:

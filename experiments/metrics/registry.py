@@ -78,6 +78,7 @@ METRICS: tuple[Metric, ...] = (
     # -- a run (metrics.json) ------------------------------------------------------------------
     Metric("run.events", "count", N, "events in the trace"),
     Metric("run.duration_s", "s", N, "the largest time in the trace"),
+    Metric("run.targeted_changes", "count", N, "world events a targeted perturbation made (0: it found no target)"),
     Metric("run.horizon_reached", "bool", L, "the run was stopped (horizon, Ctrl-C or abort) before every task ended"),
     Metric("totals.requested", "count", N, "tasks requested"),
     Metric("totals.ended", "count", N, "tasks that ended"),

@@ -26,6 +26,8 @@ from tasker.fsm import FsmState
 from tasker.trace import FAILED, INAPPLICABLE
 
 S = FsmState
+TARGETED = "perturbation (targeted"
+"""How the note of a targeted perturbation's world event begins (:mod:`experiments.run.targeting`)."""
 Source = Timeline | Iterable[ev.Event | Mapping[str, Any]]
 
 
@@ -39,7 +41,9 @@ def _stats(values: list[float]) -> dict[str, float | None]:
 def run_info(tl: Timeline) -> dict[str, Any]:
     """The run's header and how it stopped."""
     info: dict[str, Any] = {"events": len(tl.events), "duration_s": tl.t_end, "horizon_reached": False,
-                            "active_at_end": []}
+                            "active_at_end": [],
+                            # world events a targeted perturbation made (experiments.run.targeting)
+                            "targeted_changes": sum(1 for w in tl.world if w.note.startswith(TARGETED))}
     if tl.started is not None:
         info.update(seed=tl.started.seed, scheduler=tl.started.scheduler, mode=tl.started.mode)
     if tl.stopped is not None:
@@ -117,7 +121,10 @@ def switching(tl: Timeline) -> dict[str, Any]:
             suspended = None
             if c.agent != old:
                 switches.append({"t_susp": t0, "t_start": c.t, "from": old, "to": c.agent, "latency_s": c.t - t0})
+    order = [agent for _, agent in tl.exe_changes() if agent is not None]
     return {"switches": len(switches), "switch_list": switches,
+            # the agents that held the robot, in turn: two runs with the same order had the same schedule
+            "schedule": " ".join(a for k, a in enumerate(order) if k == 0 or a != order[k - 1]),
             "switch_latency_s": _stats([s["latency_s"] for s in switches]),
             "commands": dict(sorted(counts.items())), "mode_changes": len(tl.modes),
             "changes": sum(1 for c in tl.changes if c.ignored is None)}

@@ -33,7 +33,7 @@ class RunOptions:
     ``hazard_waiting``: hazard-aware waiting on; ``randomize``: a randomised variant drawn from the
     seed, with ``interruption`` placing its interrupting request and ``perturbation`` changing its
     world; ``request_fields``: every task type takes ``deadline``/``priority``; ``task_paths``:
-    task folders loaded besides the bundled ones."""
+    task folders loaded besides the bundled ones; ``cold``: planning caches forgotten first."""
 
     seed: int | None = None
     update: str | None = None
@@ -48,6 +48,9 @@ class RunOptions:
     perturbation: Perturbation | None = None
     request_fields: bool = False
     task_paths: tuple[str, ...] = ()
+    cold: bool = False
+    """Forget what planning remembered before the run (:func:`planners.pddl_task.forget_caches`), so
+    genSusp's wall time is a first run's; the run itself is the same."""
 
     def __post_init__(self) -> None:
         for name, allowed in (("update", UPDATES), ("suspension", SUSPENSIONS), ("policy", POLICIES),

@@ -379,6 +379,10 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, options: RunOptio
         spec_json = {"kind": "robot", **scn.to_json()}
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")
+    if opts.cold and kind == "robot":
+        from planners.pddl_task import forget_caches
+
+        forget_caches()
     error: BaseException | None = None
     with _journal(kind) as journal:  # the PDDL of every planning call, for problems/
         try:
@@ -495,6 +499,9 @@ def _metrics(trace: Trace, calls: list[dict[str, Any]], wall: float) -> dict[str
     m = metrics.compute(tl)
     sim_time = tl.t_end
     m["planner_wall_time_s"] = round(sum(float(c.get("planner_time_s", 0.0)) for c in calls), 6)
+    # each genSusp's planner wall time (0 for a tree's stages): what planning a suspension costs, host-dependent
+    m["gensusp_wall_s"] = [round(float(c.get("planner_time_s", 0.0)), 6) for c in calls
+                           if c.get("purpose") == "genSusp"]
     m["planner_cache_hits"] = sum(1 for c in calls if c.get("cached"))
     m["wall_time_s"] = round(wall, 3)
     m["real_time_factor"] = round(sim_time / wall, 2) if wall > 0 else None

@@ -92,7 +92,7 @@ class Targeter:
             self.loop.at(round(e.t + self.draw.delay_s, 3), lambda: self._fire(target, when))
 
     def _fire(self, target: Target, when: str) -> None:
-        note = f"{NOTE} (targeted, {when}): {target.why}"
+        note = f"{NOTE} (targeted, {when}): {target.why}"  # experiments.metrics.run.TARGETED reads its start
         self.apply(TimedAction(self.loop.now, "world", {"what": target.what, "value": list(target.value),
                                                          "note": note}))
 

@@ -1,7 +1,7 @@
-"""Where the suspension-strategy experiment (:mod:`experiments.sweep.experiment`) keeps its two
-results databases and its document, relative to the project root.  Apart, and importing nothing,
-so that ``tasker --help`` can show them without loading the experiment's machinery."""
+"""Where the suspension-strategy experiment (:mod:`experiments.sweep.experiment`) keeps its results
+databases (one per arm, ``RESULTS/ARM.db``) and its document, relative to the project root.  Apart,
+and importing nothing, so that ``tasker --help`` can show them without loading the experiment's
+machinery."""
 
-DB = "out/strategies.db"
-CONTROL_DB = "out/strategies-control.db"
+RESULTS = "out/results"
 MARKDOWN = "docs/results.md"

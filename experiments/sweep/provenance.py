@@ -14,6 +14,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import random
 import subprocess
 import tempfile
 from collections.abc import Sequence
@@ -22,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from experiments.analysis.tables import markdown_table
+from experiments.sweep.experiment import arm_spec
 from experiments.sweep.spec import Job, SweepSpec, load_spec
 
 BEGIN = "<!-- provenance "
@@ -32,13 +34,13 @@ ROOT = Path(__file__).resolve().parents[2]
 @dataclass(frozen=True)
 class Digest:
     """One run a document vouches for and its trace's SHA-256: a job of a sweep spec (``spec`` its
-    path from the project's root; ``perturbed``: with the spec's ``[perturbation]``, else the control
-    arm without it), or, with ``spec`` empty, a plain ``tasker run`` of ``scenario`` (a shipped name
-    or a path from the root; ``seed`` -1 for the scenario's own; ``strategy`` a label or empty for the
-    scenario's own settings)."""
+    path from the project's root; ``arm`` the experiment's arm it ran in,
+    :data:`experiments.sweep.experiment.ARMS`), or, with ``spec`` empty, a plain ``tasker run`` of
+    ``scenario`` (a shipped name or a path from the root; ``seed`` -1 for the scenario's own;
+    ``strategy`` a label or empty for the scenario's own settings)."""
 
     spec: str
-    perturbed: bool
+    arm: str
     scenario: str
     seed: int
     strategy: str
@@ -68,11 +70,6 @@ def commit(root: Path = ROOT) -> str:
     return head + ("-dirty" if dirty else "")
 
 
-def arm(spec: SweepSpec, perturbed: bool) -> SweepSpec:
-    """The spec as run for one arm: as written (perturbed) or without its ``[perturbation]`` (control)."""
-    return spec if perturbed else dataclasses.replace(spec, perturbation=None)
-
-
 def find_job(spec: SweepSpec, scenario: str, seed: int, strategy: str) -> Job:
     for job in spec.jobs():
         if (job.scenario, job.seed, job.strategy.label) == (scenario, seed, strategy):
@@ -90,8 +87,8 @@ def trace_digest(job: Job) -> str:
         return hashlib.sha256((out / "trace.jsonl").read_bytes()).hexdigest()
 
 
-def digest(spec_path: str, job: Job, perturbed: bool) -> Digest:
-    return Digest(spec_path, perturbed, job.scenario, job.seed, job.strategy.label, trace_digest(job))
+def digest(spec_path: str, job: Job, arm: str) -> Digest:
+    return Digest(spec_path, arm, job.scenario, job.seed, job.strategy.label, trace_digest(job))
 
 
 def run_digest(scenario: str, *, seed: int | None = None, strategy: str = "", root: Path = ROOT) -> Digest:
@@ -106,13 +103,13 @@ def run_digest(scenario: str, *, seed: int | None = None, strategy: str = "", ro
         out = Path(tmp) / "run"
         run_scenario(source, RunOptions.of(st, seed=seed), out=out, pictures=False)
         sha = hashlib.sha256((out / "trace.jsonl").read_bytes()).hexdigest()
-    return Digest("", False, scenario, -1 if seed is None else seed, strategy, sha)
+    return Digest("", "", scenario, -1 if seed is None else seed, strategy, sha)
 
 
 def render(p: Provenance) -> list[str]:
     """The block: a comment with the JSON, then a visible section."""
     data = {"commit": p.commit, "digests": [d.to_json() for d in p.digests]}
-    body = [[Path(d.scenario).stem, "tasker run" if not d.spec else "perturbed" if d.perturbed else "control",
+    body = [[Path(d.scenario).stem, "tasker run" if not d.spec else d.arm,
              "its own" if d.seed < 0 else str(d.seed), d.strategy or "its own settings", f"`{d.sha256[:16]}`"]
             for d in p.digests]
     return ["## Provenance", "",
@@ -148,24 +145,21 @@ def verify(p: Provenance, root: Path = ROOT) -> list[str]:
         else:
             if d.spec not in specs:
                 specs[d.spec] = load_spec(root / d.spec)
-            now = trace_digest(find_job(arm(specs[d.spec], d.perturbed), d.scenario, d.seed, d.strategy))
+            now = trace_digest(find_job(arm_spec(specs[d.spec], d.arm), d.scenario, d.seed, d.strategy))
         if now != d.sha256:
-            where = "tasker run" if not d.spec else "perturbed" if d.perturbed else "control"
+            where = "tasker run" if not d.spec else d.arm
             changed.append(f"{Path(d.scenario).stem} seed {d.seed} {d.strategy or 'its own settings'} "
                            f"({where}): {d.sha256[:12]} → {now[:12]}")
     return changed
 
 
-def pick(jobs: Sequence[Job], per_scenario: int = 1) -> list[Job]:
-    """A few jobs to vouch for: per scenario, ``per_scenario`` jobs of its first seed, the strategies
-    taken in turn across scenarios (so every strategy appears)."""
+def pick(jobs: Sequence[Job], per_scenario: int = 1, *, seed: str = "") -> list[Job]:
+    """A few jobs to vouch for: per scenario, ``per_scenario`` jobs drawn at random among its jobs —
+    any seed, any strategy and tree, on a stream of ``seed`` (say, the document's commit) — so the
+    drift guard re-runs a sample of the design, not only its first seed."""
+    rng = random.Random(f"provenance:{seed}")
     out: list[Job] = []
-    scenarios = list(dict.fromkeys(j.scenario for j in jobs))
-    strategies = list(dict.fromkeys(j.strategy.label for j in jobs))
-    for i, sc in enumerate(scenarios):
-        mine = [j for j in jobs if j.scenario == sc]
-        first = min(j.seed for j in mine)
-        for k in range(per_scenario):
-            label = strategies[(i + k) % len(strategies)]
-            out += [j for j in mine if j.seed == first and j.strategy.label == label][:1]
+    for sc in dict.fromkeys(j.scenario for j in jobs):
+        mine = sorted((j for j in jobs if j.scenario == sc), key=lambda j: (j.seed, j.strategy.label))
+        out += rng.sample(mine, min(per_scenario, len(mine)))
     return out

@@ -24,6 +24,7 @@ from experiments.metrics.store import JobKey
 from experiments.run.options import RunOptions
 from tasker.support import reader
 from tasker.support.reader import InputError
+from tasker.task import DEFAULT_TREE
 
 MAX_JOBS = 100_000
 """A spec that expands to more jobs than this is refused (a typo such as ``seeds = 10000000``)."""
@@ -44,6 +45,7 @@ class Job:
     task_paths: tuple[str, ...] = ()  # absolute task folders (--path), so a Dask worker elsewhere loads the same
     interruption: InterruptionGrid | None = None  # where variants place the interruption ([variants.NAME])
     perturbation: Perturbation | None = None  # exogenous world events around it ([perturbation])
+    cold: bool = False  # planning caches forgotten before the run (cold_caches)
 
     @property
     def key(self) -> JobKey:
@@ -52,7 +54,7 @@ class Job:
     def options(self) -> RunOptions:
         """How the job runs: a randomised variant of its seed, with its strategy, interruption and perturbation."""
         return RunOptions.of(self.strategy, seed=self.seed, randomize=True, task_paths=self.task_paths,
-                             interruption=self.interruption, perturbation=self.perturbation)
+                             interruption=self.interruption, perturbation=self.perturbation, cold=self.cold)
 
 
 @dataclass(frozen=True)
@@ -68,6 +70,12 @@ class SweepSpec:
     variants: Mapping[str, InterruptionGrid] = field(default_factory=dict)
     perturbation: Perturbation | None = None
     """Exogenous world events drawn around each variant's interruption (:mod:`experiments.inputs.perturbation`)."""
+    cold: bool = False
+    """``cold_caches``: every job forgets what planning remembered before it runs (genSusp's wall time is
+    then a first run's; the runs are the same)."""
+    trees: Mapping[str, tuple[str | None, ...]] = field(default_factory=dict)
+    """Per scenario, the decision trees its strategies run with (``[variants.NAME] trees``; None: the
+    default tree); a scenario not listed runs each strategy as it is."""
 
     def __post_init__(self) -> None:
         if not self.scenarios:
@@ -87,11 +95,18 @@ class SweepSpec:
         if n > MAX_JOBS:
             raise ValueError(f"the spec expands to {n} jobs, more than the {MAX_JOBS} a sweep may have")
 
+    def strategies_of(self, scenario: str) -> list[Strategy]:
+        """The strategies ``scenario`` runs: each strategy with each of its trees (tree-major)."""
+        levels = self.trees.get(scenario)
+        if not levels:
+            return list(self.strategies)
+        return [replace(st, tree=tree) if tree is not None else st for tree in levels for st in self.strategies]
+
     def jobs(self) -> list[Job]:
         """Every job, scenario-major then seed then strategy (so paired runs finish close together)."""
         return [Job(sc, self.sources.get(sc, sc), seed, st, self.task_paths, self.variants.get(sc),
-                    self.perturbation if sc in self.variants else None)
-                for sc in self.scenarios for seed in self.seeds for st in self.strategies]
+                    self.perturbation if sc in self.variants else None, self.cold)
+                for sc in self.scenarios for seed in self.seeds for st in self.strategies_of(sc)]
 
     def to_json(self) -> dict[str, Any]:
         out: dict[str, Any] = {"name": self.name, "scenarios": list(self.scenarios), "seeds": list(self.seeds),
@@ -100,6 +115,8 @@ class SweepSpec:
             out["variants"] = {sc: g.to_json() for sc, g in sorted(self.variants.items())}
         if self.perturbation is not None:
             out["perturbation"] = self.perturbation.to_json()
+        if self.trees:
+            out["trees"] = {sc: [t or DEFAULT_TREE for t in levels] for sc, levels in sorted(self.trees.items())}
         return out
 
 
@@ -108,7 +125,8 @@ def looks_like_path(text: str) -> bool:
     return "/" in text or os.sep in text or text.endswith((".toml", ".json"))
 
 
-SPEC_KEYS = ("name", "scenarios", "seeds", "seed_start", "strategies", "factors", "variants", "perturbation", "paths")
+SPEC_KEYS = ("name", "scenarios", "seeds", "seed_start", "strategies", "factors", "variants", "perturbation", "paths",
+             "cold_caches")
 
 
 def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
@@ -212,11 +230,13 @@ def load_spec(path: str | Path, *, max_jobs: int | None = None) -> SweepSpec:
     if n > limit:
         raise top.error("seeds", f"the spec expands to {len(scenario_list)} scenarios x {len(seeds)} seeds x "
                                  f"{len(strategies)} strategies = {n} jobs, more than the {limit} a sweep may have")
-    variants = _variants(top.table("variants", {}), scenario_list, sources)
+    trees: dict[str, tuple[str | None, ...]] = {}
+    variants = _variants(top.table("variants", {}), scenario_list, sources, trees)
     perturbation = _perturbation(top, variants) if "perturbation" in top else None
     _warn_ignored_factors(top, scenario_list, sources, strategies)
+    cold = bool(top.boolean("cold_caches", False))
     return SweepSpec(tuple(scenario_list), seeds, tuple(strategies), name=name, sources=sources, variants=variants,
-                     perturbation=perturbation, task_paths=paths)
+                     perturbation=perturbation, task_paths=paths, trees=trees, cold=cold)
 
 
 def _paths(top: reader.Table, here: Path) -> tuple[str, ...]:
@@ -343,8 +363,10 @@ def _grid(t: reader.Table) -> list[Strategy]:
     return expand(factors)
 
 
-def _variants(t: reader.Table, scenario_list: Sequence[str], sources: Mapping[str, str]) -> dict[str, InterruptionGrid]:
-    """``[variants.NAME]`` tables: where the variants of scenario NAME place its interruption.
+def _variants(t: reader.Table, scenario_list: Sequence[str], sources: Mapping[str, str],
+              trees: dict[str, tuple[str | None, ...]] | None = None) -> dict[str, InterruptionGrid]:
+    """``[variants.NAME]`` tables: where the variants of scenario NAME place its interruption, and the
+    decision trees its strategies are run with (``trees``, into ``trees`` if given).
 
     NAME must be a robot scenario (only those are randomised) with the request ``interrupt``
     names; its file is read for that (its own faults are left to the scenario's loader)."""
@@ -363,7 +385,10 @@ def _variants(t: reader.Table, scenario_list: Sequence[str], sources: Mapping[st
         stop = float(times.number("stop", positive=True))
         step = float(times.number("step", positive=True))
         times.done()
+        levels = _tree_levels(vt) if "trees" in vt else None
         vt.done()
+        if levels is not None and trees is not None:
+            trees[sc] = levels
         if not (stop - start) / step <= MAX_JOBS:  # inf too: ceil() of it raised in every job
             raise times.error("step", f"{(stop - start) / step:.3g} strata of {step:g} s in [{start:g}, {stop:g}), "
                                       f"more than the {MAX_JOBS} a sweep may have jobs: a larger step")
@@ -374,6 +399,26 @@ def _variants(t: reader.Table, scenario_list: Sequence[str], sources: Mapping[st
             raise vt.error(key, str(exc).partition(": ")[2]) from None
         _check_interrupt(t, vt, sc, sources.get(sc, sc), out[sc])
     return out
+
+
+def _tree_levels(vt: reader.Table) -> tuple[str | None, ...]:
+    """``trees = ["default", "cook:cooker"]``: the trees a scenario's strategies run with (``default``:
+    each folder's ``[[suspension]]``; ``NAME`` or ``TYPE:NAME`` as ``tasker run --tree``)."""
+    levels = vt.array("trees", nonempty=True)
+    at = vt.at("trees", {})
+    out: list[str | None] = []
+    for i, level in enumerate(levels):
+        if level == DEFAULT_TREE:
+            out.append(None)
+            continue
+        try:
+            out.append(Strategy(tree=level).tree)
+        except ValueError as exc:
+            raise at.error(i, f"expected {DEFAULT_TREE!r}, a tree's NAME or TYPE:NAME, got {level!r} "
+                              f"({str(exc).partition(': ')[2]})") from None
+    if len(set(out)) != len(out):
+        raise vt.error("trees", f"duplicates in {levels}")
+    return tuple(out)
 
 
 def _check_interrupt(t: reader.Table, vt: reader.Table, sc: str, source: str, grid: InterruptionGrid) -> None:

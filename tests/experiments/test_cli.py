@@ -152,10 +152,11 @@ def test_top_level_help_lists_exit_statuses(capsys: pytest.CaptureFixture[str]) 
 
 
 def _fake_result(causes: list[str]) -> Any:
-    events = [{"t": 1.0, "kind": "end", "agent": f"a{k}", "task_type": "t", "reason": c, "cause": c}
-              for k, c in enumerate(causes)]
-    trace = SimpleNamespace(events=events, of=lambda kind: [e for e in events if e["kind"] == kind])
-    return SimpleNamespace(trace=trace, record={"wall_time_s": 0.1})
+    from tasker import events as ev
+
+    typed: list[ev.Event] = [ev.TaskRequested(0.0, f"a{k}", "t", {}, "test") for k in range(len(causes))]
+    typed += [ev.TaskEnded(1.0, f"a{k}", "t", c, c) for k, c in enumerate(causes)]
+    return SimpleNamespace(trace=SimpleNamespace(typed=typed), record={"wall_time_s": 0.1}, metrics={})
 
 
 @pytest.mark.parametrize("strict, causes, status", [

@@ -56,15 +56,16 @@ def test_same_run_same_bytes(events: list[dict[str, Any]], tmp_path: Path) -> No
 def test_timeline_separates_costs_rates_roles_and_hazards(events: list[dict[str, Any]]) -> None:
     trace = [*events, {"t": 3.0, **HAZARD, "status": "on"}, {"t": 9.0, **HAZARD, "status": "off"}]
     hazards = report_html.hazards_of(trace, None)
-    assert hazards == [("d1", "device_on cooker", 3.0, 9.0)]
+    assert [(h.owner, h.label, h.start, h.end) for h in hazards] == [("d1", "device_on cooker", 3.0, 9.0)]
     fig = html_timeline.timeline_figure(trace, hazards)
     by_axis: dict[str, set[str]] = {}
     for t in fig.data:
         by_axis.setdefault(t.yaxis or "y", set()).add(t.name)
     assert by_axis["y"] >= {"cost_dac", "c_switch"} and not by_axis["y"] & {"ccps_dac", "cps_dac"}
     assert by_axis["y2"] >= {"ccps_dac"} and not by_axis["y2"] & {"cost_dac"}
-    assert by_axis["y3"] >= {"exeDA", "idleDA", "hazard on"}
-    bar = next(t for t in fig.data if t.name == "hazard on")
+    kind = hazards[0].kind  # whether d1 attended it then is the trace's: one bar of that kind
+    assert by_axis["y3"] >= {"exeDA", "idleDA", f"hazard {kind}"}
+    bar = next(t for t in fig.data if t.name == f"hazard {kind}")
     assert list(bar.base) == [3.0] and list(bar.x) == [6.0] and list(bar.y) == ["d1 hazard: device_on cooker"]
     susp = [s for s in fig.layout.shapes if s.line.dash == "dash"]  # susp commands
     n_susp = sum(1 for e in events if e["event"] == "command" and e["flag"] == "susp")
@@ -84,7 +85,9 @@ def test_hazards_fall_back_to_metric_episodes() -> None:
     metrics = {"safety": {"episodes": [{"agent": "d1", "hazard": "cooker_on", "subject": "cooker", "start": 2.0,
                                         "end": 5.0}]}}
     trace = [{"t": 6.0, "event": "mode", "mode": "IT"}]
-    assert report_html.hazards_of(trace, metrics) == [("d1", "cooker_on cooker", 2.0, 5.0)]
+    got = report_html.hazards_of(trace, metrics)  # an older run folder: drawn whole, unattended
+    assert [(h.owner, h.label, h.start, h.end, h.kind) for h in got] == [("d1", "cooker_on cooker", 2.0, 5.0,
+                                                                          "unattended")]
 
 
 def test_gantt_names_every_stage(events: list[dict[str, Any]]) -> None:
@@ -107,7 +110,7 @@ def test_world_slider_follows_the_trajectory(events: list[dict[str, Any]]) -> No
     robot_trace = last["data"][1]
     assert robot_trace["name"] == "robot" and robot_trace["x"][0] == pytest.approx(1.0 + 0.1 * 59)
     assert "peter (fallen)" in last["data"][2]["text"]
-    assert "device_on cooker (d1)" in last["layout"]["title"]["text"]
+    assert "device_on cooker (d1, " in last["layout"]["title"]["text"]
     assert "hazards on: none" in frames[0]["layout"]["title"]["text"]
     assert [t["name"] for t in fig["data"]][3:] == [t["name"] for t in last["data"]]  # frames update traces 3-5
     susp = next(t for t in fig["data"] if t["name"] == "robot at susp")
@@ -156,5 +159,6 @@ def test_hazards_nobody_owns_share_one_row(events: list[dict[str, Any]]) -> None
               "status": "on", "budget_s": 60.0, "severity": 1.0} for d in ("a", "b", "c", "d", "e")]
     trace = [*events, *doors]
     fig = html_timeline.timeline_figure(trace, report_html.hazards_of(trace, None))
-    bar = next(t for t in fig.data if t.name == "hazard on")
-    assert set(bar.y) == {"unowned hazards"} and len(bar.y) == 5
+    bar = next(t for t in fig.data if t.name == "hazard nobody's")
+    assert set(bar.y) == {"nobody's hazards"} and len(bar.y) == 5
+    assert all("so in the world file" in text for text in bar.customdata)  # and why nobody owns them
