@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 EXAMPLES = """\
 examples:
-  tasker paper --variants 50 --jobs 2 --out docs/paper.md     # the numbers of docs/paper.md
+  tasker paper --variants 50 --jobs 2 --out docs/paper.md --readme README.md   # docs/paper.md and the README's lines
   tasker paper --variants 0 --scenario paper-2019             # the shipped runs only, to stdout
   tasker paper --variants 5 --json runs.json                  # also every run's checked steps"""
 
@@ -52,15 +52,29 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
                    help="only this scenario (repeatable; default both)")
     p.add_argument("--out", default=None, help="a Markdown file whose generated block to replace (e.g. docs/paper.md)")
     p.add_argument("--json", default=None, help="also write every run's checked steps and predictions here")
+    p.add_argument("--readme", default=None,
+                   help="also rewrite this file's paper_summary block (steps 3, 4 and the whole sequence) from "
+                        "the tables written (e.g. README.md)")
     p.set_defaults(func=_command)
 
 
 def _command(args: argparse.Namespace) -> int:
-    from experiments.paper import recorded, report
+    from experiments.paper import recorded, report, summary
+    from tasker.errors import ConfigError
 
     out = Path(args.out) if args.out else None
     if out is not None and not out.is_file():
         raise UsageError("--out", f"{out}: no such file (the document whose generated block to replace)")
+    readme = Path(args.readme) if args.readme else None
+    if readme is not None:  # checked before the runs: they cost minutes
+        if out is None:
+            raise UsageError("--readme", "needs --out: the summary is made from the page written there")
+        if not readme.is_file():
+            raise UsageError("--readme", f"{readme}: no such file (the document whose summary block to replace)")
+        try:
+            summary.splice(readme.read_text(), "", str(readme))
+        except ConfigError as exc:
+            raise UsageError("--readme", str(exc)) from None
     js = writable_file(args.json, "--json") if args.json else None
     made_at = commit()  # before the runs: what is edited meanwhile is not what ran
     scenarios = tuple(args.scenario or report.SCENARIOS)
@@ -71,8 +85,9 @@ def _command(args: argparse.Namespace) -> int:
     results = report.run_all(todo, args.jobs, progress)
     if progress is not None:
         print(file=sys.stderr)
-    command = "tasker paper --variants {}{}{}".format(
-        args.variants, "".join(f" --scenario {s}" for s in args.scenario or ()), f" --out {args.out}" if out else "")
+    command = "tasker paper --variants {}{}{}{}".format(
+        args.variants, "".join(f" --scenario {s}" for s in args.scenario or ()), f" --out {args.out}" if out else "",
+        f" --readme {args.readme}" if readme else "")
     block = report.render(results, scenarios, args.variants, command, made_at, recorded.rows())
     if js is not None:
         runs = [{"scenario": s, "model": c.model, "hysteresis": c.hysteresis, "variant": v, **r}
@@ -83,4 +98,8 @@ def _command(args: argparse.Namespace) -> int:
     else:
         out.write_text(report.splice(out.read_text(), block))
         print(f"wrote {out}", file=sys.stderr)
+    if readme is not None:
+        lines = summary.render(summary.read_verdicts(block, "the generated block"), args.out)
+        readme.write_text(summary.splice(readme.read_text(), lines, str(readme)))
+        print(f"wrote {readme}", file=sys.stderr)
     return 0

@@ -30,7 +30,16 @@ outcome of a run:
    apart; the record has no robot position between 2580.6 and 2592.7, so it is taken
    where it guided John at 2580.6; the direction to Peter is free (not in the record):
    on along the way it was guiding John; of the two points for Sara, the one farther
-   from John's start (free too).
+   from John's start (free too);
+7. the robot's speed (:func:`robot_legs`): how fast Alice's remaining path fell between
+   consecutive rows of 2508.6-2521.1.  She sat still and had not been greeted (her
+   distance to John's destination is the same in every row; her cost is f_stand times
+   approach plus guidance), so her guidance part did not change and each fall is the
+   robot's progress toward her.  The fastest leg is its driving speed, the slower ones hold
+   its stops (guide John's suspension until 2513, starting, turning): as for John's speed
+   (the fastest leg of his walk).
+
+The times come from the record too (:data:`EVENTS`; t = recorded t - :data:`CLOCK`).
 
 :func:`residuals` compares the straight-line distances of the result with every
 recorded row.  ``experiments/inputs/scenarios/paper-2019.toml`` holds the result (shifted
@@ -76,9 +85,54 @@ RECORD_GUIDED: tuple[tuple[float, float, float, float], ...] = (
     (2575.5, 2.267, 5.443, 7.280),
     (2580.6, 2.120, 5.550, 7.340),
 )
+CLOCK = 2507.6
+"""The scenario's t = 0: recorded t - CLOCK puts Alice's request at t = 1.0 (2508.6, her first comparison)."""
 PETER_FROM_ROBOT = 3.636           # 2592.7: exec cost (humanFell: the path to the person)
 SARA_FROM_ROBOT = 1.274            # 2592.7: dac cost
 PETER_SARA = 4.84                  # 2592.7: cc 4.841 and 4.832 (from Sara to Peter and back)
+
+
+
+
+@dataclass(frozen=True)
+class Event:
+    """A moment of Appendix B the scenario takes from the record (``t``: recorded time, s)."""
+
+    what: str
+    t: float
+    why: str
+
+
+EVENTS: tuple[Event, ...] = (
+    Event("Peter falls", 2580.6, "the last comparison of John and Alice alone, John still guided (the last row of "
+          "RECORD_GUIDED); Peter's task executes at the next row, 2592.7"),
+    Event("Sara falls", 2592.7, "her first comparison (with Peter's task executing): she was requested by then"),
+    Event("Peter gets up", 2602.0, "Appendix B: at 2602 Peter fell's agent, waiting, learns that Peter is fine"),
+)
+"""Appendix B's falls, at the recorded rows that bound them (the record has nothing between 2580.6
+and 2592.7; Appendix B's own 2540 and 2570 for Peter contradict its rows, which show John and
+Alice compared, John guided, until 2580.6)."""
+
+
+@dataclass(frozen=True)
+class Leg:
+    """Two consecutive rows of Alice's remaining path (m) while the robot drove toward her."""
+
+    t0: float
+    t1: float
+    path0: float
+    path1: float
+
+    @property
+    def speed(self) -> float:
+        """How fast her remaining path fell (m/s): the robot's progress toward her."""
+        return (self.path0 - self.path1) / (self.t1 - self.t0)
+
+
+def robot_legs() -> tuple[Leg, ...]:
+    """Step 7's legs: Alice's remaining path (:data:`RECORD_WALK`) between consecutive rows."""
+    rows = [(t, sa) for t, _, sa, _ in RECORD_WALK]
+    return tuple(Leg(t0, t1, a, b) for (t0, a), (t1, b) in zip(rows, rows[1:], strict=False))
 
 
 @dataclass(frozen=True)
@@ -94,6 +148,7 @@ class Layout:
     peter: Point
     sara: Point
     fit_rms: float                               # of step 2 (m)
+    robot_speed: float                           # step 7 (m/s)
 
 
 def _circles(c1: np.ndarray, r1: float, c2: np.ndarray, r2: float) -> list[np.ndarray]:
@@ -160,7 +215,7 @@ def _pt(p: np.ndarray) -> Point:
 
 
 def derive() -> Layout:
-    """Steps 1-6 of the module docstring."""
+    """Steps 1-7 of the module docstring."""
     longest = WAITED_FROM_ALICE_DEST + WAITED_TO_OWN_DEST - 1e-6  # the two circles of step 1 still meet
     fit = minimize_scalar(lambda d: float(np.sum(_guided_residuals(d) ** 2)), bounds=(5.0, longest), method="bounded")
     d = float(fit.x)
@@ -198,7 +253,8 @@ def derive() -> Layout:
         sides.append(last + SARA_FROM_ROBOT * np.array([math.cos(a), math.sin(a)]))
     sara = max(sides, key=lambda p: float(np.linalg.norm(p - start)))
     return Layout(_pt(np.zeros(2)), _pt(dest), _pt(alice), _pt(j2), tuple((t, _pt(p)) for t, p in john),
-                  _pt(robot), _pt(peter), _pt(sara), float(math.sqrt(fit.fun / len(RECORD_GUIDED))))
+                  _pt(robot), _pt(peter), _pt(sara), float(math.sqrt(fit.fun / len(RECORD_GUIDED))),
+                  max(leg.speed for leg in robot_legs()))
 
 
 def residuals(layout: Layout) -> list[tuple[float, str, float, float]]:

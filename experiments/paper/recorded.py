@@ -6,7 +6,9 @@ The original verification recorded, at t = 2512.7 and 2521.1, Alg. 2 comparing g
 straight-line distances equal to the ones the record implies (the layout of
 :func:`experiments.paper.reconstruction.derive`); :func:`compare` runs our Alg. 2 on the
 parameters the bundled ``guide_human`` computes there under a cost model, with
-:class:`~planners.examples.StraightLineMotion` as the motion model (0.5 m/s, 1 rad/s).
+:class:`~planners.examples.StraightLineMotion` as the motion model: the record's robot, at the
+speed :func:`experiments.paper.reconstruction.derive` reads off the record (its step 7; the
+world file of ``paper-2019`` drives at it too), turning at ours (1 rad/s: the record shows no turn).
 Under the original model the result must be the recorded one; under ours it says what our
 model makes of the very situation the record describes (``docs/paper.md``).
 """
@@ -63,6 +65,7 @@ def compare(t: float, model: str, hysteresis: float = 1.0) -> dict[str, Any]:
     costs = task.spec.original_costs
     assert costs is not None
     world = geometry(t)
+    motion = StraightLineMotion(speed=rec.derive().robot_speed)
     ctx = {}
     for k, person in enumerate(PERSONS):
         args: dict[str, Any] = {costs.person[1:]: person, (costs.destination or "$")[1:]: f"{person}_destination"}
@@ -70,7 +73,7 @@ def compare(t: float, model: str, hysteresis: float = 1.0) -> dict[str, Any]:
             args[COST_MODEL_ARG] = model
             args.update(zip((f[1:] for f in costs.factors or ()), ORIGINAL_FACTORS[person], strict=True))
         c = TaskContext(agent=person, task_type=task.name, args=task.validate_args(args), request_time=t,
-                        rng=random.Random(k), strategy=Strategy(), world=world, motion=StraightLineMotion())
+                        rng=random.Random(k), strategy=Strategy(), world=world, motion=motion)
         c.suspended = person == "john"  # guide John was suspended (save) when guide Alice took over
         c.now = t
         ctx[person] = c
