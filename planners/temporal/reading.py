@@ -1,0 +1,68 @@
+"""Reading temporal PDDL (2.1) with unified-planning's reader, as PlanSys2 and ROSPlan write it.
+
+A domain is *temporal* when it has a ``(:durative-action`` or declares ``:durative-actions``
+(a ROSPlan domain may declare it and have only instantaneous actions: the engines here plan
+those too).  Such a domain goes to :mod:`planners.temporal`; every other one to the classical
+path, unchanged.
+
+PlanSys2's domain template writes empty blocks — ``(:functions )`` with only a comment
+inside — which UP's reader refuses ("Expected '('").  :func:`tolerant` blanks an empty
+``:functions``, ``:predicates`` or ``:constants`` block out (spaces in place of its characters,
+its newlines kept), so every line and column an error names is still the file's own.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from planners.checks import PddlError, check_depth, check_problem_domain
+
+if TYPE_CHECKING:
+    import unified_planning as up
+
+_COMMENT = re.compile(r";[^\n]*")
+_DURATIVE = re.compile(r"\(\s*:durative-action\b|:durative-actions\b", re.IGNORECASE)
+_EMPTY_BLOCK = re.compile(r"\(\s*:(?:functions|predicates|constants)(?:\s|;[^\n]*)*\)", re.IGNORECASE)
+
+
+def is_temporal(domain_text: str) -> bool:
+    """Whether the domain is PDDL 2.1 temporal: a durative action, or the requirement declared."""
+    return _DURATIVE.search(_COMMENT.sub("", domain_text)) is not None
+
+
+def tolerant(text: str) -> str:
+    """``text`` with PlanSys2's empty blocks blanked out, lines and columns unchanged."""
+    return _EMPTY_BLOCK.sub(lambda m: re.sub(r"[^\n]", " ", m.group(0)), text)
+
+
+def parse(domain_text: str, problem_text: str | None, domain_file: str | Path,
+          problem_file: str | Path = "<problem>") -> up.model.Problem:
+    """UP's model of a temporal domain (and problem); a fault is a :class:`PddlError` naming the
+    file (the domain's when the domain alone is at fault), the line and the column."""
+    from planners.checks import parse_domain
+
+    domain_text = tolerant(domain_text)
+    model = parse_domain(domain_text, domain_file)  # blames the domain for the domain's faults
+    if problem_text is None:
+        return model
+    check_depth(problem_text, problem_file)
+    check_problem_domain(domain_text, problem_text, problem_file)
+    return _parse_problem(domain_text, tolerant(problem_text), problem_file)
+
+
+def _parse_problem(domain_text: str, problem_text: str, problem_file: str | Path) -> up.model.Problem:
+    import pyparsing
+    import unified_planning as up
+    from unified_planning.io import PDDLReader
+
+    from planners.checks import _lenient_names, _located  # one reader's error wording for both paths
+
+    try:
+        with _lenient_names():
+            return PDDLReader().parse_problem_string(domain_text, problem_text)
+    except (pyparsing.ParseBaseException, SyntaxError, up.exceptions.UPException, KeyError, ValueError) as exc:
+        raise _located(problem_file, exc) from None
+    except RecursionError:
+        raise PddlError(problem_file, "nested too deep for the PDDL reader (write it flatter)") from None
