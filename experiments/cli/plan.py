@@ -144,12 +144,16 @@ def _read_arg(path: str, argument: str) -> str:
 
 def plan_command(args: argparse.Namespace) -> int:
     """Solve DOMAIN + PROBLEM; print the plan, its cost and its stages (or JSON)."""
+    from experiments.cli.temporal import plan_temporal
     from planners import cache
     from planners.planner import ENGINE_NAME, PddlText, Planner
     from planners.results import PlanStatus
+    from planners.temporal.reading import is_temporal
 
     domain_text, problem_text = _read_arg(args.domain, "DOMAIN"), _read_arg(args.problem, "PROBLEM")
     extra = _paths(args)
+    if is_temporal(domain_text):  # PDDL 2.1: durative actions (experiments.cli.temporal)
+        return plan_temporal(args, domain_text, problem_text, extra)
     planner = Planner(args.planner, timeout=args.timeout, cache_size=0)
     key = cache.content_key("pddl-problem", [domain_text, problem_text])
     model = None

@@ -12,6 +12,7 @@ with its message: never an exception out of :meth:`TemporalPlanner.solve`.
 from __future__ import annotations
 
 import contextlib
+import gc
 import math
 import tempfile
 import time
@@ -29,7 +30,9 @@ if TYPE_CHECKING:
     import unified_planning as up
 
 MESSAGE_CHARS = 300
-"""An attempt's message keeps the last this many characters of what the engine said."""
+"""An attempt's message keeps the first this many characters of what the engine said."""
+LINE_CHARS = 160
+"""A line of an engine's message longer than this is a debug dump, left out."""
 NO_GOAL = "(no goal)"
 """The ``engine`` of the empty plan of a problem that has no goal: no engine was asked."""
 
@@ -123,6 +126,7 @@ def attempt_engine(name: str, problem: up.model.Problem,
             planner.skip_checks = True  # the engine decides what it handles: a refusal is its attempt
             res = planner.solve(problem, timeout=timeout, output_stream=log) if log is not None \
                 else planner.solve(problem, timeout=timeout)
+            gc.collect()  # a killed engine's pipes are closed here, their ResourceWarning caught above
             said = _said(res, caught, log)
     except Exception as exc:  # noqa: BLE001 - an engine's failure is its attempt's, whatever it is
         said = _tail(f"{type(exc).__name__}: {' '.join(str(exc).split())}" + _log_tail(log))
@@ -141,7 +145,7 @@ def attempt_engine(name: str, problem: up.model.Problem,
         said = "found no plan (not a proof)" + (f": {said}" if said else "")
     elif res.status is UPStatus.MEMOUT:
         said = "out of memory" + (f": {said}" if said else "")
-    elif not said:
+    elif not said and outcome is Outcome.ERROR:
         said = res.status.name.lower()
     return Attempt(name, outcome, _tail(said), wall), None
 
@@ -150,27 +154,43 @@ def _said(res: Any, caught: Sequence[warnings.WarningMessage], log: IO[str] | No
     """What an engine said of a failure: its error log messages, its warnings, its server's output."""
     from unified_planning.engines import LogLevel
 
-    msgs = [" ".join(m.message.split()) for m in (res.log_messages or ()) if m.level is LogLevel.ERROR
-            and m.message.strip()]
-    msgs += [" ".join(str(w.message).split()) for w in caught]
-    return "; ".join(msgs) + _log_tail(log)
+    msgs = [_summary(m.message) for m in (res.log_messages or ()) if m.level is LogLevel.ERROR and m.message.strip()]
+    msgs += [_summary(str(w.message)) for w in caught if not _noise(w)]
+    return "; ".join(m for m in msgs if m) + _log_tail(log)
+
+
+def _noise(w: warnings.WarningMessage) -> bool:
+    """Warnings that say nothing about the problem: unclosed pipes of a killed engine, and UP's
+    "cannot establish whether ENGINE can solve this problem" (checks are the engine's, here)."""
+    return issubclass(w.category, ResourceWarning) or "cannot establish whether" in str(w.message)
+
+
+def _summary(text: str) -> str:
+    """An engine's message without its debug dumps (Aries prints whole protobuf messages): the
+    lines of at most :data:`LINE_CHARS` characters, joined."""
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    short = [ln for ln in lines if len(ln) <= LINE_CHARS]
+    return " / ".join(short) if short else (lines[0][:LINE_CHARS] + "..." if lines else "")
 
 
 def _log_tail(log: IO[str] | None) -> str:
+    """A panic or an error in an engine server's output (Aries'), if any."""
     if log is None or log.closed:
         return ""
     try:
         log.flush()
         log.seek(0)
-        lines = [ln for ln in log.read().splitlines() if "panic" in ln or "rror" in ln]
+        text = log.read()
     except (OSError, ValueError):
         return ""
-    return ("; " + " ".join(lines[-3:])) if lines else ""
+    lines = [ln for ln in text.splitlines() if "panic" in ln or "rror" in ln]
+    return ("; " + _summary("\n".join(lines[-3:]))) if lines else ""
 
 
 def _tail(text: str) -> str:
+    """At most :data:`MESSAGE_CHARS` characters of a message, its beginning (where engines say what)."""
     text = text.strip("; ")
-    return text if len(text) <= MESSAGE_CHARS else "..." + text[-MESSAGE_CHARS:]
+    return text if len(text) <= MESSAGE_CHARS else text[:MESSAGE_CHARS] + "..."
 
 
 def validate(problem: up.model.Problem, plan: up.plans.Plan) -> str | None:
