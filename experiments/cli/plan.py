@@ -253,7 +253,7 @@ def new_command(args: argparse.Namespace) -> int:
     folder = Path(args.dir if args.dir else args.task)
     existed = folder.exists()
     try:
-        files = scaffold(args.task, folder)
+        files = scaffold(args.task, folder, temporal=getattr(args, "temporal", False))
     except BaseException:
         if not existed and folder.is_dir():
             shutil.rmtree(folder)  # leave nothing half-written behind
@@ -326,4 +326,6 @@ def register(subparsers: Any) -> None:
                "  tasker new fetch_cup ~/my_tasks/fetch_cup && tasker check ~/my_tasks/fetch_cup")
     n.add_argument("task", metavar="TASK", help="the task type's name (a lower-case identifier)")
     n.add_argument("dir", metavar="DIR", nargs="?", default=None, help="folder to create (default: ./TASK)")
+    n.add_argument("--temporal", action="store_true",
+                   help="a PDDL 2.1 domain with durative actions (planned by LPG, Aries, Kairos; docs/planners.md)")
     n.set_defaults(func=new_command)

@@ -17,7 +17,7 @@ import math
 import tempfile
 import time
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from fractions import Fraction
 from typing import IO, TYPE_CHECKING, Any
 
@@ -74,8 +74,12 @@ class TemporalPlanner:
         """``lpg,aries,kairos``: the engines, in the order they are tried."""
         return ",".join(self.engines)
 
-    def solve(self, problem: up.model.Problem, timeout: float | None = None) -> TemporalResult:
-        """The first valid plan of the engines, in order, within ``timeout`` seconds (the default if None)."""
+    def solve(self, problem: up.model.Problem, timeout: float | None = None,
+              accept: Callable[[tuple[TimedStep, ...]], str | None] | None = None) -> TemporalResult:
+        """The first valid plan of the engines, in order, within ``timeout`` seconds (the default if None).
+
+        ``accept``, if given, may refuse a valid plan (it returns why, or None to take it): the
+        attempt is then ``refused`` with that reason, and the next engine is tried."""
         budget = self.timeout if timeout is None else timeout
         start = time.perf_counter()
         if not problem.goals and not getattr(problem, "timed_goals", None):
@@ -88,6 +92,9 @@ class TemporalPlanner:
                 break
             share = None if left is None else left / (len(self.engines) - k)
             attempt, plan = attempt_engine(name, problem, share)
+            why = accept(plan) if plan is not None and accept is not None else None
+            if why is not None:
+                attempt, plan = Attempt(name, Outcome.REFUSED, _tail(why), attempt.wall_time_s), None
             attempts.append(attempt)
             if plan is not None:
                 attempts += [Attempt(n, Outcome.SKIPPED, f"{name}'s plan was used") for n in self.engines[k + 1:]]

@@ -23,6 +23,7 @@ class Outcome(StrEnum):
 
     VALID = "valid"              # a plan, accepted by UP's validator
     INVALID = "invalid"          # a plan UP's validator refused: not used, the next engine tried
+    REFUSED = "refused"          # a valid plan the caller cannot use (the one robot doing two things at once)
     UNSOLVABLE = "unsolvable"    # the engine proved (or believes) no plan exists
     TIMEOUT = "timeout"          # its share of the time budget ran out
     UNSUPPORTED = "unsupported"  # the problem has a feature the engine does not handle
