@@ -59,7 +59,7 @@ class EngineSpec:
 
 
 ENGINES: Mapping[str, EngineSpec] = MappingProxyType({s.name: s for s in (
-    EngineSpec("lpg", "up-lpg", "up_lpg", "LPG-td's licence, as shipped by up-lpg (no SPDX identifier)",
+    EngineSpec("lpg", "up-lpg", "up_lpg", "up-lpg: Apache-2.0; the LPG-td binary it ships: LPG's own terms",
                "tasker-lpg", ("planners.temporal.lpg", "TaskerLPG")),
     EngineSpec("aries", "up-aries", "up_aries", "MIT", "aries", None,
                env=MappingProxyType({"ARIES_PLANNING_PREPRO_STATE_VARS": "false",

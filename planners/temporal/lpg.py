@@ -26,6 +26,7 @@ from typing import Any
 
 _LINE = re.compile(r"^\s*(\d+(?:\.\d*)?)\s*:\s*\(\s*([^()]+?)\s*\)\s*(?:\[\s*(\d+(?:\.\d*)?)\s*\])?\s*\)?\s*(;.*)?$")
 DEFAULT_SEED = 1
+_ABSENT = object()
 
 
 @contextlib.contextmanager
@@ -37,11 +38,15 @@ def _pkg_resources_stand_in() -> Iterator[None]:
         return
     except ImportError:
         pass
+    before = sys.modules.get("pkg_resources", _ABSENT)  # None: an import refused on purpose; keep that
     sys.modules["pkg_resources"] = types.ModuleType("pkg_resources", "stand-in for up_lpg's import (planners.temporal)")
     try:
         yield
     finally:
-        sys.modules.pop("pkg_resources", None)
+        if before is _ABSENT:
+            sys.modules.pop("pkg_resources", None)
+        else:
+            sys.modules["pkg_resources"] = before  # type: ignore[assignment]
 
 
 def importable() -> bool:
@@ -90,7 +95,8 @@ def _make_class() -> type:
 
 
 def read_plan(problem: Any, text: str, get_item_named: Callable[[str], Any]) -> Any:
-    """LPG-td's plan text as a UP plan (time-triggered for a temporal problem)."""
+    """LPG-td's plan text as a UP plan (time-triggered for a temporal problem); None for its
+    ``no solution`` (the engine then reports the problem unsolved, as up_lpg does)."""
     import unified_planning as up
     from unified_planning.exceptions import UPException
 
@@ -101,6 +107,8 @@ def read_plan(problem: Any, text: str, get_item_named: Callable[[str], Any]) -> 
     for n, line in enumerate(text.splitlines(), start=1):
         if not line.strip() or line.lstrip().startswith(";"):
             continue
+        if line.strip().lower() == "no solution":
+            return None
         m = _LINE.match(line)
         if m is None:
             raise UPException(f"LPG's plan, line {n}: not a plan step: {line.strip()!r}")

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from planners.checks import PddlError, check_depth, check_problem_domain
+from tasker.errors import TaskerError
 
 if TYPE_CHECKING:
     import unified_planning as up
@@ -44,12 +45,25 @@ def parse(domain_text: str, problem_text: str | None, domain_file: str | Path,
     from planners.checks import parse_domain
 
     domain_text = tolerant(domain_text)
-    model = parse_domain(domain_text, domain_file)  # blames the domain for the domain's faults
+    try:
+        model = parse_domain(domain_text, domain_file)  # blames the domain for the domain's faults
+    except TaskerError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - the reader's own failure (an assertion) on this input
+        raise _failed(domain_file, exc) from None
     if problem_text is None:
         return model
     check_depth(problem_text, problem_file)
     check_problem_domain(domain_text, problem_text, problem_file)
     return _parse_problem(domain_text, tolerant(problem_text), problem_file)
+
+
+def _failed(file: str | Path, exc: BaseException) -> PddlError:
+    """A failure of UP's reader that is none of its syntax or semantic errors (an ``assert`` inside
+    it, e.g. on a contingent problem): bad input it cannot read, said as such."""
+    said = " ".join(str(exc).split())
+    return PddlError(file, f"unified-planning's PDDL reader cannot read it ({type(exc).__name__}"
+                           f"{': ' + said if said else ''}); is it PDDL 2.1 (durative actions, no contingency)?")
 
 
 def _parse_problem(domain_text: str, problem_text: str, problem_file: str | Path) -> up.model.Problem:
@@ -66,3 +80,5 @@ def _parse_problem(domain_text: str, problem_text: str, problem_file: str | Path
         raise _located(problem_file, exc) from None
     except RecursionError:
         raise PddlError(problem_file, "nested too deep for the PDDL reader (write it flatter)") from None
+    except Exception as exc:  # noqa: BLE001 - the reader's own failure (an assertion) on this input
+        raise _failed(problem_file, exc) from None

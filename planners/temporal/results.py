@@ -78,9 +78,6 @@ class Attempt:
         return f"{self.engine}: {self.outcome.value}" + (f" ({self.message})" if self.message else "")
 
 
-_STATUS = {Outcome.UNSOLVABLE: PlanStatus.UNSOLVABLE, Outcome.TIMEOUT: PlanStatus.TIMEOUT}
-
-
 @dataclass(frozen=True, slots=True)
 class TemporalResult:
     """The outcome of a temporal planner call.
@@ -146,13 +143,6 @@ class TemporalResult:
         out["attempts"] = [{"engine": a.engine, "outcome": a.outcome.value, "message": a.message,
                             "time_s": round(a.wall_time_s, 6)} for a in self.attempts]
         return out
-
-
-def status_of(outcome: Outcome) -> PlanStatus:
-    """The status of a call whose last informative attempt ended so (``VALID`` is SOLVED)."""
-    if outcome is Outcome.VALID:
-        return PlanStatus.SOLVED
-    return _STATUS.get(outcome, PlanStatus.ERROR)
 
 
 def _order(s: TimedStep) -> tuple[Fraction, Fraction]:
