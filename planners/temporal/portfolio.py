@@ -103,9 +103,12 @@ class TemporalPlanner:
 
 
 def _failed_status(attempts: Sequence[Attempt]) -> PlanStatus:
-    """No valid plan: unsolvable if an engine said so and none failed otherwise than by time;
-    a time-out if one ran out of time; else an error (every engine failed or refused)."""
+    """No plan to use: an error if a valid plan was refused (the problem is solvable: the refusal is
+    the news); unsolvable if an engine said so; a time-out if one ran out of time; else an error
+    (every engine failed, or gave invalid plans)."""
     outcomes = {a.outcome for a in attempts}
+    if Outcome.REFUSED in outcomes:
+        return PlanStatus.ERROR
     if Outcome.UNSOLVABLE in outcomes:
         return PlanStatus.UNSOLVABLE
     if Outcome.TIMEOUT in outcomes or Outcome.SKIPPED in outcomes:
