@@ -13,6 +13,7 @@ from planners.temporal.reading import parse
 from tests.planners.temporal.conftest import pair
 
 
+@pytest.mark.slow
 def test_plan_json_is_a_validated_timed_plan(capsys: pytest.CaptureFixture[str]) -> None:
     d, p = pair("plansys2_simple")
     assert main(["plan", str(d), str(p), "--json", "--timeout", "30"]) == 0
@@ -63,6 +64,7 @@ def test_unsolvable_is_exit_1(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     assert json.loads(capsys.readouterr().out)["status"] in ("unsolvable", "timeout")
 
 
+@pytest.mark.slow
 def test_new_temporal_writes_a_durative_folder_that_plans(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     folder = tmp_path / "fetch_t"
     assert main(["new", "fetch_t", str(folder), "--temporal", "--quiet"]) == 0

@@ -55,6 +55,7 @@ def test_overlap_names_the_file_the_actions_and_the_times() -> None:
     assert overlap((a, TimedStep(F(3), "note", (), F(0))), "d") is None  # an instant takes no time
 
 
+@pytest.mark.slow
 def test_a_plan_that_needs_two_things_at_once_is_refused() -> None:
     d, p = pair("tasker_concurrency")
     result = FolderPlanner(d, timeout=30).solve(PddlText(d.read_text(), p.read_text()))
@@ -62,6 +63,7 @@ def test_a_plan_that_needs_two_things_at_once_is_refused() -> None:
     assert "two things at once" in result.message and str(d) in result.message
 
 
+@pytest.mark.slow
 def test_folder_planner_gives_steps_in_start_order_and_caches() -> None:
     d, p = pair("plansys2_simple")
     planner = FolderPlanner(d, timeout=30)
@@ -82,6 +84,7 @@ def test_an_expression_duration_needs_travel_or_duration(tmp_path: Path) -> None
         load_task(folder, use_cache=False)
 
 
+@pytest.mark.slow
 def test_the_bundled_plansys2_example_plans_its_stages() -> None:
     from planners.examples import StraightLineMotion, example_context
 
@@ -94,6 +97,7 @@ def test_the_bundled_plansys2_example_plans_its_stages() -> None:
     assert plan.stages[1].duration == 5.0  # the domain's :duration, no skill measures it
 
 
+@pytest.mark.slow
 def test_tasker_new_temporal_loads_and_plans(tmp_path: Path) -> None:
     files = scaffold("fetch_t", tmp_path / "fetch_t", temporal=True)
     assert "(:durative-action navigate" in (tmp_path / "fetch_t" / "domain.pddl").read_text()

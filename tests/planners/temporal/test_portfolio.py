@@ -21,6 +21,7 @@ def _problem(name: str = "plansys2_simple"):  # type: ignore[no-untyped-def]
     return parse(d.read_text(), p.read_text(), d, p)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("engine", engines.DEFAULT_ORDER)
 def test_each_shipped_engine_plans_plansys2s_simple_example(engine: str) -> None:
     problem = _problem()
@@ -31,6 +32,7 @@ def test_each_shipped_engine_plans_plansys2s_simple_example(engine: str) -> None
     assert Fraction(30) <= max(s.end for s in plan) < Fraction(31)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("engine", engines.DEFAULT_ORDER)
 def test_an_engine_gives_the_same_plan_twice(engine: str) -> None:
     problem = _problem("plansys2_talk")
@@ -38,12 +40,14 @@ def test_an_engine_gives_the_same_plan_twice(engine: str) -> None:
     assert first[0].outcome is Outcome.VALID and first[1] == second[1]
 
 
+@pytest.mark.slow
 def test_the_first_valid_plan_is_used_and_the_rest_skipped() -> None:
     result = TemporalPlanner(["lpg", "kairos"]).solve(_problem(), 30)
     assert result.solved and result.engine == "lpg"
     assert [(a.engine, a.outcome) for a in result.attempts] == [("lpg", Outcome.VALID), ("kairos", Outcome.SKIPPED)]
 
 
+@pytest.mark.slow
 def test_an_invalid_plan_is_refused_with_its_engine_and_the_next_is_asked(monkeypatch: pytest.MonkeyPatch) -> None:
     real = portfolio.validate
     calls: list[int] = []
@@ -58,6 +62,7 @@ def test_an_invalid_plan_is_refused_with_its_engine_and_the_next_is_asked(monkey
     assert result.attempts[0].outcome is Outcome.INVALID and "inapplicable action" in result.attempts[0].message
 
 
+@pytest.mark.slow
 def test_an_engine_that_raises_is_an_error_attempt(monkeypatch: pytest.MonkeyPatch) -> None:
     real = engines.register
 
@@ -75,6 +80,7 @@ def test_an_engine_that_raises_is_an_error_attempt(monkeypatch: pytest.MonkeyPat
     assert alone.status is PlanStatus.ERROR and alone.plan is None and "lpg: error (RuntimeError" in alone.message
 
 
+@pytest.mark.slow
 def test_accept_may_refuse_a_valid_plan() -> None:
     result = TemporalPlanner(["lpg", "kairos"]).solve(_problem(), 30, accept=lambda plan: "not today")
     assert result.status is PlanStatus.ERROR

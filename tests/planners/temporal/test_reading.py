@@ -28,6 +28,7 @@ def test_empty_blocks_are_blanked_with_lines_and_columns_kept() -> None:
     assert out.index("(:predicates") == text.index("(:predicates")
 
 
+@pytest.mark.slow
 def test_plansys2_simple_example_reads(simple: tuple[Path, Path]) -> None:
     d, p = simple
     assert "(:functions" in d.read_text()  # the empty block UP's reader refuses as written
