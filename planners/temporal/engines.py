@@ -72,7 +72,7 @@ ENGINES: Mapping[str, EngineSpec] = MappingProxyType({s.name: s for s in (
 )})
 """Every temporal engine tasker knows, by name."""
 
-DEFAULT_ORDER: tuple[str, ...] = ("lpg", "aries", "kairos")
+DEFAULT_ORDER: tuple[str, ...] = ("kairos", "lpg", "aries")
 """The engines tried, in order, when none is named (``tamer`` only when named: its licence)."""
 
 _env_lock = threading.Lock()

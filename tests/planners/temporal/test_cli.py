@@ -18,7 +18,7 @@ def test_plan_json_is_a_validated_timed_plan(capsys: pytest.CaptureFixture[str])
     d, p = pair("plansys2_simple")
     assert main(["plan", str(d), str(p), "--json", "--timeout", "30"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert out["status"] == "solved" and out["planner"] == "lpg" and out["attempts"][0]["outcome"] == "valid"
+    assert out["status"] == "solved" and out["planner"] == "kairos" and out["attempts"][0]["outcome"] == "valid"
     assert [s["action"] for s in out["timed_plan"]] == [s[0] for s in out["plan"]]
     assert out["makespan"] == out["cost"] and 30 <= out["makespan"] < 31
 

@@ -103,7 +103,7 @@ def test_tasker_new_temporal_loads_and_plans(tmp_path: Path) -> None:
     assert "(:durative-action navigate" in (tmp_path / "fetch_t" / "domain.pddl").read_text()
     assert {f.name for f in files} == {"domain.pddl", "task.toml", "scenario.toml", "problem.pddl"}
     task = load_task(tmp_path / "fetch_t")
-    assert isinstance(task.domain, TemporalDomainModel) and task.planner.name == "lpg,aries,kairos"
+    assert isinstance(task.domain, TemporalDomainModel) and task.planner.name == "kairos,lpg,aries"
 
 
 @pytest.mark.slow
