@@ -55,7 +55,49 @@ def parse(domain_text: str, problem_text: str | None, domain_file: str | Path,
         return model
     check_depth(problem_text, problem_file)
     check_problem_domain(domain_text, problem_text, problem_file)
-    return _parse_problem(domain_text, tolerant(problem_text), problem_file)
+    problem_text = tolerant(problem_text)
+    constants = {o.name.lower(): o.type.name for o in model.all_objects}
+    if constants:  # PlanSys2's problems may declare a domain constant again (POPF accepts it; UP does not)
+        problem_text = without_constants(problem_text, constants)
+    return _parse_problem(domain_text, problem_text, problem_file)
+
+
+def without_constants(problem_text: str, constants: dict[str, str]) -> str:
+    """``problem_text`` with the ``:objects`` entries that declare a domain constant again, with
+    its own type, blanked out (spaces; lines and columns kept).  Another type stays, for UP's
+    reader to refuse."""
+    code = _COMMENT.sub(lambda c: " " * len(c.group(0)), problem_text)  # positions kept
+    m = re.search(r"\(\s*:objects\b", code, re.IGNORECASE)
+    if m is None:
+        return problem_text
+    depth, end = 0, None
+    for i in range(m.start(), len(code)):
+        if code[i] == "(":
+            depth += 1
+        elif code[i] == ")":
+            depth -= 1
+            if depth == 0:
+                end = i
+                break
+    if end is None:
+        return problem_text
+    tokens = [(t.group(0).lower(), t.start(), t.end()) for t in re.finditer(r"[^\s()]+", code[:end])
+              if t.start() >= m.end()]
+    out = list(problem_text)
+    group: list[tuple[str, int, int]] = []
+    k = 0
+    while k < len(tokens):
+        if tokens[k][0] == "-" and k + 1 < len(tokens):
+            typ = tokens[k + 1]
+            again = [t for t in group if constants.get(t[0]) == typ[0]]
+            spans = again + ([tokens[k], typ] if again and len(again) == len(group) else [])
+            for _, a, b in spans:
+                out[a:b] = " " * (b - a)
+            group, k = [], k + 2
+            continue
+        group.append(tokens[k])
+        k += 1
+    return "".join(out)
 
 
 def _failed(file: str | Path, exc: BaseException) -> PddlError:

@@ -63,3 +63,19 @@ def test_a_reader_crash_is_bad_input_not_a_bug(monkeypatch: pytest.MonkeyPatch) 
     monkeypatch.setattr(PDDLReader, "parse_problem_string", boom)
     with pytest.raises(PddlError, match="reader cannot read it"):
         parse(d.read_text(), p.read_text(), d, p)
+
+
+def test_a_domain_constant_declared_again_as_an_object_is_read() -> None:
+    from planners.temporal.reading import without_constants
+
+    text = "(define (problem p)\n (:objects\n  leia - robot ; the (robot)\n  jack m1 - person\n  kitchen - room)\n)"
+    out = without_constants(text, {"leia": "robot", "jack": "person", "kitchen": "place"})
+    assert len(out) == len(text) and out.count("\n") == text.count("\n")
+    assert "leia" not in out and "- robot" not in out.split(";")[0]  # the whole entry: name, dash, type
+    assert " m1 - person" in out and "jack" not in out  # jack gone, its group's other name kept
+    assert "kitchen - room" in out  # a constant of another type stays, for the reader to refuse
+    d, p = pair("plansys2_simple")
+    domain = d.read_text().replace(");; end Types", ")\n(:constants leia - robot)", 1)
+    assert "(:constants leia - robot)" in domain and "leia - robot" in p.read_text()
+    problem = parse(domain, p.read_text(), d, p)
+    assert [o.name for o in problem.all_objects].count("leia") == 1
