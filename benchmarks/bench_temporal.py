@@ -66,6 +66,22 @@ print(json.dumps(out))
 """
 
 
+_FIRSTS = r"""
+import json, sys
+sys.path.insert(0, sys.argv[1])
+from planners.temporal.reading import parse
+from planners.temporal.portfolio import attempt_engine
+d, p, names, budget = sys.argv[2], sys.argv[3], sys.argv[4].split(","), float(sys.argv[5])
+try:
+    problem = parse(open(d).read(), open(p).read(), d, p)
+except Exception:
+    print(json.dumps({}))
+    raise SystemExit(0)
+print(json.dumps({n: attempt_engine(n, problem, budget)[0].outcome.value for n in names}))
+"""
+"""One process, one pair, each engine alone (its first plan): the outcome per engine ({} if unread)."""
+
+
 def _run(argv: list[str], cwd: Path | None = None, timeout: float = 600) -> tuple[int, str, float]:
     """Exit status, standard output and CPU seconds (the process and what it reaped) of a command."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -177,13 +193,12 @@ def corpus(root: Path, budget: float) -> int:
     print(f"{'pair':60s} " + " ".join(f"{n:>12s}" for n in names) + f" {'tasker plan':>22s}")
     for folder in pairs:
         d, p = folder / "domain.pddl", folder / "problem.pddl"
-        cells = []
-        for name in names:
-            code, out, _ = _run([sys.executable, "-c", _CHILD, str(ROOT), str(d), str(p), name, str(budget), "first"],
-                                timeout=budget * 3 + 60)
-            outcome = json.loads(out)["first"]["outcome"] if code == 0 and out.strip() else "unread"
+        code, out, _ = _run([sys.executable, "-c", _FIRSTS, str(ROOT), str(d), str(p), ",".join(names), str(budget)],
+                            timeout=budget * len(names) + 120)
+        firsts = json.loads(out) if code == 0 and out.strip() else {}
+        cells = [firsts.get(name, "unread") for name in names]
+        for name, outcome in zip(names, cells, strict=True):
             valid[name] += outcome == "valid"
-            cells.append(outcome)
         argv = [sys.executable, "-m", "experiments.cli", "plan", str(d), str(p), "--json", "--timeout",
                 str(budget * 3)]
         code, out, _ = _run(argv, timeout=budget * 3 + 120)
