@@ -118,7 +118,19 @@ def _failed_status(attempts: Sequence[Attempt]) -> PlanStatus:
 
 def attempt_engine(name: str, problem: up.model.Problem,
                    timeout: float | None) -> tuple[Attempt, tuple[TimedStep, ...] | None]:
-    """One engine on ``problem``: its attempt, and its plan when UP's validator accepts it."""
+    """One engine on ``problem``: its attempt, and its plan when UP's validator accepts it.
+    Nothing it does raises: an exception anywhere (the engine, its result, its plan's times)
+    is an ``error`` attempt with the exception's message."""
+    start = time.perf_counter()
+    try:
+        return _attempt(name, problem, timeout)
+    except Exception as exc:  # noqa: BLE001 - e.g. a plan with a negative time: the engine's fault, said
+        said = _tail(f"{type(exc).__name__}: {' '.join(str(exc).split())}")
+        return Attempt(name, Outcome.ERROR, said, time.perf_counter() - start), None
+
+
+def _attempt(name: str, problem: up.model.Problem,
+             timeout: float | None) -> tuple[Attempt, tuple[TimedStep, ...] | None]:
     from unified_planning.engines import PlanGenerationResultStatus as UPStatus
     from unified_planning.shortcuts import OneshotPlanner
 

@@ -119,3 +119,12 @@ def test_unknown_and_missing_engines(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(engines, "installed", lambda name: False)
     with pytest.raises(EngineNotInstalled, match="no temporal engine"):
         TemporalPlanner()
+
+
+def test_a_plan_the_engine_got_wrong_is_its_error_not_an_exception(monkeypatch: pytest.MonkeyPatch) -> None:
+    def negative(plan: object) -> None:
+        raise ValueError("TimedStep move: start must be >= 0, got -1")
+
+    monkeypatch.setattr(portfolio, "timed_steps", negative)
+    attempt, plan = attempt_engine("kairos", _problem(), 30)
+    assert plan is None and attempt.outcome is Outcome.ERROR and "start must be >= 0" in attempt.message
