@@ -349,6 +349,7 @@ def load_task(folder: str | Path, *, use_cache: bool = True) -> PddlTaskType:
     _cross_check(spec, dm)
     _check_suspension(spec, dm)
     bindings = _check_meaning(spec, dm)
+    # a temporal folder's FolderPlanner has Planner's interface (name, solve) but is not one: hence the ignore
     task = PddlTaskType(spec, dm, hooks=_load_hooks(spec), planner=planner_for(spec, dm))  # type: ignore[arg-type]
     task.meaning = meaning_of(spec, bindings)
     task.priority = spec.priority
