@@ -54,7 +54,9 @@ if name in ("kairos", "aries") and sys.argv[6:] != ["first"]:
             AnytimePlanner(name=engines.register(name), params=params) as planner:
         warnings.simplefilter("ignore")
         planner.skip_checks = True
-        for res in planner.get_solutions(problem, timeout=budget):
+        import tempfile
+        log = tempfile.TemporaryFile("w+")  # Aries' server output: else it leaves /tmp/aries-PORT.* behind
+        for res in planner.get_solutions(problem, timeout=budget, output_stream=log):
             if res.plan is not None and validate(problem, res.plan) is None:
                 steps = timed_steps(res.plan)
                 m = float(max((x.end for x in steps), default=0))
