@@ -153,7 +153,8 @@ def plan_command(args: argparse.Namespace) -> int:
     domain_text, problem_text = _read_arg(args.domain, "DOMAIN"), _read_arg(args.problem, "PROBLEM")
     extra = _paths(args)
     if is_temporal(domain_text):  # PDDL 2.1: durative actions (experiments.cli.temporal)
-        return plan_temporal(args, domain_text, problem_text, extra)
+        return plan_temporal(args, domain_text, problem_text,
+                             lambda r: _stages_for(domain_text, r, extra, Path(args.domain).parent))
     planner = Planner(args.planner, timeout=args.timeout, cache_size=0)
     key = cache.content_key("pddl-problem", [domain_text, problem_text])
     model = None

@@ -12,9 +12,14 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from experiments.cli.args import EXIT_FAILED, EXIT_OK, UsageError
+
+if TYPE_CHECKING:
+    from planners.results import PlanResult
+    from tasker.stage import Stage
 
 
 def engines_of(option: str, default: str) -> list[str] | None:
@@ -32,9 +37,10 @@ def engines_of(option: str, default: str) -> list[str] | None:
     return names
 
 
-def plan_temporal(args: argparse.Namespace, domain_text: str, problem_text: str, extra: list[str]) -> int:
-    """Solve a temporal DOMAIN + PROBLEM; print the timed plan (or JSON) and, for a task folder's domain, its stages."""
-    from experiments.cli.plan import _stages_for
+def plan_temporal(args: argparse.Namespace, domain_text: str, problem_text: str,
+                  stages_of: Callable[[PlanResult], tuple[Stage, ...] | str]) -> int:
+    """Solve a temporal DOMAIN + PROBLEM; print the timed plan (or JSON) and, for a task folder's domain,
+    its stages (``stages_of``: ``tasker plan``'s own, the stages or why there are none)."""
     from planners.planner import DEFAULT_PLANNER
     from planners.temporal.portfolio import TemporalPlanner
     from planners.temporal.reading import parse
@@ -52,7 +58,7 @@ def plan_temporal(args: argparse.Namespace, domain_text: str, problem_text: str,
             print(f"  {k:3d}. {step}")
         if not getattr(args, "quiet", False):
             print("engines: " + result.message)
-            stages = _stages_for(domain_text, result.to_plan_result(), extra, Path(args.domain).parent)
+            stages = stages_of(result.to_plan_result())
             if isinstance(stages, str):
                 print(f"stages: none shown: {stages}")
             else:
