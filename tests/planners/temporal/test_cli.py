@@ -74,3 +74,17 @@ def test_new_temporal_writes_a_durative_folder_that_plans(tmp_path: Path, capsys
     assert main(["plan", str(d), str(p)]) == 0
     out = capsys.readouterr().out
     assert "pick(robot, vase, kitchen) [blocking, skill=manipulate, 5 s]" in out
+
+
+def test_a_domain_that_declares_durative_actions_but_has_none_is_planned(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """As ROSPlan's domains may: every action instantaneous, :durative-actions in the header (refused before)."""
+    from tests.planners.conftest import DOMAIN, problem_text
+
+    d, p = tmp_path / "domain.pddl", tmp_path / "problem.pddl"
+    d.write_text(DOMAIN.replace(":action-costs", ":action-costs :durative-actions"))
+    p.write_text(problem_text())
+    assert main(["plan", str(d), str(p), "--json", "--timeout", "30"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["status"] == "solved" and out["plan"][-1] == ["drop", "cup", "c"]
+    assert all(s["duration"] == 0 for s in out["timed_plan"])  # instantaneous actions take no time
