@@ -90,7 +90,12 @@ def up_solver(name: str, problem: object) -> Callable[[], float | None]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5, help="solves per problem and planner (median)")
+    ap.add_argument("--temporal", action="store_true", help="only the temporal engines (benchmarks/bench_temporal.py)")
     args = ap.parse_args(argv)
+    if args.temporal:  # time to first and best plan per temporal engine, against the commit before them
+        import bench_temporal
+
+        return bench_temporal.main([])
     ours = Planner(cache_size=0)
     ratios: list[float] = []
     mismatches = 0

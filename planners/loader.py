@@ -27,11 +27,12 @@ from pathlib import Path
 from typing import Any
 
 from planners import cache, examplecheck
-from planners.checks import DefinitionError, load_domain, load_problem_text, remembered_domain
+from planners.checks import DefinitionError, remembered_domain
 from planners.pddl_task import PddlTaskType, hook_line
 from planners.problem import DomainModel
 from planners.results import PlanStatus
 from planners.taskspec import TaskSpec, meaning_of, read_task_toml
+from planners.temporal.folder import domain_model, load_domain, load_problem_text, planner_for
 from tasker.errors import BadRequest
 from tasker.meaning import Binding
 from tasker.support import reader
@@ -344,11 +345,12 @@ def load_task(folder: str | Path, *, use_cache: bool = True) -> PddlTaskType:
     remembered = cache.remembered("task-folder", key) if use_cache else None
     # a remembered folder skips unified-planning's reading of the domain (and its import, ~1 s);
     # the DomainModel is read the same way either way (planners.schema), so answers do not depend on it
-    dm = DomainModel(remembered_domain(spec.domain_file) if remembered is not None else load_domain(spec.domain_file))
+    dm = domain_model(remembered_domain(spec.domain_file) if remembered is not None else load_domain(spec.domain_file))
     _cross_check(spec, dm)
     _check_suspension(spec, dm)
     bindings = _check_meaning(spec, dm)
-    task = PddlTaskType(spec, dm, hooks=_load_hooks(spec))
+    # a temporal folder's FolderPlanner has Planner's interface (name, solve) but is not one: hence the ignore
+    task = PddlTaskType(spec, dm, hooks=_load_hooks(spec), planner=planner_for(spec, dm))  # type: ignore[arg-type]
     task.meaning = meaning_of(spec, bindings)
     task.priority = spec.priority
     if remembered is not None:  # what the checks found doubtful then is as true now: said again

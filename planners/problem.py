@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from planners.checks import CheckedDomain, PddlError
-from planners.schema import SchemaError, read_schema
+from planners.schema import DomainSchema, SchemaError, read_schema
 from tasker.world import Fact, MotionModel, Pose, WorldState
 
 PLACE_TYPE = "place"
@@ -38,10 +38,7 @@ class DomainModel:
     """
 
     def __init__(self, domain: CheckedDomain) -> None:
-        try:
-            schema = read_schema(domain.text)
-        except SchemaError as exc:
-            raise PddlError(domain.path, f"Fast Downward's parser refuses the domain: {exc}") from None
+        schema = self._schema(domain)
         self.checked = domain
         self.name = schema.name
         self.types: dict[str, set[str]] = {name: set(chain) for name, chain in schema.types}
@@ -52,6 +49,15 @@ class DomainModel:
         # render_problem's answers by everything they are made of (a pure function of these)
         self.rendered: OrderedDict[tuple[Any, ...], tuple[str, frozenset[Fact]]] = OrderedDict()
         self.rendered_lock = threading.Lock()
+
+    @staticmethod
+    def _schema(domain: CheckedDomain) -> DomainSchema:
+        """The domain's schema, read by Fast Downward's parser (a temporal domain's subclass,
+        :class:`planners.temporal.folder.TemporalDomainModel`, reads it from UP's model)."""
+        try:
+            return read_schema(domain.text)
+        except SchemaError as exc:
+            raise PddlError(domain.path, f"Fast Downward's parser refuses the domain: {exc}") from None
 
     def has_type(self, obj_type: str, wanted: str) -> bool:
         return wanted == "" or wanted in self.types.get(obj_type, ())

@@ -9,13 +9,16 @@ from tasker.errors import UsageError
 
 TEMPLATE = Path(__file__).resolve().parent / "template"
 """The template task folder (``__TASK__`` and ``__DIR__`` are replaced)."""
+TEMPORAL_TEMPLATE = Path(__file__).resolve().parent / "template_temporal"
+"""What ``tasker new --temporal`` takes instead of the template's files: a PDDL 2.1 ``domain.pddl``."""
 
 
-def scaffold(name: str, folder: Path) -> list[Path]:
+def scaffold(name: str, folder: Path, temporal: bool = False) -> list[Path]:
     """Write a task folder for ``name`` from :data:`TEMPLATE` into ``folder``; return the files.
 
-    Besides the template's files it writes ``problem.pddl``, the ``[example]``'s problem,
-    for ``tasker plan``.  The folder must not exist or be empty."""
+    ``temporal``: its ``domain.pddl`` is :data:`TEMPORAL_TEMPLATE`'s, with durative actions
+    (:mod:`planners.temporal`).  Besides the template's files it writes ``problem.pddl``, the
+    ``[example]``'s problem, for ``tasker plan``.  The folder must not exist or be empty."""
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
         raise UsageError("TASK", f"expected a lower-case identifier such as fetch_cup, got {name!r}")
     taken = bundled_names()
@@ -32,6 +35,8 @@ def scaffold(name: str, folder: Path) -> list[Path]:
     for src in sorted(TEMPLATE.iterdir()):
         if src.is_file() and src.suffix in (".pddl", ".toml"):
             dst = folder / src.name
+            if temporal and (TEMPORAL_TEMPLATE / src.name).is_file():
+                src = TEMPORAL_TEMPLATE / src.name
             dst.write_text(src.read_text(encoding="utf-8").replace("__TASK__", name).replace("__DIR__", str(folder)),
                            encoding="utf-8")
             written.append(dst)

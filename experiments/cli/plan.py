@@ -144,12 +144,17 @@ def _read_arg(path: str, argument: str) -> str:
 
 def plan_command(args: argparse.Namespace) -> int:
     """Solve DOMAIN + PROBLEM; print the plan, its cost and its stages (or JSON)."""
+    from experiments.cli.temporal import plan_temporal
     from planners import cache
     from planners.planner import ENGINE_NAME, PddlText, Planner
     from planners.results import PlanStatus
+    from planners.temporal.reading import is_temporal
 
     domain_text, problem_text = _read_arg(args.domain, "DOMAIN"), _read_arg(args.problem, "PROBLEM")
     extra = _paths(args)
+    if is_temporal(domain_text):  # PDDL 2.1: durative actions (experiments.cli.temporal)
+        return plan_temporal(args, domain_text, problem_text,
+                             lambda r: _stages_for(domain_text, r, extra, Path(args.domain).parent))
     planner = Planner(args.planner, timeout=args.timeout, cache_size=0)
     key = cache.content_key("pddl-problem", [domain_text, problem_text])
     model = None
@@ -249,7 +254,7 @@ def new_command(args: argparse.Namespace) -> int:
     folder = Path(args.dir if args.dir else args.task)
     existed = folder.exists()
     try:
-        files = scaffold(args.task, folder)
+        files = scaffold(args.task, folder, temporal=getattr(args, "temporal", False))
     except BaseException:
         if not existed and folder.is_dir():
             shutil.rmtree(folder)  # leave nothing half-written behind
@@ -322,4 +327,6 @@ def register(subparsers: Any) -> None:
                "  tasker new fetch_cup ~/my_tasks/fetch_cup && tasker check ~/my_tasks/fetch_cup")
     n.add_argument("task", metavar="TASK", help="the task type's name (a lower-case identifier)")
     n.add_argument("dir", metavar="DIR", nargs="?", default=None, help="folder to create (default: ./TASK)")
+    n.add_argument("--temporal", action="store_true",
+                   help="a PDDL 2.1 domain with durative actions (planned by LPG, Aries, Kairos; docs/planners.md)")
     n.set_defaults(func=new_command)

@@ -1,0 +1,6 @@
+(define (problem inspect-dark-corner)
+  (:domain lamp)
+  (:objects robot - robot corner - spot)
+  (:init (free robot))
+  (:goal (inspected corner))
+)

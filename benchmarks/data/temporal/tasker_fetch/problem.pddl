@@ -1,0 +1,30 @@
+; the [example] of task.toml as a PDDL problem (written by 'tasker new')
+(define (problem fetch_t)
+  (:domain fetch_t)
+  (:objects
+    vase - item
+    bedroom kitchen living - place
+    robot - robot
+  )
+  (:init
+    (at robot living)
+    (at vase kitchen)
+    (connected bedroom kitchen)
+    (connected bedroom living)
+    (connected kitchen bedroom)
+    (connected kitchen living)
+    (connected living bedroom)
+    (connected living kitchen)
+    (hand_empty robot)
+    (= (travel-time bedroom bedroom) 0)
+    (= (travel-time bedroom kitchen) 10)
+    (= (travel-time bedroom living) 10)
+    (= (travel-time kitchen bedroom) 10)
+    (= (travel-time kitchen kitchen) 0)
+    (= (travel-time kitchen living) 10)
+    (= (travel-time living bedroom) 10)
+    (= (travel-time living kitchen) 10)
+    (= (travel-time living living) 0)
+  )
+  (:goal (and (at vase living) (hand_empty robot)))
+)
