@@ -117,14 +117,14 @@ def _slow_solves(monkeypatch: pytest.MonkeyPatch, seconds: float) -> _Clock:
     """Every Fast Downward run of the facade takes ``seconds`` on a fake clock."""
     import planners.planner as facade
 
-    clock, real = _Clock(), facade.run_fast_downward
+    clock, real = _Clock(), facade.solve_text
 
     def run(*args: Any, **kwargs: Any) -> Any:
         clock.now += seconds
         return real(*args, **kwargs)
 
     monkeypatch.setattr(facade, "time", clock)
-    monkeypatch.setattr(facade, "run_fast_downward", run)
+    monkeypatch.setattr(facade, "solve_text", run)
     return clock
 
 
