@@ -22,7 +22,8 @@ def test_plan_on_up_classical_problems(name: str, up_pddl: Path, capsys: pytest.
     d, p = up_pddl / name / "domain.pddl", up_pddl / name / "problem.pddl"
     assert _run(["plan", str(d), str(p), "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert out["status"] == "solved" and out["planner"] == "tasker-fd" and out["planner_time_s"] > 0
+    assert out["status"] == "solved" and out["planner"] == "tasker-anytime" and out["planner_time_s"] > 0
+    assert out["reader"] == "unified-planning" and out["validated"] is True
     _, _, problem = load_problem(d, p)
     assert validate_plan(problem, [tuple(s) for s in out["plan"]]).valid
 
