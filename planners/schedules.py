@@ -125,8 +125,9 @@ def _unsolved(call: _Call, name: str, out: SearchRun, advice: str) -> PlanResult
                        message=f"{what}; tried: {call.tried()}" + (f"; {advice}" if advice else ""))
 
 
-def reproducible(call: _Call, name: str, expansions: int = EXPANSION_BUDGET) -> PlanResult:
+def reproducible(call: _Call, name: str) -> PlanResult:
     """``tasker-fd``: optimal within the expansion budget, else LAMA-first (module doc)."""
+    expansions = EXPANSION_BUDGET
     out, label = call.optimal(expansions=expansions)
     if out.exit is FDExit.SOLVED and out.best is not None:
         return call.result(name, PlanStatus.SOLVED, best=out.best, search=label, optimal=True)

@@ -176,11 +176,9 @@ def plan_command(args: argparse.Namespace) -> int:
                 print("stages:")
                 for k, s in enumerate(stages, 1):
                     print(f"  {k:3d}. {s.label} [{s.kind.value}, skill={s.skill or '-'}, {s.duration:g} s]")
-    elif result.status is PlanStatus.ERROR:
-        print(f"error: {result.message}", file=sys.stderr)
-    else:
+    elif result.status is not PlanStatus.ERROR:
         print(f"{result.status.value}: {result.message or 'no plan'} ({result.planner})")
-    if result.status is PlanStatus.ERROR and args.json:
+    if result.status is PlanStatus.ERROR:  # the engine's failure (or memory), not the input: exit 1
         print(f"tasker plan: error: {result.message}", file=sys.stderr)
     return EXIT_OK if result.solved else EXIT_FAILED
 
