@@ -23,6 +23,12 @@ run (``--baseline TREE``: the default of another checkout instead, e.g. the comm
 Per task: the exit status, the status, the cost, whether it is proven optimal, the
 seconds to the first and to the returned plan, which reader read it, whether UP validated it,
 and the CPU seconds of the process and its searches.  Nothing is downloaded: give it a copy.
+
+``--engines`` prints the table of ``docs/planners.md`` ("Engines"): every classical planner
+``tasker plan --planner`` takes (the search schedules and UP's installed one-shot engines),
+the distributions it comes from with their versions, licences and installed sizes (from the
+installed files), and what each answers on the PDDL cases of ``tests/planners/pddl_cases.py``
+(action costs, subtypes, and the four forms only Fast Downward's translator reads), run now.
 """
 
 from __future__ import annotations
@@ -123,7 +129,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--timeout", type=float, default=60.0, help="with --ipc: tasker plan --timeout (default 60)")
     ap.add_argument("--baseline", metavar="TREE", help="with --ipc: compare with the default planner of this "
                                                        "checkout (e.g. git archive 60ed0ea) instead of tasker-opt")
+    ap.add_argument("--engines", action="store_true", help="print the engines table of docs/planners.md instead")
     args = ap.parse_args(argv)
+    if args.engines:
+        return engines()
     if args.ipc:
         return ipc(Path(args.ipc), [d for d in args.domains.split(",") if d], args.timeout,
                    Path(args.baseline).resolve() if args.baseline else None)
@@ -191,6 +200,77 @@ def translator(problems: list[PddlText], rounds: int) -> bool:
           f"{base:.3f}, reuse path {now:.3f} = {base / now:.2f}x; SAS identical on every problem: "
           f"{'yes' if same else 'NO'}")
     return same
+
+
+ENGINE_CASES = ("costs", "subtypes", "either", "derived", "repeated parameter", "no total-cost init")
+
+
+def _distributions(name: str) -> list[str]:
+    """The installed distributions an engine comes from (a schedule: up-fast-downward and FD's translator)."""
+    from importlib import metadata
+
+    from planners.schedules import SCHEDULES
+
+    if name in SCHEDULES:
+        return ["up-fast-downward", "fast-downward.translate"]
+    from unified_planning.environment import get_environment
+
+    module = get_environment().factory.engine(name).__module__.split(".")[0]
+    return sorted(set(metadata.packages_distributions().get(module, [])) | (
+        {"pytamer"} if module == "up_tamer" else set()))
+
+
+def _licence_and_size(dist: str) -> tuple[str, str, float]:
+    from importlib import metadata
+
+    m = metadata.metadata(dist)
+    licence = m.get("License-Expression") or m.get("License") or "?"
+    size = sum((f.size or 0) for f in metadata.files(dist) or [])
+    return metadata.version(dist), licence, size / 1e6
+
+
+def engines() -> int:
+    """The engines table (module doc): what each is, where it comes from, what it answers."""
+    import tempfile
+
+    from planners.checks import PddlError
+    from planners.plan_files import Reader, plan_files
+    from planners.registration import oneshot_planners
+    from planners.schedules import SCHEDULES
+    from tests.planners.conftest import DOMAIN, problem_text
+    from tests.planners.pddl_cases import READER_LIMITS
+    from tests.planners.test_plan_files import SUBTYPES
+
+    cases = {"costs": (DOMAIN, problem_text()), "subtypes": SUBTYPES,
+             **{k: (c.domain, c.problem) for k, c in READER_LIMITS.items()}}
+    # meta-engines ("oversubscription[tamer]") wrap these for other kinds of problem: left out
+    names = [*SCHEDULES, *sorted(n for n in set(oneshot_planners()) - set(SCHEDULES) if "[" not in n)]
+    print("| planner | distributions (version, licence, installed MB) | " + " | ".join(ENGINE_CASES) + " |")
+    print("|---|---|" + "---|" * len(ENGINE_CASES))
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in names:
+            dists = "; ".join(f"{d} {v}, {lic}, {mb:.1f}" for d in _distributions(name)
+                              for v, lic, mb in [_licence_and_size(d)])
+            cells = []
+            for case in ENGINE_CASES:
+                d, p = Path(tmp) / "d.pddl", Path(tmp) / "p.pddl"
+                d.write_text(cases[case][0])
+                p.write_text(cases[case][1])
+                try:
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore")
+                        a = plan_files(d, p, cases[case][0], cases[case][1], Planner(name, cache_size=0, timeout=30))
+                except PddlError:
+                    cells.append("refused (UP's reader)")
+                    continue
+                r = a.result
+                if r.solved:
+                    cells.append(f"cost {r.cost:g}" + (", optimal" if r.optimal else "")
+                                 + (" (FD's translator)" if a.reader is Reader.FAST_DOWNWARD else ""))
+                else:
+                    cells.append(r.status.value + (f" ({r.failure.value})" if r.failure else ""))
+            print(f"| `{name}` | {dists} | " + " | ".join(cells) + " |")
+    return 0
 
 
 def first_task(folder: Path) -> tuple[Path, Path] | None:

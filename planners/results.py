@@ -71,6 +71,7 @@ class Attempt:
     cost: float | None
     started_s: float
     seconds: float
+    note: str = ""
 
     def __post_init__(self) -> None:
         if not self.search:
@@ -81,11 +82,12 @@ class Attempt:
     def describe(self) -> str:
         """``lama-first 0.31 s: solved, cost 102`` — for time-out messages."""
         found = f", cost {self.cost:g}" if self.cost is not None else ""
-        return f"{self.search} {self.seconds:.2f} s: {self.exit.value}{found}"
+        note = f" ({self.note})" if self.note else ""
+        return f"{self.search} {self.seconds:.2f} s: {self.exit.value}{found}{note}"
 
     def to_json(self) -> dict[str, object]:
         return {"search": self.search, "exit": self.exit.value, "cost": self.cost,
-                "started_s": round(self.started_s, 6), "seconds": round(self.seconds, 6)}
+                "started_s": round(self.started_s, 6), "seconds": round(self.seconds, 6), "note": self.note}
 
 
 @dataclass(frozen=True, slots=True)

@@ -94,7 +94,8 @@ class _Call:
         out = self.run(OPTIMAL_SEARCH, optimal_below("lmcut", bound), expansions=expansions)
         if out.exit is FDExit.ERROR and out.code == UNSUPPORTED_FEATURE:
             self.attempts[-1] = Attempt(OPTIMAL_SEARCH, FDExit.ERROR, None, self.attempts[-1].started_s,
-                                        self.attempts[-1].seconds)
+                                        self.attempts[-1].seconds, "LM-cut does not support the task's axioms "
+                                                                   "or conditional effects")
             return self.run(AXIOM_SEARCH, optimal_below("blind", bound), expansions=expansions), AXIOM_SEARCH
         return out, OPTIMAL_SEARCH
 
