@@ -132,9 +132,11 @@ def _validated(domain: Path, problem: Path, domain_text: str, problem_text: str,
         _, _, model = load_problem(domain, problem)
     try:
         verdict = validate_plan(model, result.plan)
-    except PddlError as exc:  # a step UP's model has no name for
-        verdict = None
-        reason = exc.reason
+    except PddlError as exc:  # a step UP's model has no name for: the plan is not one of this task
+        verdict, reason = None, exc.reason
+    except Exception as exc:  # noqa: BLE001 - the validator's own failure says nothing of the plan
+        why = " ".join(f"{type(exc).__name__}: {exc}".split())[:300]
+        return FilesAnswer(result, Reader.UNIFIED_PLANNING, validation=f"not validated: UP's validator failed: {why}")
     if verdict is not None and verdict.valid:
         cache.record("plan-valid", key, {"domain": str(domain), "problem": str(problem)})
         return FilesAnswer(result, Reader.UNIFIED_PLANNING, validated=True,

@@ -193,3 +193,18 @@ def test_files_answer_checks_fire() -> None:
         FilesAnswer(timeout, Reader.UNIFIED_PLANNING, validated=True)
     with pytest.raises(ValueError, match="ERROR result"):
         FilesAnswer(solved, Reader.UNIFIED_PLANNING, validated=False)
+
+
+def test_a_validator_that_fails_leaves_the_plan_unvalidated_not_a_crash(tmp_path: Path,
+                                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    import planners.validate
+
+    def broken(*_: object) -> None:
+        raise KeyError("fluent")
+
+    monkeypatch.setenv("TASKER_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr(planners.validate, "validate_plan", broken)
+    d, p = _files(tmp_path, (DOMAIN, problem_text()))
+    answer = plan_files(d, p, DOMAIN, problem_text(), Planner("tasker-fd", cache_size=0))
+    assert answer.result.solved and answer.validated is None
+    assert answer.validation == "not validated: UP's validator failed: KeyError: 'fluent'"
