@@ -180,6 +180,10 @@ class Planner:
             msg = "; ".join([*(m.message for m in (res.log_messages or ())), *notes])[-300:]
             if status is PlanStatus.SOLVED:  # "solved" without a plan: the engine's fault
                 status, msg = PlanStatus.ERROR, f"engine {self.name} said {res.status.name} but gave no plan"
+            elif status is PlanStatus.TIMEOUT:  # what was tried, and what to try
+                msg = (f"engine {self.name} found no plan within {timeout:g} s" if timeout else
+                       f"engine {self.name} timed out") + (f" ({msg})" if msg else "") + \
+                    "; try tasker-anytime (a plan at once, improved within the time) or a longer timeout"
             return PlanResult(status, None, None, self.name, wall, message=msg or res.status.name,
                               failure=Failure.ENGINE if status is PlanStatus.ERROR else None)
         return PlanResult(PlanStatus.SOLVED, steps, cost, self.name, wall, message="; ".join(notes)[-300:],

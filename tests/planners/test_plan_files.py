@@ -140,6 +140,32 @@ class RaisingEngine(Engine, OneshotPlannerMixin):
         raise RuntimeError("index 3 out of range in the engine")
 
 
+class TimingOutEngine(RaisingEngine):
+    """A UP one-shot engine that runs out of time."""
+
+    @property
+    def name(self) -> str:
+        return "timing-out"
+
+    def _solve(self, problem: up.model.AbstractProblem, heuristic: Callable[..., Any] | None = None,
+               timeout: float | None = None, output_stream: IO[str] | None = None) -> PlanGenerationResult:
+        from unified_planning.engines import PlanGenerationResultStatus as UPStatus
+
+        return PlanGenerationResult(UPStatus.TIMEOUT, None, self.name)
+
+
+def test_another_engines_timeout_says_what_to_try(tmp_path: Path) -> None:
+    from unified_planning.environment import get_environment
+
+    factory = get_environment().factory
+    if "timing-out" not in factory.engines:
+        factory.add_engine("timing-out", __name__, "TimingOutEngine")
+    _, _, problem = load_problem(*_files(tmp_path, (DOMAIN, problem_text())))
+    res = Planner("timing-out").solve(problem, timeout=2.0)
+    assert res.status is PlanStatus.TIMEOUT
+    assert res.message.startswith("engine timing-out found no plan within 2 s") and "try tasker-anytime" in res.message
+
+
 def test_an_exception_inside_an_engine_exits_1_naming_it(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     from unified_planning.environment import get_environment
 
