@@ -213,7 +213,7 @@ def search(sas: str, config: str, *, timeout: float | None = None, expansions: i
             proc = subprocess.Popen([str(DOWNWARD_BIN), "--search", config, "--internal-plan-file", plan_file],
                                     stdin=stdin, stdout=subprocess.PIPE, stderr=stderr)
         _limit_memory(proc.pid, memory_mb)
-        stopped, expanded, tail = _follow(proc, None if timeout is None else t0 + timeout, expansions)
+        stopped, expanded = _follow(proc, None if timeout is None else t0 + timeout, expansions)
         seconds = time.perf_counter() - t0
         plans = _plans(Path(tmp), started)
         errors = Path(err_file).read_text(errors="replace").strip().splitlines()
@@ -228,7 +228,7 @@ def search(sas: str, config: str, *, timeout: float | None = None, expansions: i
         return SearchRun(FDExit.ERROR, code, (), expanded, seconds, "no plan file written")
     message = ""
     if outcome is not FDExit.SOLVED:
-        last = (errors or tail)[-3:]
+        last = errors[-3:]  # its standard error, as before: the standard output holds measured values
         message = f"downward exited with code {code}" + (f": {' '.join(last)}" if last else "")
     return SearchRun(outcome, code, plans, expanded, seconds, message)
 
@@ -243,15 +243,14 @@ def _limit_memory(pid: int, memory_mb: int | None) -> None:
 
 
 def _follow(proc: subprocess.Popen[bytes], deadline: float | None, expansions: int | None
-            ) -> tuple[str, int | None, list[str]]:
+            ) -> tuple[str, int | None]:
     """Read the child's output until it ends; stop it at ``deadline`` or past ``expansions``.
 
-    Returns why it was stopped (``"deadline"``, ``"expansions"`` or ``""``), the last count of
-    expanded states it printed, and its last lines (for messages)."""
+    Returns why it was stopped (``"deadline"``, ``"expansions"`` or ``""``) and the last count of
+    expanded states it printed."""
     assert proc.stdout is not None
     fd = proc.stdout.fileno()
     expanded: int | None = None
-    tail: list[str] = []
     pending = b""
     stopped = ""
     with selectors.DefaultSelector() as sel:
@@ -271,8 +270,6 @@ def _follow(proc: subprocess.Popen[bytes], deadline: float | None, expansions: i
                 m = _FINAL.search(line) or _PROGRESS.search(line)
                 if m:
                     expanded = int(m.group(1))
-                elif line and not line.startswith(b"["):
-                    tail = [*tail[-4:], line.decode(errors="replace").strip()]
             if expansions is not None and expanded is not None and expanded > expansions:
                 stopped = "expansions"
                 break
@@ -280,7 +277,7 @@ def _follow(proc: subprocess.Popen[bytes], deadline: float | None, expansions: i
         proc.kill()
     proc.wait()
     proc.stdout.close()
-    return stopped, expanded, tail
+    return stopped, expanded
 
 
 def _plans(folder: Path, started: float) -> tuple[FoundPlan, ...]:

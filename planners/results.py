@@ -79,11 +79,12 @@ class Attempt:
         if self.started_s < 0 or self.seconds < 0:
             raise ValueError(f"an Attempt's times must be >= 0, got {self.started_s}, {self.seconds}")
 
-    def describe(self) -> str:
-        """``lama-first 0.31 s: solved, cost 102`` — for time-out messages."""
+    def describe(self, timed: bool = False) -> str:
+        """``lama-first: solved, cost 102`` (``timed``: ``lama-first 0.31 s: ...``).  Untimed in a result's
+        message, which a run writes to its ``problems/`` index and a task's end reason: no wall clock there."""
         found = f", cost {self.cost:g}" if self.cost is not None else ""
         note = f" ({self.note})" if self.note else ""
-        return f"{self.search} {self.seconds:.2f} s: {self.exit.value}{found}{note}"
+        return f"{self.search}{f' {self.seconds:.2f} s' if timed else ''}: {self.exit.value}{found}{note}"
 
     def to_json(self) -> dict[str, object]:
         return {"search": self.search, "exit": self.exit.value, "cost": self.cost,

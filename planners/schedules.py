@@ -108,6 +108,7 @@ class _Call:
                           best_plan_s=best_s)
 
     def tried(self) -> str:
+        """What was tried, for messages: no seconds (a result's message can reach a run's outputs)."""
         return "; ".join(a.describe() for a in self.attempts)
 
 
@@ -119,7 +120,9 @@ def _unsolved(call: _Call, name: str, out: SearchRun, advice: str) -> PlanResult
     """A call that ends with ``out`` and no plan: the status, what was tried, and what to try."""
     status = _STATUS[out.exit]
     if status is PlanStatus.UNSOLVABLE:
-        return call.result(name, status, message=f"no plan exists ({call.tried()})")
+        proof = "no plan exists" if out.code in (10, 11) else \
+            "no plan found: the search ended incompletely (no proof that none exists)"
+        return call.result(name, status, message=f"{proof} ({call.tried()})")
     failure = failure_of(out.exit, out.message)
     what = "time limit reached" if status is PlanStatus.TIMEOUT else (out.message or out.exit.value)
     return call.result(name, status, failure=failure,

@@ -178,6 +178,8 @@ def plan_command(args: argparse.Namespace) -> int:
                     print(f"  {k:3d}. {s.label} [{s.kind.value}, skill={s.skill or '-'}, {s.duration:g} s]")
     elif result.status is not PlanStatus.ERROR:
         print(f"{result.status.value}: {result.message or 'no plan'} ({result.planner})")
+        if result.attempts:
+            print("tried: " + "; ".join(a.describe(timed=True) for a in result.attempts))
     if result.status is PlanStatus.ERROR:  # the engine's failure (or memory), not the input: exit 1
         print(f"tasker plan: error: {result.message}", file=sys.stderr)
     return EXIT_OK if result.solved else EXIT_FAILED

@@ -91,13 +91,18 @@ def test_a_timeout_says_what_was_tried_and_what_to_try() -> None:
     call = schedules._Call(translate(GRIPPER, gripper_problem(14)).sas, 0.5)  # the search's time, not translation
     res = schedules.optimal_only(call, "tasker-opt")
     assert res.status is PlanStatus.TIMEOUT and res.failure is None
-    assert "tried: astar(lmcut())" in res.message and "tasker-anytime" in res.message
+    assert res.message == ("time limit reached; tried: astar(lmcut()): timeout; an optimal search may need far "
+                           "longer: the default planner, tasker-anytime, finds a plan at once and improves it")
 
 
 def test_unsolvable_is_proven_by_every_schedule() -> None:
     for name in schedules.SCHEDULES:
         res = _solve(name, problem=problem_text(goal="(holding cup) (item-at cup c)"))
         assert res.status is PlanStatus.UNSOLVABLE and not res.optimal, name
+        assert res.message.startswith("no plan exists ("), res.message
+    # a message reaches a run's problems/ index and a task's end reason: no wall-clock value in it
+    res = _solve("tasker-fd", problem=problem_text(goal="(holding cup) (item-at cup c)"))
+    assert res.message == "no plan exists (astar(lmcut()): unsolvable)"
 
 
 def test_translator_refusal_is_an_input_failure() -> None:
