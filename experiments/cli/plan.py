@@ -168,6 +168,8 @@ def plan_command(args: argparse.Namespace) -> int:
               + (f"; {result.message})" if result.message else ")"))
         if answer.reader is Reader.FAST_DOWNWARD:
             print(f"read by Fast Downward's translator; {answer.validation}")
+        elif answer.validation:
+            print(f"plan {answer.validation}")
         if not getattr(args, "quiet", False):
             stages = _stages_for(domain_text, result, extra, Path(args.domain).parent)
             if isinstance(stages, str):

@@ -31,7 +31,8 @@ def test_plan_on_up_classical_problems(name: str, up_pddl: Path, capsys: pytest.
 def test_plan_human_output(pddl_files: tuple[Path, Path], capsys: pytest.CaptureFixture[str]) -> None:
     assert _run(["plan", str(pddl_files[0]), str(pddl_files[1])]) == 0
     out = capsys.readouterr().out
-    assert "cost 6" in out and "(move a b)" in out
+    assert "cost 6" in out and "(move a b)" in out and "plan valid (UP's sequential_plan_validator" in out
+    assert "optimal: proven" in out
     # no task folder declares this domain's skills, kinds or durations: none are made up ("suspendable, 0 s")
     assert "stages: none shown: domain 'delivery' is no task folder's" in out and "0 s]" not in out
 
