@@ -202,7 +202,8 @@ def translator(problems: list[PddlText], rounds: int) -> bool:
     return same
 
 
-ENGINE_CASES = ("costs", "subtypes", "either", "derived", "repeated parameter", "no total-cost init")
+ENGINE_CASES = ("costs", "subtypes", "either", "derived", "repeated parameter", "no total-cost init",
+                "glued variable")
 
 
 def _distributions(name: str) -> list[str]:

@@ -87,8 +87,8 @@ class PddlError(DefinitionError):
     """A PDDL domain or problem is malformed or needs a feature no planner here supports.
 
     ``reader_only`` marks legal PDDL that only unified-planning's reader cannot read
-    (``(either ...)`` types, ``:derived`` predicates, a predicate naming a parameter twice, action
-    costs without ``(= (total-cost) 0)``): ``tasker plan`` then reads the task with Fast Downward's
+    (``(either ...)`` types, ``:derived`` predicates, a predicate naming a parameter twice, a name
+    glued to a variable, action costs without ``(= (total-cost) 0)``): ``tasker plan`` then reads the task with Fast Downward's
     translator (:mod:`planners.plan_files`); task folders, which need UP's model, refuse it.
     Any other refusal is an error in the PDDL, which the translator must not be left to
     accept (it takes an undeclared type for an empty one, for one).
@@ -247,6 +247,25 @@ def check_repeated_parameters(domain_text: str, file: str | Path) -> None:
                                 reader_only=True)
 
 
+_GLUED = re.compile(r"[A-Za-z0-9_\-]\?[A-Za-z]")
+
+
+def check_glued_variables(text: str, file: str | Path) -> None:
+    """Refuse a name glued to a variable (zenotravel's ``(aircraft?a)``): PDDL's names cannot hold ``?``,
+    so it reads as ``(aircraft ?a)``, and Fast Downward's reader splits it so; unified-planning's takes
+    it for one unknown name.  The line and the spaced form are named."""
+    code = _COMMENT.sub("", text)
+    m = _GLUED.search(code)
+    if m:
+        start = max(code.rfind("(", 0, m.start()), code.rfind(" ", 0, m.start()), code.rfind("\t", 0, m.start())) + 1
+        line, col = code.count("\n", 0, start) + 1, start - code.rfind("\n", 0, start)
+        word = re.match(r"[^\s()]*", code[start:])
+        glued = word.group(0) if word else m.group(0)
+        raise PddlError(file, f"{glued}: a name and a variable without a space between them, which unified-planning's "
+                              f"reader takes for one name; write {glued.replace('?', ' ?', 1)}", line, col,
+                        reader_only=True)
+
+
 _COST_INIT = re.compile(r"\(\s*=\s*\(\s*total-cost\s*\)", re.IGNORECASE)
 _INIT = re.compile(r"\(\s*:init\b", re.IGNORECASE)
 
@@ -367,6 +386,7 @@ def load_domain(path: str | Path) -> CheckedDomain:
     check_types(text, path)
     check_constructs(text, path)
     check_repeated_parameters(text, path)
+    check_glued_variables(text, path)
     check_requirements(text, path)
     check_numeric(parse_domain(text, path), text, path)
     return CheckedDomain(Path(path), text)
@@ -425,6 +445,7 @@ def load_problem_text(
 
     check_depth(problem_text, problem_file)
     check_problem_domain(domain.text, problem_text, problem_file)
+    check_glued_variables(problem_text, problem_file)
     try:
         with _lenient_names():
             problem = PDDLReader().parse_problem_string(domain.text, problem_text)

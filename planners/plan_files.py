@@ -7,7 +7,8 @@ Which reader reads the task decides what can be said of the plan:
   (:mod:`planners.cache`, kind ``pddl-problem``), so a later call skips it;
 * where it refuses **legal PDDL it cannot read** (``PddlError.reader_only``: ``(either ...)``
   types, ``:derived`` predicates, a predicate that names one parameter twice as logistics00's,
-  action costs without ``(= (total-cost) 0)`` in the problem as tetris'), a search schedule
+  a name glued to a variable as zenotravel's ``(aircraft?a)``, action costs without
+  ``(= (total-cost) 0)`` in the problem as tetris'), a search schedule
   (``tasker-fd``, ``tasker-anytime``, ...) plans from **Fast Downward's own translator**, which
   reads them.  The answer says so (:attr:`Reader.FAST_DOWNWARD`, with UP's refusal).  When
   the translator refuses it too, the refusal is UP's (it names the line), with the

@@ -70,13 +70,28 @@ REPEATED = Case("""\
   (:goal (in b t)))
 """, (("load", "b", "t", "l"),), "predicate in names parameter ?obj twice")
 
+GLUED = Case("""\
+; a name glued to its variable, as IPC's zenotravel writes (aircraft?a): PDDL reads (aircraft ?a)
+(define (domain glued)
+  (:requirements :strips)
+  (:predicates (robot ?r) (at ?r ?p) (link ?a ?b))
+  (:action go :parameters (?r ?a ?b)
+    :precondition (and (robot?r) (at ?r ?a) (link ?a ?b))
+    :effect (and (not (at ?r ?a)) (at ?r ?b))))
+""", """\
+(define (problem hop) (:domain glued)
+  (:objects r k h)
+  (:init (robot r) (at r k) (link k h))
+  (:goal (at r h)))
+""", (("go", "r", "k", "h"),), "robot?r: a name and a variable without a space between them")
+
 NO_COST_INIT = Case(DOMAIN, problem_text().replace("(= (total-cost) 0) ", ""),
                     (("pick", "cup", "a"), ("move", "a", "b"), ("move", "b", "c"), ("drop", "cup", "c")),
                     "does not set (= (total-cost) 0)")
 """The planner tests' delivery task, its problem without ``(= (total-cost) 0)`` (as IPC's tetris)."""
 
 READER_LIMITS = {"either": EITHER, "derived": DERIVED, "repeated parameter": REPEATED,
-                 "no total-cost init": NO_COST_INIT}
+                 "no total-cost init": NO_COST_INIT, "glued variable": GLUED}
 
 GRIPPER = """\
 (define (domain gripper)
