@@ -88,8 +88,9 @@ class PddlError(DefinitionError):
 
     ``reader_only`` marks legal PDDL that only unified-planning's reader cannot read
     (``(either ...)`` types, ``:derived`` predicates, a predicate naming a parameter twice, a name
-    glued to a variable, action costs without ``(= (total-cost) 0)``): ``tasker plan`` then reads the task with Fast Downward's
-    translator (:mod:`planners.plan_files`); task folders, which need UP's model, refuse it.
+    glued to a variable, action costs without ``(= (total-cost) 0)``): ``tasker plan`` then reads
+    the task with Fast Downward's translator (:mod:`planners.plan_files`); task folders, which need
+    UP's model, refuse it.
     Any other refusal is an error in the PDDL, which the translator must not be left to
     accept (it takes an undeclared type for an empty one, for one).
     """
