@@ -27,8 +27,9 @@ and the CPU seconds of the process and its searches.  Nothing is downloaded: giv
 ``--engines`` prints the table of ``docs/planners.md`` ("Engines"): every classical planner
 ``tasker plan --planner`` takes (the search schedules and UP's installed one-shot engines),
 the distributions it comes from with their versions, licences and installed sizes (from the
-installed files), and what each answers on the PDDL cases of ``tests/planners/pddl_cases.py``
-(action costs, subtypes, and the four forms only Fast Downward's translator reads), run now.
+installed files), and what each answers on the PDDL cases of ``benchmarks/data/`` (the delivery
+task's action costs, ``pddl_cases/``: subtypes and the five forms only Fast Downward's translator
+reads; the tests read them too), run now.
 """
 
 from __future__ import annotations
@@ -238,12 +239,14 @@ def engines() -> int:
     from planners.plan_files import Reader, plan_files
     from planners.registration import oneshot_planners
     from planners.schedules import SCHEDULES
-    from tests.planners.conftest import DOMAIN, problem_text
-    from tests.planners.pddl_cases import READER_LIMITS
-    from tests.planners.test_plan_files import SUBTYPES
 
-    cases = {"costs": (DOMAIN, problem_text()), "subtypes": SUBTYPES,
-             **{k: (c.domain, c.problem) for k, c in READER_LIMITS.items()}}
+    data = Path(__file__).resolve().parent / "data"
+    folders = {"subtypes": "subtypes", "either": "either", "derived": "derived",
+               "repeated parameter": "repeated-parameter", "no total-cost init": "no-total-cost-init",
+               "glued variable": "glued-variable"}
+    cases = {"costs": ((data / "delivery_domain.pddl").read_text(), (data / "delivery_problem.pddl").read_text()),
+             **{k: ((data / "pddl_cases" / f / "domain.pddl").read_text(),
+                    (data / "pddl_cases" / f / "problem.pddl").read_text()) for k, f in folders.items()}}
     # meta-engines ("oversubscription[tamer]") wrap these for other kinds of problem: left out
     names = [*SCHEDULES, *sorted(n for n in set(oneshot_planners()) - set(SCHEDULES) if "[" not in n)]
     print("| planner | distributions (version, licence, installed MB) | " + " | ".join(ENGINE_CASES) + " |")

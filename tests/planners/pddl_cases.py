@@ -6,8 +6,11 @@ Each reader-limit case carries the plan expected of it, worked out by hand."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
-from tests.planners.conftest import DOMAIN, problem_text
+CASES = Path(__file__).resolve().parents[2] / "benchmarks" / "data" / "pddl_cases"
+"""The cases' PDDL: one folder each (``domain.pddl``, ``problem.pddl``), read by these tests and by
+``benchmarks/bench_planner.py --engines`` (benchmarks import nothing from the tests)."""
 
 
 @dataclass(frozen=True)
@@ -18,80 +21,26 @@ class Case:
     refusal: str  # what unified-planning's refusal says (a fragment)
 
 
-EITHER = Case("""\
-(define (domain either-move)
-  (:requirements :strips :typing)
-  (:types robot box place)
-  (:predicates (at ?x - (either robot box) ?p - place) (link ?a ?b - place) (holding ?b - box))
-  (:action go :parameters (?r - robot ?a ?b - place)
-    :precondition (and (at ?r ?a) (link ?a ?b))
-    :effect (and (not (at ?r ?a)) (at ?r ?b)))
-  (:action pick :parameters (?r - robot ?x - box ?p - place)
-    :precondition (and (at ?r ?p) (at ?x ?p))
-    :effect (and (not (at ?x ?p)) (holding ?x))))
-""", """\
-(define (problem fetch) (:domain either-move)
-  (:objects r - robot b - box k h - place)
-  (:init (at r k) (at b h) (link k h))
-  (:goal (holding b)))
-""", (("go", "r", "k", "h"), ("pick", "r", "b", "h")), "declare a common supertype")
+def _case(folder: str, plan: tuple[tuple[str, ...], ...], refusal: str) -> Case:
+    return Case((CASES / folder / "domain.pddl").read_text(), (CASES / folder / "problem.pddl").read_text(),
+                plan, refusal)
 
-DERIVED = Case("""\
-(define (domain derived-door)
-  (:requirements :strips :derived-predicates)
-  (:predicates (at ?p) (link ?a ?b) (open ?a ?b) (passable ?a ?b))
-  (:derived (passable ?a ?b) (and (link ?a ?b) (open ?a ?b)))
-  (:action go :parameters (?a ?b)
-    :precondition (and (at ?a) (passable ?a ?b))
-    :effect (and (not (at ?a)) (at ?b)))
-  (:action open-door :parameters (?a ?b)
-    :precondition (and (at ?a) (link ?a ?b))
-    :effect (open ?a ?b)))
-""", """\
-(define (problem through) (:domain derived-door)
-  (:objects k h)
-  (:init (at k) (link k h))
-  (:goal (at h)))
-""", (("open-door", "k", "h"), ("go", "k", "h")), ":derived predicates")
 
-REPEATED = Case("""\
-; a predicate that names its parameter twice, as IPC's logistics00 does: legal PDDL
-(define (domain load-in)
-  (:requirements :strips)
-  (:predicates (box ?x) (truck ?x) (at ?x ?l)
-               (in ?obj ?obj))
-  (:action load :parameters (?b ?t ?l)
-    :precondition (and (box ?b) (truck ?t) (at ?b ?l) (at ?t ?l))
-    :effect (and (not (at ?b ?l)) (in ?b ?t))))
-""", """\
-(define (problem load) (:domain load-in)
-  (:objects b t l)
-  (:init (box b) (truck t) (at b l) (at t l))
-  (:goal (in b t)))
-""", (("load", "b", "t", "l"),), "predicate in names parameter ?obj twice")
-
-GLUED = Case("""\
-; a name glued to its variable, as IPC's zenotravel writes (aircraft?a): PDDL reads (aircraft ?a)
-(define (domain glued)
-  (:requirements :strips)
-  (:predicates (robot ?r) (at ?r ?p) (link ?a ?b))
-  (:action go :parameters (?r ?a ?b)
-    :precondition (and (robot?r) (at ?r ?a) (link ?a ?b))
-    :effect (and (not (at ?r ?a)) (at ?r ?b))))
-""", """\
-(define (problem hop) (:domain glued)
-  (:objects r k h)
-  (:init (robot r) (at r k) (link k h))
-  (:goal (at r h)))
-""", (("go", "r", "k", "h"),), "robot?r: a name and a variable without a space between them")
-
-NO_COST_INIT = Case(DOMAIN, problem_text().replace("(= (total-cost) 0) ", ""),
-                    (("pick", "cup", "a"), ("move", "a", "b"), ("move", "b", "c"), ("drop", "cup", "c")),
-                    "does not set (= (total-cost) 0)")
+EITHER = _case("either", (("go", "r", "k", "h"), ("pick", "r", "b", "h")), "declare a common supertype")
+DERIVED = _case("derived", (("open-door", "k", "h"), ("go", "k", "h")), ":derived predicates")
+REPEATED = _case("repeated-parameter", (("load", "b", "t", "l"),), "predicate in names parameter ?obj twice")
+GLUED = _case("glued-variable", (("go", "r", "k", "h"),),
+              "robot?r: a name and a variable without a space between them")
+NO_COST_INIT = _case("no-total-cost-init",
+                     (("pick", "cup", "a"), ("move", "a", "b"), ("move", "b", "c"), ("drop", "cup", "c")),
+                     "does not set (= (total-cost) 0)")
 """The planner tests' delivery task, its problem without ``(= (total-cost) 0)`` (as IPC's tetris)."""
 
 READER_LIMITS = {"either": EITHER, "derived": DERIVED, "repeated parameter": REPEATED,
                  "no total-cost init": NO_COST_INIT, "glued variable": GLUED}
+
+SUBTYPES = ((CASES / "subtypes" / "domain.pddl").read_text(), (CASES / "subtypes" / "problem.pddl").read_text())
+"""A ``tiago - robot`` hierarchy: what Tamer's type checker refuses (UP issue #290)."""
 
 GRIPPER = """\
 (define (domain gripper)

@@ -21,7 +21,7 @@ from planners.plan_files import FilesAnswer, Reader, plan_files
 from planners.planner import PddlText, Planner
 from planners.results import Failure, PlanResult, PlanStatus
 from tests.planners.conftest import DOMAIN, problem_text
-from tests.planners.pddl_cases import EITHER, READER_LIMITS, Case
+from tests.planners.pddl_cases import EITHER, READER_LIMITS, SUBTYPES, Case
 
 
 def _files(tmp_path: Path, case: Case | tuple[str, str]) -> tuple[Path, Path]:
@@ -178,22 +178,6 @@ def test_an_exception_inside_an_engine_exits_1_naming_it(tmp_path: Path, capsys:
     assert json.loads(out.out)["failure"] == "engine"
     assert "tasker plan: error: engine raising failed: RuntimeError: index 3 out of range" in out.err
     assert "internal error" not in out.err
-
-
-SUBTYPES = ("""\
-(define (domain sub)
-  (:requirements :strips :typing)
-  (:types place - object robot - object tiago - robot)
-  (:predicates (at ?r - robot ?p - place) (link ?a ?b - place))
-  (:action go :parameters (?r - robot ?a ?b - place)
-    :precondition (and (at ?r ?a) (link ?a ?b))
-    :effect (and (not (at ?r ?a)) (at ?r ?b))))
-""", """\
-(define (problem p) (:domain sub)
-  (:objects t - tiago k h - place)
-  (:init (at t k) (link k h))
-  (:goal (at t h)))
-""")
 
 
 @pytest.mark.skipif(importlib.util.find_spec("up_tamer") is None,
