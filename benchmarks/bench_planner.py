@@ -12,7 +12,8 @@ the plan costs must be equal (both optimal).  Then a repeated identical problem 
 answered from the cache.  Last, the translator alone, in CPU seconds over all the
 problems: the library's own ``main()`` on files (the baseline, what every call ran before
 :mod:`planners.translate`) against the reuse path, rounds interleaved, the SAS output of
-the two compared byte for byte.  Run: ``python benchmarks/bench_planner.py [--repeat N]``.
+the two compared byte for byte; and the states A* + LM-cut expands on each problem, against
+``tasker-fd``'s expansion budget.  Run: ``python benchmarks/bench_planner.py [--repeat N]``.
 
 ``--ipc DIR`` measures instead what ``tasker plan --json --timeout S`` answers on IPC
 classical tasks (a folder laid out as Fast Downward's benchmark collection: one folder per
@@ -181,7 +182,18 @@ def main(argv: list[str] | None = None) -> int:
           f"(target <= {TARGET_CACHE_S * 1e3:g} ms) {'OK' if cache_s <= TARGET_CACHE_S else 'MISSED'}")
     print(f"plan costs equal on every problem: {'yes' if mismatches == 0 else f'NO ({mismatches} mismatches)'}")
     same = translator(translated, max(args.repeat, TRANSLATE_ROUNDS))
+    expansions(translated)
     return 0 if mismatches == 0 and same and overall >= TARGET_SPEEDUP and cache_s <= TARGET_CACHE_S else 1
+
+
+def expansions(problems: list[PddlText]) -> None:
+    """The states A* + LM-cut expands on each problem, against ``tasker-fd``'s budget."""
+    from planners.fd import OPTIMAL_SEARCH, search
+    from planners.schedules import EXPANSION_BUDGET
+
+    counts = [search(translate(t.domain, t.problem).sas, OPTIMAL_SEARCH).expanded or 0 for t in problems]
+    print(f"A* + LM-cut expanded states over {len(problems)} problems: max {max(counts)}, median "
+          f"{statistics.median(counts):g} (tasker-fd's budget: {EXPANSION_BUDGET})")
 
 
 def translator(problems: list[PddlText], rounds: int) -> bool:
