@@ -84,7 +84,21 @@ class DefinitionError(TaskerError, ValueError):
 
 
 class PddlError(DefinitionError):
-    """A PDDL domain or problem is malformed or needs a feature no planner here supports."""
+    """A PDDL domain or problem is malformed or needs a feature no planner here supports.
+
+    ``reader_only`` marks legal PDDL that only unified-planning's reader cannot read
+    (``(either ...)`` types, ``:derived`` predicates, a predicate naming a parameter twice, a name
+    glued to a variable, action costs without ``(= (total-cost) 0)``): ``tasker plan`` then reads
+    the task with Fast Downward's translator (:mod:`planners.plan_files`); task folders, which need
+    UP's model, refuse it.
+    Any other refusal is an error in the PDDL, which the translator must not be left to
+    accept (it takes an undeclared type for an empty one, for one).
+    """
+
+    def __init__(self, file: str | Path, reason: str, line: int | None = None, col: int | None = None,
+                 *, reader_only: bool = False) -> None:
+        super().__init__(file, reason, line, col)
+        self.reader_only = reader_only
 
 
 def _read(path: str | Path) -> str:
@@ -169,11 +183,13 @@ def check_requirements(domain_text: str, file: str | Path) -> None:
 
 
 _INSTEAD = {
-    "either": "(either ...) types are not supported by tasker (unified-planning's PDDL reader cannot read "
-              "them): declare a common supertype instead, e.g. (:types item robot - carriable), and use it",
-    "derived": ":derived predicates are not supported by tasker (unified-planning's PDDL reader cannot read "
-               "them): compute the predicate in task.py's extra_facts (as domains/doors.py does for "
-               "free_passage), or write its condition into the actions' preconditions",
+    "either": "(either ...) types: unified-planning's PDDL reader cannot read them, so a task folder cannot use "
+              "them (tasker plan reads them with Fast Downward's translator): declare a common supertype instead, "
+              "e.g. (:types item robot - carriable), and use it",
+    "derived": ":derived predicates: unified-planning's PDDL reader cannot read them, so a task folder cannot use "
+               "them (tasker plan reads them with Fast Downward's translator): compute the predicate in task.py's "
+               "extra_facts (as domains/doors.py does for free_passage), or write its condition into the "
+               "actions' preconditions",
 }
 _CONSTRUCT_RE = {"either": re.compile(r"-\s*(\(\s*either\b)", re.IGNORECASE),
                  "derived": re.compile(r"(\(\s*:derived\b|:derived-predicates\b)", re.IGNORECASE)}
@@ -204,17 +220,76 @@ def check_constructs(domain_text: str, file: str | Path) -> None:
         m = _CONSTRUCT_RE[what].search(code)
         at = m.start(1) if m else 0
         line, col = (code.count("\n", 0, at) + 1, at - code.rfind("\n", 0, at)) if m else (None, None)
-        raise PddlError(file, _INSTEAD[what], line, col)
+        raise PddlError(file, _INSTEAD[what], line, col, reader_only=True)
 
 
-def check_kind(problem: up.model.Problem, file: str | Path) -> None:
-    """Refuse a problem whose UP problem kind needs features the planner lacks."""
+def check_repeated_parameters(domain_text: str, file: str | Path) -> None:
+    """Refuse a predicate that names one parameter twice (logistics00's ``(in ?obj ?obj)``), which PDDL
+    allows: unified-planning's reader keeps one of them and then calls every use of the predicate
+    "arity 1 but 2 parameters were passed", at the use.  Read from Fast Downward's s-expression reader."""
+    nested = _nested(domain_text)
+    if nested is None:
+        return
+    for block in nested:
+        if not (isinstance(block, list) and block[:1] == [":predicates"]):
+            continue
+        for pred in block[1:]:
+            if not (isinstance(pred, list) and pred and isinstance(pred[0], str)):
+                continue
+            names = [x for x in pred[1:] if isinstance(x, str) and x.startswith("?")]
+            twice = next((n for k, n in enumerate(names) if n in names[:k]), None)
+            if twice is not None:
+                code = _COMMENT.sub("", domain_text)
+                m = re.search(rf"\(\s*{re.escape(pred[0])}\s+{re.escape(twice)}\b", code, re.IGNORECASE)
+                line = code.count("\n", 0, m.start()) + 1 if m else None
+                raise PddlError(file, f"predicate {pred[0]} names parameter {twice} twice: unified-planning's reader "
+                                      f"keeps one, and every use of {pred[0]} then has an argument too many; give "
+                                      f"each parameter its own name, e.g. ({pred[0]} {twice} {twice}2)", line,
+                                reader_only=True)
+
+
+_GLUED = re.compile(r"[A-Za-z0-9_\-]\?[A-Za-z]")
+
+
+def check_glued_variables(text: str, file: str | Path) -> None:
+    """Refuse a name glued to a variable (zenotravel's ``(aircraft?a)``): PDDL's names cannot hold ``?``,
+    so it reads as ``(aircraft ?a)``, and Fast Downward's reader splits it so; unified-planning's takes
+    it for one unknown name.  The line and the spaced form are named."""
+    code = _COMMENT.sub("", text)
+    m = _GLUED.search(code)
+    if m:
+        start = max(code.rfind("(", 0, m.start()), code.rfind(" ", 0, m.start()), code.rfind("\t", 0, m.start())) + 1
+        line, col = code.count("\n", 0, start) + 1, start - code.rfind("\n", 0, start)
+        word = re.match(r"[^\s()]*", code[start:])
+        glued = word.group(0) if word else m.group(0)
+        raise PddlError(file, f"{glued}: a name and a variable without a space between them, which unified-planning's "
+                              f"reader takes for one name; write {glued.replace('?', ' ?', 1)}", line, col,
+                        reader_only=True)
+
+
+_COST_INIT = re.compile(r"\(\s*=\s*\(\s*total-cost\s*\)", re.IGNORECASE)
+_INIT = re.compile(r"\(\s*:init\b", re.IGNORECASE)
+
+
+def check_kind(problem: up.model.Problem, file: str | Path, domain_text: str = "", problem_text: str = "") -> None:
+    """Refuse a problem whose UP problem kind needs features the planner lacks.  Action costs whose
+    problem does not set ``(= (total-cost) 0)`` (which PDDL lets it omit: FD assumes 0) are named
+    as such, not in UP's words for numeric planning."""
     from planners.kind import supported_kind
 
     supported = set(supported_kind().features)
     extra = sorted(set(problem.kind.features) - supported - _TOLERATED_FEATURES)
-    if extra:
-        raise PddlError(file, f"unsupported PDDL features for a classical planner: {', '.join(extra)}")
+    if not extra:
+        return
+    code = _COMMENT.sub("", problem_text)
+    if "INCREASE_EFFECTS" in extra and re.search(r"\(\s*total-cost\s*\)", _COMMENT.sub("", domain_text),
+                                                   re.IGNORECASE) and not _COST_INIT.search(code):
+        m = _INIT.search(code)
+        raise PddlError(file, "the problem's :init does not set (= (total-cost) 0): unified-planning's reader takes "
+                              "(increase (total-cost) ...) for action costs only when it does (Fast Downward assumes "
+                              "0); add (= (total-cost) 0) to :init",
+                        code.count("\n", 0, m.start()) + 1 if m else None, reader_only=True)
+    raise PddlError(file, f"unsupported PDDL features for a classical planner: {', '.join(extra)}")
 
 
 @dataclass(frozen=True, slots=True)
@@ -311,6 +386,8 @@ def load_domain(path: str | Path) -> CheckedDomain:
     check_depth(text, path)
     check_types(text, path)
     check_constructs(text, path)
+    check_repeated_parameters(text, path)
+    check_glued_variables(text, path)
     check_requirements(text, path)
     check_numeric(parse_domain(text, path), text, path)
     return CheckedDomain(Path(path), text)
@@ -369,6 +446,7 @@ def load_problem_text(
 
     check_depth(problem_text, problem_file)
     check_problem_domain(domain.text, problem_text, problem_file)
+    check_glued_variables(problem_text, problem_file)
     try:
         with _lenient_names():
             problem = PDDLReader().parse_problem_string(domain.text, problem_text)
@@ -376,7 +454,7 @@ def load_problem_text(
         raise _located(problem_file, exc) from None
     except RecursionError:
         raise PddlError(problem_file, "nested too deep for the PDDL reader (write it flatter)") from None
-    check_kind(problem, problem_file)
+    check_kind(problem, problem_file, domain.text, problem_text)
     return problem
 
 

@@ -7,9 +7,11 @@ Registered with UP's factory under :data:`~planners.registration.ENGINE_NAME` (b
         result = planner.solve(problem, timeout=5)
 
 It writes the problem with ``PDDLWriter``, runs Fast Downward's translator in-process
-and the ``downward`` binary (A* + LM-cut by default: optimal under action costs, like
-``fast-downward-opt``), and maps the plan back through the writer's name table.  It is
-a drop-in for ``fast-downward-opt`` at a fraction of its start-up cost.
+and the ``downward`` binary under a search schedule (:mod:`planners.schedules`; by
+default ``tasker-fd``: A* + LM-cut, optimal under action costs like ``fast-downward-opt``,
+within an expansion budget, else LAMA-first), and maps the plan back through the writer's
+name table.  It is a drop-in for ``fast-downward-opt`` at a fraction of its start-up cost;
+``SOLVED_OPTIMALLY`` means the plan is proven optimal.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from planners.fd import OPTIMAL_SEARCH, run_fast_downward
 from planners.kind import supported_kind
 from planners.registration import ENGINE_NAME
 from planners.results import PlanStatus, from_fd_outcome
+from planners.schedules import SCHEDULES, solve_text
 
 _UP_STATUS = {
     PlanStatus.UNSOLVABLE: UPStatus.UNSOLVABLE_PROVEN,
@@ -38,23 +41,29 @@ _UP_STATUS = {
 
 
 class TaskerFastDownward(Engine, OneshotPlannerMixin):
-    """Optimal Fast Downward as a UP one-shot planner, without the driver's start-up cost.
+    """Fast Downward as a UP one-shot planner, without the driver's start-up cost.
 
-    ``search`` is a Fast Downward search string (default ``astar(lmcut())``); with a
-    non-optimal search the engine reports ``SOLVED_SATISFICING``.  ``timeout`` given
-    to the constructor is the default for :meth:`solve` calls that pass none.  Any
+    ``schedule`` names a search schedule (:data:`~planners.schedules.SCHEDULES`, default
+    ``tasker-fd``); ``search``, a Fast Downward search string, replaces it with that one search
+    (not claimed optimal unless it is ``astar(lmcut())``).  A plan proven optimal is reported
+    ``SOLVED_OPTIMALLY`` (with a quality metric), any other ``SOLVED_SATISFICING``.  ``timeout``
+    given to the constructor is the default for :meth:`solve` calls that pass none.  Any
     other parameter (``OneshotPlanner(name="tasker-fd", params={...})``) is refused, as
     ``TypeError`` naming it: a misspelt option must not be ignored.
     """
 
-    def __init__(self, search: str = OPTIMAL_SEARCH, timeout: float | None = None) -> None:
-        if not isinstance(search, str) or not search.strip():
+    def __init__(self, search: str | None = None, timeout: float | None = None,
+                 schedule: str = ENGINE_NAME) -> None:
+        if search is not None and (not isinstance(search, str) or not search.strip()):
             raise ValueError(f"tasker-fd: search must be a Fast Downward search string, got {search!r}")
+        if schedule not in SCHEDULES:
+            raise ValueError(f"tasker-fd: schedule must be one of {', '.join(SCHEDULES)}, got {schedule!r}")
         if timeout is not None and not timeout > 0:
             raise ValueError(f"tasker-fd: timeout must be a positive number of seconds, got {timeout!r}")
         Engine.__init__(self)
         OneshotPlannerMixin.__init__(self)
         self._search = search
+        self._schedule = schedule
         self._timeout = timeout
 
     @property
@@ -71,7 +80,8 @@ class TaskerFastDownward(Engine, OneshotPlannerMixin):
 
     @staticmethod
     def satisfies(optimality_guarantee: OptimalityGuarantee) -> bool:
-        return True  # the default search is optimal; a user-supplied search is the user's choice
+        # the default schedule is optimal within its expansion budget only (SOLVED_OPTIMALLY says when)
+        return optimality_guarantee is OptimalityGuarantee.SATISFICING
 
     def _solve(
         self,
@@ -83,16 +93,15 @@ class TaskerFastDownward(Engine, OneshotPlannerMixin):
         assert isinstance(problem, up.model.Problem)
         start = time.perf_counter()
         writer = PDDLWriter(problem)
-        outcome = run_fast_downward(
-            writer.get_domain(), writer.get_problem(), search=self._search,
-            timeout=timeout if timeout is not None else self._timeout,
-        )
-        result = from_fd_outcome(outcome, self.name, time.perf_counter() - start)
-        metrics = {
-            "engine_internal_time": str(outcome.translate_s + outcome.search_s),
-            "translate_time": str(outcome.translate_s),
-            "search_time": str(outcome.search_s),
-        }
+        budget = timeout if timeout is not None else self._timeout
+        if self._search is None:
+            result = solve_text(self._schedule, writer.get_domain(), writer.get_problem(), budget)
+        else:
+            outcome = run_fast_downward(writer.get_domain(), writer.get_problem(), search=self._search, timeout=budget)
+            result = from_fd_outcome(outcome, self.name, time.perf_counter() - start, search=self._search,
+                                     optimal=self._search == OPTIMAL_SEARCH)
+        metrics = {"engine_internal_time": str(result.wall_time_s), "search": result.search,
+                   "optimal": str(result.optimal)}
         if result.status is not PlanStatus.SOLVED:
             if output_stream is not None and result.message:
                 output_stream.write(result.message + "\n")
@@ -107,8 +116,10 @@ class TaskerFastDownward(Engine, OneshotPlannerMixin):
             for step in result.plan
         ]
         metrics["cost"] = str(result.cost)
-        optimal = self._search == OPTIMAL_SEARCH and bool(problem.quality_metrics)
+        optimal = result.optimal and bool(problem.quality_metrics)
         status = UPStatus.SOLVED_OPTIMALLY if optimal else UPStatus.SOLVED_SATISFICING
-        logs = [LogMessage(LogLevel.INFO, f"{len(result.plan)} steps, cost {result.cost:g}, search {self._search}")]
+        note = f"{len(result.plan)} steps, cost {result.cost:g}, search {result.search}" + (
+            f"; {result.message}" if result.message else "")
+        logs = [LogMessage(LogLevel.INFO, note)]
         return PlanGenerationResult(status, up.plans.SequentialPlan(actions), self.name, metrics, logs)
 

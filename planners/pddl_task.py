@@ -482,7 +482,7 @@ class PddlTaskType(TaskType):
         stages = self.builder.from_steps(result.plan, travel, ctx.args)
         return StagePlan(stages, purpose, strategy="planned", sim_time=self.spec.planning_time_s,
                          note=label or None,
-                         info={"planner": result.planner, "cost": result.cost, "cached": result.cached,
+                         info={**result.trace_info(), "cached": result.cached,
                                "planner_time_s": result.wall_time_s}, goal=_goal_of(purpose, goal))
 
     # -- a suspension planned ahead --------------------------------------------------------

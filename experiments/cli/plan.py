@@ -5,9 +5,10 @@
 plan, 2 bad input; :mod:`experiments.cli.args`).  Handlers raise on bad input and the caller
 (:func:`experiments.cli.args.run_handler`) prints one line, never a traceback.
 
-Heavy modules are imported inside the handlers.  ``tasker plan`` with the default
-engine goes to Fast Downward without unified-planning's engine framework, and skips
-UP's PDDL reader when the same domain and problem passed its checks before
+Heavy modules are imported inside the handlers.  ``tasker plan`` is
+:func:`planners.plan_files.plan_files`: with a search schedule it goes to Fast Downward
+without unified-planning's engine framework, skips UP's PDDL reader when the same domain
+and problem passed its checks before, and UP's validator when the same plan passed it
 (:mod:`planners.cache`).
 """
 
@@ -143,11 +144,11 @@ def _read_arg(path: str, argument: str) -> str:
 
 
 def plan_command(args: argparse.Namespace) -> int:
-    """Solve DOMAIN + PROBLEM; print the plan, its cost and its stages (or JSON)."""
+    """Solve DOMAIN + PROBLEM; print the plan, its cost, whether it is optimal and its stages (or JSON)."""
     from experiments.cli.temporal import plan_temporal
-    from planners import cache
-    from planners.planner import ENGINE_NAME, PddlText, Planner
-    from planners.results import PlanStatus
+    from planners.plan_files import Reader, plan_files
+    from planners.planner import Planner
+    from planners.results import Failure, PlanStatus
     from planners.temporal.reading import is_temporal
 
     domain_text, problem_text = _read_arg(args.domain, "DOMAIN"), _read_arg(args.problem, "PROBLEM")
@@ -156,31 +157,24 @@ def plan_command(args: argparse.Namespace) -> int:
         return plan_temporal(args, domain_text, problem_text,
                              lambda r: _stages_for(domain_text, r, extra, Path(args.domain).parent))
     planner = Planner(args.planner, timeout=args.timeout, cache_size=0)
-    key = cache.content_key("pddl-problem", [domain_text, problem_text])
-    model = None
-    if planner.name != ENGINE_NAME or not cache.passed("pddl-problem", key):
-        from planners.checks import load_problem
-
-        _, _, model = load_problem(args.domain, args.problem)
-        cache.record("pddl-problem", key, {"domain": str(args.domain), "problem": str(args.problem)})
-    result = planner.solve(PddlText(domain_text, problem_text) if planner.name == ENGINE_NAME else model)
-    if result.status is PlanStatus.ERROR and planner.name == ENGINE_NAME and result.message.startswith("translator"):
-        # FD's own PDDL reader is stricter than UP's (e.g. an empty ``(:goal ())``): let UP write it.
-        if model is None:
-            from planners.checks import load_problem
-
-            _, _, model = load_problem(args.domain, args.problem)
-        result = planner.solve(model)
-    if result.status is PlanStatus.ERROR:
-        raise UsageError("PROBLEM", f"planner {result.planner} failed on {args.problem}: {result.message}")
+    answer = plan_files(Path(args.domain), Path(args.problem), domain_text, problem_text, planner)
+    result = answer.result
+    if result.failure is Failure.INPUT:
+        raise UsageError("PROBLEM", f"planner {result.planner} refuses {args.problem}: {result.message}")
     if args.json:
-        print(json.dumps(result.to_json()))
+        print(json.dumps(answer.to_json()))
     elif result.solved:
         assert result.plan is not None and result.cost is not None
         print(f"plan ({len(result.plan)} steps, cost {result.cost:g}, {result.planner}, "
               f"{result.wall_time_s * 1000:.0f} ms):")
         for k, step in enumerate(result.plan, 1):
             print(f"  {k:3d}. ({' '.join(step)})")
+        print(f"optimal: {'proven' if result.optimal else 'not proven'} ({result.search}'s plan"
+              + (f"; {result.message})" if result.message else ")"))
+        if answer.reader is Reader.FAST_DOWNWARD:
+            print(f"read by Fast Downward's translator; {answer.validation}")
+        elif answer.validation:
+            print(f"plan {answer.validation}")
         if not getattr(args, "quiet", False):
             stages = _stages_for(domain_text, result, extra, Path(args.domain).parent)
             if isinstance(stages, str):
@@ -189,8 +183,12 @@ def plan_command(args: argparse.Namespace) -> int:
                 print("stages:")
                 for k, s in enumerate(stages, 1):
                     print(f"  {k:3d}. {s.label} [{s.kind.value}, skill={s.skill or '-'}, {s.duration:g} s]")
-    else:
+    elif result.status is not PlanStatus.ERROR:
         print(f"{result.status.value}: {result.message or 'no plan'} ({result.planner})")
+        if result.attempts:
+            print("tried: " + "; ".join(a.describe(timed=True) for a in result.attempts))
+    if result.status is PlanStatus.ERROR:  # the engine's failure (or memory), not the input: exit 1
+        print(f"tasker plan: error: {result.message}", file=sys.stderr)
     return EXIT_OK if result.solved else EXIT_FAILED
 
 
@@ -270,21 +268,28 @@ def new_command(args: argparse.Namespace) -> int:
 
 def register(subparsers: Any) -> None:
     """Add ``plan``, ``domains``, ``fsm`` and ``new`` to an argparse sub-parser set."""
-    from planners.planner import DEFAULT_PLANNER
+    from planners.schedules import CLI_PLANNER, SCHEDULES
 
     p = subparsers.add_parser(
         "plan", help="solve a PDDL domain + problem with Fast Downward (or any UP one-shot engine)",
-        description="Check a PDDL domain and problem, solve them and print the plan, its cost and, when the domain "
-                    "is a registered task's, the stages it becomes. No plan exits 1.",
+        description="Check a PDDL domain and problem, solve them and print the plan, its cost, whether it is "
+                    "proven optimal and, when the domain is a registered task's, the stages it becomes. The default "
+                    "planner finds a plan at once and improves it within --timeout. Where unified-planning's reader "
+                    "refuses the task, Fast Downward's own translator reads it (said so; the plan is then not "
+                    "validated). No plan exits 1; an engine's own failure exits 1 naming it.",
         epilog="examples:\n"
                "  tasker plan domains/cook/domain.pddl problem.pddl\n"
                "  tasker plan domain.pddl problem.pddl --json --timeout 5\n"
-               "  tasker plan domain.pddl problem.pddl --planner fast-downward-opt   # any UP one-shot engine")
+               "  tasker plan domain.pddl problem.pddl --planner tasker-opt          # optimal or nothing\n"
+               "  tasker plan domain.pddl problem.pddl --planner fast-downward-opt   # any UP one-shot engine\n"
+               "planners (--planner):\n" + "\n".join(f"  {s.name:15s} {s.summary}" for s in SCHEDULES.values())
+               + "\n  (any other name: a unified-planning one-shot engine)")
     p.add_argument("domain", metavar="DOMAIN", help="domain.pddl")
     p.add_argument("problem", metavar="PROBLEM", help="problem.pddl")
-    p.add_argument("--planner", default=DEFAULT_PLANNER,
-                   help=f"a unified-planning one-shot engine by name (default {DEFAULT_PLANNER}: Fast Downward "
-                        "A* + LM-cut in-process; e.g. fast-downward, fast-downward-opt)")
+    p.add_argument("--planner", default=CLI_PLANNER,
+                   help=f"a search schedule or a unified-planning one-shot engine by name (default {CLI_PLANNER}: "
+                        "a plan at once, improved within --timeout; tasker-fd, tasker-opt, tasker-first; "
+                        "e.g. fast-downward, fast-downward-opt)")
     p.add_argument("--timeout", type=positive_seconds, default=60.0, metavar="S", help="seconds (default 60)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     _path_option(p)

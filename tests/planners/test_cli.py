@@ -22,7 +22,8 @@ def test_plan_on_up_classical_problems(name: str, up_pddl: Path, capsys: pytest.
     d, p = up_pddl / name / "domain.pddl", up_pddl / name / "problem.pddl"
     assert _run(["plan", str(d), str(p), "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert out["status"] == "solved" and out["planner"] == "tasker-fd" and out["planner_time_s"] > 0
+    assert out["status"] == "solved" and out["planner"] == "tasker-anytime" and out["planner_time_s"] > 0
+    assert out["reader"] == "unified-planning" and out["validated"] is True
     _, _, problem = load_problem(d, p)
     assert validate_plan(problem, [tuple(s) for s in out["plan"]]).valid
 
@@ -30,7 +31,8 @@ def test_plan_on_up_classical_problems(name: str, up_pddl: Path, capsys: pytest.
 def test_plan_human_output(pddl_files: tuple[Path, Path], capsys: pytest.CaptureFixture[str]) -> None:
     assert _run(["plan", str(pddl_files[0]), str(pddl_files[1])]) == 0
     out = capsys.readouterr().out
-    assert "cost 6" in out and "(move a b)" in out
+    assert "cost 6" in out and "(move a b)" in out and "plan valid (UP's sequential_plan_validator" in out
+    assert "optimal: proven" in out
     # no task folder declares this domain's skills, kinds or durations: none are made up ("suspendable, 0 s")
     assert "stages: none shown: domain 'delivery' is no task folder's" in out and "0 s]" not in out
 

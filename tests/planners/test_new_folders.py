@@ -231,11 +231,11 @@ def _refused_domain(tmp_path: Path, prepare: tuple[str, str], old: str, new: str
 
 @pytest.mark.parametrize(("old", "new", "at", "fragment"), [
     ("(holding ?r - robot ?i - item)", "(holding ?r - robot ?i - (either item robot))", "(either",
-     "(either ...) types are not supported by tasker"),
+     "(either ...) types: unified-planning's PDDL reader cannot read them, so a task folder cannot use them"),
     ("  (:action navigate", "  (:derived (busy ?r - robot) (not (hand_empty ?r)))\n  (:action navigate", "(:derived",
-     ":derived predicates are not supported by tasker"),
+     ":derived predicates: unified-planning's PDDL reader cannot read them, so a task folder cannot use them"),
     (":action-costs)", ":action-costs :derived-predicates)", ":derived-predicates",
-     ":derived predicates are not supported by tasker"),
+     ":derived predicates: unified-planning's PDDL reader cannot read them, so a task folder cannot use them"),
 ])
 def test_either_types_and_derived_predicates_are_refused_plainly(tmp_path: Path, old: str, new: str, at: str,
                                                                  fragment: str) -> None:

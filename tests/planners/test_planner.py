@@ -92,9 +92,9 @@ def test_plan_result_checks_fire() -> None:
     with pytest.raises(TypeError, match="PlanStatus"):
         PlanResult("solved", (), 0.0, "x", 0.0)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="tuples"):
-        PlanResult(PlanStatus.SOLVED, ((),), 0.0, "x", 0.0)
+        PlanResult(PlanStatus.SOLVED, ((),), 0.0, "x", 0.0, search="lama-first")
     with pytest.raises(ValueError, match="wall_time_s"):
-        PlanResult(PlanStatus.SOLVED, (), 0.0, "x", -1.0)
+        PlanResult(PlanStatus.SOLVED, (), 0.0, "x", -1.0, search="lama-first")
 
 
 def test_deterministic() -> None:
@@ -117,14 +117,14 @@ def _slow_solves(monkeypatch: pytest.MonkeyPatch, seconds: float) -> _Clock:
     """Every Fast Downward run of the facade takes ``seconds`` on a fake clock."""
     import planners.planner as facade
 
-    clock, real = _Clock(), facade.run_fast_downward
+    clock, real = _Clock(), facade.solve_text
 
     def run(*args: Any, **kwargs: Any) -> Any:
         clock.now += seconds
         return real(*args, **kwargs)
 
     monkeypatch.setattr(facade, "time", clock)
-    monkeypatch.setattr(facade, "run_fast_downward", run)
+    monkeypatch.setattr(facade, "solve_text", run)
     return clock
 
 
@@ -153,3 +153,25 @@ def test_planner_wall_time_counts_each_solve_once(monkeypatch: pytest.MonkeyPatc
     plans = [task.update_task(ctx) for _ in range(3)]
     assert [p.info["cached"] for p in plans] == [False, True, True]
     assert sum(p.info["planner_time_s"] for p in plans) == 5.0
+
+
+def test_engine_takes_a_schedule_and_claims_optimality_only_when_proven(pddl_files: tuple[Path, Path]) -> None:
+    _, _, problem = load_problem(*pddl_files)
+    with OneshotPlanner(name="tasker-fd", params={"schedule": "tasker-first"}) as engine:
+        engine.skip_checks = True
+        res = engine.solve(problem)
+    assert res.status.name == "SOLVED_SATISFICING" and len(res.plan.actions) == 3  # pick, move a-c, drop
+    with pytest.raises(ValueError, match="schedule must be one of"):
+        OneshotPlanner(name="tasker-fd", params={"schedule": "fastest"})
+
+
+def test_an_engine_that_raises_is_an_engine_error_not_an_exception(pddl_files: tuple[Path, Path]) -> None:
+    from unified_planning.environment import get_environment
+
+    factory = get_environment().factory
+    if "raising" not in factory.engines:
+        factory.add_engine("raising", "tests.planners.test_plan_files", "RaisingEngine")
+    _, _, problem = load_problem(*pddl_files)
+    res = Planner("raising").solve(problem)
+    assert res.status is PlanStatus.ERROR and res.failure.value == "engine"
+    assert res.message == "engine raising failed: RuntimeError: index 3 out of range in the engine"

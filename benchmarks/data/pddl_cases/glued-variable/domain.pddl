@@ -1,0 +1,7 @@
+; a name glued to its variable, as IPC's zenotravel writes (aircraft?a): PDDL reads (aircraft ?a)
+(define (domain glued)
+  (:requirements :strips)
+  (:predicates (robot ?r) (at ?r ?p) (link ?a ?b))
+  (:action go :parameters (?r ?a ?b)
+    :precondition (and (robot?r) (at ?r ?a) (link ?a ?b))
+    :effect (and (not (at ?r ?a)) (at ?r ?b))))

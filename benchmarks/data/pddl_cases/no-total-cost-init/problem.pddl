@@ -1,0 +1,6 @@
+(define (problem deliver)
+  (:domain delivery)
+  (:objects a b c - room cup - item)
+  (:init (robot-at a) (item-at cup a) (free) (= (dist a b) 2) (= (dist b a) 2) (= (dist b c) 2) (= (dist c b) 2) (= (dist a c) 10) (= (dist c a) 10) (= (dist a a) 0) (= (dist b b) 0) (= (dist c c) 0) )
+  (:goal (and (item-at cup c)))
+  (:metric minimize (total-cost)))

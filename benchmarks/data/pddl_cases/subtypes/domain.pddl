@@ -1,0 +1,7 @@
+(define (domain sub)
+  (:requirements :strips :typing)
+  (:types place - object robot - object tiago - robot)
+  (:predicates (at ?r - robot ?p - place) (link ?a ?b - place))
+  (:action go :parameters (?r - robot ?a ?b - place)
+    :precondition (and (at ?r ?a) (link ?a ?b))
+    :effect (and (not (at ?r ?a)) (at ?r ?b))))
