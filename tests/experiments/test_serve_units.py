@@ -151,13 +151,6 @@ def test_a_change_is_checked_whole_by_the_task_type_and_against_the_world(tasks:
                     world=world).field == "prio"
 
 
-def test_a_body_that_is_not_json_is_a_400_saying_where() -> None:
-    err = _refused(bodies.parse_json, b'{"task": ', "POST /requests")
-    assert err.status == 400 and "line 1, column 10" in err.message
-    assert _refused(bodies.parse_json, b'{"deadline": NaN}', "POST /requests").status == 400
-    assert _refused(bodies.parse_json, b"\xff", "POST /requests").status == 400
-
-
 def test_the_saved_session_renumbers_requests_in_file_order_and_reads_back(tmp_path: Path,
                                                                             paper: scenarios.RobotScenario) -> None:
     """A request that arrived at t=5 comes before the scenario's own at t=8 in the file, so it is d2
@@ -263,27 +256,6 @@ def test_the_live_page_is_offline_and_holds_the_world_figure_and_the_queue() -> 
     assert f"const DOORS = {json.dumps(doors)};" in text
 
 
-def _asgi(app: object, method: str, path: str, body: bytes = b"") -> tuple[int, dict]:
-    """One HTTP call to an ASGI app, in this process (no server, no client library)."""
-    import asyncio
-
-    sent: list[dict] = []
-
-    async def receive() -> dict:
-        return {"type": "http.request", "body": body, "more_body": False}
-
-    async def send(message: dict) -> None:
-        sent.append(message)
-
-    scope = {"type": "http", "asgi": {"version": "3.0"}, "http_version": "1.1", "method": method, "path": path,
-             "raw_path": path.encode(), "query_string": b"", "root_path": "", "scheme": "http",
-             "headers": [(b"content-type", b"application/json")], "client": ("127.0.0.1", 1),
-             "server": ("127.0.0.1", 80)}
-    asyncio.run(app(scope, receive, send))  # type: ignore[operator]
-    status = next(m["status"] for m in sent if m["type"] == "http.response.start")
-    return status, json.loads(b"".join(m.get("body", b"") for m in sent if m["type"] == "http.response.body"))
-
-
 def test_a_bug_in_reading_one_request_fails_that_request_not_the_session(
         tmp_path: Path, paper: scenarios.RobotScenario, monkeypatch: pytest.MonkeyPatch) -> None:
     from experiments.serve.app import create_app
@@ -306,12 +278,17 @@ def test_a_bug_in_reading_one_request_fails_that_request_not_the_session(
             ask.reply.set_exception(RuntimeError("a bug"))
             return ask.reply
 
-    status, said = _asgi(create_app(Failing(), page=lambda: ""), "POST", "/requests",  # type: ignore[arg-type]
-                         b'{"task": "guide"}')
-    assert status == 500 and "internal error, not a fault of the request (RuntimeError: a bug)" in said["detail"]
-    status, said = _asgi(create_app(Failing(), page=lambda: ""), "POST", "/requests", b'{"task": ')  # type: ignore
-    schema = create_app(Failing(), page=lambda: "").openapi()  # type: ignore[arg-type]
+    from fastapi.testclient import TestClient
+
+    def client() -> TestClient:
+        return TestClient(create_app(Failing(), page=lambda: ""), base_url="http://127.0.0.1:8765")  # type: ignore
+
+    said = client().post("/requests", content=b'{"task": "guide"}', headers={"Content-Type": "application/json"})
+    assert said.status_code == 500
+    assert "internal error, not a fault of the request (RuntimeError: a bug)" in said.json()["detail"]
+    said = client().post("/requests", content=b'{"task": ', headers={"Content-Type": "application/json"})
+    assert said.status_code == 400 and "not valid JSON" in said.json()["detail"]
+    schema = client().get("/openapi.json").json()
     body = schema["paths"]["/requests"]["post"]["requestBody"]["content"]["application/json"]["schema"]
     first = next(a.fields for a in paper.actions if a.kind == "request")
     assert body["example"] == {"task": first["task"], "args": first["args"]}  # the served scenario's first request
-    assert status == 400 and "not valid JSON" in said["detail"]
