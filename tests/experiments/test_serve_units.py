@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
@@ -386,3 +387,24 @@ def test_a_session_saves_every_suspension_strategy_the_scenario_reader_knows(
     record = Record(dataclasses.replace(paper, name="paper-session", suspension=suspension, actions=()))
     loaded = record.write(tmp_path / "session.toml", 10.0, "a test session")
     assert loaded.suspension == suspension
+
+
+@pytest.mark.parametrize(("changed_at", "warned"), [(None, True), (9.0, False), (21.0, True)])
+def test_a_replay_warns_of_a_repeated_request_only_while_its_twin_is_that_request(
+        tmp_path: Path, paper: scenarios.RobotScenario, changed_at: float | None, warned: bool) -> None:
+    """A session whose d1 was changed (PATCH) before the same request came again replays without the
+    warning that d1 "may still run" as that request: by then it was another one."""
+    from tasker.support.reader import InputWarning
+
+    record = Record(dataclasses.replace(paper, name="paper-session", actions=()))
+    john = {"task": "guide_human", "args": {"person": "john", "destination": "john_destination"}}
+    record.add(TimedAction(1.0, "request", john), "d1")
+    if changed_at is not None:
+        record.add(TimedAction(changed_at, "change", {"agent": "d1", "args": {"destination": "kitchen"}}), None)
+    record.add(TimedAction(20.0, "request", john), "d2")
+    record.write(tmp_path / "session.toml", 30.0, "a test session")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        scenarios.load(tmp_path / "session.toml")
+    said = [str(w.message) for w in caught if issubclass(w.category, InputWarning)]
+    assert any("the same request as d1" in s for s in said) is warned, said
