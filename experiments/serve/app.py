@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import asyncio
 import re
+import weakref
 from collections.abc import AsyncIterator, Callable
 from typing import Annotated, Any
 
@@ -41,6 +42,12 @@ REPLY_S = 120.0
 
 POLL_S = 0.1
 """How often ``GET /events`` looks for new trace lines."""
+
+MAX_STREAMS = 100
+"""The most ``GET /events`` streams open at once; one more is refused ``503`` (each idle stream
+wakes every :data:`POLL_S`: a thousand would take the event loop from ``GET /state``)."""
+
+UNAVAILABLE = 503
 
 AGENT = re.compile(r"d[1-9][0-9]{0,8}")
 """What a task's id looks like (``d1``, ``d2``, …): anything else names no task."""
@@ -163,29 +170,59 @@ def _reads(app: FastAPI, session: Session, page: Callable[[], str]) -> None:
     async def state() -> Response:
         return Response(session.state_json(), media_type="application/json")
 
+    streams = _Streams()
+
     @app.get("/events", summary="The trace as server-sent events, one trace.jsonl line each, id = its index",
-             response_class=StreamingResponse, responses=schemas.GUARDED)
+             response_class=StreamingResponse, responses={**schemas.GUARDED, 503: schemas.REFUSED})
     async def events(request: Request, first: int = Query(0, alias="from", ge=0, le=2**63 - 1,
                                                           description="the index of the first line to send")
                      ) -> StreamingResponse:
         last = strict.event_id(request.headers.get("last-event-id"))
         start = first if last is None else last + 1  # a reconnecting EventSource goes on where it was
-        return StreamingResponse(_stream(session, request, start), media_type="text/event-stream",
+        if streams.open >= MAX_STREAMS:
+            raise Refused(UNAVAILABLE, _where(request), f"{streams.open} event streams are open, the most this "
+                                                        "server keeps: close one, or poll GET /state")
+        return StreamingResponse(streams.stream(session, request, start), media_type="text/event-stream",
                                  headers={"Cache-Control": "no-cache", "X-Accel-Buffering": "no"})
 
 
-async def _stream(session: Session, request: Request, start: int) -> AsyncIterator[str]:
-    i = start
-    while True:
-        lines = session.lines[i:]
-        for line in lines:
-            yield f"id: {i}\nevent: trace\ndata: {line}\n\n"
-            i += 1
-        if not lines:
-            if session.stopped.is_set() or await request.is_disconnected():
-                yield "event: end\ndata: {}\n\n"
-                return
-            await asyncio.sleep(POLL_S)
+class _Streams:
+    """The ``GET /events`` streams of one app, counted from the call that opens one (so that a burst of
+    them is counted before any has started) until it ends or is dropped unstarted."""
+
+    def __init__(self) -> None:
+        self.open = 0
+
+    def stream(self, session: Session, request: Request, start: int) -> AsyncIterator[str]:
+        self.open += 1
+        released = False
+
+        def release() -> None:
+            nonlocal released
+            if not released:
+                released = True
+                self.open -= 1
+
+        lines = _lines(session, request, start, release)
+        weakref.finalize(lines, release)  # a stream whose client left before it started never runs its finally
+        return lines
+
+
+async def _lines(session: Session, request: Request, start: int, release: Callable[[], None]) -> AsyncIterator[str]:
+    try:
+        i = start
+        while True:
+            lines = session.lines[i:]
+            for line in lines:
+                yield f"id: {i}\nevent: trace\ndata: {line}\n\n"
+                i += 1
+            if not lines:
+                if session.stopped.is_set() or await request.is_disconnected():
+                    yield "event: end\ndata: {}\n\n"
+                    return
+                await asyncio.sleep(POLL_S)
+    finally:
+        release()
 
 
 def _writes(app: FastAPI, session: Session) -> None:

@@ -151,7 +151,10 @@ document.getElementById("queue-body").addEventListener("click", async ev => {
   if (t.term) { await api("DELETE", "/requests/" + t.term); }
   if (t.change) {
     const body = prompt(`change ${t.change}: JSON, e.g. {"priority": 3} or {"deadline": 300}`, '{"priority": 1}');
-    if (body) { const r = await api("PATCH", "/requests/" + t.change, JSON.parse(body));
+    if (body) {
+      let parsedBody;
+      try { parsedBody = JSON.parse(body); } catch (e) { alert("not JSON: " + e.message); return; }
+      const r = await api("PATCH", "/requests/" + t.change, parsedBody);
       if (r.status >= 300) alert((r.body && r.body.detail) || "HTTP " + r.status); }
   }
 });

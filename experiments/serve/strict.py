@@ -147,8 +147,8 @@ def event_id(header: str | None) -> int | None:
         return None
     text = header.strip()
     if not _DIGITS.fullmatch(text):
-        raise Refused(BAD, "GET /events", f"Last-Event-ID {shown(text)}: expected the id of a trace line this "
-                                          "stream sent (a number)", "Last-Event-ID")
+        raise Refused(BAD, "GET /events", f"expected the id of a trace line this stream sent (a number), got "
+                                          f"{shown(text)}", "Last-Event-ID")
     return int(text)
 
 

@@ -323,3 +323,35 @@ def test_fuzz_no_body_gets_a_5xx_and_what_passes_can_be_saved(body: Any, where: 
 
 
 _FUZZ = client()
+
+
+def test_event_streams_past_the_most_kept_open_are_refused_503_and_an_ended_one_frees_its_place(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    from experiments.serve import app as app_module
+
+    monkeypatch.setattr(app_module, "MAX_STREAMS", 1)
+    c, _ = client()
+    assert c.get("/events").text.endswith("event: end\ndata: {}\n\n")  # ran, ended: its place is free again
+    assert c.get("/events").status_code == 200
+    monkeypatch.setattr(app_module, "MAX_STREAMS", 0)
+    said = refusal(c.get("/events"), 503, "")
+    assert "0 event streams are open" in said["message"]
+
+
+def test_an_event_stream_is_counted_from_the_call_that_opens_it_until_it_ends_or_is_dropped() -> None:
+    import asyncio
+    import gc
+
+    from experiments.serve.app import _Streams
+
+    streams, session = _Streams(), StandIn()
+    first, second = (streams.stream(session, None, 0) for _ in range(2))  # type: ignore[arg-type]
+    assert streams.open == 2  # counted before either has started: a burst of opens is refused in time
+
+    async def drain() -> list[str]:
+        return [x async for x in first]
+
+    assert asyncio.run(drain())[-1] == "event: end\ndata: {}\n\n" and streams.open == 1
+    del second  # its client left before it started: it never runs, and frees its place
+    gc.collect()
+    assert streams.open == 0

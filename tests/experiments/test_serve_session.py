@@ -237,3 +237,24 @@ def test_the_state_lists_live_tasks_first_and_the_form_starts_on_a_task_the_worl
     first = next(t for t in s["task_types"] if t["example"] is not None)
     r = live.client.post("/requests", json={"task": first["name"], "args": first["example"]})
     assert r.status_code == 201, r.text
+
+
+def test_a_trace_writer_that_fails_part_way_leaves_the_whole_trace_written_from_memory(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """What a lone surrogate once did (the run folder's trace.jsonl left empty): whatever cuts the
+    final writer short, the session's own lines are the trace."""
+    from tasker.trace import Trace
+
+    def cut_short(self: Trace, path: str | Path) -> None:
+        Path(path).write_text("", encoding="utf-8")
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(Trace, "write", cut_short)
+    live = start(tmp_path / "live")
+    assert live.client.post("/requests", json=JOHN).status_code == 201
+    live.stop()
+    [failure] = live.failure
+    assert isinstance(failure, RunAborted) and "No space left on device" in failure.reason
+    trace = (live.session.out / "trace.jsonl").read_text(encoding="utf-8")
+    assert len(live.session.lines) > 5 and trace == "".join(f"{x}\n" for x in live.session.lines)
+    assert "session.toml" in failure.reason.split("kept in")[1]
