@@ -31,8 +31,8 @@ so that they stay in sight however long its arguments or another task's end are.
 _STYLE = """<style>
 #status{font-family:monospace;background:#f4f4f4;padding:4px 8px}
 #queue{border-collapse:collapse;font-size:.9em} #queue th,#queue td{padding:2px 5px;vertical-align:top}
-#queue td{overflow-wrap:anywhere} #queue td.args{max-width:18em} #queue td.end{max-width:22em}
-#queue td.act{white-space:nowrap} #queue .ended td{color:#999} #queue .exeDA td{background:#eaf2fb}
+#queue td{white-space:nowrap} #queue td.args,#queue td.end{white-space:normal;overflow-wrap:anywhere;min-width:9em;
+max-width:16em} #queue .ended td{color:#999} #queue .exeDA td{background:#eaf2fb}
 form{margin:.4em 0} input,select,textarea{font:inherit;margin:0 .3em} .err{color:#c0392b} .ok{color:#2a7a2a}
 </style>"""
 
