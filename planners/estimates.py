@@ -304,7 +304,7 @@ class Estimator:
     def suspension_stages(self, ctx: TaskContext) -> tuple[Stage, ...]:
         """What genSusp would do now; only its effects matter here, so no travel table is built."""
         task = self.task
-        if ctx.strategy.suspension != "static":
+        if ctx.strategy.suspension not in ("static", "fallback"):  # fallback: the tree, where it can run
             world, goal, _ = task.suspension_inputs(ctx)
             steps, status, _ = self.plan(ctx, world, goal, task.suspension_facts(ctx, world))
             if status is PlanStatus.SOLVED:

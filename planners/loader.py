@@ -140,8 +140,8 @@ def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
     _check_texts(spec, dm)
     lits = [("problem.goal", spec.goal), ("problem.facts", spec.facts),
             ("problem.suspended_facts", spec.suspended_facts)]
-    lits += [(f"suspension[{k}].{key}", getattr(b, key)) for k, b in enumerate(spec.suspension)
-             for key in ("when", "goal")]
+    lits += [(f"{where}[{k}].{key}", getattr(b, key)) for _, where, tree in spec.all_trees()
+             for k, b in enumerate(tree) for key in ("when", "goal")]
     for where, group in lits:
         for lit in group:
             try:
@@ -149,7 +149,8 @@ def _cross_check(spec: TaskSpec, dm: DomainModel) -> None:
             except DefinitionError as exc:  # located in task.toml, at the field's line
                 raise DefinitionError(toml, exc.reason, spec.lines.get(where)) from None
     templates = [("static.update", t) for t in spec.static_update]
-    templates += [(f"suspension[{k}].stages", t) for k, b in enumerate(spec.suspension) for t in b.stages]
+    templates += [(f"{where}[{k}].stages", t) for _, where, tree in spec.all_trees() for k, b in enumerate(tree)
+                  for t in b.stages]
     tokens = [*((w, tok) for w, group in lits for lit in group for tok in lit),
               *((w, tok) for w, t in templates for tok in t.args)]
     _check_request_tokens(spec, tokens)
@@ -204,8 +205,7 @@ def _check_suspension(spec: TaskSpec, dm: DomainModel) -> None:
     ``goal`` from any state where its ``when`` holds.  The stages' PDDL effects are applied
     in order to what ``when`` says (facts it does not mention are unknown), so every goal
     literal must be stated by ``when`` or made so by a stage, and not undone later."""
-    for k, b in enumerate(spec.suspension):
-        where = f"suspension[{k}]"
+    for b, where in ((b, f"{at}[{k}]") for _, at, tree in spec.all_trees() for k, b in enumerate(tree)):
         bound = {tok for lit in b.when if lit[0] != "not" for tok in lit if tok.startswith("?")}
         for lit in [*b.goal, *(("stage", *t.args) for t in b.stages)]:
             free = sorted(tok for tok in lit if tok.startswith("?") and tok not in bound)

@@ -41,7 +41,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from planners import derived, original_costs, stagecheck
+from planners import derived, fallback, original_costs, stagecheck
 from planners.checks import DefinitionError
 from planners.derived import INTERRUPTION_KEY
 from planners.estimates import estimator_for, executing
@@ -66,6 +66,8 @@ from tasker.stage import Purpose, Stage, StagePlan
 from tasker.task import Effects, Leaving, TaskContext, TaskType
 from tasker.world import Pose, WorldState
 
+PLANNING = ("planned", "derived")
+"""The suspension strategies whose genSusp always plans (a suspension may be planned ahead for them)."""
 PLANS_REMEMBERED = 8
 """How many plans ``PLANNED_FROM_KEY`` (:mod:`planners.stagecheck`) keeps per agent."""
 RESTORE_KEY = "_restore_baseline"
@@ -116,6 +118,11 @@ def default_planner() -> Planner:
     if _shared_planner is None:
         _shared_planner = Planner()
     return _shared_planner
+
+
+def _goal_of(purpose: Purpose, goal: list[Literal]) -> tuple[Literal, ...] | None:
+    """What a plan for ``purpose`` says it aims for: genSusp's goal (judged when the suspension ends)."""
+    return tuple(goal) if purpose is Purpose.GEN_SUSP else None
 
 
 def hook_line(exc: BaseException, path: Path) -> int | None:
@@ -178,6 +185,10 @@ class PddlTaskType(TaskType):
                 raise DefinitionError(path, f"check_args raised {type(exc).__name__}: {exc} (refuse a request "
                                             "with tasker.errors.BadRequest)", hook_line(exc, path)) from None
 
+    def tree_names(self) -> tuple[str, ...]:
+        """``default`` (``[[suspension]]``) and the names of the folder's ``[[trees.NAME]]``."""
+        return self.spec.tree_names
+
     def check_terminate(self, ctx: TaskContext) -> str | None:
         """``ic_term``: the folder's ``task.py`` may say the task is no longer needed."""
         hook = self.hooks.get("check_terminate")
@@ -222,6 +233,8 @@ class PddlTaskType(TaskType):
     def _generate_suspension(self, ctx: TaskContext) -> StagePlan:
         if ctx.strategy.suspension == "static":
             return self.static_suspension(ctx)
+        if ctx.strategy.suspension == "fallback":
+            return fallback.suspension(self, ctx)
         world, goal, branch = self.suspension_inputs(ctx)  # the tree's branch, or the derived goal
         extra = self.suspension_facts(ctx, world)
         ready = self._preplanned(ctx, world, goal, extra, branch.label)
@@ -238,12 +251,16 @@ class PddlTaskType(TaskType):
         """Why ``stage`` cannot run now, or None (:func:`planners.stagecheck.inapplicable`)."""
         return stagecheck.inapplicable(self, ctx, stage)
 
+    def already_done(self, ctx: TaskContext, stage: Stage) -> str | None:
+        """Why ``stage`` need not run, its effects holding already (:func:`planners.stagecheck.already_done`)."""
+        return stagecheck.already_done(self, ctx, stage)
+
     def compute_params(self, ctx: TaskContext) -> CostParams:
         """``cost = cps * (age + cTime)``; cTime and endPose from :meth:`estimate` of the state now.
 
         While a stage of ``exeTsk`` runs under the planned suspension strategy, the
         suspension of the state now is planned here too (:meth:`_preplan_suspension`)."""
-        if executing(ctx) and ctx.strategy.suspension != "static" and isinstance(ctx.world, WorldState):
+        if executing(ctx) and ctx.strategy.suspension in PLANNING and isinstance(ctx.world, WorldState):
             self._preplan_suspension(ctx)
         if self._original(ctx):
             return self.original_params(ctx)
@@ -327,6 +344,11 @@ class PddlTaskType(TaskType):
         """The declared hazards that hold now and are this task's (:func:`planners.derived.owned_hazards`)."""
         return derived.owned_hazards(self, ctx, world)
 
+    def plan_suspension_to(self, ctx: TaskContext, world: WorldState, goal: list[Literal],
+                           label: str) -> StagePlan | PlanResult:
+        """genSusp planned from ``world`` to ``goal`` (with the suspension's extra facts), or the failed result."""
+        return self._plan(ctx, world, goal, self.suspension_facts(ctx, world), Purpose.GEN_SUSP, label=label)
+
     def derived_goal(self, ctx: TaskContext, world: WorldState) -> tuple[list[Literal], str]:
         """The ``derived`` suspension goal and a label saying what it asks for (:func:`planners.derived.goal`)."""
         return derived.goal(self, ctx, world)
@@ -380,7 +402,8 @@ class PddlTaskType(TaskType):
         travel = travel_table(world, ctx.motion, self.spec.travel_s)
         stages = self.builder.from_templates(branch.stages, b, travel, ctx.suspended)
         return StagePlan(stages, Purpose.GEN_SUSP, strategy="static", sim_time=self.spec.static_time_s,
-                         note=f"decision tree: {branch.label or ('save' if not stages else 'branch')}")
+                         note=f"decision tree: {branch.label or ('save' if not stages else 'branch')}",
+                         goal=tuple(b.literals(branch.goal)))
 
     # -- helpers ----------------------------------------------------------------------
 
@@ -417,14 +440,15 @@ class PddlTaskType(TaskType):
         expected = ctx.memory.get(INTERRUPTION_KEY)
         length = math.inf if expected is None else float(expected)
         base = Bindings(ctx.args, world)
-        for br in self.spec.suspension:
+        tree = self.spec.tree(ctx.strategy.tree)
+        for br in tree:
             if br.policy == "conditional" and (ctx.strategy.policy != "conditional"
                                                or br.max_interruption_s is None or length > br.max_interruption_s):
                 continue
             bound = base.match(br.when, world.facts)
             if bound is not None:
                 return br, bound
-        return self.spec.suspension[-1], base
+        return tree[-1], base
 
     def problem_text(self, ctx: TaskContext, world: WorldState, goal: list[Literal],
                      extra: list[Literal]) -> tuple[PddlText, frozenset[Literal], dict[tuple[str, str], float]]:
@@ -440,7 +464,7 @@ class PddlTaskType(TaskType):
         """A planned StagePlan, or the failed PlanResult for the caller to handle."""
         text, init, travel = self.problem_text(ctx, world, goal, extra)
         if holds(init, goal):
-            return self._holds(ctx, purpose, label, text)
+            return self._holds(ctx, purpose, label, text, goal)
         result = self.planner.solve(text, timeout=self.timeout)
         self._record(ctx, purpose, label, text, result)
         if not result.solved:
@@ -450,7 +474,7 @@ class PddlTaskType(TaskType):
         return StagePlan(stages, purpose, strategy="planned", sim_time=self.spec.planning_time_s,
                          note=label or None,
                          info={"planner": result.planner, "cost": result.cost, "cached": result.cached,
-                               "planner_time_s": result.wall_time_s})
+                               "planner_time_s": result.wall_time_s}, goal=_goal_of(purpose, goal))
 
     # -- a suspension planned ahead --------------------------------------------------------
 
@@ -496,7 +520,7 @@ class PddlTaskType(TaskType):
                 return None
         text, init, travel = self.problem_text(ctx, world, goal, extra)
         if not steps:  # the goal held in this very state
-            return self._holds(ctx, Purpose.GEN_SUSP, label, text)
+            return self._holds(ctx, Purpose.GEN_SUSP, label, text, goal)
         journal = _journal.get()
         if journal is not None:
             journal.append(PlanningRecord(
@@ -506,13 +530,15 @@ class PddlTaskType(TaskType):
         stages = self.builder.from_steps(steps, travel, ctx.args)
         return StagePlan(stages, Purpose.GEN_SUSP, strategy="planned", sim_time=self.spec.static_time_s,
                          note=(label + "; " if label else "") + "planned ahead",
-                         info={"planner": self.planner.name, "planned_ahead": True})
+                         info={"planner": self.planner.name, "planned_ahead": True}, goal=tuple(goal))
 
-    def _holds(self, ctx: TaskContext, purpose: Purpose, label: str, text: PddlText) -> StagePlan:
+    def _holds(self, ctx: TaskContext, purpose: Purpose, label: str, text: PddlText,
+               goal: list[Literal]) -> StagePlan:
         """The plan when the goal already holds: nothing to do, journalled as such."""
         self._record(ctx, purpose, label, text, None)
         note = "goal already holds" + (f" ({label})" if label else "")
-        return StagePlan((), purpose, strategy="planned", sim_time=self.spec.static_time_s, note=note)
+        return StagePlan((), purpose, strategy="planned", sim_time=self.spec.static_time_s, note=note,
+                         goal=_goal_of(purpose, goal))
 
     def _record(self, ctx: TaskContext, purpose: Purpose, label: str, text: PddlText,
                 result: PlanResult | None) -> None:
@@ -526,7 +552,7 @@ class PddlTaskType(TaskType):
     @staticmethod
     def _fallback(plan: StagePlan, why: str) -> StagePlan:
         return StagePlan(plan.stages, plan.purpose, strategy="static", sim_time=plan.sim_time,
-                         note=f"fallback to static: {why}", info=plan.info)
+                         note=f"fallback to static: {why}", info=plan.info, goal=plan.goal)
 
     def estimate(self, ctx: TaskContext, start: Pose | None, after: str | None = None) -> tuple[float, Pose | None]:
         """Seconds to complete the task from ``start`` (the robot's pose if None) and the end pose.

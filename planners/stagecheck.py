@@ -68,6 +68,22 @@ def inapplicable(task: CheckedTask, ctx: TaskContext, stage: Stage) -> str | Non
     said = ", ".join(f"({' '.join(lit)})" for lit in unmet)
     return f"{INAPPLICABLE} {stage.action}({' '.join(stage.args)}) needs {said}, which does not hold"
 
+def already_done(task: CheckedTask, ctx: TaskContext, stage: Stage) -> str | None:
+    """Why ``stage`` need not run: every effect of its action holds in the world as it is now (each
+    fact it adds holds, none it deletes does), or None.  A stage with no effects is never already
+    done.  The agent asks it of a stage :func:`inapplicable` refuses: a door someone else closed
+    makes ``close_door`` already done, not a failure."""
+    world = ctx.world
+    if not isinstance(world, WorldState):
+        return None
+    add = [tuple(str(x) for x in f) for f in stage.data.get("add", ())]
+    delete = [tuple(str(x) for x in f) for f in stage.data.get("delete", ())]
+    if not (add or delete) or any(f not in world.facts for f in add) or any(f in world.facts for f in delete):
+        return None
+    said = ", ".join([f"({' '.join(f)})" for f in add] + [f"(not ({' '.join(f)}))" for f in delete])
+    return f"already done: {said} hold{'s' if len(add) + len(delete) == 1 else ''} in the world now"
+
+
 def _projection(ctx: TaskContext, stage: Stage,
             extra: frozenset[Literal]) -> tuple[frozenset[Literal], frozenset[str]] | None:
     """What ``stage``'s plan may assume: the facts it was made from of the kinds :func:`_assumed` names,

@@ -12,18 +12,26 @@ negated as ``["not", "following", "$person"]``; ``$name`` is a request argument,
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
-from contextlib import contextmanager
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from planners.checks import DefinitionError
-from tasker.errors import BadRequest, ConfigError
+from planners.specreader import (
+    DEFAULT_TREE,
+    Branch,
+    Literal,
+    SpecReader,
+    StageTemplate,
+    as_definition_error,
+    read_trees,
+)
+from tasker.errors import BadRequest, ConfigError, UnknownName
 from tasker.meaning import BINDING_KINDS, ROLES, Binding, Hazard, Meaning, People
 from tasker.stage import StageKind
 from tasker.support import reader
-from tasker.task import POLICIES, ArgSpec
+from tasker.task import ArgSpec
 
 SKILLS = ("navigate", "say", "manipulate", "wait")
 
@@ -48,7 +56,6 @@ seconds); ``taskER-2019``, the original TaskER code's (path metres weighted per 
 offered by a folder that declares ``[schedule.taskER-2019]``."""
 ORIGINAL = COST_MODELS[1]
 
-Literal = tuple[str, ...]
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,33 +69,6 @@ class ActionSpec:
     travel: tuple[str, str] | None = None
     to: str | None = None
     text: str | None = None
-
-
-@dataclass(frozen=True, slots=True)
-class StageTemplate:
-    """One stage of a static strategy: an action with argument templates."""
-
-    action: str
-    args: tuple[str, ...]
-    suspended: str | None = None
-
-
-@dataclass(frozen=True, slots=True)
-class Branch:
-    """One branch of the suspension decision list (eq. 47), shared by both strategies.
-
-    It applies when every ``when`` literal holds (``?vars`` are bound by the first match,
-    in sorted order, and may be used in ``goal`` and ``stages``); ``planned`` plans to
-    ``goal``, ``static`` runs ``stages`` — the load check proves the stages reach the goal.
-    A ``policy = "conditional"`` branch trades safety for time: it is eligible only under
-    that policy and when the expected interruption is at most ``max_interruption_s``."""
-
-    when: tuple[Literal, ...] = ()
-    goal: tuple[Literal, ...] = ()
-    stages: tuple[StageTemplate, ...] = ()
-    label: str = ""
-    policy: str = "strict"
-    max_interruption_s: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -163,10 +143,32 @@ class TaskSpec:
     """``[schedule.taskER-2019]``: the folder offers the original TaskER cost model."""
     lines: Mapping[str, int | None] = field(default_factory=dict)
     """Where each checked field is written (``"hazards[0].fact"`` -> line), for later checks."""
+    trees: Mapping[str, tuple[Branch, ...]] = field(default_factory=dict)
+    """``[[trees.NAME]]``: other decision trees besides ``[[suspension]]`` (the tree named
+    :data:`DEFAULT_TREE`), written from other assumptions; ``Strategy.tree`` picks one."""
 
     @property
     def toml(self) -> Path:
         return self.folder / "task.toml"
+
+    def tree(self, name: str | None) -> tuple[Branch, ...]:
+        """The branches of tree ``name`` (None or :data:`DEFAULT_TREE`: ``[[suspension]]``)."""
+        if name is None or name == DEFAULT_TREE:
+            return self.suspension
+        try:
+            return self.trees[name]
+        except KeyError:
+            raise UnknownName(f"decision tree of task {self.name!r}", name, list(self.tree_names)) from None
+
+    @property
+    def tree_names(self) -> tuple[str, ...]:
+        """Every tree's name, the default first."""
+        return (DEFAULT_TREE, *sorted(self.trees))
+
+    def all_trees(self) -> list[tuple[str, str, tuple[Branch, ...]]]:
+        """``(name, where it is written, branches)`` of every tree: ``[[suspension]]`` first."""
+        return [(DEFAULT_TREE, "suspension", self.suspension),
+                *((n, f"trees.{n}", self.trees[n]) for n in sorted(self.trees))]
 
     def error(self, fieldname: str, message: str) -> DefinitionError:
         """A fault found after reading (against the domain), located like the reader's own."""
@@ -197,114 +199,7 @@ def meaning_of(spec: TaskSpec, bindings: tuple[Binding, ...]) -> Meaning:
     return Meaning(spec.hazards, spec.people, bindings)
 
 
-def _object_token(token: str) -> str:
-    """A literal's argument as the domain reads it: an object name in lower case (``$at:NAME``'s
-    name too); a request argument ``$name`` as written."""
-    if token.startswith("$at:"):
-        return "$at:" + token[4:].lower()
-    return token if token.startswith("$") else token.lower()
-
-
-class _Reader:
-    """Reads ``task.toml`` through :class:`tasker.support.reader.Table`; remembers field lines."""
-
-    def __init__(self, file: Path) -> None:
-        self.file = file
-        self.lines: dict[str, int | None] = {}
-
-    def fail(self, t: reader.Table, key: str | int | None, reason: str) -> DefinitionError:
-        return _definition(t.error(key, reason))
-
-    def note(self, t: reader.Table, key: str | int | None = None) -> str:
-        name = t.field(key)
-        self.lines[name] = t.line(key)
-        return name
-
-    def literals(self, t: reader.Table, key: str, default: Any = None) -> tuple[Literal, ...]:
-        value = t.raw(key, [] if default is None else default)
-        self.note(t, key)
-        if not isinstance(value, list):
-            raise self.fail(t, key, 'expected a list of literals such as [["at", "$x", "$place"]], '
-                                    f"got {value!r}")
-        out: list[Literal] = []
-        for lit in value:
-            out.append(self.literal(t, key, lit))
-        return tuple(out)
-
-    def literal(self, t: reader.Table, key: str, lit: Any) -> Literal:
-        if not isinstance(lit, list) or not lit or not all(isinstance(s, str) and s for s in lit):
-            raise self.fail(t, key, f"a literal is a non-empty list of strings, got {lit!r}")
-        if lit[0].lower() == "not" and len(lit) < 2:
-            raise self.fail(t, key, f"'not' needs a predicate: {lit!r}")
-        # PDDL names are case-insensitive and the domain is read in lower case: so are a predicate
-        # and an object named here (a world's names are lower case); $arguments keep theirs
-        head = 2 if lit[0].lower() == "not" else 1
-        return (*(s.lower() for s in lit[:head]), *(_object_token(s) for s in lit[head:]))
-
-    def templates(self, t: reader.Table, key: str) -> tuple[StageTemplate, ...]:
-        value = t.raw(key, [])
-        self.note(t, key)
-        if not isinstance(value, list):
-            raise self.fail(t, key, "stages must be a list of {action = ..., args = [...]} tables")
-        out = []
-        for i, raw in enumerate(value):
-            if not isinstance(raw, dict):
-                raise self.fail(t, key, f"a stage is a table {{action = ..., args = [...]}}, got {raw!r}")
-            st = reader.Table(self.file, raw, (*t.path, key, i), t._index)
-            action = st.string("action").lower()  # PDDL names are case-insensitive
-            args = st.raw("args", [])
-            if not isinstance(args, list) or not all(isinstance(a, str) for a in args):
-                raise self.fail(st, "args", f"stage {action!r}: expected a list of strings")
-            sus = st.string("suspended", None)
-            sus = None if sus is None else sus.lower()
-            st.done()
-            out.append(StageTemplate(action, tuple(_object_token(a) for a in args), sus))
-        return tuple(out)
-
-    def branches(self, t: reader.Table, key: str) -> tuple[Branch, ...]:
-        if key not in t:
-            out = [Branch()]
-        else:
-            out = []
-            tables = t.tables(key)
-            for b in tables:
-                policy = b.string("policy", "strict", choices=POLICIES)
-                limit = b.number("max_interruption_s", None, min=0, max=reader.MAX_SECONDS)
-                if (policy == "conditional") != (limit is not None):
-                    raise self.fail(b, "max_interruption_s" if limit is not None else "policy",
-                                    'a branch that trades safety for time has policy = "conditional" and '
-                                    "max_interruption_s (the longest interruption it accepts), and only such a branch")
-                out.append(Branch(self.literals(b, "when"), self.literals(b, "goal"), self.templates(b, "stages"),
-                                  b.string("label", "", empty=True), policy,
-                                  None if limit is None else float(limit)))
-                self.note(b)
-                b.done()
-            if not out:
-                raise self.fail(t, key, "needs at least one branch (the default case, with no 'when')")
-            for k, branch in enumerate(out[:-1]):  # the first branch that holds is chosen: this one always does
-                if not branch.when and branch.policy == "strict":
-                    later = ", ".join(repr(x.label or f"suspension[{j}]") for j, x in enumerate(out[k + 1:], k + 1))
-                    raise self.fail(tables[k], None, f"no 'when': it always holds, so the branches after it ({later}) "
-                                                     "are never chosen; give it a 'when' or make it the last")
-        last = out[-1]
-        if last.when or last.policy != "strict":
-            raise self.fail(t, key, "the last branch must have no 'when' and the strict policy (the default case)")
-        return tuple(out)
-
-
-def _definition(exc: reader.InputError) -> DefinitionError:
-    return DefinitionError(exc.file, f"{exc.field}: {exc.message}" if exc.field else exc.message, exc.line)
-
-
-@contextmanager
-def _as_definition_error() -> Iterator[None]:
-    try:
-        yield
-    except reader.InputError as exc:
-        raise _definition(exc) from None
-
-
-def _action(r: _Reader, a: reader.Table, name: str) -> ActionSpec:
+def _action(r: SpecReader, a: reader.Table, name: str) -> ActionSpec:
     skill = a.string("skill", choices=SKILLS)
     kind = StageKind(a.string("kind", "suspendable", choices=[k.value for k in StageKind]))
     travel = a.raw("travel", None)
@@ -325,7 +220,7 @@ def _action(r: _Reader, a: reader.Table, name: str) -> ActionSpec:
                       tuple(travel) if travel else None, to, text)
 
 
-def _args(r: _Reader, top: reader.Table) -> tuple[ArgSpec, ...]:
+def _args(r: SpecReader, top: reader.Table) -> tuple[ArgSpec, ...]:
     out: list[ArgSpec] = []
     first: dict[str, int | None] = {}
     for a in top.tables("args", []):
@@ -361,7 +256,7 @@ def _args(r: _Reader, top: reader.Table) -> tuple[ArgSpec, ...]:
     return tuple(out)
 
 
-def _original_costs(r: _Reader, schedule: reader.Table, top: reader.Table,
+def _original_costs(r: SpecReader, schedule: reader.Table, top: reader.Table,
                     args: tuple[ArgSpec, ...]) -> OriginalCosts | None:
     """``[schedule.taskER-2019]``, checked against the declared request arguments: a folder that
     offers the model declares ``cost_model`` (choices: the models), and one that does not, does not."""
@@ -405,7 +300,7 @@ def _original_costs(r: _Reader, schedule: reader.Table, top: reader.Table,
     return out
 
 
-def _example(r: _Reader, top: reader.Table) -> ExampleWorld | None:
+def _example(r: SpecReader, top: reader.Table) -> ExampleWorld | None:
     if "example" not in top:
         return None
     ex = top.table("example")
@@ -425,7 +320,7 @@ def _example(r: _Reader, top: reader.Table) -> ExampleWorld | None:
     return ExampleWorld(args, objects, facts, poses)
 
 
-def _hazards(r: _Reader, top: reader.Table) -> tuple[Hazard, ...]:
+def _hazards(r: SpecReader, top: reader.Table) -> tuple[Hazard, ...]:
     out = []
     for h in top.tables("hazards", []):
         name = h.string("name")
@@ -454,7 +349,7 @@ def _hazards(r: _Reader, top: reader.Table) -> tuple[Hazard, ...]:
     return tuple(out)
 
 
-def _people(r: _Reader, top: reader.Table) -> People | None:
+def _people(r: SpecReader, top: reader.Table) -> People | None:
     if "people" not in top:
         return None
     p = top.table("people")
@@ -471,7 +366,7 @@ def _people(r: _Reader, top: reader.Table) -> People | None:
     return People(person, roles, safe)
 
 
-def _derived(r: _Reader, top: reader.Table) -> tuple[Literal, ...]:
+def _derived(r: SpecReader, top: reader.Table) -> tuple[Literal, ...]:
     """``[derived] invariants``: what must hold whenever the task is suspended (besides its hazards
     off and its person in a safe role), for the ``derived`` suspension strategy."""
     if "derived" not in top:
@@ -482,7 +377,7 @@ def _derived(r: _Reader, top: reader.Table) -> tuple[Literal, ...]:
     return tuple(invariants)
 
 
-def _bindings(r: _Reader, top: reader.Table) -> tuple[RawBinding, ...]:
+def _bindings(r: SpecReader, top: reader.Table) -> tuple[RawBinding, ...]:
     out: list[RawBinding] = []
     where: dict[tuple[str, int], tuple[RawBinding, int | None]] = {}
     for b in top.tables("bindings", []):
@@ -521,8 +416,8 @@ def _bindings(r: _Reader, top: reader.Table) -> tuple[RawBinding, ...]:
 
 def read_task_toml(path: Path) -> TaskSpec:
     """Read and check one ``task.toml`` (the PDDL is checked by :mod:`planners.pddl_task`)."""
-    r = _Reader(path)
-    with _as_definition_error():
+    r = SpecReader(path)
+    with as_definition_error():
         top = reader.load(path)
         task = top.table("task")
         name = task.string("name")
@@ -570,6 +465,7 @@ def read_task_toml(path: Path) -> TaskSpec:
             priority=None if priority is None else int(priority),
             hazards=_hazards(r, top), people=_people(r, top), bindings=_bindings(r, top),
             invariants=_derived(r, top), restore=tuple(restore), original_costs=original, lines=r.lines,
+            trees=read_trees(r, top),
         )
         top.done()
     return spec

@@ -17,8 +17,9 @@ folder *binds* to physical state (:class:`tasker.meaning.Binding`, given with
 :meth:`Simulation.bind`) — a device's state, a door open, an object held, a person
 following or waiting — is never stored: :meth:`Simulation.apply` changes the device,
 the door, the grip or the person, and :meth:`Simulation.snapshot` derives the fact from
-it.  The world names no task's predicate.  Device states are reported as
-``("state", device, value)``, postures as ``("posture", person, posture)``.
+it.  The world names no task's predicate but the facts it derives (:data:`DERIVED`):
+``("clear", place)`` while no movable object rests at a place.  Device states are reported
+as ``("state", device, value)``, postures as ``("posture", person, posture)``.
 """
 
 from __future__ import annotations
@@ -53,6 +54,10 @@ AT_TOLERANCE = 0.3  # metres: the robot starts "at" a place this close
 TOGETHER = 1.5  # metres: a person this close to the robot is symbolically at the robot's place
 WAIT_MARGIN = 0.05  # metres beyond a standing person's radius and the robot's width (Simulation._aside_spot)
 ASIDE_STEP, ASIDE_MAX, ASIDE_DIRECTIONS = 0.1, 3.0, 16  # where a person stepping aside looks for a spot
+CLEAR = "clear"
+DERIVED = frozenset({CLEAR})
+"""Predicates the world derives and never stores: ``("clear", place)`` holds while no movable object
+(of the world file or the scenario) is ``at`` the place; an effect on one is ignored (:meth:`Simulation.apply`)."""
 
 
 class Simulation:
@@ -477,6 +482,8 @@ class Simulation:
                 facts.add(("fallen", p.name))
         facts |= {("state", n, v) for n, v in self.device_state.items()}
         facts |= self._bound_facts()
+        occupied = {f[2] for f in facts if f[0] == "at" and len(f) == 3 and f[1] in self.spec.objects}
+        facts |= {(CLEAR, p) for p in self.spec.places if p not in occupied}
         objects: list[tuple[str, Pose | None]] = []
         for name in sorted(self.spec.objects):  # an object is posed at its place, or with the robot holding it
             place = next((f[2] for f in facts if f[0] == "at" and len(f) == 3 and f[1] == name), None)
@@ -523,11 +530,23 @@ class Simulation:
         """The nearest of ``spots`` not behind a wall (:meth:`robot.places.Places.place_of`)."""
         return self.places.place_of(x, y, spots)
 
+    def move(self, thing: str, place: str) -> bool:
+        """Someone moved ``thing`` to ``place`` (not while the robot holds it): it rests at ``place`` now,
+        and its relations to other things — every stored fact of two or more arguments naming it, such
+        as where it stood or what it stood on (``("on_cooker", "pan", "cooker")``) — are gone; its own
+        properties (one-argument facts: ``("cooked", "pan")``) stay.  False if it was held."""
+        if thing in self.held:
+            return False
+        self.apply(delete=[f for f in self.facts if len(f) >= 3 and thing in f[1:]], add=[("at", thing, place)])
+        return True
+
     def apply(self, add: Iterable[Iterable[str]] = (), delete: Iterable[Iterable[str]] = ()) -> None:
         """Change the symbolic state: ``delete`` first, then ``add`` (lists of ground facts)."""
         removed: list[Fact] = [tuple(f) for f in delete]
         added: list[Fact] = [tuple(f) for f in add]
         for fact, value in [(f, False) for f in removed] + [(f, True) for f in added]:
+            if fact and fact[0] in DERIVED:  # the world derives it from where things are
+                continue
             if not self._set_bound(fact, value):  # bound facts change the physical state, not a copy
                 (self.facts.add if value else self.facts.discard)(fact)
         self.version += 1

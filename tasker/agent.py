@@ -36,16 +36,12 @@ from tasker.errors import AgentEnded, ConfigError, FSMError, PlanningFailed
 from tasker.messages import Command, Flag, FsmState, Report, ScheduleParams, SPRequest
 from tasker.protocols import CoreAgent, SkillState
 from tasker.stage import Purpose, Stage, StagePlan
-from tasker.stagerun import UNCONTAINED, StageRunner, describe
+from tasker.stagerun import UNCONTAINED, StageRunner, check_goal, describe, emit_plan
 from tasker.task import TaskContext, TaskType
 from tasker.trace import Trace
 
 S = FsmState
-
-VOLATILE_INFO = frozenset({"planner_time_s", "cached", "wall_time_s"})
-"""Keys of ``StagePlan.info`` that vary from run to run: kept out of the trace (it must be
-reproducible byte for byte) and collected in :attr:`DynamicAgent.planner_calls` instead."""
-
+_SUSPENDING = frozenset({S.GEN_SUSP, S.EXE_SUSP})
 
 @dataclass(frozen=True, slots=True)
 class Rates:
@@ -106,6 +102,7 @@ class DynamicAgent:
         self._params_at: float | None = None  # when _params was computed (None: not since the last change)
         self._fresh: tuple[float, ScheduleParams | None] | None = None  # fresh_params' answer at one moment
         self.planner_calls: list[dict[str, Any]] = []
+        self._recovered = False  # this suspension already planned around a stage of exeSusp (fallback)
 
     # -- the harmoniser's side ----------------------------------------------------------
 
@@ -327,9 +324,14 @@ class DynamicAgent:
             raise ConfigError(f"agent {self.id}: a stage must run but no core agent was given")
         self.refresh(now)  # the stage before may just have changed the world
         why = self.task.inapplicable(self.ctx, stage)
-        if why is not None:  # as on a robot: an action that cannot run fails, and changes nothing
+        if why is not None:
             runner.event(now, self.state, "begin")
-            self._stage_failed(now, stage, why)
+            done = self.task.already_done(self.ctx, stage)
+            if done is not None:  # its effects hold already (someone else did it): skipped, no failure
+                runner.close(now, self.state, "already_done", reason=done)
+                self._advance(now, stage)
+                return
+            self._stage_failed(now, stage, why)  # as on a robot: an action that cannot run fails, changes nothing
             return
         if in_task:
             self.ctx.stage_started = now
@@ -351,13 +353,7 @@ class DynamicAgent:
             return
         if status.state is SkillState.SUCCEEDED:
             runner.close(now, self.state, "done")
-            if in_task:
-                self.ctx.stage_started = None
-                self.ctx.done.append(stage)
-                self.ctx.stage_index = runner.index + 1
-            self.task.on_stage_done(self.ctx, stage)
-            runner.index += 1
-            self._enter_stage(now)
+            self._advance(now, stage)
             if self.state is not S.EXE_TSK:
                 return
         elif in_task and self._latched.term is None:
@@ -375,14 +371,35 @@ class DynamicAgent:
         if runner.running:
             self.next_wake = _next_tick_of(now, self.rates.task_exe_rate)
 
+    def _advance(self, now: float, stage: Stage) -> None:
+        """``stage`` is over and done (it ran, or its effects held already): on to the next one."""
+        runner = self._runner
+        assert runner is not None
+        if self.state is S.EXE_TSK:
+            self.ctx.stage_started = None
+            self.ctx.done.append(stage)
+            self.ctx.stage_index = runner.index + 1
+        self.task.on_stage_done(self.ctx, stage)
+        runner.index += 1
+        self._enter_stage(now)
+
     def _stage_failed(self, now: float, stage: Stage, reason: str) -> None:
         """The running stage failed (its skill said so, or it could not run): close it ``failed``; in
-        ``exeSusp`` the task ends, in ``exeTsk`` it is first made safe (genSusp, exeSusp), then ends."""
+        ``exeSusp`` the task ends (or, under ``fallback``, plans around it once), in ``exeTsk`` it is
+        first made safe (genSusp, exeSusp), then ends."""
         runner = self._runner
         assert runner is not None
         runner.close(now, self.state, "failed", reason=reason)
         failure = f"stage {stage.label} failed: {reason}"
-        if fsm.resolve(self.state, "stage_failed", self._guard).target is S.END:
+        target = fsm.resolve(self.state, "stage_failed", self._guard).target
+        if self.state is S.EXE_SUSP and target is S.GEN_SUSP:  # fallback: from the world as it is, once
+            self.ctx.recovering = failure
+            try:
+                self._start_gen_susp(now, "stage_failed")
+            finally:
+                self.ctx.recovering = None
+            return
+        if target is S.END:
             # a suspension's own stage: nothing safer to fall back on
             self._end(now, self._after_failure(failure), cause="failed", event="stage_failed")
             return
@@ -406,33 +423,25 @@ class DynamicAgent:
         return why
 
     def _start_gen_susp(self, now: float, event: str = "suspend") -> None:
+        """Enter ``genSusp`` by ``event`` and ask ``generate_suspension``: after a ``susp``, a ``term`` or a
+        failed stage; again after a stage of ``exeSusp`` that cannot run (``fallback``); or, by
+        ``secure``, from ``wait`` (hazard-aware waiting): then under the ``strict`` policy, so that
+        whatever a ``conditional`` branch left unsafe for a short interruption is made safe now that
+        the interruption has lasted."""
+        secure, again = event == "secure", self.state is S.EXE_SUSP  # again: planning around its own failed stage
         self.ctx.suspended = True
-        self.ctx.terminating = self._latched.term is not None
+        self.ctx.terminating = not secure and self._latched.term is not None
         self._fire(event, now)
+        self._recovered = again
         self.refresh(now)  # the stage that just ended may have changed the world
-        try:
-            plan = self.task.generate_suspension(self.ctx)
-        except PlanningFailed as exc:
-            self._end(now, self._after_failure(f"genSusp {exc.status}: {exc}"), cause="failed", event="plan_failed")
-            return
-        self._run_suspension(now, plan)
-
-    def _start_secure(self, now: float) -> None:
-        """Hazard-aware waiting: from ``wait``, reach the ``strict`` policy's safe state, then wait again.
-
-        The same hook as any suspension (``generate_suspension``), asked under the
-        ``strict`` policy: whatever a ``conditional`` branch left unsafe for a short
-        interruption is made safe now that the interruption has lasted.
-        """
-        self.ctx.terminating = False
-        self._fire("secure", now)
-        self.refresh(now)
         strategy = self.ctx.strategy
-        self.ctx.strategy = replace(strategy, policy="strict")
+        if secure:
+            self.ctx.strategy = replace(strategy, policy="strict")
         try:
             plan = self.task.generate_suspension(self.ctx)
         except PlanningFailed as exc:
-            self._end(now, f"genSusp (secure) {exc.status}: {exc}", cause="failed", event="plan_failed")
+            what = "genSusp (secure)" if secure else "genSusp"
+            self._end(now, self._after_failure(f"{what} {exc.status}: {exc}"), cause="failed", event="plan_failed")
             return
         finally:
             self.ctx.strategy = strategy
@@ -475,6 +484,8 @@ class DynamicAgent:
     def _fire(self, event: str, now: float) -> None:
         """Fire ``event`` through the FSM table: the table picks the target; traced and reported."""
         t = fsm.resolve(self.state, event, self._guard)
+        if self.state in _SUSPENDING and t.target not in _SUSPENDING:
+            self._check_goal(now)
         self._trace.emit(ev.Transition(now, self.id, event, self.state.value, t.target.value))
         self.state = t.target
         self._latched.enter(t.target)
@@ -482,6 +493,13 @@ class DynamicAgent:
             self.next_wake = math.inf
         else:
             self._publish()
+
+    def _check_goal(self, now: float) -> None:
+        """The suspension ends: which literals of the goal its ``exeSusp`` aimed for do not hold now."""
+        plan = self._runner.plan if self._runner is not None else None
+        if plan is not None and plan.purpose is Purpose.GEN_SUSP and plan.goal is not None:
+            self.refresh(now)
+            check_goal(self._trace, now, self.id, plan, self.ctx.world)
 
     def _end(self, now: float, reason: str, *, cause: str, event: str) -> None:
         """Every end goes through here: the running stage is stopped (once), then ``event`` leads to ``end``."""
@@ -518,21 +536,10 @@ class DynamicAgent:
                 self._on_report(self)
 
     def _emit_plan(self, now: float, plan: StagePlan) -> None:
-        if not isinstance(plan, StagePlan):
-            raise ConfigError(f"task type {self.ctx.task_type!r} returned a {type(plan).__name__} in "
-                              f"{self.state.value}, expected a StagePlan")
-        info = None
-        if plan.info:
-            info = {k: v for k, v in plan.info.items() if k not in VOLATILE_INFO} or None
-            self.planner_calls.append({"t": now, "agent": self.id, "purpose": plan.purpose.value,
-                                       "strategy": plan.strategy, **dict(plan.info)})
         expected = Purpose.UP_TSK if self.state is S.UP_TSK else Purpose.GEN_SUSP
-        if plan.purpose is not expected:
-            raise ConfigError(
-                f"task type {self.ctx.task_type!r} returned a {plan.purpose.value} plan in {self.state.value}"
-            )
-        self._trace.emit(ev.PlanMade(now, self.id, plan.purpose.value, plan.strategy,
-                                     [s.to_json() for s in plan.stages], plan.note or None, info))
+        call = emit_plan(self._trace, now, self.id, self.ctx.task_type, self.state, expected, plan)
+        if call is not None:
+            self.planner_calls.append(call)
 
 
 def _next_tick_of(now: float, rate: float) -> float:
@@ -558,13 +565,14 @@ _GUARDS: dict[str, Callable[[DynamicAgent], bool]] = {
     "not_ic_term": lambda a: not a._latched.holds("ic_term"),
     "secure": lambda a: a._latched.holds("secure"),
     "suspendable": _suspendable,
+    "recovers": lambda a: not a._recovered and a.task.recovers_suspension(a.ctx),
 }
 """How the agent evaluates each guard of :data:`tasker.fsm.GUARDS`."""
 
 _COMMANDS: dict[str, Callable[[DynamicAgent, float], None]] = {
     "term": DynamicAgent._terminate,
     "start": DynamicAgent._start_up_tsk,
-    "secure": DynamicAgent._start_secure,
+    "secure": lambda a, now: a._start_gen_susp(now, "secure"),
 }
 """What the command rows that leave ``compSP`` and ``wait`` do (``suspend`` leaves ``exeTsk``)."""
 

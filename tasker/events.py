@@ -92,7 +92,7 @@ class RunStarted(Event):
     task_exe_rate: float = _json("taskExeRate", "the rate stages are advanced at (Hz)")
     sp_up_rate: float = _json("SPupRate", "the rate an executing agent recomputes its parameters (Hz)")
     update: str = _doc("the default `upTsk` strategy (`planned` or `static`)")
-    suspension: str = _doc("the default `genSusp` strategy (`planned`, `static` or `derived`)")
+    suspension: str = _doc("the default `genSusp` strategy (`planned`, `static`, `derived` or `fallback`)")
 
 
 @dataclass(frozen=True, slots=True)
@@ -214,14 +214,16 @@ class PlanMade(Event):
     """``upTsk`` built ``exeTsk`` or ``genSusp`` built ``exeSusp``."""
 
     KIND: ClassVar[str] = "plan"
-    OPTIONAL: ClassVar[frozenset[str]] = frozenset({"note", "info"})
+    OPTIONAL: ClassVar[frozenset[str]] = frozenset({"note", "info", "goal"})
     agent: str = _doc("the agent")
     purpose: str = _doc("`upTsk` or `genSusp`")
-    strategy: str = _doc("`planned`, `static` or `derived`")
+    strategy: str = _doc("`planned`, `static`, `derived` or `fallback`")
     stages: Sequence[Mapping[str, Any]] = _doc("`{action, args, kind}` of each stage, `kind` `suspendable` or "
                                                "`blocking`")
     note: str | None = _doc("e.g. why a static fallback was used, or `planned ahead`", default=None)
     info: Mapping[str, Any] | None = _doc("planner name, plan cost, ... (never wall-clock values)", default=None)
+    goal: Sequence[Sequence[str]] | None = _doc("`genSusp`: the ground literals `exeSusp` aims for (`[\"not\", ...]` "
+                                                "for a fact that must not hold), when the task type says", default=None)
 
 
 @dataclass(frozen=True, slots=True)
@@ -236,8 +238,10 @@ class StageChanged(Event):
     action: str = _doc("its action")
     args: Sequence[Any] = _doc("its arguments")
     kind: str = _doc("`suspendable` or `blocking`")
-    status: str = _doc("`begin`, `done`, `stopped` or `failed`")
-    reason: str | None = _doc("with `failed`: the skill's reason, or the exception", default=None)
+    status: str = _doc("`begin`, `done`, `stopped`, `failed`, or `already_done` (its effects held already: it "
+                       "did not run, and that is no failure)")
+    reason: str | None = _doc("with `failed`: the skill's reason, or the exception; with `already_done`: the "
+                              "effects that held", default=None)
 
 
 @dataclass(frozen=True, slots=True)
@@ -276,6 +280,7 @@ class HazardChanged(Event):
     """A hazard a task folder declares became true or false in the world, whatever the cause."""
 
     KIND: ClassVar[str] = "hazard"
+    OPTIONAL: ClassVar[frozenset[str]] = frozenset({"carried"})
     agent: str | None = _doc("the agent it belongs to, or null if nobody owns it")
     hazard: str = _doc("its declared name")
     args: Sequence[str] = _doc("the ground fact's arguments")
@@ -283,6 +288,8 @@ class HazardChanged(Event):
     status: str = _doc("`on` or `off`")
     budget_s: float = _doc("how long it may stay unattended (s)")
     severity: float = _doc("its declared severity")
+    carried: bool | None = _doc("true when the fact is something the robot holds (a `held` binding): it goes "
+                                "wherever the robot goes, into other tasks too", default=None)
 
 
 @dataclass(frozen=True, slots=True)
@@ -295,6 +302,17 @@ class SecureChanged(Event):
     status: str = _doc("`start`, `done` or `ended`")
     hazards: Sequence[Mapping[str, Any]] | None = _doc("with `start`: `{hazard, args}` of the episodes it secures",
                                                        default=None)
+
+
+@dataclass(frozen=True, slots=True)
+class GoalChecked(Event):
+    """A suspension ended (its agent left ``genSusp``/``exeSusp``): the literals of the goal its
+    ``exeSusp`` aimed for that do not hold in the world at that moment (none: the goal holds)."""
+
+    KIND: ClassVar[str] = "goal"
+    agent: str = _doc("the agent")
+    goal: Sequence[Sequence[str]] = _doc("the goal, as in its `plan` event")
+    unmet: Sequence[Sequence[str]] = _doc("the literals of `goal` that do not hold")
 
 
 @dataclass(frozen=True, slots=True)
@@ -321,7 +339,8 @@ class TaskEnded(Event):
 
 TYPES: tuple[type[Event], ...] = (
     RunStarted, RunStopped, TaskRequested, Transition, CommandSent, RolesChanged, Decision, PlanMade,
-    StageChanged, ModeChanged, ArgsChanged, WorldChanged, HazardChanged, SecureChanged, RoleChanged, TaskEnded,
+    StageChanged, ModeChanged, ArgsChanged, WorldChanged, HazardChanged, SecureChanged, GoalChecked, RoleChanged,
+    TaskEnded,
 )
 """Every event type, in the order ``docs/trace.md`` documents them."""
 

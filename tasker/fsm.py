@@ -149,6 +149,9 @@ TRANSITIONS: tuple[Transition, ...] = (
     Transition(S.GEN_SUSP, "plan_failed", S.END, condition="suspension planning failed"),
     Transition(S.EXE_SUSP, "finished", S.WAIT, ("not_ic_term",), "exeSusp finished"),
     Transition(S.EXE_SUSP, "finished", S.END, ("ic_term",), "exeSusp finished"),
+    # not in Fig. 5: under the fallback strategy a stage of exeSusp that cannot run is planned around once
+    # (genSusp again, from the world as it is: docs/model.md, departures); otherwise the task ends
+    Transition(S.EXE_SUSP, "stage_failed", S.GEN_SUSP, ("recovers",), "plan around it, once (fallback)"),
     Transition(S.EXE_SUSP, "stage_failed", S.END, condition="stage failed"),
     Transition(S.WAIT, "term", S.END, ("ic_term",), auto=True),
     # not in Fig. 5: hazard-aware waiting (docs/model.md) lets a waiting task secure its hazard,
@@ -193,6 +196,8 @@ GUARD_MEANING: Mapping[str, str] = {
     "not_ic_term": "no ic_term is latched",
     "secure": "the latched start asks to secure a hazard (hazard-aware waiting)",
     "suspendable": "the stage of exeTsk about to run or running is suspendable (eq. 26), not blocking (eq. 25)",
+    "recovers": "the task plans around a stage of exeSusp that cannot run (the fallback strategy), not yet in "
+                "this suspension",
 }
 """What each guard means; the runner evaluates them."""
 

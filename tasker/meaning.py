@@ -243,6 +243,7 @@ class Monitor:
         self._since: dict[tuple[str | None, str, Fact], float] = {}  # when each active hazard went on
         self.roles: dict[tuple[str, str], str] = {}
         self._done_in_tick: list[str] = []
+        self._held: tuple[Binding, ...] | None = None  # the held bindings of the run's task types
         self._live: set[str] = set()
         trace.subscribe(self._on_event)
 
@@ -337,7 +338,13 @@ class Monitor:
     def _emit_hazard(self, now: float, key: tuple[str | None, str, Fact], hz: Hazard, status: str) -> None:
         agent, name, fact = key
         self.trace.emit(ev.HazardChanged(now, agent, name, list(fact[1:]), list(fact), status, hz.budget_s,
-                                         hz.severity))
+                                         hz.severity, True if self._carried(fact) else None))
+
+    def _carried(self, fact: Fact) -> bool:
+        """Whether ``fact`` is something the robot holds: a ``held`` binding of a type the run knows."""
+        if self._held is None:
+            self._held = tuple(b for t in self.task_types for b in self._meaning_of(t).bindings if b.kind == "held")
+        return any(b.object_of(fact) is not None for b in self._held)
 
     def _people(self, now: float, facts: frozenset[Fact], agents: list[Any], robot: str) -> None:
         """Roles of live agents; an agent that ended since the last look is evaluated once

@@ -75,9 +75,12 @@ class Stage:
 class StagePlan:
     """An ``exeTsk`` or ``exeSusp`` FSM: a sequence of stages, and how it was made.
 
-    ``strategy`` is ``"planned"`` or ``"static"``; ``sim_time`` is the simulated time
-    the agent spends in ``upTsk``/``genSusp`` producing it (from a deterministic model,
-    never the wall clock, so traces are reproducible); ``note`` explains a fallback.
+    ``strategy`` is ``"planned"``, ``"static"``, ``"derived"`` or ``"fallback"``; ``sim_time`` is
+    the simulated time the agent spends in ``upTsk``/``genSusp`` producing it (from a
+    deterministic model, never the wall clock, so traces are reproducible); ``note`` explains
+    a fallback.  ``goal``, for an ``exeSusp``, is what it aims to leave true: ground literals
+    (``("not", ...)`` for a fact that must not hold), checked against the world when the
+    suspension ends (:class:`tasker.events.GoalChecked`); None when the task type does not say.
     """
 
     stages: tuple[Stage, ...]
@@ -86,8 +89,12 @@ class StagePlan:
     sim_time: float = 0.0
     note: str | None = None
     info: Mapping[str, Any] = field(default_factory=dict)
+    goal: tuple[tuple[str, ...], ...] | None = None
 
     def __post_init__(self) -> None:
+        if self.goal is not None and not (isinstance(self.goal, tuple) and all(
+                isinstance(lit, tuple) and lit and all(isinstance(x, str) and x for x in lit) for lit in self.goal)):
+            raise TypeError(f"StagePlan.goal must be a tuple of literals (tuples of strings), got {self.goal!r}")
         if not isinstance(self.stages, tuple):
             raise TypeError("StagePlan.stages must be a tuple of Stage")
         for s in self.stages:

@@ -6,7 +6,8 @@ closes it -- ``core.stop`` at most once a stage, guarded -- writing the ``stage`
 of the trace.  The dynamic agent (:mod:`tasker.agent`) decides when, from its FSM; this
 module only does it.  Also here, since both modules call hooks: what a hook's exception is
 called in the trace (:func:`describe`) and which exceptions are no one task's fault
-(:data:`UNCONTAINED`).  Stdlib only.
+(:data:`UNCONTAINED`); and what a plan is and what it left, in the trace (:func:`emit_plan`,
+:func:`check_goal`).  Stdlib only.
 """
 
 from __future__ import annotations
@@ -16,11 +17,16 @@ from pathlib import Path
 from typing import Any
 
 from tasker import events as ev
-from tasker.errors import InvariantViolation, WorldError
+from tasker.errors import ConfigError, InvariantViolation, WorldError
 from tasker.fsm import FsmState
+from tasker.meaning import holds
 from tasker.protocols import CoreAgent
-from tasker.stage import Stage, StagePlan
+from tasker.stage import Purpose, Stage, StagePlan
 from tasker.trace import Trace
+
+VOLATILE_INFO = frozenset({"planner_time_s", "cached", "wall_time_s"})
+"""Keys of ``StagePlan.info`` that vary from run to run: kept out of the trace (it must be
+reproducible byte for byte) and collected in :attr:`tasker.agent.DynamicAgent.planner_calls` instead."""
 
 UNCONTAINED = (InvariantViolation, WorldError)
 """Exceptions that are not one task's fault: a broken model invariant or a broken world."""
@@ -104,3 +110,36 @@ class StageRunner:
         assert stage is not None
         self._trace.emit(ev.StageChanged(now, self._agent, state.value, self.index, stage.action, list(stage.args),
                                          stage.kind.value, status, **extra))
+
+
+def emit_plan(trace: Trace, now: float, agent: str, task_type: str, state: FsmState, expected: Purpose,
+              plan: StagePlan) -> dict[str, Any] | None:
+    """Trace the ``plan`` event of what ``upTsk``/``genSusp`` (``state``) built; return the planner
+    call to remember (with its wall-clock values, which stay out of the trace), or None.  A hook
+    that returned something else than a :class:`StagePlan` of the ``expected`` purpose is the task
+    type's error (:class:`~tasker.errors.ConfigError`)."""
+    if not isinstance(plan, StagePlan):
+        raise ConfigError(f"task type {task_type!r} returned a {type(plan).__name__} in {state.value}, "
+                          "expected a StagePlan")
+    info, call = None, None
+    if plan.info:
+        info = {k: v for k, v in plan.info.items() if k not in VOLATILE_INFO} or None
+        call = {"t": now, "agent": agent, "purpose": plan.purpose.value, "strategy": plan.strategy,
+                **dict(plan.info)}
+    if plan.purpose is not expected:
+        raise ConfigError(f"task type {task_type!r} returned a {plan.purpose.value} plan in {state.value}")
+    goal = None if plan.goal is None else [list(lit) for lit in plan.goal]
+    trace.emit(ev.PlanMade(now, agent, plan.purpose.value, plan.strategy, [s.to_json() for s in plan.stages],
+                           plan.note or None, info, goal))
+    return call
+
+
+def check_goal(trace: Trace, now: float, agent: str, plan: StagePlan, world: Any) -> None:
+    """A suspension ends: trace (:class:`~tasker.events.GoalChecked`) which literals of the goal its
+    ``exeSusp`` ``plan`` aimed for do not hold in ``world`` now — nothing when the plan says no goal or
+    the world has no facts (a synthetic run)."""
+    facts = getattr(world, "facts", None)
+    if plan.goal is None or facts is None:
+        return
+    unmet = [list(lit) for lit in plan.goal if not holds(lit, facts)]
+    trace.emit(ev.GoalChecked(now, agent, [list(lit) for lit in plan.goal], unmet))

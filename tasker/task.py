@@ -88,9 +88,10 @@ class Effects:
 POLICIES = ("strict", "conditional")
 UPDATES = ("planned", "static")
 """How upTsk builds exeTsk: plan from the world as it is, or the template (Alg. 3)."""
-SUSPENSIONS = ("planned", "static", "derived")
-"""How genSusp builds exeSusp: plan to the decision tree's goal, run its stages, or plan to the goal
-derived from the task's declarations."""
+SUSPENSIONS = ("planned", "static", "derived", "fallback")
+"""How genSusp builds exeSusp: plan to the decision tree's goal, run its stages, plan to the goal
+derived from the task's declarations, or run the tree's stages where they can run and plan to the
+derived goal where they cannot (``fallback``)."""
 """Suspension policies (:attr:`Strategy.policy`)."""
 
 _ARG_TYPES: dict[str, type] = {"str": str, "float": float, "int": int, "bool": bool, "pose": tuple}
@@ -147,15 +148,20 @@ class Strategy:
     (the task's template ``exeTsk``, Alg. 3, and decision-tree ``exeSusp``, eq. 47); both
     pursue the goal of the decision tree's branch.  ``suspension`` may also be ``"derived"``:
     plan to a goal derived from what the task declares (every hazard it owns off, every
-    person it affects in a safe role, its invariants), not from the tree.  ``policy`` is a separate factor applied to
-    both: ``"strict"`` always reaches the safe state; ``"conditional"`` also allows the
-    branches a task declares as trading safety for time (e.g. leave a device on for a
-    short interruption).
+    person it affects in a safe role, its invariants), not from the tree; or ``"fallback"``:
+    run the tree's branch where its stages can run in the world as it is, and plan from the
+    state as it is to the derived goal where they cannot (a stage inapplicable, the branch out
+    of reach, genSusp failing, or a stage of ``exeSusp`` that cannot run when its turn comes).
+    ``policy`` is a separate factor applied to all: ``"strict"`` always reaches the safe
+    state; ``"conditional"`` also allows the branches a task declares as trading safety for
+    time (e.g. leave a device on for a short interruption).  ``tree`` names which of the
+    task's decision trees genSusp reads (None: its default tree).
     """
 
     update: str = "planned"
     suspension: str = "planned"
     policy: str = "strict"
+    tree: str | None = None
 
     def __post_init__(self) -> None:
         if self.update not in UPDATES:
@@ -164,6 +170,8 @@ class Strategy:
             raise ConfigError(f"Strategy.suspension must be one of {list(SUSPENSIONS)}, got {self.suspension!r}")
         if self.policy not in POLICIES:
             raise ConfigError(f"Strategy.policy must be one of {list(POLICIES)}, got {self.policy!r}")
+        if self.tree is not None and (not isinstance(self.tree, str) or not self.tree.isidentifier()):
+            raise ConfigError(f"Strategy.tree must be a tree's name (an identifier), got {self.tree!r}")
 
 
 @dataclass(slots=True)
@@ -203,6 +211,9 @@ class TaskContext:
     stage_started: float | None = None
     suspended: bool = False
     terminating: bool = False
+    recovering: str | None = None
+    """In a ``genSusp`` asked again because a stage of ``exeSusp`` could not run (the ``fallback``
+    strategy, :meth:`TaskType.recovers_suspension`): why that stage could not run; else None."""
     handover: Callable[[str | None], Effects | None] | None = None
     hazards: Callable[[], Sequence[tuple[str, tuple[str, ...]]]] | None = None
     """The hazards this agent owns that hold now, as ``(hazard name, ground fact)`` (set by the loop
@@ -341,6 +352,28 @@ class TaskType:
         a task type that knows its actions' preconditions (a PDDL task folder does); the
         default knows none."""
         return None
+
+    def already_done(self, ctx: TaskContext, stage: Stage) -> str | None:
+        """Why ``stage`` need not run: its effects already hold in the world as it is (a door someone
+        else closed, a device someone else switched off), or None.
+
+        Asked only for a stage that cannot run (:meth:`inapplicable` gave a reason): such a stage is
+        traced ``already_done`` and skipped, never a failure.  Override it with
+        :meth:`inapplicable` (a PDDL task folder does, from its actions' effects); the default
+        knows no effects."""
+        return None
+
+    def tree_names(self) -> tuple[str, ...]:
+        """The names of the decision trees genSusp may read (:attr:`Strategy.tree`); empty when the
+        task type has no tree to choose.  A task folder's: ``default`` and its ``[[trees.NAME]]``."""
+        return ()
+
+    def recovers_suspension(self, ctx: TaskContext) -> bool:
+        """Whether a stage of ``exeSusp`` that cannot run is planned around — ``genSusp`` again,
+        from the world as it is, with :attr:`TaskContext.recovering` saying why — rather than
+        ending the task.  Asked once per suspension.  Default: under the ``fallback``
+        suspension strategy."""
+        return ctx.strategy.suspension == "fallback"
 
     def on_stage_done(self, ctx: TaskContext, stage: Stage) -> None:
         """Override to note progress in ``ctx.memory``; called after each stage of ``exeTsk`` or

@@ -1,5 +1,6 @@
 ; carry_object: carry a fragile object to a place, through doors the robot must open
-; with an empty hand. Objects may only be put down on a surface.
+; with an empty hand. Objects may only be put down on a clear surface (`clear` is the world's:
+; no movable object rests there).
 (define (domain carry_object)
   (:requirements :strips :typing :negative-preconditions :action-costs)
   (:types locatable place door - object
@@ -13,7 +14,8 @@
     (open ?d - door)
     (holding ?r - robot ?i - item)
     (hand_empty ?r - robot)
-    (surface ?p - place))
+    (surface ?p - place)
+    (clear ?p - place))
   (:functions
     (travel-time ?from ?to - place) - number
     (total-cost) - number)
@@ -43,10 +45,10 @@
   (:action pick
     :parameters (?r - robot ?i - item ?p - place)
     :precondition (and (at ?r ?p) (at ?i ?p) (hand_empty ?r))
-    :effect (and (holding ?r ?i) (not (hand_empty ?r)) (not (at ?i ?p)) (increase (total-cost) 8)))
+    :effect (and (holding ?r ?i) (not (hand_empty ?r)) (not (at ?i ?p)) (clear ?p) (increase (total-cost) 8)))
 
   (:action place
     :parameters (?r - robot ?i - item ?p - place)
-    :precondition (and (at ?r ?p) (holding ?r ?i) (surface ?p))
-    :effect (and (at ?i ?p) (hand_empty ?r) (not (holding ?r ?i)) (increase (total-cost) 8)))
+    :precondition (and (at ?r ?p) (holding ?r ?i) (surface ?p) (clear ?p))
+    :effect (and (at ?i ?p) (not (clear ?p)) (hand_empty ?r) (not (holding ?r ?i)) (increase (total-cost) 8)))
 )

@@ -1,5 +1,8 @@
 ; cook: put a pan on the cooker, cook, turn the cooker off and put the hot pan down.
 ; A door found closed on the way is opened with an empty hand (as in carry_object).
+; The pan rests at a place (at ?k ?p), is held, or stands on the cooker (on_cooker, not at a
+; place). It goes down only on a clear, heat-proof spot: `clear` is the world's (no movable
+; object rests there), `heat_proof` a fact of the world file.
 (define (domain cook)
   (:requirements :strips :typing :negative-preconditions :action-costs)
   (:types locatable place door - object
@@ -13,7 +16,8 @@
     (open ?d - door)
     (holding ?r - robot ?k - pan)
     (hand_empty ?r - robot)
-    (on_counter ?k - pan)
+    (heat_proof ?p - place)
+    (clear ?p - place)
     (on_cooker ?k - pan ?c - cooker)
     (cooker_on ?c - cooker)
     (cooked ?k - pan))
@@ -29,26 +33,26 @@
 
   (:action pick_pan
     :parameters (?r - robot ?k - pan ?p - place)
-    :precondition (and (at ?r ?p) (at ?k ?p) (on_counter ?k) (hand_empty ?r))
-    :effect (and (holding ?r ?k) (not (hand_empty ?r)) (not (on_counter ?k)) (not (at ?k ?p))
+    :precondition (and (at ?r ?p) (at ?k ?p) (hand_empty ?r))
+    :effect (and (holding ?r ?k) (not (hand_empty ?r)) (not (at ?k ?p)) (clear ?p)
                  (increase (total-cost) 6)))
 
   (:action put_on_cooker
     :parameters (?r - robot ?k - pan ?c - cooker ?p - place)
     :precondition (and (at ?r ?p) (at ?c ?p) (holding ?r ?k))
-    :effect (and (on_cooker ?k ?c) (at ?k ?p) (hand_empty ?r) (not (holding ?r ?k))
+    :effect (and (on_cooker ?k ?c) (hand_empty ?r) (not (holding ?r ?k))
                  (increase (total-cost) 5)))
 
   (:action take_off_cooker
     :parameters (?r - robot ?k - pan ?c - cooker ?p - place)
-    :precondition (and (at ?r ?p) (on_cooker ?k ?c) (at ?k ?p) (hand_empty ?r))
-    :effect (and (holding ?r ?k) (not (hand_empty ?r)) (not (on_cooker ?k ?c)) (not (at ?k ?p))
+    :precondition (and (at ?r ?p) (on_cooker ?k ?c) (at ?c ?p) (hand_empty ?r))
+    :effect (and (holding ?r ?k) (not (hand_empty ?r)) (not (on_cooker ?k ?c))
                  (increase (total-cost) 5)))
 
   (:action put_down
     :parameters (?r - robot ?k - pan ?p - place)
-    :precondition (and (at ?r ?p) (holding ?r ?k))
-    :effect (and (at ?k ?p) (on_counter ?k) (hand_empty ?r) (not (holding ?r ?k))
+    :precondition (and (at ?r ?p) (holding ?r ?k) (heat_proof ?p) (clear ?p))
+    :effect (and (at ?k ?p) (not (clear ?p)) (hand_empty ?r) (not (holding ?r ?k))
                  (increase (total-cost) 5)))
 
   (:action turn_on

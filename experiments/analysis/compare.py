@@ -17,14 +17,14 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 from experiments.analysis.stats import Estimate, estimate, holm, paired_p
-from experiments.inputs.strategy import FACTORS, Strategy
+from experiments.inputs.strategy import FACTORS, SUSPENSION_VALUES, Strategy
 from experiments.metrics.registry import direction, has_verdict, host_dependent, lookup, numeric_metrics, outcome
 from experiments.metrics.store import RunRow, Status
 
 ALL = "*"
 """The scenario column of rows pooled over every scenario (descriptive summaries only, never a verdict)."""
 
-LEVEL_ORDER = {"update": ("static", "planned"), "suspension": ("static", "planned", "derived"),
+LEVEL_ORDER = {"update": ("static", "planned"), "suspension": SUSPENSION_VALUES,
                "policy": ("strict", "conditional"), "hazard_waiting": ("off", "on")}
 """Each factor's levels, baseline first: of two levels compared, the later one is the treatment
 (``planned`` and ``derived`` against ``static``, ``derived`` against ``planned``)."""

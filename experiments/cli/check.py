@@ -8,6 +8,14 @@ a world (``places``), a ``task.toml`` or a PDDL domain.  Every problem is listed
 only the first), one line each, and the command exits 1 when there is any (2 for bad
 arguments).  A task folder's ``[example]`` is solved again even when the check cache
 says it passed before.
+
+Each task folder that loads also gets its suspension tree read (:mod:`planners.treecheck`):
+per branch, at each ``exeTsk`` stage of its ``[example]``, whether the branch the tree chooses
+there reaches its goal and leaves every declared hazard off, and which ``when`` conditions name
+a fact the world never has (the worlds shipped, and those of the worlds and scenarios checked
+in the same call, count as worlds it may have; the other task folders checked, as tasks that
+may act on the same world).  Printed as ``tree`` lines; what fails is a
+warning, not a problem (the exit status stays 0).
 """
 
 from __future__ import annotations
@@ -23,6 +31,8 @@ from experiments.cli.args import EXIT_FAILED, EXIT_OK, error_text
 from experiments.cli.run import add_path_option, task_paths
 from tasker.support import reader
 from tasker.support.reader import InputWarning
+
+Fact = tuple[str, ...]
 
 EXAMPLES = """\
 examples:
@@ -45,6 +55,8 @@ class Checker:
         self.problems: list[tuple[str, str]] = []
         self.passed: list[tuple[str, str]] = []
         self.loaded: dict[Path, bool] = {}  # task folder -> it passed its checks
+        self.tasks: dict[Path, tuple[Path, Any]] = {}  # task folder -> (as named, its PddlTaskType): tree reports
+        self.world_facts: list[Fact] = []  # what the worlds and scenarios checked state: trees may read it
         self._store: Any = None
         self._store_error: str | None = None
 
@@ -94,11 +106,14 @@ class Checker:
     def _task_folder(self, p: Path) -> None:
         from planners.loader import load_task
 
+        loaded: list[Any] = []
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", InputWarning)
             ok = self.attempt(p, "task folder: PDDL, task.toml and the [example] solved",
-                              lambda: load_task(p, use_cache=False))
+                              lambda: loaded.append(load_task(p, use_cache=False)))
         self.loaded[p.resolve()] = ok
+        if ok:
+            self.tasks.setdefault(p.resolve(), (p, loaded[0]))
         for w in caught:  # shown as any other warning; they only change what "ok" claims
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         if ok and any(issubclass(w.category, InputWarning) for w in caught):
@@ -136,7 +151,9 @@ class Checker:
         elif "places" in raw or "bounds" in raw:
             from robot.spec import load_world
 
-            self.attempt(p, "world", lambda: load_world(p))
+            worlds: list[Any] = []
+            if self.attempt(p, "world", lambda: worlds.append(load_world(p))):
+                self.world_facts += world_facts(worlds[0])
         else:
             self.problems.append((str(p), "cannot tell what this is: a scenario has 'kind', a sweep spec "
                                           "'scenarios' and 'seeds', a day protocol '[day]' and '[tasks]', a world "
@@ -169,8 +186,11 @@ class Checker:
         world: list[Any] = []
         from robot.spec import load_world
 
+        self.world_facts += scenario_facts(scn)
         if self.attempt(p, f"world {scn.world}", lambda: world.append(load_world(scn.world))):
             from experiments.cli.args import did_you_mean
+
+            self.world_facts += world_facts(world[0])
 
             for name in scn.people:
                 if name not in world[0].people:
@@ -203,6 +223,53 @@ class Checker:
                 else:
                     self.check(src)
 
+    # -- suspension trees ------------------------------------------------------------------------
+
+    def trees(self) -> list[tuple[str, str]]:
+        """``(path, line)`` of each loaded task folder's tree report (:mod:`planners.treecheck`); its
+        findings are warnings.  A report that fails is a problem of its folder."""
+        from planners import treecheck
+        from robot.spec import load_world, shipped_worlds
+        from tasker.errors import TaskerError
+
+        if not self.tasks:
+            return []
+        known = [*self.world_facts, *(f for name in shipped_worlds() for f in world_facts(load_world(name)))]
+        out: list[tuple[str, str]] = []
+        for shown, task in self.tasks.values():
+            others = [t for _, t in self.tasks.values() if t is not task]
+            try:
+                reports = treecheck.reports(task, world_facts=known, others=others)
+            except (TaskerError, ValueError) as exc:
+                self.problems.append((str(shown), f"its suspension tree cannot be read: {error_text(exc)}"))
+                continue
+            for report in reports:
+                report.warn(task)
+                out += [(str(shown), line) for line in report.lines()]
+        return out
+
+
+def world_facts(world: Any) -> list[Fact]:
+    """What a world (:class:`robot.spec.WorldSpec`) can hold, as :class:`robot.sim.Simulation` reads it
+    off: its facts, its devices at their places in their states, and its people's postures — any of
+    whom may fall (a script or a world event), which the simulation says as ``(fallen name)``."""
+    out = [tuple(f) for f in world.facts] + [("clear", p) for p in world.places]  # the world derives clear
+    for d in world.devices.values():
+        out += [("at", d.name, d.place), ("state", d.name, d.state)]
+    for person in world.people.values():
+        out += [("posture", person.name, person.posture), ("fallen", person.name)]
+    return out
+
+
+def scenario_facts(scn: Any) -> list[Fact]:
+    """What a robot scenario adds to its world: its objects at their places with their facts, its devices."""
+    out: list[Fact] = []
+    for name, o in scn.objects.items():
+        out += [("at", name, str(o["place"])), *(tuple(f) for f in o.get("facts", ()))]
+    for name, d in scn.devices.items():
+        out += [("at", name, str(d["place"])), ("state", name, str(d.get("state", "off")))]
+    return out
+
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p = sub.add_parser("check", help="check task folders, scenarios, worlds, sweep specs and day protocols; list "
@@ -210,7 +277,10 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
                        description="Run every load-time check on each PATH (task folders with their examples "
                                    "solved, scenarios with their requests, worlds, sweep specs with their "
                                    "scenarios, day protocols with their robot backend) and list every problem "
-                                   "found. Exits 1 if there is any.",
+                                   "found. Exits 1 if there is any. Each task folder's suspension tree is read "
+                                   "too ('tree' lines): at each exeTsk stage of its [example], does the branch "
+                                   "chosen reach its goal and leave every declared hazard off, and can each "
+                                   "`when` match the world at all; what fails is a warning.",
                        epilog=EXAMPLES)
     p.add_argument("targets", metavar="PATH", nargs="+", help="a task folder, a folder, or a .toml / .pddl file")
     add_path_option(p)
@@ -243,9 +313,12 @@ def _check(args: argparse.Namespace) -> int:
     for t in args.targets:
         if t not in first:
             checker.check(t)
+    trees = checker.trees()
     if not args.quiet:
         for where, what in checker.passed:
             print(f"ok     {where}: {what}")
+        for where, line in trees:
+            print(f"tree   {where}: {line}")
     for where, problem in checker.problems:
         print(f"error  {where}: {problem}")
     n = len(checker.problems)

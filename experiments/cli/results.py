@@ -164,9 +164,7 @@ def _replay(args: argparse.Namespace, spec: SweepSpec) -> int:
                                      "planned or derived)")
     job = match[0]
     st = job.strategy
-    run_scenario(job.source, seed=job.seed, update=st.update, suspension=st.suspension, scheduler=st.scheduler,
-                 randomize=True, task_paths=job.task_paths, policy=st.policy, hazard_waiting=st.hazard_waiting,
-                 interruption=job.interruption, perturbation=job.perturbation, out=Path(args.out))
+    run_scenario(job.source, job.options(), out=Path(args.out))
     print(f"wrote {args.out}/ ({scenario}, seed {seed_text}, {st.label}"
           f"{', control arm' if args.control else ''})")
     return EXIT_OK

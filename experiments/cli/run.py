@@ -23,6 +23,7 @@ from experiments.cli.args import (
     show_progress,
     writable_dir,
 )
+from experiments.inputs.strategy import SUSPENSION_VALUES
 from tasker.errors import RunInterrupted
 from tasker.support.reader import InputWarning
 from tasker.trace import FAILED
@@ -63,8 +64,13 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p.add_argument("scenario", help="shipped scenario name or scenario file")
     p.add_argument("--out", default=None, metavar="DIR", help="output folder (default: out/NAME)")
     p.add_argument("--seed", type=seed, default=None, help="seed, 0 <= N < 2**32 (default: the scenario's)")
-    p.add_argument("--suspension", choices=("static", "planned", "derived"), default=None,
-                   help="genSusp strategy for every task (default: the scenario's)")
+    p.add_argument("--suspension", choices=SUSPENSION_VALUES, default=None,
+                   help="genSusp strategy for every task: static (the tree's stages), planned (plan to the tree's "
+                        "goal), derived (plan to the goal the folder's declarations give), fallback (the tree "
+                        "where it can run, a plan to the derived goal where it cannot); default: the scenario's")
+    p.add_argument("--tree", default=None, metavar="[TYPE:]NAME",
+                   help="the decision tree genSusp reads: NAME in every task folder that declares [[trees.NAME]], "
+                        "or TYPE:NAME in one (default: each folder's [[suspension]])")
     p.add_argument("--update", choices=("static", "planned"), default=None,
                    help="upTsk strategy for every task (default: the scenario's)")
     p.add_argument("--scheduler", default=None,
@@ -85,9 +91,12 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     from experiments.inputs import scenario as scenarios
+    from experiments.run.options import RunOptions
     from experiments.run.runner import run_scenario
     from tasker import schedulers
 
+    if args.tree is not None and not all(p.isidentifier() for p in args.tree.split(":", 1)):
+        raise UsageError("--tree", f"expected a tree's NAME or TYPE:NAME (identifiers), got {args.tree!r}")
     if args.scheduler is not None and args.scheduler not in schedulers.names():
         raise UsageError("--scheduler", f"unknown scheduler {args.scheduler!r}"
                                         f"{did_you_mean(args.scheduler, schedulers.names())}; "
@@ -109,11 +118,10 @@ def _run(args: argparse.Namespace) -> int:
             from planners.bundled import task_types
 
             task_types(paths)  # every folder checked now, before the run
-        result = run_scenario(path, seed=args.seed, update=args.update, suspension=args.suspension,
-                              scheduler=args.scheduler, mode=args.mode, out=out, randomize=args.randomize,
-                              progress=show_progress(args), pictures=not args.no_pictures,
-                              task_paths=tuple(paths), policy=args.policy,
-                              hazard_waiting=args.hazard_waiting)
+        options = RunOptions(seed=args.seed, update=args.update, suspension=args.suspension, scheduler=args.scheduler,
+                             mode=args.mode, randomize=args.randomize, task_paths=tuple(paths), policy=args.policy,
+                             hazard_waiting=args.hazard_waiting, tree=args.tree)
+        result = run_scenario(path, options, out=out, progress=show_progress(args), pictures=not args.no_pictures)
     except RunInterrupted as exc:  # stopped while running: what ran is written (experiments.run.runner)
         print(f"tasker run: {exc.reason}; the trace so far, run.json and metrics.json are in {out}/",
               file=sys.stderr)

@@ -19,7 +19,6 @@ TASKS_HINT = "to add a task type, add its folder with --path DIR or TASKER_TASKS
 
 MODES = ("IT", "CT")
 STRATEGIES = ("planned", "static")
-SUSPENSIONS = ("planned", "static", "derived")
 POLICIES = ("strict", "conditional")
 
 

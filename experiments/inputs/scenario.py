@@ -27,11 +27,12 @@ import numpy as np
 from experiments.inputs import fields
 from experiments.inputs import perturbation as perturbations
 from experiments.inputs.actions import TABLES, TimedAction, read_actions
-from experiments.inputs.fields import MODES, POLICIES, STRATEGIES, SUSPENSIONS, ScenarioError
+from experiments.inputs.fields import MODES, POLICIES, STRATEGIES, ScenarioError
 from experiments.inputs.filekinds import expect
 from experiments.inputs.perturbation import Perturbation
 from experiments.inputs.robot_scenario import RobotScenario
 from tasker.support import reader
+from tasker.task import SUSPENSIONS
 
 __all__ = ["InterruptionGrid", "RobotScenario", "ScenarioError", "load", "randomize", "resolve", "kind_of", "SCENARIOS",
            "with_devices"]
@@ -241,6 +242,13 @@ class InterruptionGrid:
         return {"interrupt": self.interrupt, "times": {"start": self.start, "stop": self.stop, "step": self.step}}
 
 
+def placed_time(name: str, seed: int, interruption: InterruptionGrid) -> float:
+    """Where the variant of ``seed`` of scenario ``name`` places its interruption: uniform in the seed's
+    stratum, drawn on a stream of its own (so it does not depend on how many other times there are)."""
+    low, high = interruption.stratum(seed)
+    return round(random.Random(f"interrupt:{name}:{seed}").uniform(low, high), 3)
+
+
 def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, pose_jitter: float = 0.5,
               interruption: InterruptionGrid | None = None,
               perturbation: Perturbation | None = None) -> RobotScenario:
@@ -276,9 +284,7 @@ def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, 
             n = sum(1 for a in scenario.actions if a.kind == "request")
             raise ScenarioError(scenario.source, f"variants: interrupt: no {interruption.interrupt} (the scenario "
                                                  f"has {n} requests, requests[0]..requests[{n - 1}])")
-        low, high = interruption.stratum(seed)
-        # its own stream, so the draw does not depend on how many other times there are
-        placed = round(random.Random(f"interrupt:{scenario.name}:{seed}").uniform(low, high), 3)
+        placed = placed_time(scenario.name, seed, interruption)
         new_t[hit[0].t] = placed
     actions = [TimedAction(round(new_t[a.t], 3), a.kind, dict(a.fields), a.origin) for a in scenario.actions]
     spec = load_world(scenario.world)
@@ -319,8 +325,9 @@ def randomize(scenario: RobotScenario, seed: int, *, time_jitter: float = 0.25, 
         if placed is None:
             raise ScenarioError(scenario.source, "perturbation: needs an interruption grid ([variants.NAME]) to "
                                                  "place its window around")
-        offer = perturbations.candidates(with_devices(scenario, spec), scenario.objects, actions, people)
-        drawn_events = perturbations.events(perturbation, f"{scenario.name}:{seed}", placed, **offer)
-        actions += [dataclasses.replace(a, origin=("perturbation", k)) for k, a in enumerate(drawn_events)]
+        if perturbation.mode == "untargeted":  # a targeted change is chosen while the run runs (run.targeting)
+            offer = perturbations.candidates(with_devices(scenario, spec), scenario.objects, actions, people)
+            drawn_events = perturbations.events(perturbation, f"{scenario.name}:{seed}", placed, **offer)
+            actions += [dataclasses.replace(a, origin=("perturbation", k)) for k, a in enumerate(drawn_events)]
     return dataclasses.replace(scenario, actions=tuple(sorted(actions, key=lambda a: a.t)), people=people,
                                seed=seed, name=f"{scenario.name}~{seed}")

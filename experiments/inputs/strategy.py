@@ -1,7 +1,7 @@
 """The factorial design of a sweep: the factors a run varies, their levels, and :class:`Strategy`.
 
 A :class:`Strategy` is one cell of the design (``update``, ``suspension``, ``policy``,
-``hazard_waiting``, ``scheduler``); its :attr:`~Strategy.label` is the strategy's key in the
+``hazard_waiting``, ``scheduler``, ``tree``); its :attr:`~Strategy.label` is the strategy's key in the
 results database and in reports, and :meth:`Strategy.parse` reads it back.  :func:`expand`
 makes every cell of a grid of levels.  The sweep spec (:mod:`experiments.sweep.spec`) builds
 strategies from its file; reports (:mod:`experiments.sweep.report`) parse them back from labels.
@@ -15,10 +15,13 @@ from dataclasses import dataclass
 from typing import Any
 
 from tasker.support import reader
+from tasker.task import SUSPENSIONS
 
 STRATEGY_VALUES = ("static", "planned")
-SUSPENSION_VALUES = ("static", "planned", "derived")
-"""``suspension`` may also be ``derived`` (plan to the goal the task folder's declarations give)."""
+SUSPENSION_VALUES = ("static", *(s for s in SUSPENSIONS if s != "static"))
+"""``suspension``'s levels, the baseline first: ``static`` (the tree's stages), ``planned`` (plan to the
+tree's goal), ``derived`` (plan to the goal the task folder's declarations give), ``fallback`` (the
+tree where it can run, a plan to the derived goal where it cannot)."""
 
 
 @dataclass(frozen=True)
@@ -28,7 +31,9 @@ class Strategy:
     ``update``/``suspension``: how ``upTsk`` and ``genSusp`` build their plans (``static`` or
     ``planned``); ``policy``: when a suspension is required (``strict`` or ``conditional``,
     applied to both suspension strategies); ``hazard_waiting``: hazard-aware waiting off or
-    on; ``scheduler``: the harmoniser's scheduler.  ``None`` leaves the scenario's own setting.
+    on; ``scheduler``: the harmoniser's scheduler; ``tree``: the decision tree genSusp reads
+    (``NAME`` or ``TYPE:NAME``, :class:`experiments.run.options.RunOptions`).  ``None`` leaves the
+    scenario's own setting.
     """
 
     update: str | None = None
@@ -36,6 +41,7 @@ class Strategy:
     scheduler: str | None = None
     policy: str | None = None
     hazard_waiting: bool | None = None
+    tree: str | None = None
 
     def __post_init__(self) -> None:
         for name, values in (("update", STRATEGY_VALUES), ("suspension", SUSPENSION_VALUES)):
@@ -48,6 +54,9 @@ class Strategy:
             raise ValueError(f"hazard_waiting: expected true or false, got {self.hazard_waiting!r}")
         if self.scheduler is not None and (not isinstance(self.scheduler, str) or not self.scheduler):
             raise ValueError(f"scheduler: expected a scheduler name, got {self.scheduler!r}")
+        if self.tree is not None and (not isinstance(self.tree, str) or not 1 <= len(self.tree.split(":")) <= 2
+                                      or not all(p.isidentifier() for p in self.tree.split(":"))):
+            raise ValueError(f"tree: expected a tree's NAME or TYPE:NAME, got {self.tree!r}")
 
     @property
     def label(self) -> str:
@@ -72,18 +81,19 @@ class Strategy:
             key, value = key.strip(), value.strip()
             if sep and key in FACTORS and not value:  # the factor is right: "did you mean" it would mislead
                 levels = FACTOR_LEVELS[key]
-                one_of = "a scheduler name" if levels is None else " or ".join(_show(v) for v in levels)
+                one_of = (("a tree's name" if key == "tree" else "a scheduler name") if levels is None
+                          else " or ".join(_show(v) for v in levels))
                 raise ValueError(f"{key}: expected {one_of} after '{key}=', got nothing in {text!r}")
             if not sep or key not in FACTORS or not value:
                 raise ValueError(f"expected 'update=…,suspension=…[,policy=…][,hazard_waiting=on|off]"
-                                 f"[,scheduler=…]', got {text!r}{reader.suggest(key, list(FACTORS))}")
+                                 f"[,scheduler=…][,tree=…]', got {text!r}{reader.suggest(key, list(FACTORS))}")
             if key in fields:
                 raise ValueError(f"{key} given twice in {text!r}")
             fields[key] = _switch(value) if key == "hazard_waiting" else value
         return cls(**fields)
 
 
-FACTORS = ("update", "suspension", "policy", "hazard_waiting", "scheduler")
+FACTORS = ("update", "suspension", "policy", "hazard_waiting", "scheduler", "tree")
 """The factors of a :class:`Strategy`, in the order of its label."""
 
 POLICY_VALUES = ("strict", "conditional")
@@ -118,6 +128,6 @@ def expand(factors: Mapping[str, Sequence[Any]]) -> list[Strategy]:
 
 FACTOR_LEVELS: dict[str, tuple[Any, ...] | None] = {
     "update": STRATEGY_VALUES, "suspension": SUSPENSION_VALUES, "policy": POLICY_VALUES,
-    "hazard_waiting": (False, True), "scheduler": None}
-"""The levels each factor of a ``[factors]`` grid may take (``None``: a registered scheduler)."""
+    "hazard_waiting": (False, True), "scheduler": None, "tree": None}
+"""The levels each factor of a ``[factors]`` grid may take (``None``: a registered scheduler; a tree's name)."""
 

@@ -112,8 +112,9 @@ METRICS: tuple[Metric, ...] = (
     Metric("decisions.margins.*", "count", N, "cost decisions by margin 1 − c_switch/c_wait (bins of 0.1)"),
     Metric("decisions.hysteresis_flips.*", "count", N, "cost decisions that would have gone the other way "
            "at this hysteresis"),
-    Metric("safety.unattended_s", "s", L, "hazard time on while its owner was not in cmd, over owned hazards",
-           label="hazard time unattended (s)"),
+    Metric("safety.unattended_s", "s", L, "hazard time on while its owner was not in cmd, over owned hazards, "
+           "until the hazard went off or the run ended, whether or not its owner had ended; the primary hazard "
+           "outcome", label="hazard time unattended (s)"),
     Metric("safety.longest_unattended_s", "s", L, "the longest unbroken unattended stretch of an owned hazard"),
     Metric("safety.budget_overruns", "count", L, "unattended stretches longer than the hazard's budget",
            label="hazard budget overruns"),
@@ -125,20 +126,33 @@ METRICS: tuple[Metric, ...] = (
     Metric("safety.hazards_active_at_switch", "count", L, "owned hazards on, whoever's, at each entry into wait"),
     Metric("safety.unowned_hazards", "count", N, "hazard episodes nobody owns"),
     Metric("safety.unattended_alive_s", "s", L, "hazard time unattended while its owner was alive (what a "
-           "suspension could attend to); the primary hazard outcome", label="hazard unattended, owner alive (s)"),
+           "suspension could attend to; 0.3's primary outcome, which a task that failed and ended stops "
+           "counting)", label="hazard unattended, owner alive (s)"),
     Metric("safety.severity_unattended_s", "s", L, "unattended_alive_s weighted by each hazard's declared severity",
            label="severity-weighted unattended (s)"),
     Metric("safety.unowned_s", "s", L, "time hazards nobody owns were on (doors opened by a person or an "
            "exogenous event)", label="unowned hazard exposure (s)"),
     Metric("suspensions.count", "count", N, "suspension episodes that closed (wait or end)"),
-    Metric("suspensions.safe", "count", H, "episodes that closed with no hazard of their agent on and every "
-           "stage applicable"),
-    Metric("suspensions.unsafe", "count", L, "episodes that closed with a hazard of their agent on, or ran an "
-           "inapplicable stage", label="unsafe suspensions"),
+    Metric("suspensions.safe", "count", H, "episodes that ended with their goal holding and no hazard of their "
+           "agent, nor one the robot carries, on (goal-based judge)"),
+    Metric("suspensions.unsafe", "count", L, "episodes that ended with their goal unmet, no plan, or a hazard of "
+           "their agent or one the robot carries on", label="unsafe suspensions"),
     Metric("suspensions.all_safe", "bool", H, "every suspension of the run was safe (the binary outcome)",
            label="all suspensions safe"),
+    Metric("suspensions.goal_unmet", "count", L, "episodes that ended with a literal of their goal not holding",
+           label="suspensions with their goal unmet"),
+    Metric("suspensions.no_plan", "count", L, "episodes whose genSusp made no plan (the task ended there)",
+           label="suspensions with no plan"),
     Metric("suspensions.inapplicable_stages", "count", L, "suspension stages whose action could not run",
            label="inapplicable stages"),
+    Metric("suspensions.already_done_stages", "count", N, "suspension stages skipped because their effects held "
+           "already (someone else did it): not failures", label="stages already done"),
+    Metric("suspensions.fallback_planned", "count", N, "fallback suspensions that planned (the tree's branch could "
+           "not run, or a stage of it failed)", label="fallback suspensions planned"),
+    Metric("carried.count", "count", L, "hazards the robot carried into another agent's execution (each pair "
+           "of hazard and agent)", label="hazards carried into another task"),
+    Metric("carried.seconds", "s", L, "time the robot ran another agent's task with a hazard of another agent in "
+           "hand (e.g. helping with the hot pan held)", label="time with a carried hazard (s)"),
     *_stats("suspensions.time_to_safe_s", "s", L, "genSusp to wait or end, over safe suspensions",
             label="time to a safe suspension (s)"),
     Metric(f"{_HAZARD}.episodes", "count", N, "owned episodes of this hazard"),

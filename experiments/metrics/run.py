@@ -274,28 +274,71 @@ def safety(tl: Timeline) -> dict[str, Any]:
 
 
 def suspensions(tl: Timeline) -> dict[str, Any]:
-    """Each suspension episode (entering ``genSusp`` until ``wait`` or ``end``): was it *safe* — when
-    it closed, no hazard its agent owns was on, and every stage it executed was applicable
-    (``tasker.trace.INAPPLICABLE``) — and how long it took to get there."""
+    """Each suspension episode (entering ``genSusp`` until ``wait`` or ``end``) judged by what it left
+    behind: *safe* when, as it ended, the goal its ``exeSusp`` aimed for held (the ``goal`` event) and
+    no hazard its agent owns, nor one the robot carries, was on.  A genSusp that made no plan (it
+    never entered ``exeSusp``) is not safe.  Without a declared goal (a task type that gives none)
+    the stages stand for it: every stage it ran ended ``done`` or ``already_done``.  A stage skipped
+    because its effects held already (``already_done``) is never a failure."""
     rows: list[dict[str, Any]] = []
     for a in tl.agents.values():
         for s in a.suspensions:
             if s.outcome == "open":
                 continue
-            left_on = [f"{h.hazard}({', '.join(h.args)})" for h in _active_at(tl.hazards, s.end) if h.owner == a.id]
+            on = _active_at(tl.hazards, s.end)
+            left_on = [f"{h.hazard}({', '.join(h.args)})" for h in on if h.owner == a.id or h.carried]
             inapplicable = [r.action for r in s.stages if r.status == "failed" and (r.reason or "").startswith(
                 INAPPLICABLE)]
+            failed = [r.action for r in s.stages if r.status == "failed"]
+            unmet = [" ".join(lit) for lit in s.goal.unmet] if s.goal is not None else []
+            entered = any(st.state == S.EXE_SUSP.value and s.start <= st.start <= s.end for st in a.states)
+            if not entered:  # genSusp made no plan: the task ended there
+                reached = False
+            elif s.goal is not None:
+                reached = not unmet
+            else:
+                reached = not failed
+            last = s.last_plan
             rows.append({"agent": a.id, "task_type": a.task_type, "start": s.start, "end": s.end,
                          "trigger": s.trigger, "outcome": s.outcome,
                          "strategy": s.plan.strategy if s.plan is not None else None,
-                         "stages": len(s.stages), "left_on": left_on, "inapplicable": inapplicable,
-                         "safe": not left_on and not inapplicable, "duration_s": s.duration})
+                         "fallback": (last.info or {}).get("fallback") if last is not None else None,
+                         "replanned": len(s.replans), "stages": len(s.stages), "left_on": left_on,
+                         "goal_unmet": unmet, "inapplicable": inapplicable,
+                         "already_done": sum(1 for r in s.stages if r.status == "already_done"),
+                         "no_plan": not entered,
+                         "safe": reached and not left_on, "duration_s": s.duration})
     rows.sort(key=lambda r: (r["start"], r["agent"]))
     safe = [r for r in rows if r["safe"]]
     return {"episodes": rows, "count": len(rows), "safe": len(safe), "unsafe": len(rows) - len(safe),
             "all_safe": not rows or len(safe) == len(rows),
+            "goal_unmet": sum(1 for r in rows if r["goal_unmet"]),
+            "no_plan": sum(1 for r in rows if r["no_plan"]),
             "inapplicable_stages": sum(len(r["inapplicable"]) for r in rows),
+            "already_done_stages": sum(r["already_done"] for r in rows),
+            "fallback_planned": sum(1 for r in rows if r["fallback"] == "planned"),
             "time_to_safe_s": _stats([r["duration_s"] for r in safe])}
+
+
+def carried(tl: Timeline) -> dict[str, Any]:
+    """Hazards the robot carried into another task: for each ``carried`` hazard episode, the time it
+    was on while an agent other than its owner held the robot (was in ``cmd``), named after that
+    agent's task (e.g. ``human_fell (d3) with hot_pan_held(robot, pan)``: helping with the hot pan in hand)."""
+    rows: list[dict[str, Any]] = []
+    for h in tl.hazards:
+        if not h.carried:
+            continue
+        end = h.end if h.end is not None else tl.t_end
+        for a in tl.agents.values():
+            if a.id == h.owner:
+                continue
+            seconds = math.fsum(s.overlap(h.start, end) for s in a.in_cmd())
+            if seconds > 0:
+                rows.append({"hazard": h.hazard, "args": list(h.args), "owner": h.owner, "agent": a.id,
+                             "task_type": a.task_type, "seconds": seconds,
+                             "name": f"{a.task_type} ({a.id}) with {h.hazard}({', '.join(h.args)})"})
+    rows.sort(key=lambda r: (r["agent"], r["hazard"], r["args"]))
+    return {"episodes": rows, "count": len(rows), "seconds": math.fsum(r["seconds"] for r in rows)}
 
 
 # -- people -------------------------------------------------------------------------------------
@@ -351,7 +394,7 @@ def compute(events: Source) -> dict[str, Any]:
     tl = timeline(events)
     per, totals = tasks(tl)
     out = {"run": run_info(tl), "totals": totals, "switching": switching(tl), "decisions": decisions(tl),
-           "safety": safety(tl), "suspensions": suspensions(tl), "people": people(tl),
+           "safety": safety(tl), "suspensions": suspensions(tl), "carried": carried(tl), "people": people(tl),
            "calibration": calibration(tl), "tasks": per}
     return _clean(out)
 

@@ -21,7 +21,7 @@ import platform
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -29,10 +29,12 @@ import tasker
 from experiments.inputs import fields, synthetic
 from experiments.inputs import scenario as scenarios
 from experiments.inputs.actions import TimedAction
-from experiments.inputs.perturbation import Perturbation
+from experiments.inputs.perturbation import TOGGLE, TargetDraw, named
 from experiments.inputs.request_fields import asked_for
 from experiments.metrics import run as metrics
 from experiments.report.explain import INDEX, write_problems
+from experiments.run.options import RunOptions
+from experiments.run.targeting import Targeter
 from experiments.trace.timeline import Timeline
 from tasker import events as ev
 from tasker import schedulers
@@ -59,28 +61,27 @@ class RunResult:
     """A robot run's :class:`robot.recording.Recorder` (``trajectory.jsonl`` is written from it); None if synthetic."""
 
 
-def build_robot(scn: scenarios.RobotScenario, *, seed: int, **options: Any) -> tuple[SimulationLoop, Any]:
+def build_robot(scn: scenarios.RobotScenario, options: RunOptions, *, trace: Trace | None = None,
+                task_wrapper: Callable[[TaskType], TaskType] | None = None) -> tuple[SimulationLoop, Any]:
     """The loop and the simulation for a robot scenario, with every request and event scheduled
-    (:func:`build_robot_actions`, whose keywords it takes)."""
-    loop, sim, _ = build_robot_actions(scn, seed=seed, **options)
+    (:func:`build_robot_actions`)."""
+    loop, sim, _ = build_robot_actions(scn, options, trace=trace, task_wrapper=task_wrapper)
     return loop, sim
 
 
-def build_robot_actions(scn: scenarios.RobotScenario, *, seed: int, update: str | None = None,
-                        suspension: str | None = None, scheduler: str | None = None,
-                        trace: Trace | None = None, task_paths: tuple[str, ...] = (), policy: str | None = None,
-                        hazard_waiting: bool = False, request_fields: bool = False,
+def build_robot_actions(scn: scenarios.RobotScenario, options: RunOptions, *, trace: Trace | None = None,
                         task_wrapper: Callable[[TaskType], TaskType] | None = None
                         ) -> tuple[SimulationLoop, Any, Actions]:
     """The loop, the simulation and the :class:`Actions` of a robot scenario, every action scheduled.
 
-    ``task_paths`` are task folders loaded besides the bundled ones and ``$TASKER_TASKS``.
-    ``policy`` (default: the scenario's) reaches every task's :class:`Strategy`;
-    ``hazard_waiting`` is passed to the loop; ``request_fields`` lets every task type take
-    the requests' ``deadline`` and ``priority`` (:mod:`experiments.inputs.request_fields`); it is on
-    whenever the scenario's requests give one or its ``settings.request_fields`` is true.  ``task_wrapper``
-    is applied to every task type after that (a day's drawn work: :mod:`experiments.days.robot_work`).
-    A ``people`` entry may set a person's ``pose``, ``walk`` and walking ``speed``."""
+    ``options`` (:class:`~experiments.run.options.RunOptions`, whose ``seed`` must be set) choose
+    the strategies, the scheduler and the tree over the scenario's own; its ``task_paths`` are task
+    folders loaded besides the bundled ones and ``$TASKER_TASKS``; ``request_fields`` lets every
+    task type take the requests' ``deadline`` and ``priority`` (:mod:`experiments.inputs.request_fields`),
+    on too whenever the scenario's requests give one or its ``settings.request_fields`` is true.
+    ``task_wrapper`` is applied to every task type after that (a day's drawn work:
+    :mod:`experiments.days.robot_work`).  A ``people`` entry may set a person's ``pose``, ``walk`` and
+    walking ``speed``."""
     from planners.bundled import task_types
     from robot.sim import Simulation
     from robot.spec import load_world
@@ -103,9 +104,11 @@ def build_robot_actions(scn: scenarios.RobotScenario, *, seed: int, update: str 
         spec = dataclasses.replace(spec, people=people)
     spec = _with_objects(scn, spec)
     spec, from_world = _world_file_events(spec, str(scn.world))
+    seed = scn.seed if options.seed is None else options.seed
+    update, suspension, scheduler, policy = options.update, options.suspension, options.scheduler, options.policy
     sim = Simulation(spec, seed=seed)
-    loaded = task_types(task_paths)
-    if request_fields or scn.request_fields or asked_for(scn.actions):
+    loaded = task_types(options.task_paths)
+    if options.request_fields or scn.request_fields or asked_for(scn.actions):
         from experiments.inputs.request_fields import with_request_fields
 
         loaded = [with_request_fields(t) for t in loaded]
@@ -118,14 +121,15 @@ def build_robot_actions(scn: scenarios.RobotScenario, *, seed: int, update: str 
     per_type = {t: Strategy(update or s.get("update", default.update),
                             suspension or s.get("suspension", default.suspension), default.policy)
                 for t, s in scn.strategies.items()}
+    per_type = _with_trees(options, types, default, per_type)
     # another scheduler than the scenario's gets no options of its, but what the folders declare (alg2's classes)
-    options = scn.scheduler_options if scheduler in (None, scn.scheduler) else \
+    scheduler_options = scn.scheduler_options if scheduler in (None, scn.scheduler) else \
         fields.scheduler_defaults(str(scheduler), {}, types)
     loop = SimulationLoop(
-        store, schedulers.create(scheduler or scn.scheduler, **options), seed=seed, trace=trace,
+        store, schedulers.create(scheduler or scn.scheduler, **scheduler_options), seed=seed, trace=trace,
         mode=Mode(scn.mode), s_freq=scn.s_freq, rates=Rates(scn.rep_rate, scn.task_exe_rate, scn.sp_up_rate),
         strategy=default, strategies=per_type, core=sim, world=sim, motion=sim.motion, horizon=scn.horizon,
-        hazard_waiting=hazard_waiting, secure_over_higher=scn.secure_over_higher,
+        hazard_waiting=options.hazard_waiting, secure_over_higher=scn.secure_over_higher,
     )
     monitor = Monitor(loop.trace, lambda: loop.all_agents, lambda name: store.get(name).meaning,
                       lambda: sim.snapshot().facts, task_types=store.names(),
@@ -157,9 +161,33 @@ class Actions:
         self.loop.at(a.t, _action(self.loop, self.sim, self._made, a, f"d{self.requests}"))
         return f"d{self.requests}" if a.kind == "request" else None
 
+    def now(self, a: TimedAction) -> None:
+        """Run world action ``a`` at once (a change chosen while the run runs: :mod:`experiments.run.targeting`)."""
+        _action(self.loop, self.sim, self._made, a, "")()
+
     def agents(self, sid: str) -> tuple[str, ...]:
         """The agents made for the scenario's request ``sid`` so far (renewals after the first)."""
         return tuple(self._made.agents.get(sid, ()))
+
+
+def _with_trees(options: RunOptions, types: list[TaskType], default: Strategy,
+                per_type: dict[str, Strategy]) -> dict[str, Strategy]:
+    """``per_type`` with ``options.tree`` given to each task type that declares a tree of that name (or
+    to the one it names, ``TYPE:NAME``); a tree no task type of the run declares is an error."""
+    if options.tree is None:
+        return per_type
+    out = dict(per_type)
+    chosen = []
+    for t in types:
+        name = options.tree_for(t.name, t.tree_names())
+        if name is not None:
+            out[t.name] = replace(out.get(t.name, default), tree=name)
+            chosen.append(t.name)
+    if not chosen:
+        known = sorted(f"{t.name}:{n}" for t in types for n in t.tree_names())
+        raise scenarios.ScenarioError(f"--tree {options.tree}: no task type of this run has that decision tree; "
+                                      f"known: {', '.join(known) or 'none'}")
+    return out
 
 
 def _world_file_events(spec: Any, world: str) -> tuple[Any, list[TimedAction]]:
@@ -260,13 +288,15 @@ def _action(loop: SimulationLoop, sim: Any, made: _Made, a: TimedAction, sid: st
         elif what == "walk":
             sim.people[value[0]].go_to(loop.now, float(value[1]), float(value[2]))
         elif what == "door":
+            if value[1] == TOGGLE:  # whichever it is not now (the robot may have opened or closed it)
+                value = [value[0], not sim.door_open[value[0]]]
             sim.set_door(value[0], value[1])
         elif what == "device":
+            if value[1] == TOGGLE:
+                value = [value[0], "off" if sim.device_state[value[0]] == "on" else "on"]
             sim.set_device(value[0], value[1])
-        elif what == "move":  # an object someone moved: wherever it was (not if the robot holds it)
-            if value[0] not in sim.held:
-                sim.apply(delete=[f for f in sim.facts if f[0] == "at" and len(f) == 3 and f[1] == value[0]],
-                          add=[("at", value[0], value[1])])
+        elif what == "move":  # an object someone moved: wherever it was, its relations gone (not if held)
+            sim.move(value[0], value[1])
         elif what == "add":
             sim.apply(add=value)
         else:
@@ -301,26 +331,24 @@ def _after(loop: SimulationLoop, made: _Made, sid: str, event: Callable[[], None
     return at_time
 
 
-def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | None = None,
-                 update: str | None = None, suspension: str | None = None, scheduler: str | None = None,
-                 mode: str | None = None, out: Path | None = None, randomize: bool = False,
-                 progress: bool = False, pictures: bool = True, task_paths: tuple[str, ...] = (),
-                 policy: str | None = None, hazard_waiting: bool | None = None,
-                 interruption: scenarios.InterruptionGrid | None = None,
-                 perturbation: Perturbation | None = None, request_fields: bool = False,
+def run_scenario(source: str | Path | scenarios.RobotScenario, options: RunOptions | None = None, *,
+                 out: Path | None = None, progress: bool = False, pictures: bool = True,
                  task_wrapper: Callable[[TaskType], TaskType] | None = None,
-                 live: Callable[[SimulationLoop, Any, Actions], scenarios.RobotScenario] | None = None) -> RunResult:
+                 live: Callable[[SimulationLoop, Any, Actions], scenarios.RobotScenario] | None = None,
+                 **changes: Any) -> RunResult:
     """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced.
 
-    ``task_paths``: task folders to load besides the bundled ones (``tasker run --path``).
-    ``policy`` (``strict``/``conditional``) overrides the scenario's; ``hazard_waiting`` switches
-    hazard-aware waiting on; ``interruption`` (with ``randomize``) places the interrupting request
-    in the seed's stratum (:class:`experiments.inputs.scenario.InterruptionGrid`) and ``perturbation``
-    draws exogenous world events around it (:mod:`experiments.inputs.perturbation`);
-    ``request_fields`` and ``task_wrapper``: see :func:`build_robot_actions`.  ``live`` drives a robot
-    scenario's loop instead of running it to its end (``tasker serve``, :mod:`experiments.serve`): it gets
-    the loop, the simulation and their :class:`Actions`, and returns the scenario that replays what it ran
-    (the scenario ``run.json`` records)."""
+    ``options`` (:class:`~experiments.run.options.RunOptions`) choose the seed, the strategies, the
+    scheduler, the tree, a randomised variant (``randomize``, with ``interruption`` placing the
+    interrupting request in the seed's stratum, :class:`experiments.inputs.scenario.InterruptionGrid`,
+    and ``perturbation`` changing its world, :mod:`experiments.inputs.perturbation`) and the task
+    folders besides the bundled ones; ``changes`` are fields of it given as keywords
+    (``run_scenario("carry", suspension="static")``).  ``task_wrapper``: see
+    :func:`build_robot_actions`.  ``live`` drives a robot scenario's loop instead of running it to its
+    end (``tasker serve``, :mod:`experiments.serve`): it gets the loop, the simulation and their
+    :class:`Actions`, and returns the scenario that replays what it ran (the scenario ``run.json``
+    records)."""
+    opts = dataclasses.replace(options or RunOptions(), **changes)
     if isinstance(source, scenarios.RobotScenario):
         kind, scn_path = "robot", Path(source.source)
     else:
@@ -331,21 +359,23 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
     actions: Actions | None = None
     if kind == "synthetic":
         syn = synthetic.load(scn_path)
-        run_seed = syn.seed if seed is None else seed
-        loop = synthetic.build(syn, seed=run_seed, scheduler=scheduler, mode=mode)
+        run_seed = syn.seed if opts.seed is None else opts.seed
+        loop = synthetic.build(syn, seed=run_seed, scheduler=opts.scheduler, mode=opts.mode)
         spec_json: dict[str, Any] = {"kind": "synthetic", "name": syn.name, "source": str(scn_path)}
         sim = None
     elif kind == "robot":
-        scn = source if isinstance(source, scenarios.RobotScenario) else scenarios.load(scn_path, task_paths=task_paths)
-        run_seed = scn.seed if seed is None else seed
-        if randomize:
-            scn = scenarios.randomize(scn, run_seed, interruption=interruption, perturbation=perturbation)
-        if mode is not None:
-            scn = dataclasses.replace(scn, mode=mode)
-        loop, sim, actions = build_robot_actions(
-            scn, seed=run_seed, update=update, suspension=suspension, scheduler=scheduler, task_paths=task_paths,
-            policy=policy, hazard_waiting=bool(hazard_waiting), request_fields=request_fields,
-            task_wrapper=task_wrapper)
+        scn = source if isinstance(source, scenarios.RobotScenario) else scenarios.load(
+            scn_path, task_paths=opts.task_paths)
+        run_seed = scn.seed if opts.seed is None else opts.seed
+        draw = _target_draw(scn, run_seed, opts)
+        if opts.randomize:
+            scn = scenarios.randomize(scn, run_seed, interruption=opts.interruption, perturbation=opts.perturbation)
+        if opts.mode is not None:
+            scn = dataclasses.replace(scn, mode=opts.mode)
+        loop, sim, actions = build_robot_actions(scn, dataclasses.replace(opts, seed=run_seed),
+                                                 task_wrapper=task_wrapper)
+        if draw is not None:
+            Targeter(loop, sim, actions.now, *draw)
         spec_json = {"kind": "robot", **scn.to_json()}
     else:
         raise scenarios.ScenarioError(f"{scn_path}: kind: expected 'robot' or 'synthetic', got {kind!r}")
@@ -372,13 +402,15 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
         "scenario": spec_json, "seed": run_seed,
         "settings": {"scheduler": loop.harmoniser.scheduler.name, "mode": loop.harmoniser.mode.value,
                      # synthetic task types have only static strategies: say what was used
-                     "update": "static" if kind == "synthetic" else (update or loop.strategy.update),
-                     "suspension": "static" if kind == "synthetic" else (suspension or loop.strategy.suspension),
-                     "randomized": randomize,
+                     "update": "static" if kind == "synthetic" else (opts.update or loop.strategy.update),
+                     "suspension": "static" if kind == "synthetic" else (opts.suspension or loop.strategy.suspension),
+                     "randomized": opts.randomize,
                      "policy": None if kind == "synthetic" else loop.strategy.policy,
-                     "hazard_waiting": bool(hazard_waiting),
-                     **({"interruption": interruption.to_json()} if interruption and randomize else {}),
-                     **({"perturbation": perturbation.to_json()} if perturbation and randomize else {})},
+                     "hazard_waiting": opts.hazard_waiting,
+                     **({"tree": opts.tree} if opts.tree is not None else {}),
+                     **({"interruption": opts.interruption.to_json()} if opts.interruption and opts.randomize else {}),
+                     **({"perturbation": opts.perturbation.to_json()} if opts.perturbation and opts.randomize
+                        else {})},
         "planner": _planner_config() if kind == "robot" else None,
         "host": platform.node(), "platform": platform.platform(), "python": sys.version.split()[0],
         "date": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "tasker_version": tasker.__version__,
@@ -406,6 +438,15 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, *, seed: int | No
     if error is not None:
         raise RunAborted(reason, result) from error
     return result
+
+
+def _target_draw(scn: scenarios.RobotScenario, seed: int,
+                 opts: RunOptions) -> tuple[TargetDraw, float, set[str]] | None:
+    """For a targeted variant: its draw, the time of its interruption and what its requests name."""
+    p, grid = opts.perturbation, opts.interruption
+    if not (opts.randomize and p is not None and p.mode == "targeted" and grid is not None):
+        return None
+    return TargetDraw.of(p, f"{scn.name}:{seed}"), scenarios.placed_time(scn.name, seed, grid), named(scn.actions)
 
 
 def _journal(kind: str) -> contextlib.AbstractContextManager[list[Any]]:

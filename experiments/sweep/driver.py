@@ -148,9 +148,7 @@ def precheck(jobs: Iterable[Job]) -> None:
         try:
             if isinstance(scn, scenarios.RobotScenario):
                 variant = scenarios.randomize(scn, job.seed, interruption=job.interruption)
-                build_robot(variant, seed=job.seed, update=st.update, suspension=st.suspension,
-                            scheduler=st.scheduler, task_paths=job.task_paths, policy=st.policy,
-                            hazard_waiting=bool(st.hazard_waiting))
+                build_robot(variant, job.options())
             else:
                 synthetic.build(scn, seed=job.seed, scheduler=st.scheduler)
         except Exception as exc:  # noqa: BLE001 - whatever it is, every job like it would fail

@@ -84,13 +84,9 @@ def trace_digest(job: Job) -> str:
     """Run ``job`` (no pictures) into a temporary folder; the SHA-256 of its ``trace.jsonl``."""
     from experiments.run.runner import run_scenario
 
-    st = job.strategy
     with tempfile.TemporaryDirectory(prefix="tasker-provenance-") as tmp:
         out = Path(tmp) / "run"
-        run_scenario(job.source, seed=job.seed, update=st.update, suspension=st.suspension, scheduler=st.scheduler,
-                     randomize=True, task_paths=job.task_paths, policy=st.policy,
-                     hazard_waiting=st.hazard_waiting, interruption=job.interruption,
-                     perturbation=job.perturbation, out=out, pictures=False)
+        run_scenario(job.source, job.options(), out=out, pictures=False)
         return hashlib.sha256((out / "trace.jsonl").read_bytes()).hexdigest()
 
 
@@ -101,14 +97,14 @@ def digest(spec_path: str, job: Job, perturbed: bool) -> Digest:
 def run_digest(scenario: str, *, seed: int | None = None, strategy: str = "", root: Path = ROOT) -> Digest:
     """The digest of a plain run of ``scenario`` (as ``tasker run`` runs it: not randomised)."""
     from experiments.inputs.strategy import Strategy
+    from experiments.run.options import RunOptions
     from experiments.run.runner import run_scenario
 
     st = Strategy.parse(strategy) if strategy else Strategy()
     source = scenario if not scenario.endswith(".toml") else str(root / scenario)
     with tempfile.TemporaryDirectory(prefix="tasker-provenance-") as tmp:
         out = Path(tmp) / "run"
-        run_scenario(source, seed=seed, update=st.update, suspension=st.suspension, scheduler=st.scheduler,
-                     policy=st.policy, hazard_waiting=st.hazard_waiting, out=out, pictures=False)
+        run_scenario(source, RunOptions.of(st, seed=seed), out=out, pictures=False)
         sha = hashlib.sha256((out / "trace.jsonl").read_bytes()).hexdigest()
     return Digest("", False, scenario, -1 if seed is None else seed, strategy, sha)
 

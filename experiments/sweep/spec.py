@@ -16,10 +16,12 @@ from typing import Any
 
 from experiments.inputs.filekinds import expect
 from experiments.inputs.perturbation import KINDS as perturbation_kinds
+from experiments.inputs.perturbation import MODES as perturbation_modes
 from experiments.inputs.perturbation import Perturbation
 from experiments.inputs.scenario import InterruptionGrid
 from experiments.inputs.strategy import FACTOR_LEVELS, FACTORS, Strategy, expand
 from experiments.metrics.store import JobKey
+from experiments.run.options import RunOptions
 from tasker.support import reader
 from tasker.support.reader import InputError
 
@@ -46,6 +48,11 @@ class Job:
     @property
     def key(self) -> JobKey:
         return (self.scenario, self.seed, self.strategy.label)
+
+    def options(self) -> RunOptions:
+        """How the job runs: a randomised variant of its seed, with its strategy, interruption and perturbation."""
+        return RunOptions.of(self.strategy, seed=self.seed, randomize=True, task_paths=self.task_paths,
+                             interruption=self.interruption, perturbation=self.perturbation)
 
 
 @dataclass(frozen=True)
@@ -263,7 +270,9 @@ def _perturbation(top: reader.Table, variants: Mapping[str, InterruptionGrid]) -
                          after_s=float(t.number("after_s", 60.0, min=0)),
                          kinds=tuple(str(k) for k in kinds),
                          stand_s=(float(stand[0]), float(stand[1])) if len(stand) == 2 and all(
-                             isinstance(v, int | float) and not isinstance(v, bool) for v in stand) else (-1.0, -1.0))
+                             isinstance(v, int | float) and not isinstance(v, bool) for v in stand) else (-1.0, -1.0),
+                         mode=str(t.string("mode", "untargeted", choices=perturbation_modes)),
+                         during_s=float(t.number("during_s", 8.0, min=0)))
     except ValueError as exc:
         raise t.error(str(exc).partition(":")[0].split(",")[0], str(exc).partition(": ")[2]) from None
     t.done()
@@ -316,6 +325,11 @@ def _grid(t: reader.Table) -> list[Strategy]:
                 if not isinstance(v, str) or not v:
                     raise lt.error(i, f"expected a scheduler name, got {v!r}")
                 _check_scheduler(lt, i, Strategy(scheduler=v))
+            elif key == "tree":
+                try:
+                    Strategy(tree=v)
+                except ValueError as exc:
+                    raise lt.error(i, str(exc).partition(": ")[2]) from None
             else:
                 choices = FACTOR_LEVELS[key] or ()
                 if v not in choices:

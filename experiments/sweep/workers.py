@@ -60,11 +60,7 @@ def run_job(job: Job) -> tuple[dict[str, Any], dict[str, Any]]:
     """The default ``run_fn``: a randomised run of the job's scenario with its seed and strategy."""
     from experiments.run.runner import run_scenario  # imported in the worker, never shared across processes
 
-    st = job.strategy
-    result = run_scenario(job.source, seed=job.seed, update=st.update, suspension=st.suspension,
-                          scheduler=st.scheduler, randomize=True, task_paths=job.task_paths, policy=st.policy,
-                          hazard_waiting=st.hazard_waiting, interruption=job.interruption,
-                          perturbation=job.perturbation)
+    result = run_scenario(job.source, job.options())
     return dict(result.record), dict(result.metrics)
 
 

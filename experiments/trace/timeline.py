@@ -10,10 +10,13 @@ trace dicts.  So what a state, a suspension or a hazard episode *is* is decided 
   events) and **person role spans** (the task folders' declared roles, ``role`` events);
 * **stage runs**: each stage from ``begin`` to its closing event;
 * **suspension episodes**: from entering ``genSusp`` (by ``suspend``, ``stage_failed`` or
-  ``secure``) to entering ``wait`` or ``end``, with the ``exeSusp`` plan and the stages run;
+  ``secure``) to entering ``wait`` or ``end``, with the ``exeSusp`` plan (and any made again
+  when the ``fallback`` strategy planned around a stage of it), the stages run, and the check
+  of its goal as it ended (the ``goal`` event);
 * **interruptions**: from a ``susp`` command to the agent's next ``start`` (a ``start`` with
   ``secure`` does not end one), with the expected and realised lengths;
-* **hazard episodes** with their owner (``null``: nobody's), from ``on`` to ``off``.
+* **hazard episodes** with their owner (``null``: nobody's), from ``on`` to ``off``, and whether
+  the robot carries the thing (``carried``).
 
 A span still open when the trace ends is closed at the trace's last time with
 ``closed=False``.  Times are the trace's simulated seconds.  The names of states and
@@ -25,7 +28,7 @@ from __future__ import annotations
 
 import bisect
 import math
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -106,7 +109,9 @@ class Suspension:
     ``trigger``: ``suspend`` (a ``susp`` or ``term`` command, or the task's own ``ic_term``),
     ``stage_failed`` (a failed stage, before the task ends) or ``secure`` (hazard-aware
     waiting, from ``wait``).  ``outcome``: ``wait``, ``end`` or ``open`` (the trace ended).
-    ``ready`` is when ``exeSusp`` began (its plan was ready), if it did."""
+    ``ready`` is when ``exeSusp`` began (its plan was ready), if it did.  ``replans`` are the plans
+    made again within the episode (``fallback`` planning around a stage that could not run);
+    ``goal`` is the check of the goal its ``exeSusp`` aimed for as it ended, if the task type said one."""
 
     agent: str
     start: float
@@ -116,6 +121,13 @@ class Suspension:
     ready: float | None
     end: float
     outcome: str
+    replans: tuple[ev.PlanMade, ...] = ()
+    goal: ev.GoalChecked | None = None
+
+    @property
+    def last_plan(self) -> ev.PlanMade | None:
+        """The plan ``exeSusp`` last ran (the first, unless it was planned again)."""
+        return self.replans[-1] if self.replans else self.plan
 
     @property
     def duration(self) -> float:
@@ -148,6 +160,7 @@ class HazardEpisode:
     severity: float
     start: float
     end: float | None
+    carried: bool = False
 
     @property
     def label(self) -> str:
@@ -235,6 +248,7 @@ class Timeline:
         self.commands: list[ev.CommandSent] = []
         self.hazards: list[HazardEpisode] = []
         self.needs: dict[str, str] = {}
+        self.goals: list[ev.GoalChecked] = []
         self._role_times: list[float] | None = None
         self.people_order: list[str] = []
         """Agents in the order their first person-role edge came (the order of ``people`` metrics)."""
@@ -263,162 +277,8 @@ class Timeline:
         return cls(read_events(path))
 
     def _build(self) -> None:
-        state: dict[str, tuple[str, float, str]] = {}  # agent -> (state, since, entered_by)
-        stage_open: dict[str, tuple[ev.StageChanged, int]] = {}  # agent -> (its begin, index in stages)
-        susp_open: dict[str, dict[str, Any]] = {}
-        inter_open: dict[str, dict[str, Any]] = {}
-        roles_now: dict[str, tuple[str, float]] = {}
-        person_open: dict[tuple[str, str], tuple[float, str]] = {}
-        hazard_open: dict[tuple[str | None, str, tuple[str, ...]], ev.HazardChanged] = {}
-        resuming: dict[str, float] = {}
-        for e in self.events:
-            if isinstance(e, ev.TaskRequested):
-                self.agents[e.agent] = AgentTimeline(e.agent, e.task_type, e.args, e.requester, e.renews, e.t)
-                state[e.agent] = (S.INIT_COMM.value, e.t, "request")
-                self.needs[e.agent] = (self.needs.get(e.renews, e.renews) if e.renews is not None else e.agent)
-            elif isinstance(e, ev.Transition):
-                a = self.agents.get(e.agent)
-                if a is None:
-                    continue
-                a.transitions.append(e)
-                was, since, by = state.pop(e.agent, (e.source, e.t, ""))
-                a.states.append(StateSpan(since, e.t, True, was, by, e.trigger))
-                if e.target != S.END.value:
-                    state[e.agent] = (e.target, e.t, e.trigger)
-                if e.source == S.WAIT.value and e.target == S.UP_TSK.value:
-                    resuming[e.agent] = e.t
-                self._on_transition(a, e, susp_open, inter_open)
-            elif isinstance(e, ev.StageChanged):
-                a = self.agents.get(e.agent)
-                if a is None:
-                    continue
-                if e.status == "begin":
-                    if e.agent in resuming:
-                        a.resumptions.append(Span(resuming.pop(e.agent), e.t))
-                    a.stages.append(StageRun(e.agent, e.fsm, e.index, e.action, tuple(e.args), e.kind, e.t, None,
-                                             "running"))
-                    stage_open[e.agent] = (e, len(a.stages) - 1)
-                    if e.fsm == S.EXE_SUSP.value and e.agent in susp_open and susp_open[e.agent]["ready"] is None:
-                        susp_open[e.agent]["ready"] = e.t
-                elif e.agent in stage_open:
-                    begin, k = stage_open.pop(e.agent)
-                    run = a.stages[k]
-                    a.stages[k] = StageRun(run.agent, run.fsm, run.index, run.action, run.args, run.kind, run.begin,
-                                           e.t, e.status, e.reason)
-                    if run.fsm == S.EXE_SUSP.value and e.agent in susp_open:
-                        susp_open[e.agent]["stages"].append(a.stages[k])
-            elif isinstance(e, ev.PlanMade):
-                a = self.agents.get(e.agent)
-                if a is None:
-                    continue
-                a.plans.append(e)
-                if e.purpose == S.GEN_SUSP.value and e.agent in susp_open:
-                    susp_open[e.agent]["plan"] = e
-            elif isinstance(e, ev.CommandSent):
-                self.commands.append(e)
-                a = self.agents.get(e.agent)
-                if a is None:
-                    continue
-                a.commands.append(e)
-                self._on_command(a, e, inter_open)
-            elif isinstance(e, ev.TaskEnded):
-                a = self.agents.get(e.agent)
-                if a is None:
-                    continue
-                a.end = e
-                opened = inter_open.pop(e.agent, None)
-                if opened is not None:
-                    a.interruptions.append(Interruption(**opened, resume_t=None, outcome="ended"))
-            elif isinstance(e, ev.RolesChanged):
-                self.roles.append(e)
-                now = {x: "idleDA" for x in e.idle_da}
-                if e.exe_da:
-                    now[e.exe_da] = "exeDA"
-                if e.irr_da:
-                    now[e.irr_da] = "irrDA"
-                for agent in [x for x in roles_now if now.get(x) != roles_now[x][0]]:
-                    role, t0 = roles_now.pop(agent)
-                    if e.t > t0 and agent in self.agents:
-                        self.agents[agent].roles.append(RoleSpan(t0, e.t, True, agent, role))
-                for agent, role in now.items():
-                    roles_now.setdefault(agent, (role, e.t))
-            elif isinstance(e, ev.RoleChanged):
-                if e.agent in self.agents and e.agent not in self.people_order:
-                    self.people_order.append(e.agent)
-                key = (e.agent, e.role)
-                if e.status == "on":
-                    person_open.setdefault(key, (e.t, e.person))
-                elif key in person_open and e.agent in self.agents:
-                    t0, person = person_open.pop(key)
-                    self.agents[e.agent].person_roles.append(PersonRoleSpan(t0, e.t, True, e.agent, e.role, person))
-            elif isinstance(e, ev.HazardChanged):
-                hkey = (e.agent, e.hazard, tuple(str(x) for x in e.args))
-                if e.status == "on" and hkey not in hazard_open:
-                    hazard_open[hkey] = e
-                elif e.status == "off" and hkey in hazard_open:
-                    on = hazard_open.pop(hkey)
-                    self.hazards.append(_episode(on, e.t))
-            elif isinstance(e, ev.Decision):
-                self.decisions.append(e)
-            elif isinstance(e, ev.WorldChanged):
-                self.world.append(e)
-            elif isinstance(e, ev.ModeChanged):
-                self.modes.append(e)
-            elif isinstance(e, ev.ArgsChanged):
-                self.changes.append(e)
-            elif isinstance(e, ev.SecureChanged):
-                self.secures.append(e)
-            elif isinstance(e, ev.RunStarted):
-                self.started = self.started or e
-            elif isinstance(e, ev.RunStopped):
-                self.stopped = e
-        t_end = self.t_end
-        for agent, (st, since, by) in state.items():
-            self.agents[agent].states.append(StateSpan(since, t_end, False, st, by, None))
-        for agent, (_, k) in stage_open.items():
-            run = self.agents[agent].stages[k]
-            if run.fsm == S.EXE_SUSP.value and agent in susp_open:
-                susp_open[agent]["stages"].append(run)
-        for agent, opened in susp_open.items():
-            opened["stages"] = tuple(opened["stages"])
-            self.agents[agent].suspensions.append(Suspension(**opened, end=t_end, outcome="open"))
-        for agent, opened in inter_open.items():
-            self.agents[agent].interruptions.append(Interruption(**opened, resume_t=None,
-                                                                 outcome="open at the end of the run"))
-        for agent, (role, t0) in roles_now.items():
-            if agent in self.agents:
-                self.agents[agent].roles.append(RoleSpan(t0, t_end, False, agent, role))
-        for (agent, role), (t0, person) in person_open.items():
-            if agent in self.agents:
-                self.agents[agent].person_roles.append(PersonRoleSpan(t0, t_end, False, agent, role, person))
-        self.hazards += [_episode(on, None) for on in hazard_open.values()]
-        self.hazards.sort(key=lambda h: (h.start, h.hazard, h.args, str(h.owner)))
-        for a in self.agents.values():
-            a.roles.sort(key=lambda s: s.start)
-            a.person_roles.sort(key=lambda s: (s.start, s.role))
-
-    def _on_transition(self, a: AgentTimeline, e: ev.Transition, susp_open: dict[str, dict[str, Any]],
-                       inter_open: dict[str, dict[str, Any]]) -> None:
-        if e.target == S.GEN_SUSP.value:
-            susp_open[a.id] = {"agent": a.id, "start": e.t, "trigger": e.trigger, "plan": None, "stages": [],
-                               "ready": None}
-        elif e.source in SUSPENDING and e.target not in SUSPENDING and a.id in susp_open:
-            opened = susp_open.pop(a.id)
-            opened["stages"] = tuple(opened["stages"])
-            a.suspensions.append(Suspension(**opened, end=e.t, outcome=e.target))
-        if e.target == S.WAIT.value and a.id in inter_open and inter_open[a.id]["wait_t"] is None:
-            inter_open[a.id]["wait_t"] = e.t
-
-    def _on_command(self, a: AgentTimeline, e: ev.CommandSent, inter_open: dict[str, dict[str, Any]]) -> None:
-        if e.flag == "start" and not e.secure:
-            opened = inter_open.pop(a.id, None)
-            if opened is not None:
-                outcome = "resumed" if opened["wait_t"] is not None else "not suspended"
-                a.interruptions.append(Interruption(**opened, resume_t=e.t if outcome == "resumed" else None,
-                                                    outcome=outcome))
-        elif e.flag == "susp":
-            inter_open[a.id] = {"agent": a.id, "task_type": a.task_type, "by": e.by, "susp_t": e.t,
-                                "expected_s": e.expected_s, "wait_t": None}
+        """Read every event once, through the handler of its type (:class:`_Reading`)."""
+        _Reading(self).read(self.events)
 
     # -- queries --------------------------------------------------------------------------------
 
@@ -460,9 +320,212 @@ class Timeline:
         return [a for a in self.agents if self.needs.get(a) == a]
 
 
+class _Reading:
+    """One pass over a trace's events, building a :class:`Timeline`: a small handler per event type
+    (:data:`_HANDLERS`), the spans and episodes still open kept here until their closing event, then
+    closed at the trace's last time (``closed=False``) by :meth:`finish`."""
+
+    def __init__(self, tl: Timeline) -> None:
+        self.tl = tl
+        self.state: dict[str, tuple[str, float, str]] = {}  # agent -> (state, since, entered_by)
+        self.stage_open: dict[str, int] = {}  # agent -> index of its running stage in its stages
+        self.susp_open: dict[str, dict[str, Any]] = {}
+        self.inter_open: dict[str, dict[str, Any]] = {}
+        self.roles_now: dict[str, tuple[str, float]] = {}
+        self.person_open: dict[tuple[str, str], tuple[float, str]] = {}
+        self.hazard_open: dict[tuple[str | None, str, tuple[str, ...]], ev.HazardChanged] = {}
+        self.resuming: dict[str, float] = {}
+
+    def read(self, events: Iterable[ev.Event]) -> None:
+        for e in events:
+            handler = _HANDLERS.get(type(e))
+            if handler is not None:
+                handler(self, e)
+        self.finish()
+
+    def _agent(self, agent: str | None) -> AgentTimeline | None:
+        return self.tl.agents.get(agent) if agent is not None else None
+
+    # -- one handler per event type ----------------------------------------------------------------
+
+    def request(self, e: ev.TaskRequested) -> None:
+        tl = self.tl
+        tl.agents[e.agent] = AgentTimeline(e.agent, e.task_type, e.args, e.requester, e.renews, e.t)
+        self.state[e.agent] = (S.INIT_COMM.value, e.t, "request")
+        tl.needs[e.agent] = (tl.needs.get(e.renews, e.renews) if e.renews is not None else e.agent)
+
+    def transition(self, e: ev.Transition) -> None:
+        a = self._agent(e.agent)
+        if a is None:
+            return
+        a.transitions.append(e)
+        was, since, by = self.state.pop(e.agent, (e.source, e.t, ""))
+        a.states.append(StateSpan(since, e.t, True, was, by, e.trigger))
+        if e.target != S.END.value:
+            self.state[e.agent] = (e.target, e.t, e.trigger)
+        if e.source == S.WAIT.value and e.target == S.UP_TSK.value:
+            self.resuming[e.agent] = e.t
+        if e.target == S.GEN_SUSP.value and not (e.source == S.EXE_SUSP.value and a.id in self.susp_open):
+            self.susp_open[a.id] = {"agent": a.id, "start": e.t, "trigger": e.trigger, "plan": None, "stages": [],
+                                    "ready": None, "replans": [], "goal": None}
+        elif e.source in SUSPENDING and e.target not in SUSPENDING and a.id in self.susp_open:
+            a.suspensions.append(_suspension(self.susp_open.pop(a.id), e.t, e.target))
+        if e.target == S.WAIT.value and a.id in self.inter_open and self.inter_open[a.id]["wait_t"] is None:
+            self.inter_open[a.id]["wait_t"] = e.t
+
+    def stage(self, e: ev.StageChanged) -> None:
+        a = self._agent(e.agent)
+        if a is None:
+            return
+        if e.status == "begin":
+            if e.agent in self.resuming:
+                a.resumptions.append(Span(self.resuming.pop(e.agent), e.t))
+            a.stages.append(StageRun(e.agent, e.fsm, e.index, e.action, tuple(e.args), e.kind, e.t, None, "running"))
+            self.stage_open[e.agent] = len(a.stages) - 1
+            opened = self.susp_open.get(e.agent)
+            if e.fsm == S.EXE_SUSP.value and opened is not None and opened["ready"] is None:
+                opened["ready"] = e.t
+        elif e.agent in self.stage_open:
+            k = self.stage_open.pop(e.agent)
+            run = a.stages[k]
+            a.stages[k] = StageRun(run.agent, run.fsm, run.index, run.action, run.args, run.kind, run.begin,
+                                   e.t, e.status, e.reason)
+            if run.fsm == S.EXE_SUSP.value and e.agent in self.susp_open:
+                self.susp_open[e.agent]["stages"].append(a.stages[k])
+
+    def plan(self, e: ev.PlanMade) -> None:
+        a = self._agent(e.agent)
+        if a is None:
+            return
+        a.plans.append(e)
+        opened = self.susp_open.get(e.agent)
+        if e.purpose == S.GEN_SUSP.value and opened is not None:
+            if opened["plan"] is None:
+                opened["plan"] = e
+            else:
+                opened["replans"].append(e)
+
+    def goal(self, e: ev.GoalChecked) -> None:
+        self.tl.goals.append(e)
+        if e.agent in self.susp_open:
+            self.susp_open[e.agent]["goal"] = e
+
+    def command(self, e: ev.CommandSent) -> None:
+        self.tl.commands.append(e)
+        a = self._agent(e.agent)
+        if a is None:
+            return
+        a.commands.append(e)
+        if e.flag == "start" and not e.secure:
+            opened = self.inter_open.pop(a.id, None)
+            if opened is not None:
+                outcome = "resumed" if opened["wait_t"] is not None else "not suspended"
+                a.interruptions.append(Interruption(**opened, resume_t=e.t if outcome == "resumed" else None,
+                                                    outcome=outcome))
+        elif e.flag == "susp":
+            self.inter_open[a.id] = {"agent": a.id, "task_type": a.task_type, "by": e.by, "susp_t": e.t,
+                                     "expected_s": e.expected_s, "wait_t": None}
+
+    def end(self, e: ev.TaskEnded) -> None:
+        a = self._agent(e.agent)
+        if a is None:
+            return
+        a.end = e
+        opened = self.inter_open.pop(e.agent, None)
+        if opened is not None:
+            a.interruptions.append(Interruption(**opened, resume_t=None, outcome="ended"))
+
+    def roles(self, e: ev.RolesChanged) -> None:
+        self.tl.roles.append(e)
+        now = {x: "idleDA" for x in e.idle_da}
+        if e.exe_da:
+            now[e.exe_da] = "exeDA"
+        if e.irr_da:
+            now[e.irr_da] = "irrDA"
+        for agent in [x for x in self.roles_now if now.get(x) != self.roles_now[x][0]]:
+            role, t0 = self.roles_now.pop(agent)
+            if e.t > t0 and agent in self.tl.agents:
+                self.tl.agents[agent].roles.append(RoleSpan(t0, e.t, True, agent, role))
+        for agent, role in now.items():
+            self.roles_now.setdefault(agent, (role, e.t))
+
+    def role(self, e: ev.RoleChanged) -> None:
+        tl = self.tl
+        if e.agent in tl.agents and e.agent not in tl.people_order:
+            tl.people_order.append(e.agent)
+        key = (e.agent, e.role)
+        if e.status == "on":
+            self.person_open.setdefault(key, (e.t, e.person))
+        elif key in self.person_open and e.agent in tl.agents:
+            t0, person = self.person_open.pop(key)
+            tl.agents[e.agent].person_roles.append(PersonRoleSpan(t0, e.t, True, e.agent, e.role, person))
+
+    def hazard(self, e: ev.HazardChanged) -> None:
+        key = (e.agent, e.hazard, tuple(str(x) for x in e.args))
+        if e.status == "on" and key not in self.hazard_open:
+            self.hazard_open[key] = e
+        elif e.status == "off" and key in self.hazard_open:
+            self.tl.hazards.append(_episode(self.hazard_open.pop(key), e.t))
+
+    def run(self, e: ev.RunStarted) -> None:
+        self.tl.started = self.tl.started or e
+
+    def stopped(self, e: ev.RunStopped) -> None:
+        self.tl.stopped = e
+
+    # -- what the trace left open ----------------------------------------------------------------
+
+    def finish(self) -> None:
+        """Close what is still open at the trace's last time (``closed=False``) and sort."""
+        tl, t_end = self.tl, self.tl.t_end
+        for agent, (st, since, by) in self.state.items():
+            tl.agents[agent].states.append(StateSpan(since, t_end, False, st, by, None))
+        for agent, k in self.stage_open.items():
+            run = tl.agents[agent].stages[k]
+            if run.fsm == S.EXE_SUSP.value and agent in self.susp_open:
+                self.susp_open[agent]["stages"].append(run)
+        for agent, opened in self.susp_open.items():
+            tl.agents[agent].suspensions.append(_suspension(opened, t_end, "open"))
+        for agent, opened in self.inter_open.items():
+            tl.agents[agent].interruptions.append(Interruption(**opened, resume_t=None,
+                                                               outcome="open at the end of the run"))
+        for agent, (role, t0) in self.roles_now.items():
+            if agent in tl.agents:
+                tl.agents[agent].roles.append(RoleSpan(t0, t_end, False, agent, role))
+        for (agent, role), (t0, person) in self.person_open.items():
+            if agent in tl.agents:
+                tl.agents[agent].person_roles.append(PersonRoleSpan(t0, t_end, False, agent, role, person))
+        tl.hazards += [_episode(on, None) for on in self.hazard_open.values()]
+        tl.hazards.sort(key=lambda h: (h.start, h.hazard, h.args, str(h.owner)))
+        for a in tl.agents.values():
+            a.roles.sort(key=lambda s: s.start)
+            a.person_roles.sort(key=lambda s: (s.start, s.role))
+
+
+def _appender(name: str) -> Callable[[_Reading, Any], None]:
+    """A handler that only keeps the event in the timeline's list ``name``."""
+    return lambda r, e: getattr(r.tl, name).append(e)
+
+
+_HANDLERS: dict[type[ev.Event], Callable[[_Reading, Any], None]] = {
+    ev.TaskRequested: _Reading.request, ev.Transition: _Reading.transition, ev.StageChanged: _Reading.stage,
+    ev.PlanMade: _Reading.plan, ev.CommandSent: _Reading.command, ev.TaskEnded: _Reading.end,
+    ev.RolesChanged: _Reading.roles, ev.RoleChanged: _Reading.role, ev.HazardChanged: _Reading.hazard,
+    ev.Decision: _appender("decisions"), ev.WorldChanged: _appender("world"), ev.ModeChanged: _appender("modes"),
+    ev.ArgsChanged: _appender("changes"), ev.SecureChanged: _appender("secures"),
+    ev.RunStarted: _Reading.run, ev.RunStopped: _Reading.stopped, ev.GoalChecked: _Reading.goal,
+}
+"""How each event type is read; a type not listed (none today) is skipped."""
+
+
 def _episode(on: ev.HazardChanged, end: float | None) -> HazardEpisode:
     return HazardEpisode(on.agent, on.hazard, tuple(str(x) for x in on.args), tuple(str(x) for x in on.fact),
-                         float(on.budget_s), float(on.severity), on.t, end)
+                         float(on.budget_s), float(on.severity), on.t, end, bool(on.carried))
+
+
+def _suspension(opened: dict[str, Any], end: float, outcome: str) -> Suspension:
+    return Suspension(opened["agent"], opened["start"], opened["trigger"], opened["plan"], tuple(opened["stages"]),
+                      opened["ready"], end, outcome, tuple(opened["replans"]), opened["goal"])
 
 
 def timeline(source: Timeline | Iterable[ev.Event | Mapping[str, Any]] | str | Path) -> Timeline:

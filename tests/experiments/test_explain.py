@@ -26,7 +26,7 @@ from tests.experiments.events import complete
 UNSOLVABLE = """
 kind = "robot"
 name = "unsolvable"
-world = "paper"
+world = "flat"
 seed = 1
 
 [settings]
@@ -35,15 +35,14 @@ update = "planned"
 suspension = "planned"
 horizon = 60.0
 
-[[world_events]]
-t = 0.0
-door = ["hall_bathroom", false]
-note = "Sara shuts the bathroom door: the robot cannot reach her"
+# Anna stands in the flat's storage room, walled off (no door): the robot cannot reach her
+[people.anna]
+pose = [0.7, 5.2, 0.0]
 
 [[requests]]
 t = 1.0
 task = "guide_human"
-args = { person = "sara", destination = "living" }
+args = { person = "anna", destination = "living" }
 """
 
 

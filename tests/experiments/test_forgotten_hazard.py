@@ -27,6 +27,7 @@ import pytest
 from unified_planning.exceptions import UPInvalidActionError
 
 from experiments.inputs import scenario as scenarios
+from experiments.run.options import RunOptions
 from experiments.run.runner import build_robot
 from experiments.trace.timeline import Timeline
 from planners.checks import PddlError, load_problem_text
@@ -114,7 +115,7 @@ class Witness:
 
 
 def _run(scn: scenarios.RobotScenario, suspension: str) -> tuple[Timeline, Witness]:
-    loop, sim = build_robot(scn, seed=scn.seed, suspension=suspension, task_paths=PATHS)
+    loop, sim = build_robot(scn, RunOptions(seed=scn.seed, suspension=suspension, task_paths=PATHS))
     witness = Witness(loop.all_agents, sim)
     return Timeline.of(loop.run().events), witness
 

@@ -11,6 +11,7 @@ import pytest
 
 from experiments.inputs import scenario as scenarios
 from experiments.inputs.fields import ScenarioError
+from experiments.run.options import RunOptions
 from experiments.run.runner import build_robot
 
 SCENARIO = """\
@@ -39,7 +40,7 @@ def _write(tmp_path: Path, device: str) -> Path:
 def test_a_scenario_device_is_in_the_world_where_and_as_declared(tmp_path: Path) -> None:
     scn = scenarios.load(_write(tmp_path, GOOD))
     assert scn.devices == {"kettle": {"type": "cooker", "place": "kitchen", "state": "on"}}
-    _, sim = build_robot(scn, seed=1)
+    _, sim = build_robot(scn, RunOptions(seed=1))
     facts = sim.snapshot().facts
     assert ("at", "kettle", "kitchen") in facts and ("state", "kettle", "on") in facts
     assert sim.objects()["kettle"] == "cooker"

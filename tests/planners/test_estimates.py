@@ -385,9 +385,10 @@ def test_a_plan_estimated_across_a_closed_door_opens_it() -> None:
     """The reference table keeps closed doors closed (but for door_between pairs, which the
     plan may open): carry's first estimate is a plan through the door it opens, and finite."""
     from experiments.inputs import scenario as scenarios
+    from experiments.run.options import RunOptions
     from experiments.run.runner import build_robot
 
-    loop, _ = build_robot(scenarios.load(scenarios.resolve("carry")), seed=1)
+    loop, _ = build_robot(scenarios.load(scenarios.resolve("carry")), RunOptions(seed=1))
     trace = loop.run(until=0.5)
     start = next(e for e in trace.events if e["event"] == "command" and e["flag"] == "start")
     assert isinstance(start["predicted_s"], float) and math.isfinite(start["predicted_s"])
@@ -432,10 +433,11 @@ def test_a_waiting_task_is_estimated_from_the_state_the_executing_task_leaves() 
     from pathlib import Path
 
     from experiments.inputs import scenario as scenarios
+    from experiments.run.options import RunOptions
     from experiments.run.runner import build_robot
 
     path = Path(__file__).resolve().parents[2] / "experiments" / "sweep" / "specs" / "scenarios" / "compound.toml"
-    loop, _ = build_robot(scenarios.load(scenarios.resolve(str(path))), seed=1)
+    loop, _ = build_robot(scenarios.load(scenarios.resolve(str(path))), RunOptions(seed=1))
     trace = loop.run(until=35.001)  # the first decision after cook's request at 35, carry holding the vase
     held = [e for e in trace.events if e["event"] == "decision" and e.get("dac") == "d2" and e.get("exeDA") == "d1"]
     assert held, "cook must be compared with carry while carry runs"

@@ -284,9 +284,10 @@ def test_suspend_estimate_counts_the_blocking_stages_left() -> None:
 
 def test_the_runner_gives_the_harmoniser_the_monitors_hazards() -> None:
     from experiments.inputs import scenario as scenarios
+    from experiments.run.options import RunOptions
     from experiments.run.runner import build_robot
 
-    loop, _ = build_robot(scenarios.load(scenarios.resolve("household")), seed=1, hazard_waiting=True)
+    loop, _ = build_robot(scenarios.load(scenarios.resolve("household")), RunOptions(seed=1, hazard_waiting=True))
     harm = loop.harmoniser
     assert harm.hazard_waiting and harm.hazards is not None
     assert isinstance(harm.hazards.__self__, Monitor)  # type: ignore[attr-defined]

@@ -113,4 +113,4 @@ def test_events_resolve_through_guards() -> None:
     with pytest.raises(FSMError, match="no guard holds"):
         fsm.resolve(S.UP_TSK, "planned", lambda g: False)
     assert set(fsm.GUARDS) == {"has_stages", "no_stages", "ic_term", "not_ic_term", "ic_start", "ic_susp", "secure",
-                               "suspendable"}
+                               "recovers", "suspendable"}
