@@ -50,7 +50,7 @@ from enum import StrEnum
 from typing import Any, Protocol
 
 from planners.planner import PddlText, Planner
-from planners.problem import PLACE_TYPE, DomainModel, holds, render_problem, travel_table
+from planners.problem import PLACE_TYPE, DomainModel, closed_door_pairs, holds, render_problem, travel_table
 from planners.results import PlanStatus, PlanStep
 from planners.stages import Bindings, StageBuilder, robot_name
 from planners.taskspec import Branch, Literal, TaskSpec
@@ -351,8 +351,9 @@ class Estimator:
         return Estimate(c_time, end, source, steps, note)
 
     def _door_check(self, world: WorldState) -> Callable[[Stage], bool] | None:
-        """Does a stage travel between places joined by a ``door_between`` fact (a door the plan opens)?"""
-        pairs = {(f[2], f[3]) for f in world.matching("door_between") if len(f) == 4}
+        """Does a stage travel between places joined by a ``door_between`` fact through a door closed now
+        (a door the plan opens)?  Through an open door a leg is timed like any other."""
+        pairs = closed_door_pairs(world)
         if not pairs:
             return None
         task = self.task
@@ -406,8 +407,8 @@ class Estimator:
 
     def reference_table(self, world: WorldState, motion: Any) -> Travel:
         """Place-to-place seconds with nobody in the way, remembered per motion model and set
-        of closed doors: the doors as they are, except that places a ``door_between`` fact
-        joins are timed with their door open (the plan decides whether to open it).
+        of closed doors: the doors as they are, except that places a ``door_between`` fact joins
+        through a closed door are timed with it open (the plan decides whether to open it).
 
         A model without ``estimate_ignoring_people`` and ``estimate_ignoring_doors`` is asked
         with :func:`~planners.problem.travel_table` every time (it may change); without a
@@ -419,7 +420,7 @@ class Estimator:
             return travel_table(world, motion, self.task.spec.travel_s)
         places = tuple(sorted((n, tuple(world.poses.get(n, ()))) for n, t in world.objects.items()
                               if t == PLACE_TYPE))
-        through_door = frozenset((f[2], f[3]) for f in world.matching("door_between") if len(f) == 4)
+        through_door = frozenset(closed_door_pairs(world))
         closed: tuple[str, ...] = tuple(getattr(motion, "closed_doors", tuple)())
         key = (places, through_door, closed)
         with self._lock:

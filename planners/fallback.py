@@ -23,22 +23,38 @@ factor level of its own: ``static`` stays the pure tree.
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import TYPE_CHECKING
+from typing import Protocol
 
-from planners.problem import CONNECTED
-from planners.results import PlanStatus
+from planners.problem import CONNECTED, DomainModel
+from planners.results import PlanResult, PlanStatus
+from planners.taskspec import Literal
 from tasker.errors import PlanningFailed
 from tasker.stage import Stage, StagePlan
 from tasker.task import TaskContext
 from tasker.world import WorldState
 
-if TYPE_CHECKING:
-    from planners.pddl_task import PddlTaskType
-
 FALLBACK = "fallback"
 
 
-def suspension(task: PddlTaskType, ctx: TaskContext) -> StagePlan:
+class FallbackTask(Protocol):
+    """What the strategy needs of a task type (:class:`planners.pddl_task.PddlTaskType` has it)."""
+
+    name: str
+    domain: DomainModel
+
+    def world_of(self, ctx: TaskContext) -> WorldState: ...
+
+    def static_suspension(self, ctx: TaskContext) -> StagePlan: ...
+
+    def suspension_facts(self, ctx: TaskContext, world: WorldState) -> list[Literal]: ...
+
+    def derived_goal(self, ctx: TaskContext, world: WorldState) -> tuple[list[Literal], str]: ...
+
+    def plan_suspension_to(self, ctx: TaskContext, world: WorldState, goal: list[Literal],
+                           label: str) -> StagePlan | PlanResult: ...
+
+
+def suspension(task: FallbackTask, ctx: TaskContext) -> StagePlan:
     """genSusp's ``exeSusp`` under ``fallback`` (see the module docstring)."""
     world = task.world_of(ctx)
     if ctx.recovering is not None:
@@ -54,7 +70,7 @@ def suspension(task: PddlTaskType, ctx: TaskContext) -> StagePlan:
     return _planned(task, ctx, world, blocked, tree)
 
 
-def blocked_stage(task: PddlTaskType, ctx: TaskContext, world: WorldState, stages: tuple[Stage, ...]) -> str | None:
+def blocked_stage(task: FallbackTask, ctx: TaskContext, world: WorldState, stages: tuple[Stage, ...]) -> str | None:
     """Why ``stages``, run in order from the state the planner would see, cannot all run: the first
     stage whose precondition does not hold where the ones before it leave the state; None if they can."""
     facts = set(world.facts) | set(task.suspension_facts(ctx, world))
@@ -73,7 +89,7 @@ def blocked_stage(task: PddlTaskType, ctx: TaskContext, world: WorldState, stage
     return None
 
 
-def _planned(task: PddlTaskType, ctx: TaskContext, world: WorldState, why: str, tree: StagePlan | None) -> StagePlan:
+def _planned(task: FallbackTask, ctx: TaskContext, world: WorldState, why: str, tree: StagePlan | None) -> StagePlan:
     goal, label = task.derived_goal(ctx, world)
     outcome = task.plan_suspension_to(ctx, world, goal, label)
     if isinstance(outcome, StagePlan):

@@ -99,14 +99,16 @@ def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float)
     (walled off, or behind a closed door: people in the way only slow a leg, :func:`_past_people`).
 
     Without a motion model (or a pose) the declared ``travel_s`` is used, never zero.
-    Pairs joined by a ``door_between`` fact are timed with the motion model's optional
-    ``estimate_ignoring_doors`` (``robot.estimator.MotionEstimator`` has it).  A motion model
+    Pairs joined by a ``door_between`` fact whose door is closed now (no ``open`` fact) are timed
+    with the motion model's optional ``estimate_ignoring_doors`` (``robot.estimator.MotionEstimator``
+    has it): the plan may open it.  Through an open door a leg is timed like any other, people
+    and all (:func:`closed_door_pairs`).  A motion model
     with a ``table(poses)`` method (the same class) gives the whole matrix in one pass.
     """
     places = sorted(n for n, t in world.objects.items() if t == PLACE_TYPE)
-    # places joined by a door the domain models: the plan decides whether the door is open, so
-    # their travel time is the geometry's with the door open (if the motion model can say it)
-    through_door = {(f[2], f[3]) for f in world.matching("door_between") if len(f) == 4}
+    # places joined by a door the domain models and closed now: the plan decides whether to open it,
+    # so their travel time is the geometry's with the door open (if the motion model can say it)
+    through_door = closed_door_pairs(world)
     ignoring_doors = getattr(motion, "estimate_ignoring_doors", None)
     out: dict[tuple[str, str], float] = {}
     table = getattr(motion, "table", None)  # a whole matrix in one pass (robot.estimator.MotionEstimator)
@@ -128,6 +130,11 @@ def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float)
     _from_robot(world, motion, out, through_door, ignoring_doors)
     _past_people(world, motion, out)
     return out
+
+
+def closed_door_pairs(world: WorldState) -> set[tuple[str, str]]:
+    """Ordered pairs of places a ``door_between`` fact joins through a door that is not ``open`` now."""
+    return {(f[2], f[3]) for f in world.matching("door_between") if len(f) == 4 and ("open", f[1]) not in world.facts}
 
 
 def _past_people(world: WorldState, motion: MotionModel | None, out: dict[tuple[str, str], float]) -> None:

@@ -58,6 +58,10 @@ CLEAR = "clear"
 DERIVED = frozenset({CLEAR})
 """Predicates the world derives and never stores: ``("clear", place)`` holds while no movable object
 (of the world file or the scenario) is ``at`` the place; an effect on one is ignored (:meth:`Simulation.apply`)."""
+DOOR_BETWEEN = "door_between"
+"""A world file's fact ``(door_between door a b)``: the route from place ``a`` to place ``b`` passes the door."""
+WORLD_PREDICATES = DERIVED | {DOOR_BETWEEN}
+"""Predicates the world speaks of itself, which a task domain may read (the contract, like ``at``)."""
 
 
 class Simulation:

@@ -43,9 +43,10 @@
     :precondition (and (at ?r ?p) (at ?h ?p))
     :effect (and (reassured ?h) (increase (total-cost) 4)))
 
+  ; to a closed door's place, to open it (not a way of moving about: that is approach's)
   (:action approach_door
     :parameters (?r - robot ?d - door ?from ?to - place)
-    :precondition (and (at ?r ?from) (connected ?from ?to) (free_passage ?from ?to) (door_at ?d ?to))
+    :precondition (and (at ?r ?from) (connected ?from ?to) (free_passage ?from ?to) (door_at ?d ?to) (not (open ?d)))
     :effect (and (not (at ?r ?from)) (at ?r ?to)
                  (increase (total-cost) (travel-time ?from ?to))))
 

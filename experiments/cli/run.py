@@ -130,22 +130,18 @@ def _run(args: argparse.Namespace) -> int:
         if made and out.is_dir() and not any(out.iterdir()):
             out.rmdir()
         raise
-    ends = result.trace.of("end")
-    causes: dict[str, int] = {}
-    for e in ends:
-        causes[e["cause"]] = causes.get(e["cause"], 0) + 1
-    last = result.trace.events[-1]["t"] if result.trace.events else 0.0
-    suspensions = sum(1 for e in result.trace.of("command") if e["flag"] == "susp")
-    print(f"{label}: {len(result.trace.of('request'))} tasks, {len(ends)} ended "
-          f"({', '.join(f'{n} {c}' for c, n in sorted(causes.items()))}), {suspensions} suspensions, "
-          f"{last:.1f} s simulated in {result.record['wall_time_s']:.1f} s")
+    from experiments.report import summary
+    from experiments.trace.timeline import Timeline
+
+    tl = Timeline(result.trace.typed)
+    print(summary.headline(label, tl, result.metrics, float(result.record["wall_time_s"])))
     if not args.quiet:
-        for e in ends:
-            print(f"  {e['agent']} {e['task_type']}: {e['reason']} at t={e['t']:.1f}")
+        for line in summary.ends(tl) + summary.safety(tl, result.metrics):
+            print(line)
     note(args, f"wrote {out}/")
-    failed = [e for e in ends if e["cause"] in FAILED]
+    failed = [a.end for a in tl.agents.values() if a.end is not None and a.end.cause in FAILED]
     if args.strict and failed:
         print(f"tasker run: {len(failed)} task(s) failed: "
-              + "; ".join(f"{e['agent']}: {e['reason']}" for e in failed), file=sys.stderr)
+              + "; ".join(f"{e.agent}: {e.reason}" for e in failed), file=sys.stderr)
         return EXIT_FAILED
     return EXIT_OK

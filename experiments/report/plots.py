@@ -24,6 +24,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
+from experiments.metrics.exposure import KINDS, Stretch, stretches
 from experiments.trace.timeline import Timeline
 from experiments.trace.timeline import timeline as timeline_of
 from tasker import events as ev
@@ -39,6 +40,9 @@ RATES = ("cps_dac", "cps_exeDA", "ccps_dac", "ccps_exeDA")
 COST_KEYS = COSTS + RATES
 """Every Alg. 2 parameter the timeline draws."""
 HAZARD_COLOUR = "#c0392b"
+HAZARD_COLOURS = {"attended": "#f0b27a", "unattended": "#e74c3c", "over budget": "#78281f", "nobody's": "#95a5a6"}
+"""How each kind of hazard stretch is drawn (:mod:`experiments.metrics.exposure`): attended in amber,
+unattended in red, over its budget in dark red, nobody's in grey."""
 
 ROLE_COLOURS = {"exeDA": "#2e8b57", "irrDA": "#e67e22", "idleDA": "#b0b0b0"}
 STATES = ("initComm", "compSP", "upTsk", "exeTsk", "genSusp", "exeSusp", "wait")
@@ -112,12 +116,10 @@ def _with_gaps(costs: list[ev.Decision]) -> tuple[list[float], list[ev.Decision 
     return out_t, out_e
 
 
-def hazard_spans(tl: Timeline) -> list[tuple[str, str, float, float]]:
-    """(agent, hazard label, start, end) of every hazard episode; one still on at the end of the
-    trace lasts until its last time; one no agent owns (e.g. a door open in the world file) is
-    labelled ``unowned``."""
-    spans = [(h.owner or "unowned", h.label, h.start, h.end if h.end is not None else tl.t_end) for h in tl.hazards]
-    return sorted(spans, key=lambda s: (s[2], s[0], s[1]))
+def hazard_spans(tl: Timeline) -> list[Stretch]:
+    """Every hazard episode as stretches attended, unattended, over budget or nobody's
+    (:func:`experiments.metrics.exposure.stretches`); one still on at the end lasts until the trace's end."""
+    return stretches(tl)
 
 
 def _mark_other_decisions(axes: Sequence[Axes], tl: Timeline) -> None:
@@ -199,14 +201,15 @@ def timeline_figure(events: Source, *, title: str | None = None) -> Figure:
         rows = {a: i for i, a in enumerate(agents + sorted({s[0] for s in spans} - set(agents)))}
         for agent, role, t0, t1 in spans:
             bottom.broken_barh([(t0, t1 - t0)], (rows[agent] - 0.4, 0.8), color=ROLE_COLOURS[role])
-        for agent, _, t0, t1 in hazards:
-            if agent in rows:
-                bottom.broken_barh([(t0, max(t1 - t0, 1e-3))], (rows[agent] + 0.28, 0.12), color=HAZARD_COLOUR)
+        for h in hazards:
+            if h.owner in rows:
+                bottom.broken_barh([(h.start, max(h.end - h.start, 1e-3))], (rows[h.owner] + 0.28, 0.12),
+                                   color=HAZARD_COLOURS[h.kind])
         bottom.set_yticks(range(len(rows)), list(rows), fontsize=8)
         bottom.set_ylim(len(rows) - 0.5, -0.5)
         handles = [Patch(color=c, label=r) for r, c in ROLE_COLOURS.items()]
-        if hazards:
-            handles.append(Patch(color=HAZARD_COLOUR, label="hazard on"))
+        handles += [Patch(color=HAZARD_COLOURS[k], label=f"hazard {k}") for k in KINDS
+                    if any(h.kind == k and h.owner in rows for h in hazards)]
         bottom.legend(handles=handles, fontsize=7, loc="upper left", bbox_to_anchor=(1.005, 1.0))
         _mark_commands(bottom, tl)
     else:

@@ -28,6 +28,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from experiments.metrics.exposure import Stretch
 from experiments.metrics.registry import host_dependent
 from experiments.report.page import Raw, figure_div, page, table
 from experiments.report.plots import Source, hazard_spans
@@ -43,9 +44,10 @@ def _fmt(v: Any) -> str:
     return str(v)
 
 
-def hazards_of(events: Source, metrics: Mapping[str, Any] | None) -> list[tuple[str, str, float, float]]:
-    """Hazard stretches: from ``hazard`` events if the trace has them, else from the metrics'
-    ``safety.episodes`` (``agent``, ``hazard``, ``subject``, ``start``, ``end``) if present."""
+def hazards_of(events: Source, metrics: Mapping[str, Any] | None) -> list[Stretch]:
+    """Hazard stretches: from ``hazard`` events if the trace has them, else (an older run folder) from the
+    metrics' ``safety.episodes`` (``agent``, ``hazard``, ``subject``, ``start``, ``end``), each then drawn
+    whole as unattended (or nobody's), since what attended it is not known there."""
     spans = hazard_spans(timeline_of(events))
     if spans or not metrics:
         return spans
@@ -54,10 +56,12 @@ def hazards_of(events: Source, metrics: Mapping[str, Any] | None) -> list[tuple[
     for ep in episodes or []:
         try:
             label = " ".join(str(x) for x in (ep["hazard"], ep.get("subject", "")) if x)
-            out.append((str(ep["agent"]), label, float(ep["start"]), float(ep["end"])))
+            owner = None if ep.get("agent") in (None, "unowned") else str(ep["agent"])
+            out.append(Stretch(owner, label, float(ep["start"]), float(ep["end"]),
+                               "unattended" if owner else "nobody's"))
         except (KeyError, TypeError, ValueError):
             continue
-    return sorted(out, key=lambda s: (s[2], s[0], s[1]))
+    return sorted(out, key=lambda s: (s.start, s.owner or "", s.label))
 
 
 def _flatten(m: Mapping[str, Any], prefix: str = "") -> list[tuple[str, Any]]:

@@ -17,9 +17,10 @@ from typing import Any
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
+from experiments.metrics.exposure import KINDS, Stretch
 from experiments.report.plots import (
     COSTS,
-    HAZARD_COLOUR,
+    HAZARD_COLOURS,
     LABEL_FONT,
     RATES,
     ROLE_COLOURS,
@@ -37,7 +38,7 @@ from experiments.trace.timeline import Timeline
 from experiments.trace.timeline import timeline as timeline_of
 
 
-def _roles_bars(fig: go.Figure, tl: Timeline, hazards: Sequence[tuple[str, str, float, float]], row: int) -> None:
+def _roles_bars(fig: go.Figure, tl: Timeline, hazards: Sequence[Stretch], row: int) -> None:
     spans = role_spans(tl)
     order = list(_agents(tl))
     for role, colour in ROLE_COLOURS.items():
@@ -46,20 +47,27 @@ def _roles_bars(fig: go.Figure, tl: Timeline, hazards: Sequence[tuple[str, str, 
             orientation="h", base=[s[2] for s in mine], x=[s[3] - s[2] for s in mine], y=[s[0] for s in mine],
             name=role, marker_color=colour, legendgroup="roles", legendgrouptitle_text="roles",
             hovertemplate=f"%{{y}} {role}<br>%{{base:.1f}} s – +%{{x:.1f}} s<extra></extra>"), row=row, col=1)
-    # one row per owned hazard (never overlapping); every hazard nobody owns (a door open in the world
-    # file, say) on one row of its own, named in the hover: they are not any task's to attend to
-    hazard_rows = {h[:2]: f"{h[0]} hazard: {h[1]}" if h[0] != "unowned" else "unowned hazards" for h in hazards}
-    if hazards:
+    # one row per owned hazard (never overlapping), its stretches coloured by what they were: attended,
+    # unattended, over budget; every hazard nobody owns (a door open in the world file, say) on one row
+    # of its own, grey, why in the hover: they are not any task's to attend to
+    hazard_rows = {(h.owner, h.label): f"{h.owner} hazard: {h.label}" if h.owner else "nobody's hazards"
+                   for h in hazards}
+    for kind in KINDS:
+        mine_h = [h for h in hazards if h.kind == kind]
+        if not mine_h:
+            continue
         fig.add_trace(go.Bar(
-            orientation="h", base=[h[2] for h in hazards], x=[max(h[3] - h[2], 1e-3) for h in hazards],
-            y=[hazard_rows[h[:2]] for h in hazards], name="hazard on", marker_color=HAZARD_COLOUR,
-            customdata=[h[1] for h in hazards], legendgroup="roles",
-            hovertemplate="%{y}: %{customdata}<br>on %{base:.1f} s – +%{x:.1f} s<extra></extra>"),
+            orientation="h", base=[h.start for h in mine_h], x=[max(h.end - h.start, 1e-3) for h in mine_h],
+            y=[hazard_rows[(h.owner, h.label)] for h in mine_h], name=f"hazard {kind}",
+            marker_color=HAZARD_COLOURS[kind], customdata=[f"{h.label}" + (f" ({h.why})" if h.why else "")
+                                                           for h in mine_h], legendgroup="hazards",
+            legendgrouptitle_text="hazards",
+            hovertemplate=f"%{{y}}: %{{customdata}}<br>{kind} %{{base:.1f}} s – +%{{x:.1f}} s<extra></extra>"),
             row=row, col=1)
     rows = [a for a in order] + sorted({s[0] for s in spans} - set(order))
     cats = [c for a in rows for c in [a, *sorted({v for k, v in hazard_rows.items() if k[0] == a})]]
-    if any(h[0] == "unowned" for h in hazards):
-        cats.append("unowned hazards")
+    if any(h.owner is None for h in hazards):
+        cats.append("nobody's hazards")
     fig.update_yaxes(categoryorder="array", categoryarray=cats[::-1], row=row, col=1)
 
 
@@ -78,7 +86,7 @@ def _mark_commands(tl: Timeline, panels: int = 1) -> list[dict[str, Any]]:
     return shapes
 
 
-def timeline_figure(events: Source, hazards: Sequence[tuple[str, str, float, float]] = ()) -> go.Figure:
+def timeline_figure(events: Source, hazards: Sequence[Stretch] = ()) -> go.Figure:
     """Fig. 11: costs (row 1), cost rates (row 2, own axis), roles and hazards (row 3)."""
     tl = timeline_of(events)
     t_end = max(tl.t_end, 1.0)

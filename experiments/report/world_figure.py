@@ -17,6 +17,7 @@ from typing import Any, TypeVar
 
 import plotly.graph_objects as go
 
+from experiments.metrics.exposure import Stretch
 from experiments.report.plots import Source
 from experiments.trace.timeline import Timeline
 from experiments.trace.timeline import timeline as timeline_of
@@ -105,7 +106,7 @@ _FILL = {"wall": "#444", "furniture": "#c8b48a", "door": "#7a4f2a"}
 
 
 def world_figure(world: Any, robot: Sequence[Sample], people: Mapping[str, Sequence[tuple[float, float, float, str]]],
-                 events: Source, hazards: Sequence[tuple[str, str, float, float]]) -> dict[str, Any]:
+                 events: Source, hazards: Sequence[Stretch]) -> dict[str, Any]:
     """The world from above, a time slider over the trajectory: the robot, its path so far,
     people, the hazards on and the agent executing at that moment; red crosses where the robot
     was at each ``susp`` command.  A figure dict: its
@@ -213,14 +214,14 @@ def _suspension_spans(tl: Timeline, t_end: float) -> list[tuple[str, float, floa
     return out + [(a, t0, t_end) for a, t0 in since.items()]
 
 
-def _world_title(t: float, hazards: Sequence[tuple[str, str, float, float]],
+def _world_title(t: float, hazards: Sequence[Stretch],
                  suspended: Sequence[tuple[str, float, float]], roles: Sequence[tuple[float, Any]],
                  t_end: float) -> str:
     """The world's title at ``t``; a stretch still open at ``t_end`` (the end of the run) includes it."""
     exe = next((a for tt, a in reversed(roles) if tt <= t), None)
-    now = [h for h in hazards if h[2] <= t and (t < h[3] or h[3] >= t_end)]
-    on = [f"{h[1]} ({h[0]})" for h in now if h[0] != "unowned"]
-    unowned = sum(1 for h in now if h[0] == "unowned")  # e.g. doors open in the world file: nobody's to attend
+    now = [h for h in hazards if h.start <= t and (t < h.end or h.end >= t_end)]
+    on = [f"{h.label} ({h.owner}, {h.kind})" for h in now if h.owner is not None]
+    unowned = sum(1 for h in now if h.owner is None)  # e.g. doors open in the world file: nobody's to attend
     if unowned:
         on.append(f"{unowned} nobody owns")
     susp = sorted({a for a, t0, t1 in suspended if t0 <= t and (t < t1 or t1 >= t_end)})

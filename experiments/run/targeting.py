@@ -35,7 +35,7 @@ from typing import Any
 
 from experiments.inputs.actions import TimedAction
 from experiments.inputs.perturbation import NOTE, TOGGLE, TargetDraw
-from robot.sim import CLEAR
+from robot.sim import CLEAR, DOOR_BETWEEN
 from tasker import events as ev
 from tasker.agent import DynamicAgent
 from tasker.errors import PlanningFailed
@@ -157,7 +157,7 @@ def candidates(stages: Sequence[Stage], world: WorldState, *, clutter: Sequence[
               if len(legs := [a for a in s.args if world.objects.get(a) == "place"]) >= 2 and legs[0] != legs[-1]]
     on_route: set[str] = set()
     for a, b in routes:
-        on_route |= {f[1] for f in world.matching("door_between") if len(f) == 4 and (f[2], f[3]) == (a, b)}
+        on_route |= {f[1] for f in world.matching(DOOR_BETWEEN) if len(f) == 4 and (f[2], f[3]) == (a, b)}
         path = list(route(a, b))
         on_route |= {d for d, door in doors.items() for p, q in zip(path, path[1:], strict=False)
                      if crosses(p, q, door.box)}

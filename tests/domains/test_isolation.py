@@ -14,16 +14,17 @@ import pytest
 import domains
 from planners.loader import load_task_folder
 from planners.taskspec import SKILLS
+from robot.sim import WORLD_PREDICATES
 from robot.spec import POSTURES
 from tasker.meaning import ROLES
 
 ROOT = Path(__file__).parents[2]
 PACKAGES = ("experiments", "robot")
 WORLD_VOCABULARY = (frozenset({"at", "connected", "open", "door", "place", "person", "robot"})
-                    | frozenset(SKILLS) | frozenset(POSTURES) | frozenset(ROLES))
-"""Words the world and the framework speak: where things are, doors, postures, the robot's
-skills, and people's roles (:data:`tasker.meaning.ROLES`, which a task folder maps to its
-own predicates)."""
+                    | frozenset(SKILLS) | frozenset(POSTURES) | frozenset(ROLES) | WORLD_PREDICATES)
+"""Words the world and the framework speak: where things are, doors (and the door facts a world file
+states), what the world derives (``clear``), postures, the robot's skills, and people's roles
+(:data:`tasker.meaning.ROLES`, which a task folder maps to its own predicates)."""
 
 
 def bundled_names() -> dict[str, str]:

@@ -39,7 +39,8 @@ def test_strategy_label_with_policy_and_hazard_waiting_round_trips() -> None:
     with pytest.raises(ValueError, match="did you mean 'policy'"):
         Strategy.parse("polcy=strict")
     # a factor with no value was answered "did you mean 'suspension'?" for 'suspension='
-    for text, expected in (("suspension=", "suspension: expected static or planned or derived after 'suspension='"),
+    for text, expected in (("suspension=",
+                            "suspension: expected static or planned or derived or fallback after 'suspension='"),
                            ("update=static, hazard_waiting = ", "hazard_waiting: expected off or on after"),
                            ("scheduler=", "scheduler: expected a scheduler name after 'scheduler='")):
         with pytest.raises(ValueError, match=expected) as info:

@@ -90,12 +90,13 @@ def test_a_job_that_cannot_be_built_stops_the_sweep_before_any_job(tmp_path: Pat
 def test_the_precheck_builds_every_strategy_of_a_scenario(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     built: list[tuple[str | None, str | None]] = []
     from experiments.run import runner
+    from experiments.run.options import RunOptions
 
     real = runner.build_robot
 
-    def spy(scn: scenarios.RobotScenario, **kw: object) -> object:
-        built.append((kw.get("suspension"), kw.get("scheduler")))  # type: ignore[arg-type]
-        return real(scn, **kw)  # type: ignore[arg-type]
+    def spy(scn: scenarios.RobotScenario, options: RunOptions, **kw: object) -> object:
+        built.append((options.suspension, options.scheduler))
+        return real(scn, options, **kw)  # type: ignore[arg-type]
 
     monkeypatch.setattr(runner, "build_robot", spy)
     from experiments.sweep.driver import precheck

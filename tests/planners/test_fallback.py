@@ -29,7 +29,7 @@ def _holding(task: PddlTaskType, at: str, suspension: str = "fallback") -> TaskC
     """The example's world with the robot at ``at`` holding the vase, interrupted."""
     ctx = example_context(task, strategy=Strategy("planned", suspension, "strict"))
     assert ctx is not None and isinstance(ctx.world, WorldState)
-    world = ctx.world.updated([("holding", "robot", "vase"), ("at", "robot", at)],
+    world = ctx.world.updated([("holding", "robot", "vase"), ("at", "robot", at), ("clear", "kitchen")],
                               [("hand_empty", "robot"), ("at", "vase", "kitchen"), ("at", "robot", "livingroom")])
     return replace(ctx, world=world, suspended=True)
 
@@ -43,16 +43,24 @@ def test_where_the_trees_stages_can_run_fallback_runs_them_as_written(carry: Pdd
     assert plan.note is not None and "runs as written" in plan.note
 
 
+def _cluttered(ctx: TaskContext, place: str) -> TaskContext:
+    """``ctx`` with ``place`` not clear: someone left something there."""
+    assert isinstance(ctx.world, WorldState)
+    return replace(ctx, world=ctx.world.updated(delete=[("clear", place)]))
+
+
 def test_where_a_stage_of_the_tree_cannot_run_fallback_plans_to_the_derived_goal_and_says_why(
         carry: PddlTaskType) -> None:
-    plan = carry.generate_suspension(_holding(carry, "hall"))  # no surface in the hall: `place` cannot run
+    # the tree puts the vase down where the robot stands, a surface -- but someone left a box there
+    plan = carry.generate_suspension(_cluttered(_holding(carry, "livingroom"), "livingroom"))
     assert plan.strategy == "fallback" and plan.info["fallback"] == "planned"
-    assert plan.note is not None and "place(robot, vase, hall) needs (surface hall)" in plan.note
+    assert plan.note is not None and "place(robot, vase, livingroom) needs (clear livingroom)" in plan.note
     labels = [s.label for s in plan.stages]
-    assert labels[-1].startswith("place(robot, vase, ") and labels[-1] != "place(robot, vase, hall)"
+    assert labels[-1].startswith("place(robot, vase, ") and labels[-1] != "place(robot, vase, livingroom)"
     assert ("not", "holding", "robot", "vase") in (plan.goal or ())
-    static = carry.generate_suspension(_holding(carry, "hall", "static"))  # static stays the pure tree
-    assert [s.label for s in static.stages] == ["place(robot, vase, hall)"] and static.strategy == "static"
+    static = carry.generate_suspension(_cluttered(_holding(carry, "livingroom", "static"), "livingroom"))
+    assert [s.label for s in static.stages] == ["place(robot, vase, livingroom)"]  # static stays the pure tree
+    assert static.strategy == "static"
 
 
 def test_asked_again_after_a_stage_of_exesusp_failed_fallback_plans_at_once(carry: PddlTaskType) -> None:
@@ -62,9 +70,9 @@ def test_asked_again_after_a_stage_of_exesusp_failed_fallback_plans_at_once(carr
 
 
 def test_when_no_plan_reaches_the_derived_goal_fallback_fails_genSusp_with_both_reasons(carry: PddlTaskType) -> None:
-    ctx = _holding(carry, "hall")
+    ctx = _holding(carry, "livingroom")
     assert isinstance(ctx.world, WorldState)
-    bare = WorldState(frozenset(f for f in ctx.world.facts if f[0] != "surface"), ctx.world.poses, ctx.world.objects)
-    with pytest.raises(PlanningFailed) as err:
-        carry.generate_suspension(replace(ctx, world=bare))
-    assert "needs (surface hall)" in str(err.value) and "no plan reaches the derived goal" in str(err.value)
+    full = WorldState(frozenset(f for f in ctx.world.facts if f[0] != "clear"), ctx.world.poses, ctx.world.objects)
+    with pytest.raises(PlanningFailed) as err:  # no surface anywhere is clear
+        carry.generate_suspension(replace(ctx, world=full))
+    assert "needs (clear livingroom)" in str(err.value) and "no plan reaches the derived goal" in str(err.value)
