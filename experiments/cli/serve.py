@@ -51,7 +51,8 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 
 def _serve(args: argparse.Namespace) -> int:
-    from experiments.serve.server import describe, loopback, serve, served
+    from experiments.serve.server import describe, loopback, scripted, serve, served
+    from tasker.errors import RunAborted
 
     if args.token is not None and not args.token:
         raise UsageError("--token", "expected a non-empty token")
@@ -65,14 +66,20 @@ def _serve(args: argparse.Namespace) -> int:
               f"move the robot; every call needs the token {token} (Authorization: Bearer TOKEN or ?token=TOKEN)",
               file=sys.stderr, flush=True)
 
-    def announce(url: str) -> None:
+    def announce(url: str) -> None:  # the address first (scripts read it from the first line), then the script
         page = url + (f"?token={token}" if token else "")
         print(f"tasker serve: {what} at ×{args.speed:g} on {url} (live page {page}, API schema {url}openapi.json); "
               f"Ctrl-C stops and writes {out}/", flush=True)
+        for line in scripted(scenario):
+            print(f"tasker serve: {line}", flush=True)
 
-    session, result = serve(scenario, what=what, speed=args.speed, out=out, host=args.host, port=args.port,
-                            token=token, task_paths=paths, pictures=not args.no_pictures, announce=announce)
-    print(f"tasker serve: stopped at t={session.t_stop or 0.0:g} s ({session.stop_reason}): {describe(result)}; "
-          f"replay: tasker run {out / 'session.toml'}", flush=True)
+    try:
+        session, result = serve(scenario, what=what, speed=args.speed, out=out, host=args.host, port=args.port,
+                                token=token, task_paths=paths, pictures=not args.no_pictures, announce=announce)
+    except RunAborted as exc:  # the session's record could not all be written: what failed, what was kept
+        print(f"tasker serve: error: {exc.reason}", file=sys.stderr, flush=True)
+        return EXIT_FAILED
+    print(f"tasker serve: stopped at t={round(session.t_stop or 0.0, 6)!r} s ({session.stop_reason}): "
+          f"{describe(result)}; replay: tasker run {out / 'session.toml'}", flush=True)
     note(args, f"wrote {out}/")
     return EXIT_OK if result.record.get("status") is None else EXIT_FAILED

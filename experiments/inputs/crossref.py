@@ -370,14 +370,20 @@ class _Checker:
         return req, self.tasks[req.fields["task"]].validate_args(req.fields["args"])
 
     def overlaps(self, requests: list[tuple[TimedAction, dict[str, Any]]]) -> None:
-        """Two requests of one task type with the same arguments, the first not terminated before the second."""
+        """Two requests of one task type with the same arguments, the first not terminated before the
+        second, nor changed (``[[changes]]``) into another request by then."""
         ends = {int(a.fields["agent"][1:]): a.t for a in self.scn.actions if a.kind == "terminate"}
+        changes = [a for a in self.scn.actions if a.kind == "change"]
         for j, (later, args_j) in enumerate(requests):
             for i in range(j):
                 earlier, args_i = requests[i]
-                if earlier.fields["task"] != later.fields["task"] or args_i != args_j:
+                if earlier.fields["task"] != later.fields["task"] or ends.get(i + 1, float("inf")) <= later.t:
                     continue
-                if ends.get(i + 1, float("inf")) <= later.t:
+                given = [c.fields["args"] for c in changes if c.fields["agent"] == f"d{i + 1}" and c.t < later.t]
+                if given:  # its arguments when the second comes (the changes were checked above)
+                    args_i = self.tasks[earlier.fields["task"]].validate_args({k: v for g in [args_i, *given]
+                                                                               for k, v in g.items()})
+                if args_i != args_j:
                     continue
                 self.warn(located(self.top, later), "task",
                           f"the same request as d{i + 1} (requests[{earlier.origin[1]}], t={earlier.t:g}: "

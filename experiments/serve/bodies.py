@@ -47,23 +47,6 @@ class Refused(TaskerError, ValueError):
         return {"detail": str(self), "field": self.field, "message": self.message}
 
 
-def parse_json(raw: bytes, where: str) -> Any:
-    """A body's JSON (numbers finite), or :class:`Refused` ``400`` saying where it is not."""
-    try:
-        return json.loads(raw.decode("utf-8"), parse_constant=_no_constant)
-    except UnicodeDecodeError as exc:
-        raise Refused(BAD, where, f"the body is not UTF-8 text (byte {raw[exc.start]:#04x})") from None
-    except json.JSONDecodeError as exc:
-        raise Refused(BAD, where, f"the body is not valid JSON: {exc.msg} (line {exc.lineno}, column "
-                                  f"{exc.colno})") from None
-    except ValueError as exc:
-        raise Refused(BAD, where, f"the body is not valid JSON: {exc}") from None
-
-
-def _no_constant(name: str) -> float:
-    raise ValueError(f"{name} is not a number JSON allows")
-
-
 def _located(exc: InputError, where: str, prefix: str) -> Refused:
     """The reader's fault at the body's own field (``requests[0].args.person`` -> ``args.person``)."""
     field = exc.field

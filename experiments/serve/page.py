@@ -23,13 +23,16 @@ from experiments.report.world_figure import world_figure
 POLL_MS = 300
 """How often the page asks for ``/state``."""
 
-COLUMNS = ("agent", "task", "args", "role", "FSM state", "cost", "cps", "cTime [s]", "deadline [s]", "priority",
-           "requested at [s]", "ended", "")
-"""The queue's columns (the script fills its rows in this order)."""
+COLUMNS = ("", "agent", "task", "args", "role", "FSM state", "cost", "cps", "cTime [s]", "deadline [s]", "priority",
+           "requested at [s]", "ended")
+"""The queue's columns (the script fills its rows in this order): a live task's controls come first,
+so that they stay in sight however long its arguments or another task's end are."""
 
 _STYLE = """<style>
 #status{font-family:monospace;background:#f4f4f4;padding:4px 8px}
-#queue .ended td{color:#999} #queue .exeDA td{background:#eaf2fb}
+#queue{border-collapse:collapse;font-size:.9em} #queue th,#queue td{padding:2px 5px;vertical-align:top}
+#queue td{white-space:nowrap} #queue td.args,#queue td.end{white-space:normal;overflow-wrap:anywhere;min-width:9em;
+max-width:16em} #queue .ended td{color:#999} #queue .exeDA td{background:#eaf2fb}
 form{margin:.4em 0} input,select,textarea{font:inherit;margin:0 .3em} .err{color:#c0392b} .ok{color:#2a7a2a}
 </style>"""
 
@@ -76,11 +79,16 @@ function fillTypes(s) {
   if (types || !s.task_types) return;
   types = s.task_types;
   const sel = document.getElementById("task");
-  sel.innerHTML = types.map(t => `<option>${esc(t.name)}</option>`).join("");
+  // a type the world cannot take is listed, disabled, saying why; the form starts on the first it can take
+  sel.innerHTML = types.map(t => `<option value="${esc(t.name)}"${t.example ? "" : " disabled"}` +
+    ` title="${esc(t.refused || "")}">${esc(t.name)}${t.example ? "" : " (not in this world)"}</option>`).join("");
+  const first = types.find(t => t.example);
+  if (first) sel.value = first.name;
   const show = () => {
     const t = types.find(t => t.name === sel.value);
     document.getElementById("task-args").textContent = t ? "arguments: " + t.args.map(
-      a => a.name + (a.required ? "" : "?") + ": " + a.type).join(", ") : "";
+      a => a.name + (a.required ? "" : "?") + ": " + a.type).join(", ") + (t.refused ? " · " + t.refused : "") : "";
+    document.getElementById("args").value = t && t.example ? JSON.stringify(t.example) : "";
   };
   sel.onchange = show; show();
 }
@@ -116,12 +124,13 @@ function draw(s) {
     const end = a.ended ? `${esc(a.ended.cause)} at ${num(a.ended.t)}: ${esc(a.ended.reason)}` : "";
     const act = a.ended ? "" : `<button data-term="${esc(a.id)}">terminate</button> ` +
       `<button data-change="${esc(a.id)}">change…</button>`;
-    return `<tr class="${a.ended ? "ended" : esc(a.role || "")}"><td>${esc(a.id)}</td><td>${esc(a.task)}</td>` +
-      `<td>${esc(JSON.stringify(given(a.args)))}</td><td>${esc(a.role || "–")}</td>` +
+    return `<tr class="${a.ended ? "ended" : esc(a.role || "")}"><td class="act">${act}</td>` +
+      `<td>${esc(a.id)}</td><td>${esc(a.task)}</td><td class="args">${esc(JSON.stringify(given(a.args)))}</td>` +
+      `<td>${esc(a.role || "–")}</td>` +
       `<td>${esc(a.superstate)} / ${esc(a.state)}</td>` +
       `<td class="num">${num(q.cost)}</td><td class="num">${num(q.cps)}</td><td class="num">${num(q.c_time)}</td>` +
       `<td class="num">${num(q.deadline)}</td><td class="num">${num(q.priority)}</td>` +
-      `<td class="num">${num(a.requested_at)}</td><td>${end}</td><td>${act}</td></tr>`;
+      `<td class="num">${num(a.requested_at)}</td><td class="end">${end}</td></tr>`;
   });
   document.getElementById("queue-body").innerHTML = rows.join("") ||
     '<tr><td colspan="13">no task yet: request one below</td></tr>';
@@ -142,7 +151,10 @@ document.getElementById("queue-body").addEventListener("click", async ev => {
   if (t.term) { await api("DELETE", "/requests/" + t.term); }
   if (t.change) {
     const body = prompt(`change ${t.change}: JSON, e.g. {"priority": 3} or {"deadline": 300}`, '{"priority": 1}');
-    if (body) { const r = await api("PATCH", "/requests/" + t.change, JSON.parse(body));
+    if (body) {
+      let parsedBody;
+      try { parsedBody = JSON.parse(body); } catch (e) { alert("not JSON: " + e.message); return; }
+      const r = await api("PATCH", "/requests/" + t.change, parsedBody);
       if (r.status >= 300) alert((r.body && r.body.detail) || "HTTP " + r.status); }
   }
 });
@@ -190,7 +202,7 @@ def live_page(world: Any, *, title: str) -> str:
     sections = [_STYLE, '<p id="status">connecting…</p>', figure_div(fig, "world"),
                 "<h2>Queue</h2>",
                 '<p class="note">Every agent: its role, its FSM state (Fig. 5) and the schedule parameters of its '
-                "last report, as Alg. 2 reads them; ended ones below in grey.</p>",
+                "last report, as Alg. 2 reads them; the live ones first, ended ones below them in grey.</p>",
                 '<table id="queue"><thead><tr>' + "".join(f"<th>{html.escape(h)}</th>" for h in COLUMNS)
                 + '</tr></thead><tbody id="queue-body"></tbody></table>',
                 "<h2>The harmoniser's last decision</h2>", '<pre id="decision">none yet</pre>',

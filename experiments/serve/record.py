@@ -89,13 +89,22 @@ class Record:
         with warnings.catch_warnings():  # actions after the stop are kept on purpose (docs/serve.md)
             warnings.simplefilter("ignore", InputWarning)
             loaded = scenarios.load(path, task_paths=self.task_paths)
-        ids, table = self.renumbering(), {kind: i for i, (_, kind) in enumerate(TABLES)}
-        # the reader's order: by time, then by table, then by place in the file
-        wanted = [_renamed(e.action, ids) for e in sorted(self.entries, key=lambda e: (e.action.t,
-                                                                                       table[e.action.kind], e.order))]
+        wanted = self.actions()
         if [(a.t, a.kind, a.fields) for a in loaded.actions] != [(a.t, a.kind, a.fields) for a in wanted]:
             raise AssertionError(f"{path}: the saved session does not read back as the actions it ran")
         return loaded
+
+    def actions(self) -> list[TimedAction]:
+        """The session's actions as its file's reader gives them: by time, then by table, then by place
+        in the file, every request id renumbered to the file's."""
+        ids, table = self.renumbering(), {kind: i for i, (_, kind) in enumerate(TABLES)}
+        return [_renamed(e.action, ids) for e in sorted(self.entries, key=lambda e: (e.action.t,
+                                                                                     table[e.action.kind], e.order))]
+
+    def scenario(self, horizon: float) -> RobotScenario:
+        """The session as a scenario, built in memory (what :meth:`write` returns once read back): what
+        ``run.json`` records when ``session.toml`` cannot be written."""
+        return dataclasses.replace(self.base, horizon=horizon, actions=tuple(self.actions()), request_fields=True)
 
 
 def _renamed(a: TimedAction, ids: dict[str, str]) -> TimedAction:

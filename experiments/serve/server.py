@@ -24,6 +24,7 @@ from experiments.inputs import scenario as scenarios
 from experiments.inputs.robot_scenario import RobotScenario
 from experiments.run.runner import RunResult
 from experiments.serve.app import create_app
+from experiments.serve.guard import allowed_hosts
 from experiments.serve.page import live_page
 from experiments.serve.session import LIVE_HORIZON, Session
 from tasker.errors import UsageError
@@ -41,6 +42,36 @@ def loopback(host: str) -> bool:
         return ipaddress.ip_address(host).is_loopback
     except ValueError:
         return False
+
+
+def scripted(scn: RobotScenario) -> list[str]:
+    """What a session of ``scn`` will do on its own, and how to serve it without that, in words
+    (``tasker serve``'s lines after its address): the world file's scripted falls and walks, the
+    scenario's own requests and world events, each with its simulated time."""
+    from robot.spec import load_world, world_path
+
+    world = load_world(scn.world)
+    path = world_path(scn.world)
+    shown_path = str(path.relative_to(Path.cwd())) if path.is_relative_to(Path.cwd()) else str(path)
+    said = [f"{p.name} {posture} at t={t:g} s" for p in world.people.values() for t, posture in p.events]
+    for p in world.people.values():
+        walk = scn.people.get(p.name, {}).get("walk", p.walk)
+        if walk:
+            said.append(f"{p.name} walking (t={walk[0][0]:g} s to {walk[-1][0]:g} s)")
+    lines = []
+    if said:
+        flat = ", or the flat world (tasker serve flat)" if scn.world != "flat" else ""
+        lines.append(f"on its own, the world file {shown_path} has {', '.join(said)} (simulated time), in every "
+                     f"session; to serve it without them, serve a copy of it without those people's events and walk "
+                     f"(tasker serve my_world.toml){flat}")
+    requests = [a.t for a in scn.actions if a.kind == "request"]
+    others = [a.t for a in scn.actions if a.kind != "request"]
+    if requests or others:
+        at = ", ".join(f"{t:g}" for t in sorted(requests)[:6]) + (", …" if len(requests) > 6 else "")
+        lines.append(f"the scenario's own {len(requests)} requests (t={at} s) and {len(others)} other actions happen "
+                     f"at their times besides what arrives over HTTP; to take requests only over HTTP, serve its world "
+                     f"(tasker serve {scn.world})")
+    return lines or ["nothing is scripted: the world changes and tasks come only over HTTP"]
 
 
 def served(source: str, *, seed: int | None = None, task_paths: tuple[str, ...] = ()) -> tuple[RobotScenario, str]:
@@ -98,7 +129,7 @@ def serve(scenario: RobotScenario, *, what: str, speed: float, out: Path, host: 
 
     session = Session(scenario, speed=speed, out=out, served=what, task_paths=task_paths, pictures=pictures)
     html = live_page(load_world(scenario.world), title=f"tasker serve: {what}")
-    app = create_app(session, page=lambda: html, token=token)
+    app = create_app(session, page=lambda: html, token=token, hosts=allowed_hosts(host))
     server = uvicorn.Server(uvicorn.Config(app, host=host, port=port, log_level="warning", lifespan="off",
                                            timeout_graceful_shutdown=5))
     thread = threading.Thread(target=server.run, name="tasker-serve-http", daemon=True)

@@ -2,7 +2,7 @@
 
 :func:`snapshot` reads the harmoniser (``exeDA``, ``irrDA``, ``idleDA``, the mode), every agent
 (task type, arguments, FSM state, the schedule parameters of its last report — what Alg. 2
-reads — and how it ended), the robot (pose, the path it follows, its trail), the people, the
+reads — and how it ended; the live ones first), the robot (pose, the path it follows, its trail), the people, the
 doors, devices and held objects, and the hazards that hold.  It only reads: nothing it calls
 changes the run (no world snapshot, whose caches belong to the run), so publishing states
 changes no trace.
@@ -11,7 +11,7 @@ changes no trace.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from tasker.loop import SimulationLoop
@@ -21,8 +21,11 @@ TRAIL = 400
 
 
 def snapshot(loop: SimulationLoop, sim: Any, *, ended: Mapping[str, Mapping[str, Any]],
-             decision: Mapping[str, Any] | None) -> dict[str, Any]:
-    """The state (JSON-ready once :func:`tasker.trace.encode` has rounded it; see the module docstring)."""
+             decision: Mapping[str, Any] | None, task_types: Sequence[Mapping[str, Any]] = ()) -> dict[str, Any]:
+    """The state (JSON-ready once :func:`tasker.trace.encode` has rounded it; see the module docstring).
+
+    ``agents`` lists the live ones first, then the ended ones (each group in the order of their
+    requests); ``task_types`` is passed through (:func:`experiments.serve.examples.task_types`)."""
     harm = loop.harmoniser
     roles: dict[str | None, str] = {a: "idleDA" for a in harm.idle_da}
     roles |= {harm.exe_da: "exeDA", harm.irr_da: "irrDA"}
@@ -34,6 +37,7 @@ def snapshot(loop: SimulationLoop, sim: Any, *, ended: Mapping[str, Mapping[str,
             "id": a.id, "task": a.ctx.task_type, "args": dict(a.ctx.args), "state": a.state.value,
             "superstate": a.state.superstate, "role": roles.get(a.id), "requested_at": a.ctx.request_time,
             "params": _params(params), "ended": dict(ended[a.id]) if a.id in ended else None})
+    agents.sort(key=lambda a: a["ended"] is not None)  # stable: live first, then ended, each in request order
     x, y, yaw = sim.robot_pose()
     follower = getattr(sim.skill, "follower", None)
     path = [list(p) for p in getattr(follower, "path", ())] if follower is not None else []
@@ -51,9 +55,7 @@ def snapshot(loop: SimulationLoop, sim: Any, *, ended: Mapping[str, Mapping[str,
         "people": [{"name": p.name, "pose": [p.x, p.y, p.yaw], "posture": p.posture, "following": p.following,
                     "waiting": p.waiting} for p in sim.people],
         "doors": dict(sim.door_open), "devices": dict(sim.device_state), "held": sorted(sim.held),
-        "hazards": hazards,
-        "task_types": [{"name": n, "args": [{"name": s.name, "type": s.type, "required": s.required} for s in
-                                            loop.store.get(n).arg_specs]} for n in loop.store.names()],
+        "hazards": hazards, "task_types": [dict(t) for t in task_types],
     }
 
 

@@ -23,6 +23,8 @@ from typing import Any
 
 import pytest
 
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parents[2]
 JOHN = {"task": "guide_human", "args": {"person": "john", "destination": "john_destination"}}
 
@@ -70,6 +72,8 @@ def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
     if found is None:
         proc.kill()
         raise AssertionError(f"tasker serve did not start: {line!r} {proc.stderr.read() if proc.stderr else ''}")
+    script = proc.stdout.readline()  # what the world file does on its own, said before anything happens
+    assert script.startswith("tasker serve: on its own, the world file ") and "peter fallen at t=60 s" in script
     yield Server(proc, found.group(1), out)
     if proc.poll() is None:
         proc.kill()
@@ -131,7 +135,8 @@ def test_the_live_page_draws_the_apartment_the_robot_and_the_queue(server: Serve
     assert re.search(r'class="shapelayer"', dom)  # the walls, furniture and doors
     assert 'data-unformatted="robot"' in dom and 'data-unformatted="people"' in dom  # the figure's traces
     assert 'data-unformatted="kitchen"' in dom  # the apartment's rooms
-    assert re.search(r'<tr class="[^"]*"><td>' + re.escape(server.ids[0]) + r"</td><td>guide_human</td>", dom)
+    assert re.search(r'<tr class="[^"]*"><td class="act">.*?</td><td>' + re.escape(server.ids[0])
+                     + r"</td><td>guide_human</td>", dom)
     assert re.search(r'id="status">(running|stopped) · t = ', dom)  # /state was read and drawn
     shot = tmp_path / "page.png"
     subprocess.run([*browser, "--window-size=1300,1500", f"--screenshot={shot}", server.url], capture_output=True,

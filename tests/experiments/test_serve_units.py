@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
@@ -151,13 +152,6 @@ def test_a_change_is_checked_whole_by_the_task_type_and_against_the_world(tasks:
                     world=world).field == "prio"
 
 
-def test_a_body_that_is_not_json_is_a_400_saying_where() -> None:
-    err = _refused(bodies.parse_json, b'{"task": ', "POST /requests")
-    assert err.status == 400 and "line 1, column 10" in err.message
-    assert _refused(bodies.parse_json, b'{"deadline": NaN}', "POST /requests").status == 400
-    assert _refused(bodies.parse_json, b"\xff", "POST /requests").status == 400
-
-
 def test_the_saved_session_renumbers_requests_in_file_order_and_reads_back(tmp_path: Path,
                                                                             paper: scenarios.RobotScenario) -> None:
     """A request that arrived at t=5 comes before the scenario's own at t=8 in the file, so it is d2
@@ -229,6 +223,7 @@ args = {{ person = "john", destination = "bedroom" }}
 """
 
 
+@pytest.mark.slow
 def test_settings_request_fields_makes_every_task_type_take_them_in_the_run(tmp_path: Path) -> None:
     """A session runs with the request fields on (any request may give a priority), none of its
     requests may give one: its saved scenario says so in ``settings``, or the replay's task types
@@ -263,31 +258,10 @@ def test_the_live_page_is_offline_and_holds_the_world_figure_and_the_queue() -> 
     assert f"const DOORS = {json.dumps(doors)};" in text
 
 
-def _asgi(app: object, method: str, path: str, body: bytes = b"") -> tuple[int, dict]:
-    """One HTTP call to an ASGI app, in this process (no server, no client library)."""
-    import asyncio
-
-    sent: list[dict] = []
-
-    async def receive() -> dict:
-        return {"type": "http.request", "body": body, "more_body": False}
-
-    async def send(message: dict) -> None:
-        sent.append(message)
-
-    scope = {"type": "http", "asgi": {"version": "3.0"}, "http_version": "1.1", "method": method, "path": path,
-             "raw_path": path.encode(), "query_string": b"", "root_path": "", "scheme": "http",
-             "headers": [(b"content-type", b"application/json")], "client": ("127.0.0.1", 1),
-             "server": ("127.0.0.1", 80)}
-    asyncio.run(app(scope, receive, send))  # type: ignore[operator]
-    status = next(m["status"] for m in sent if m["type"] == "http.response.start")
-    return status, json.loads(b"".join(m.get("body", b"") for m in sent if m["type"] == "http.response.body"))
-
-
 def test_a_bug_in_reading_one_request_fails_that_request_not_the_session(
         tmp_path: Path, paper: scenarios.RobotScenario, monkeypatch: pytest.MonkeyPatch) -> None:
     from experiments.serve.app import create_app
-    from experiments.serve.session import Ask, Session
+    from experiments.serve.session import Ask, Session, _Drive
 
     def broken(*_: object, **__: object) -> None:
         raise RuntimeError("a bug")
@@ -296,7 +270,8 @@ def test_a_bug_in_reading_one_request_fails_that_request_not_the_session(
     session = Session(paper, speed=1.0, out=tmp_path, served="test")
     loop = make_loop([guide()])
     ask = Ask("request", {"task": "guide"})
-    assert session._take(ask, loop, None, None, Record(paper), []) == loop.now  # nothing scheduled, no raise
+    drive = _Drive(loop, None, None, Record(paper), 0.0)  # type: ignore[arg-type]
+    assert session._take(ask, drive) == loop.now and drive.waiting == []  # nothing scheduled, no raise
     assert isinstance(ask.reply.exception(), RuntimeError)
 
     class Failing:
@@ -306,12 +281,130 @@ def test_a_bug_in_reading_one_request_fails_that_request_not_the_session(
             ask.reply.set_exception(RuntimeError("a bug"))
             return ask.reply
 
-    status, said = _asgi(create_app(Failing(), page=lambda: ""), "POST", "/requests",  # type: ignore[arg-type]
-                         b'{"task": "guide"}')
-    assert status == 500 and "internal error, not a fault of the request (RuntimeError: a bug)" in said["detail"]
-    status, said = _asgi(create_app(Failing(), page=lambda: ""), "POST", "/requests", b'{"task": ')  # type: ignore
-    schema = create_app(Failing(), page=lambda: "").openapi()  # type: ignore[arg-type]
+    from fastapi.testclient import TestClient
+
+    def client() -> TestClient:
+        return TestClient(create_app(Failing(), page=lambda: ""), base_url="http://127.0.0.1:8765")  # type: ignore
+
+    said = client().post("/requests", content=b'{"task": "guide"}', headers={"Content-Type": "application/json"})
+    assert said.status_code == 500
+    assert "internal error, not a fault of the request (RuntimeError: a bug)" in said.json()["detail"]
+    said = client().post("/requests", content=b'{"task": ', headers={"Content-Type": "application/json"})
+    assert said.status_code == 400 and "not valid JSON" in said.json()["detail"]
+    schema = client().get("/openapi.json").json()
     body = schema["paths"]["/requests"]["post"]["requestBody"]["content"]["application/json"]["schema"]
     first = next(a.fields for a in paper.actions if a.kind == "request")
     assert body["example"] == {"task": first["task"], "args": first["args"]}  # the served scenario's first request
-    assert status == 400 and "not valid JSON" in said["detail"]
+
+
+def test_the_first_lines_say_what_the_world_file_does_on_its_own_and_how_to_serve_without_it() -> None:
+    from experiments.serve.server import scripted, served
+
+    paper, _ = served("paper")
+    [line] = scripted(paper)
+    assert "robot/worlds/paper.toml has peter fallen at t=60 s, sara fallen at t=90 s, john walking (t=10 s to " \
+           "60 s) (simulated time), in every session" in line
+    assert "serve a copy of it without those people's events and walk" in line and "tasker serve flat" in line
+    flat, _ = served("flat")
+    assert scripted(flat) == ["nothing is scripted: the world changes and tasks come only over HTTP"]
+    household, _ = served("household")
+    said = scripted(household)
+    assert any(s.startswith("the scenario's own ") and "happen at their times" in s for s in said), said
+
+
+def test_the_request_form_gets_for_each_task_type_a_request_the_world_takes_or_why_not(
+        paper: scenarios.RobotScenario, tasks: list) -> None:
+    from experiments.serve.examples import task_types
+    from experiments.serve.server import served
+    from robot.spec import load_world
+
+    world = load_world("paper")
+    session, _ = served("paper")
+    types = {t["name"]: t for t in task_types(session, tasks, world)}
+    assert types["carry_object"]["example"] is None
+    assert types["carry_object"]["refused"].startswith("args.item: ")  # the paper world has no item
+    assert types["guide_human"]["example"] == {"person": "alice", "destination": "alice_destination"}
+    assert types["human_fell"]["example"] == {"person": "alice"} and types["human_fell"]["refused"] is None
+    for t in types.values():  # every example is a body the session takes
+        if t["example"] is not None:
+            bodies.read_request({"task": t["name"], "args": t["example"]}, t=1.0, scn=session, tasks=tasks)
+    first = next(a for a in paper.actions if a.kind == "request")  # a scenario's own first request is the example
+    assert {t["name"]: t for t in task_types(paper, tasks, world)}[first.fields["task"]]["example"] == \
+        first.fields["args"]
+
+
+class _StillSim:
+    """What :func:`experiments.serve.snapshot.snapshot` reads of a simulation, with nothing in it."""
+
+    skill = None
+    trajectory: list = []
+    people: list = []
+    door_open: dict = {}
+    device_state: dict = {}
+    held: set = set()
+
+    @staticmethod
+    def robot_pose() -> tuple[float, float, float]:
+        return (1.0, 2.0, 0.0)
+
+
+def test_the_state_lists_live_agents_first_then_ended_ones_each_in_request_order() -> None:
+    from experiments.serve.snapshot import snapshot
+
+    loop = make_loop([guide("short"), guide("long")])
+    loop.request(0.0, "long")
+    loop.request(0.0, "short")
+    loop.request(0.5, "long")
+    loop.run(until=1.0)
+    loop.terminate(1.001, "d2")
+    loop.run(until=10.0)
+    ended = {e["agent"]: e for e in loop.trace.events if e["event"] == "end"}
+    assert set(ended) == {"d2"}
+    state = snapshot(loop, _StillSim(), ended={a: {"t": e["t"]} for a, e in ended.items()}, decision=None,
+                     task_types=[{"name": "x"}])
+    assert [(a["id"], a["ended"] is not None) for a in state["agents"]] == [("d1", False), ("d3", False),
+                                                                          ("d2", True)]
+    assert state["task_types"] == [{"name": "x"}]
+
+
+def test_a_session_that_cannot_write_session_toml_records_the_same_actions_from_memory(
+        tmp_path: Path, paper: scenarios.RobotScenario) -> None:
+    record = Record(dataclasses.replace(paper, name="paper-session"))
+    for k, a in enumerate(sorted(paper.actions, key=lambda a: a.t)):
+        record.add(a, f"d{k + 1}" if a.kind == "request" else None)
+    record.add(TimedAction(5.0, "request", {"task": "human_fell", "args": {"person": "alice"}}), "d9")
+    record.add(TimedAction(6.001, "terminate", {"agent": "d9", "reason": "by hand"}), None)
+    in_memory = record.scenario(80.001)
+    loaded = record.write(tmp_path / "session.toml", 80.001, "a test session")
+    assert in_memory.actions == loaded.actions and in_memory.horizon == loaded.horizon == 80.001
+    assert ("terminate", {"agent": "d2", "reason": "by hand"}) in [(a.kind, a.fields) for a in in_memory.actions]
+
+
+@pytest.mark.parametrize("suspension", __import__("experiments.inputs.strategy", fromlist=["x"]).SUSPENSION_VALUES)
+def test_a_session_saves_every_suspension_strategy_the_scenario_reader_knows(
+        tmp_path: Path, paper: scenarios.RobotScenario, suspension: str) -> None:
+    """serve keeps no list of its own: a strategy added to the shared one (``fallback``) is saved and read back."""
+    record = Record(dataclasses.replace(paper, name="paper-session", suspension=suspension, actions=()))
+    loaded = record.write(tmp_path / "session.toml", 10.0, "a test session")
+    assert loaded.suspension == suspension
+
+
+@pytest.mark.parametrize(("changed_at", "warned"), [(None, True), (9.0, False), (21.0, True)])
+def test_a_replay_warns_of_a_repeated_request_only_while_its_twin_is_that_request(
+        tmp_path: Path, paper: scenarios.RobotScenario, changed_at: float | None, warned: bool) -> None:
+    """A session whose d1 was changed (PATCH) before the same request came again replays without the
+    warning that d1 "may still run" as that request: by then it was another one."""
+    from tasker.support.reader import InputWarning
+
+    record = Record(dataclasses.replace(paper, name="paper-session", actions=()))
+    john = {"task": "guide_human", "args": {"person": "john", "destination": "john_destination"}}
+    record.add(TimedAction(1.0, "request", john), "d1")
+    if changed_at is not None:
+        record.add(TimedAction(changed_at, "change", {"agent": "d1", "args": {"destination": "kitchen"}}), None)
+    record.add(TimedAction(20.0, "request", john), "d2")
+    record.write(tmp_path / "session.toml", 30.0, "a test session")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        scenarios.load(tmp_path / "session.toml")
+    said = [str(w.message) for w in caught if issubclass(w.category, InputWarning)]
+    assert any("the same request as d1" in s for s in said) is warned, said
