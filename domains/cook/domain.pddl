@@ -1,4 +1,6 @@
 ; cook: put a pan on the cooker, cook, turn the cooker off and put the hot pan down.
+; The robot remembers a door it opened (opened_by_robot) until it closes it: its suspension tree
+; closes such a door, never one it found open.
 ; A door found closed on the way is opened with an empty hand (as in carry_object).
 ; The pan rests at a place (at ?k ?p), is held, or stands on the cooker (on_cooker, not at a
 ; place). It goes down only on a clear, heat-proof spot: `clear` is the world's (no movable
@@ -14,6 +16,7 @@
     (door_between ?d - door ?from ?to - place)
     (door_at ?d - door ?p - place)
     (open ?d - door)
+    (opened_by_robot ?d - door)
     (holding ?r - robot ?k - pan)
     (hand_empty ?r - robot)
     (heat_proof ?p - place)
@@ -79,10 +82,10 @@
   (:action open_door
     :parameters (?r - robot ?d - door ?p - place)
     :precondition (and (at ?r ?p) (door_at ?d ?p) (hand_empty ?r) (not (open ?d)))
-    :effect (and (open ?d) (increase (total-cost) 6)))
+    :effect (and (open ?d) (opened_by_robot ?d) (increase (total-cost) 6)))
 
   (:action close_door
     :parameters (?r - robot ?d - door ?p - place)
     :precondition (and (at ?r ?p) (door_at ?d ?p) (hand_empty ?r) (open ?d))
-    :effect (and (not (open ?d)) (increase (total-cost) 6)))
+    :effect (and (not (open ?d)) (not (opened_by_robot ?d)) (increase (total-cost) 6)))
 )
