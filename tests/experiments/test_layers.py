@@ -67,10 +67,10 @@ def _rank(module: str) -> int | None:
 
 
 def test_every_experiments_module_lives_in_a_known_layer_or_is_the_facade() -> None:
-    for name, path in MODULES.items():
-        parts = name.split(".")
-        if parts[0] == "experiments" and len(parts) > 2:
-            assert parts[1] in LAYERS, f"{path}: {parts[1]!r} is not a layer of experiments/ ({sorted(LAYERS)})"
+    layered = [name.split(".") for name in MODULES if name.startswith("experiments.") and name.count(".") > 1]
+    assert len(layered) > 50  # the scan found the modules of experiments/'s layers (89 on 60ed0ea)
+    wrong = [".".join(parts) for parts in layered if parts[1] not in LAYERS]
+    assert not wrong, f"not in a layer of experiments/ ({sorted(LAYERS)}): {wrong}"
 
 
 def test_layers_import_only_downward() -> None:

@@ -6,6 +6,7 @@ exit status and no word, or a contradiction accepted without a warning.
 
 from __future__ import annotations
 
+import json
 import os
 import warnings
 from pathlib import Path
@@ -62,9 +63,12 @@ def test_a_very_deep_goal_is_refused_with_its_line(tmp_path: Path, depth: int,
     assert "nested more than 32 deep" in err and "internal error" not in err
 
 
-def test_a_goal_nested_within_the_limit_plans(tmp_path: Path) -> None:
+def test_a_goal_nested_within_the_limit_plans(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     d, p = _files(tmp_path, DOMAIN, _problem("(and " * 20 + "(q o)" + ")" * 20))
     assert load_problem(d, p)[2] is not None
+    assert cli_main(["plan", str(d), str(p), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["status"] == "solved" and out["plan"] == [["act", "o"]]
 
 
 def test_a_deep_domain_is_refused(tmp_path: Path) -> None:
