@@ -1,31 +1,72 @@
-"""The planners' benchmarks run to the end (their figures are pasted in docs/planners.md).
+"""The planners' benchmarks still work: their functions, called on one small problem.
 
-Not a timing test: it checks that the scripts work and that what they compare agrees
-(equal plan costs), never how fast anything is.  ``bench_planner.py`` once failed
-unnoticed, after the package stopped registering ``tasker-fd`` on import."""
+A benchmark is not a test, and no test runs one (``python benchmarks/run_all.py`` does; their
+figures are pasted in docs/planners.md).  These tests import the scripts and call the pieces
+they are built of on a tiny input, so a script that stopped importing or whose comparison
+broke fails here — ``bench_planner.py`` once failed unnoticed, after the package stopped
+registering ``tasker-fd`` on import.  They check what the scripts compare (equal plan costs,
+identical SAS), never how fast anything is.
+"""
 
 from __future__ import annotations
 
-import subprocess
+import importlib.util
+import math
 import sys
 from pathlib import Path
+from types import ModuleType
+
+from planners.bundled import task_types
+from planners.examples import StraightLineMotion, example_context
+from planners.pddl_task import PddlTaskType
+from tasker.task import Strategy
 
 BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
 
 
-def _run(script: str, *args: str) -> str:
-    done = subprocess.run([sys.executable, str(BENCHMARKS / script), *args], capture_output=True, text=True,
-                          timeout=600)
-    assert done.returncode == 0, done.stderr[-2000:]
-    return done.stdout
+def _script(name: str) -> ModuleType:
+    """A benchmark script imported as a module (its ``main`` is not called)."""
+    module_name = f"_bench_{name}"
+    if module_name in sys.modules:
+        return sys.modules[module_name]
+    spec = importlib.util.spec_from_file_location(module_name, BENCHMARKS / f"{name}.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[module_name] = module
+    spec.loader.exec_module(module)
+    return module
 
 
-def test_bench_planner_compares_every_problem_with_fast_downward_opt() -> None:
-    out = _run("bench_planner.py", "--repeat", "1")
-    assert "plan costs equal on every problem: yes" in out and "overall median speed-up" in out
-    assert "SAS identical on every problem: yes" in out
+def _task(name: str) -> PddlTaskType:
+    task = {t.name: t for t in task_types()}[name]
+    assert isinstance(task, PddlTaskType)
+    return task
 
 
-def test_bench_estimates_measures_every_case() -> None:
-    out = _run("bench_estimates.py", "--repeat", "1")
-    assert "paper world, OMPL" in out and "worst cached estimate with people moving" in out
+def test_bench_planner_compares_a_problem_with_fast_downward_opt() -> None:
+    from planners.checks import load_problem_text
+    from planners.planner import Planner
+
+    bench = _script("bench_planner")
+    task = _task("human_fell")
+    problems = bench.problems_of(task)
+    assert problems, "the example world gives no problem to compare"
+    label, text = problems[0]
+    model = load_problem_text(task.domain.checked, text.problem)
+    _, ours = bench.timed(lambda: Planner(cache_size=0).solve(text).cost, 1)
+    _, engine = bench.timed(bench.up_solver("tasker-fd", model), 1)
+    _, optimal = bench.timed(bench.up_solver("fast-downward-opt", model), 1)
+    assert ours is not None and math.isfinite(ours) and ours == engine == optimal, (label, ours, engine, optimal)
+    assert bench.translator([text], 1)  # the reuse path writes the SAS the library's main() writes
+
+
+def test_bench_estimates_measures_a_stale_plan_against_a_fresh_one() -> None:
+    bench = _script("bench_estimates")
+    task = _task("human_fell")
+    ctx = example_context(task, motion=StraightLineMotion(), strategy=Strategy())
+    assert ctx is not None
+    stale = bench.stale_context(task, ctx)
+    assert stale.suspended and stale.stage_index >= 1
+    row = bench.measure("human_fell (example world)", task, stale, 1)
+    assert set(row) == {"stale walk", "stale walk, moved", "cold", "cached", "cached, moved"}
+    assert all(v >= 0 for v in row.values())
