@@ -60,6 +60,7 @@ def _read(domain: str, problem: str):  # noqa: ANN202 - a UP Problem
     return PDDLReader().parse_problem_string(domain, problem)  # default settings, as any user would
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("task", [t for t in task_types() if isinstance(t, PddlTaskType)], ids=lambda t: t.name)
 def test_portable_pddl_is_read_by_a_default_reader_and_plans_map_back(task: PddlTaskType) -> None:
     ctx = example_context(task, strategy=Strategy("planned", "planned"), motion=StraightLineMotion())
@@ -87,6 +88,7 @@ def test_journal_records_only_inside_the_block() -> None:
     assert [(r.agent, r.purpose, r.status) for r in journal] == [(ctx.agent, "upTsk", "solved")]
 
 
+@pytest.mark.slow
 def test_unsolvable_uptsk_is_explained_with_pddl_a_planner_confirms(unsolvable_run: Path, tmp_path: Path) -> None:
     index = json.loads((unsolvable_run / "problems" / "index.json").read_text())
     assert [(e["agent"], e["purpose"], e["status"]) for e in index] == [("d1", "upTsk", "unsolvable")]

@@ -31,6 +31,7 @@ def _names(fig: Any) -> set[str]:
     return {t.name for t in fig.data}
 
 
+@pytest.mark.slow
 def test_the_run_writes_a_self_contained_page(tmp_path: Path) -> None:
     run_scenario(DEMO, out=tmp_path)
     page = (tmp_path / "report.html").read_text(encoding="utf-8")
@@ -43,6 +44,7 @@ def test_the_run_writes_a_self_contained_page(tmp_path: Path) -> None:
     assert "synthetic-demo" in page
 
 
+@pytest.mark.slow
 def test_same_run_same_bytes(events: list[dict[str, Any]], tmp_path: Path) -> None:
     world = load_world("paper")
     trajectory = [(0.0, 1.0, 1.0, 0.0), (5.0, 2.0, 1.5, 0.5), (9.0, 3.0, 2.0, 1.0)]

@@ -12,6 +12,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[2]
 LAYERS = {"inputs": 0, "trace": 1, "metrics": 2, "analysis": 3, "report": 4, "run": 5, "sweep": 6,
           "days": 7, "paper": 7, "serve": 7, "cli": 9}
@@ -86,12 +88,14 @@ def test_layers_import_only_downward() -> None:
     assert not wrong, "\n".join(wrong)
 
 
+@pytest.mark.slow
 def test_no_other_package_imports_experiments() -> None:
     wrong = [f"{n} imports {d}" for n in MODULES if not n.startswith("experiments")
              for d in _imports(n) if d.startswith("experiments")]
     assert not wrong, "\n".join(wrong)
 
 
+@pytest.mark.slow
 def test_no_two_modules_import_each_other() -> None:
     graph = {n: {d for d in _imports(n) if not d.startswith(n + ".") and not n.startswith(d + ".")}
              for n in MODULES}
@@ -109,6 +113,7 @@ def test_benchmarks_import_nothing_from_tests() -> None:
     assert not wrong, wrong
 
 
+@pytest.mark.slow
 def test_the_generated_docs_are_up_to_date() -> None:
     """docs/trace.md's event fields and docs/metrics.md's registry are generated (`tasker docs`)."""
     from experiments.report.reference import update
@@ -117,6 +122,7 @@ def test_the_generated_docs_are_up_to_date() -> None:
     assert not stale, f"out of date: {stale}; run 'tasker docs'"
 
 
+@pytest.mark.slow
 def test_argparse_lives_only_in_cli() -> None:
     users = sorted(n for n, p in MODULES.items() if not n.startswith("experiments.cli")
                    and any(isinstance(x, ast.Import | ast.ImportFrom) and "argparse" in
@@ -125,6 +131,7 @@ def test_argparse_lives_only_in_cli() -> None:
     assert users == [], users
 
 
+@pytest.mark.slow
 def test_every_documented_event_is_emitted_somewhere() -> None:
     """docs/trace.md documents every type of tasker.events; each must be made by some module (none
     reserved today), and the scan must see the emits it claims to (a broken scan is not silence)."""

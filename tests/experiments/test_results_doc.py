@@ -81,6 +81,7 @@ def test_the_pilot_sizes_each_test_and_n_is_clamped() -> None:
     assert n["cr"] == ex.MIN_N and ex.MIN_N <= n["hh"] <= ex.MAX_N
 
 
+@pytest.mark.slow
 def test_the_document_is_deterministic_declares_first_and_ends_with_its_provenance() -> None:
     rows = _rows(range(1, 31))
     plan = ex.Plan(tuple(pilot_sizes(rows, ["hh", "cr"], ex.CONTRASTS, ex.OUTCOMES)), {"hh": 30, "cr": 30})
@@ -156,6 +157,7 @@ def test_a_spec_names_its_task_folders_relative_to_itself(tmp_path: Path) -> Non
         load_spec(_spec(tmp_path, 'paths = ["nowhere"]\n'))
 
 
+@pytest.mark.slow
 def test_sweep_runs_a_limit_and_says_how_long_the_rest_takes(tmp_path: Path,
                                                               capsys: pytest.CaptureFixture[str]) -> None:
     from experiments.cli import main

@@ -229,6 +229,7 @@ args = {{ person = "john", destination = "bedroom" }}
 """
 
 
+@pytest.mark.slow
 def test_settings_request_fields_makes_every_task_type_take_them_in_the_run(tmp_path: Path) -> None:
     """A session runs with the request fields on (any request may give a priority), none of its
     requests may give one: its saved scenario says so in ``settings``, or the replay's task types

@@ -48,6 +48,7 @@ def scratch(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return tmp_path_factory.mktemp("fuzz")
 
 
+@pytest.mark.slow
 @examples(300)
 @given(st.text(max_size=300) | st.binary(max_size=300).map(lambda b: b.decode("latin-1")))
 def test_random_text_is_toml_or_a_clean_error(text: str) -> None:
@@ -131,6 +132,7 @@ def test_a_mutated_task_toml(scratch: Path, data: bytes) -> None:
     _reads_cleanly(lambda: read_task_toml(p))
 
 
+@pytest.mark.slow
 @examples(20)
 @given(mutated(SEEDS["domain"].read_bytes()))
 def test_a_mutated_domain(scratch: Path, data: bytes) -> None:
@@ -140,6 +142,7 @@ def test_a_mutated_domain(scratch: Path, data: bytes) -> None:
     _reads_cleanly(lambda: load_domain(p), seconds=20.0)
 
 
+@pytest.mark.slow
 @examples(200)
 @given(st.text(alphabet="() ;-?:abcdefxyz\n", max_size=400))
 def test_random_pddl_text_passes_the_cheap_checks_or_is_refused(text: str) -> None:

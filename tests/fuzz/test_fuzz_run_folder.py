@@ -84,6 +84,7 @@ ESCAPES = ["../../../secret.txt", "../../secret.txt", "/etc/hostname", "", ".", 
            "x/" * 300, "ö" * 200, 5, None, [], {"a": 1}, True, 1e308]
 
 
+@pytest.mark.slow
 @examples(60)
 @given(key=st.sampled_from(["domain", "problem", "plan_file", "agent", "t", "label", "message", "status"]),
        value=st.sampled_from(ESCAPES) | st.text(max_size=30), which=st.integers(0, 50))
@@ -96,6 +97,7 @@ def test_an_index_naming_anything(run: Path, key: str, value: object, which: int
     _explains_cleanly(folder, run.parent / "out")
 
 
+@pytest.mark.slow
 @examples(80)
 @given(data=st.data())
 def test_a_mutated_trace(run: Path, data: st.DataObject) -> None:

@@ -16,6 +16,8 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
+import pytest
+
 from planners.bundled import task_types
 from planners.examples import StraightLineMotion, example_context
 from planners.pddl_task import PddlTaskType
@@ -43,6 +45,7 @@ def _task(name: str) -> PddlTaskType:
     return task
 
 
+@pytest.mark.slow
 def test_bench_planner_compares_a_problem_with_fast_downward_opt() -> None:
     from planners.checks import load_problem_text
     from planners.planner import Planner

@@ -52,6 +52,7 @@ def _write(tmp_path: Path, name: str) -> tuple[Path, Path, str, bool, str]:
     return d, p, str(d if at_fault == "domain" else p), has_line, fragment
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_malformed_input_is_refused_with_file_and_line(name: str, tmp_path: Path) -> None:
     d, p, fault, has_line, fragment = _write(tmp_path, name)
@@ -65,6 +66,7 @@ def test_malformed_input_is_refused_with_file_and_line(name: str, tmp_path: Path
         assert f"{fault}:{err.line}" in str(err)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_plan_command_exits_2_without_traceback(name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     d, p, fault, _, _ = _write(tmp_path, name)

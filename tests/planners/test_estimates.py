@@ -294,6 +294,7 @@ def test_a_leg_through_a_door_the_plan_opens_is_timed_with_the_door_open(tasks: 
     assert motion.ignoring > 0
 
 
+@pytest.mark.slow
 def test_paper_scenario_trace_does_not_depend_on_what_earlier_runs_cached() -> None:
     """The estimator's cache lives as long as the task type: a second run in the same process
     (warm caches) must write the same trace, byte for byte, as the first."""

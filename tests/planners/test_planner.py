@@ -29,6 +29,7 @@ def test_engine_is_registered_and_found_by_name(pddl_files: tuple[Path, Path]) -
     assert check.valid and check.cost == 6
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["tasker-fd", "fast-downward-opt"])
 def test_planner_by_name_same_optimal_cost(name: str, pddl_files: tuple[Path, Path]) -> None:
     _, _, problem = load_problem(*pddl_files)

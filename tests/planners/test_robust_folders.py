@@ -101,6 +101,7 @@ def _edit(path: Path, old: str, new: str) -> None:
     path.write_text(text.replace(old, new, 1))
 
 
+@pytest.mark.slow
 def test_an_argument_declared_twice_is_refused(folder: Path) -> None:
     """Before: accepted; the request's value went to whichever declaration came first."""
     toml = folder / "task.toml"
@@ -109,6 +110,7 @@ def test_an_argument_declared_twice_is_refused(folder: Path) -> None:
         load_task(folder, use_cache=False)
 
 
+@pytest.mark.slow
 def test_choices_must_fit_the_type_and_duplicates_warn(folder: Path) -> None:
     toml = folder / "task.toml"
     _edit(toml, '# choices = ["living", "kitchen"]', 'choices = ["living", 5]')
@@ -139,6 +141,7 @@ def test_one_fact_bound_twice(folder: Path) -> None:
     assert len(task.meaning.bindings) == 1
 
 
+@pytest.mark.slow
 def test_a_fact_bound_differently_by_two_folders_is_refused(folder: Path, tmp_path: Path) -> None:
     """The world reads a bound fact from the first binding that covers it: the other was silently ignored."""
     from planners.bundled import task_types
@@ -153,6 +156,7 @@ def test_a_fact_bound_differently_by_two_folders_is_refused(folder: Path, tmp_pa
     assert {t.name for t in task_types([folder])} >= {"fetch", "carry_object"}  # alike: accepted
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("key", "old", "new", "fragment"), [
     ("timeout", "timeout_s = 10.0", "timeout_s = 1e300", "task.timeout_s: expected a number <= 86400"),
     ("cps", "cps = 1.0", "cps = 1" + "0" * 400, "schedule.cps: expected a 64-bit integer"),
@@ -171,6 +175,7 @@ def test_numbers_and_nesting_out_of_range_are_refused_where_read(folder: Path, k
     assert fragment in str(info.value) and str(folder / "task.toml") in str(info.value)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("body", "fragment"), [
     ("import sys\nsys.exit(4)\n", "task.py:2: called sys.exit(4) on import"),
     ("import sys\nsys.exit()\n", "task.py:2: called sys.exit() on import"),
@@ -185,6 +190,7 @@ def test_a_task_py_that_exits_on_import_is_named(folder: Path, body: str, fragme
     assert f"tasker domains: error: {folder / 'task.py'}" in err and fragment in err
 
 
+@pytest.mark.slow
 def test_a_hook_that_exits_is_an_error_of_its_task(folder: Path) -> None:
     """sys.exit() in a hook at run time ended tasker; now it is an exception the agent contains."""
     (folder / "task.py").write_text("import sys\n\ndef check_terminate(ctx, world):\n    sys.exit(3)\n")
@@ -195,6 +201,7 @@ def test_a_hook_that_exits_is_an_error_of_its_task(folder: Path) -> None:
     assert issubclass(HookExited, Exception)
 
 
+@pytest.mark.slow
 def test_a_task_py_that_is_a_device_is_refused(folder: Path) -> None:
     os.symlink("/dev/zero", folder / "task.py")
     with pytest.raises(DefinitionError, match="task.py: is not a regular file"):
@@ -239,6 +246,7 @@ def hook_job(job: Any) -> tuple[dict[str, Any], dict[str, Any]]:
     return {}, {}
 
 
+@pytest.mark.slow
 def test_a_hook_that_kills_its_process_is_named_in_the_sweep(folder: Path) -> None:
     """Before: 'worker process died (exit code 7) ... (a crash in native code, os._exit, or the OOM killer)'."""
     from experiments.inputs.strategy import Strategy
@@ -256,6 +264,7 @@ def test_a_hook_that_kills_its_process_is_named_in_the_sweep(folder: Path) -> No
     assert f"in the task.py hook check_args of {folder / 'task.py'}" in row.error
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["robot", "deadline", "priority", "death_at"])
 def test_a_reserved_argument_name_is_refused(folder: Path, name: str) -> None:
     """Before: an argument named deadline was stripped from the folder's own arguments by the request
@@ -273,6 +282,7 @@ def test_the_reserved_names_cover_the_request_fields() -> None:
     assert set(FIELD_NAMES) <= set(RESERVED_ARGS)
 
 
+@pytest.mark.slow
 def test_one_condition_declared_as_two_hazards_is_refused(folder: Path) -> None:
     """Before: accepted; every hazard metric counted the held item twice."""
     toml = folder / "task.toml"

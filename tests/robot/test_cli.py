@@ -11,6 +11,7 @@ from experiments.cli import main as cli
 from robot.spec import load_world, shipped_worlds
 
 
+@pytest.mark.slow
 def test_world_json_and_picture(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     png = tmp_path / "paper.png"
     assert cli(["world", "paper", "--json", "--out", str(png)]) == 0

@@ -34,6 +34,7 @@ def _scene(world: str, people: bool, toggle_one: bool) -> Scene:
     return scene
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("toggle_one", [False, True], ids=["doors-as-shipped", "one-door-toggled"])
 @pytest.mark.parametrize("people", [False, True], ids=["empty", "with-people"])
 @pytest.mark.parametrize("world", shipped_worlds())

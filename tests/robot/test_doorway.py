@@ -128,6 +128,7 @@ def test_navigate_leaves_the_doorway_in_mujoco(paper, to: str) -> None:
     assert status.state is SkillState.SUCCEEDED, status
 
 
+@pytest.mark.slow
 def test_navigate_retries_a_failed_replan_once_the_doorway_clears(paper) -> None:
     """Peter steps into the only door of the bedroom while the robot drives there (no path:
     it brakes), then walks on: the robot re-plans at the next check and gets there, rather

@@ -25,6 +25,7 @@ def _dense(path, step=0.02):
     return out
 
 
+@pytest.mark.slow
 def test_paths_are_collision_free_against_the_tiago_mesh_model(paper, paper_motion) -> None:
     assert isinstance(paper_motion, MotionModel)
     boxes = [(*o.box, o.height) for o in paper.obstacles]

@@ -38,6 +38,7 @@ def test_protocols(paper) -> None:
     assert "robot" in snap.poses and "kitchen" in snap.poses
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("a", "b"), [("hall", "kitchen"), ("kitchen", "bedroom"), ("bedroom", "stove"),
                                       ("stove", "bathroom"), ("bathroom", "alice_destination")])
 def test_estimates_match_mujoco_time(paper, a: str, b: str) -> None:
@@ -264,6 +265,7 @@ def test_equal_facts_keys_mean_equal_facts(paper) -> None:
     assert max(len(p) for p in poses.values()) > 5
 
 
+@pytest.mark.slow
 def test_people_not_stepped_while_still_are_where_stepping_them_puts_them(paper, monkeypatch) -> None:
     """Still people are not stepped (``Person._idle_after``), the world syncs and re-examines
     only people touched since it last looked: the same samples as stepping, syncing and
