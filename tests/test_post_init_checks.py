@@ -126,7 +126,7 @@ def _cases() -> list[Case]:
              "does not fit source plan"),
         Case("FDOutcome.solved", lambda: FDOutcome(FDExit.SOLVED, 0, None, None, 0.0, 0.0), ValueError,
              "solved FDOutcome needs a plan"),
-        Case("FDOutcome.unsolved", lambda: FDOutcome(FDExit.TIMEOUT, 23, ((("a",),)), None, 0.0, 0.0),  # type: ignore[arg-type]
+        Case("FDOutcome.unsolved", lambda: FDOutcome(FDExit.TIMEOUT, 23, (("a",),), None, 0.0, 0.0),
              ValueError, "exit timeout must not carry a plan"),
         Case("PlanResult.status", lambda: PlanResult("solved", (), 0.0, "fd", 0.0), TypeError,  # type: ignore[arg-type]
              "PlanResult.status must be a PlanStatus"),
