@@ -106,16 +106,23 @@ def test_unsolvable_uptsk_is_explained_with_pddl_a_planner_confirms(unsolvable_r
     assert "transition upTsk -> end" in text and "end (failed): upTsk unsolvable" in text
 
 
-def test_explain_picks_the_problem_in_force(tmp_path: Path) -> None:
-    run = tmp_path / "run"
+def _problems(run: Path, task_type: str, calls: list[tuple[float, str]]) -> Path:
+    """A run folder's ``problems/``: one solved call of d1 per ``(t, purpose)``, file ``N.pddl`` holding
+    ``; problem N``."""
     (run / "problems").mkdir(parents=True)
     entries = []
-    for n, (t, purpose) in enumerate([(0.5, "upTsk"), (40.0, "genSusp"), (80.0, "upTsk")], start=1):
+    for n, (t, purpose) in enumerate(calls, start=1):
         (run / "problems" / f"{n}.pddl").write_text(f"; problem {n}\n")
-        entries.append({"n": n, "t": t, "agent": "d1", "task_type": "cook", "purpose": purpose, "label": "",
-                        "status": "solved", "domain": "cook.domain.pddl", "problem": f"{n}.pddl", "message": ""})
-    (run / "problems" / "cook.domain.pddl").write_text("; domain\n")
+        entries.append({"n": n, "t": t, "agent": "d1", "task_type": task_type, "purpose": purpose, "label": "",
+                        "status": "solved", "domain": f"{task_type}.domain.pddl", "problem": f"{n}.pddl",
+                        "message": ""})
+    (run / "problems" / f"{task_type}.domain.pddl").write_text("; domain\n")
     (run / "problems" / "index.json").write_text(json.dumps(entries))
+    return run
+
+
+def test_explain_picks_the_problem_in_force(tmp_path: Path) -> None:
+    run = _problems(tmp_path / "run", "cook", [(0.5, "upTsk"), (40.0, "genSusp"), (80.0, "upTsk")])
     assert explain.explain(run, "d1").entry["n"] == 3
     assert explain.explain(run, "d1", at=45.0).entry["n"] == 2
     assert explain.explain(run, "d1", at=0.5).problem == "; problem 1\n"
@@ -129,15 +136,8 @@ def _instant_run(folder: Path) -> Path:
     """A run folder as ``tasker run carry`` writes one, cut down: d1 plans at 0.002; a fall is requested
     at 40.0, Alg. 2 sends ``susp`` at 40.001, d1 plans its suspension at 40.002 and runs it from 40.052;
     d1 plans again at 80.1 (the loop's float: 80.10000000000001)."""
-    run = folder / "run"
-    (run / "problems").mkdir(parents=True)
-    entries = []
-    for n, (t, purpose) in enumerate([(0.002, "upTsk"), (40.002, "genSusp"), (80.10000000000001, "upTsk")], start=1):
-        (run / "problems" / f"{n}.pddl").write_text(f"; problem {n}\n")
-        entries.append({"n": n, "t": t, "agent": "d1", "task_type": "carry_object", "purpose": purpose, "label": "",
-                        "status": "solved", "domain": "carry.domain.pddl", "problem": f"{n}.pddl", "message": ""})
-    (run / "problems" / "carry.domain.pddl").write_text("; domain\n")
-    (run / "problems" / "index.json").write_text(json.dumps(entries))
+    run = _problems(folder / "run", "carry_object", [(0.002, "upTsk"), (40.002, "genSusp"),
+                                                     (80.10000000000001, "upTsk")])
     events = [{"t": 0.0, "event": "run"},
               {"t": 0.001, "event": "command", "agent": "d1", "flag": "start"},
               {"t": 0.002, "event": "transition", "agent": "d1", "from": "compSP", "to": "upTsk"},
