@@ -146,6 +146,7 @@ def test_a_type_that_is_not_preemptive_runs_blocking_from_its_first_stage(origin
         is StageKind.SUSPENDABLE
 
 
+@pytest.mark.slow
 def test_no_scheduler_interrupts_a_fall_or_a_pick_and_place_of_tabsas_day() -> None:
     """The type's own property, whatever the scheduler asks: srtf asks falls and pick-and-places to
     suspend for any shorter task; they run on, and only transports suspend."""

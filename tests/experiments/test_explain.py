@@ -184,6 +184,7 @@ def test_at_the_interruption_of_a_real_run_explains_its_suspension(tmp_path: Pat
     assert "transition exeTsk -> genSusp" in text
 
 
+@pytest.mark.slow
 def test_explain_without_an_agent_names_the_agents_of_the_run(unsolvable_run: Path,
                                                               capsys: pytest.CaptureFixture[str]) -> None:
     """Before: argparse's bare "the following arguments are required: --agent", whatever the folder held."""

@@ -55,6 +55,7 @@ def test_same_run_same_bytes(events: list[dict[str, Any]], tmp_path: Path) -> No
     assert (a / "report.html").read_bytes() == (b / "report.html").read_bytes()
 
 
+@pytest.mark.slow
 def test_timeline_separates_costs_rates_roles_and_hazards(events: list[dict[str, Any]]) -> None:
     trace = [*events, {"t": 3.0, **HAZARD, "status": "on"}, {"t": 9.0, **HAZARD, "status": "off"}]
     hazards = report_html.hazards_of(trace, None)

@@ -55,6 +55,7 @@ def test_random_text_is_toml_or_a_clean_error(text: str) -> None:
     _reads_cleanly(lambda: reader.loads(text, "f.toml"))
 
 
+@pytest.mark.slow
 @examples(300)
 @given(st.text(alphabet="[]{}\",:0123456789.eE-+ aZ\\ntrueflsn", max_size=300))
 def test_random_text_is_json_or_a_clean_error(text: str) -> None:
@@ -67,6 +68,7 @@ def _write(scratch: Path, name: str, data: bytes) -> Path:
     return p
 
 
+@pytest.mark.slow
 @examples(120)
 @given(mutated(SEEDS["synthetic"].read_bytes()))
 def test_a_mutated_synthetic_scenario(scratch: Path, data: bytes) -> None:

@@ -71,6 +71,7 @@ def _explains_cleanly(folder: Path, capture: Path) -> None:
         assert all(SECRET not in f.read_text() for f in files)
 
 
+@pytest.mark.slow
 @examples(60)
 @given(data=st.data())
 def test_a_mutated_index(run: Path, data: st.DataObject) -> None:

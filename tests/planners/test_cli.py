@@ -72,6 +72,7 @@ def test_domains_lists_bundled(capsys: pytest.CaptureFixture[str]) -> None:
         assert name in out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["mermaid", "dot"])
 @pytest.mark.parametrize("purpose", ["upTsk", "genSusp"])
 def test_fsm(fmt: str, purpose: str, capsys: pytest.CaptureFixture[str]) -> None:

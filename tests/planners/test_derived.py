@@ -50,6 +50,7 @@ def test_a_goal_that_leaves_its_own_hazard_on_is_warned_about_and_restore_asks_i
     assert ("not", "open", "door1") in goal  # closed when it first planned: closed at its goal
 
 
+@pytest.mark.slow
 def test_a_branch_whose_stage_cannot_run_is_warned_about(tmp_path: Path) -> None:
     """A branch that puts the object down wherever the robot is: not a surface in every state."""
     folder = _folder(tmp_path, "bad_branch", edit={

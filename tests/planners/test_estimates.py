@@ -425,6 +425,7 @@ def test_people_in_the_way_slow_a_leg_but_never_cut_it(tasks: dict[str, PddlTask
     assert all(math.isinf(walled[k]) for k in into)  # no estimate_ignoring_people: nothing to fall back on
 
 
+@pytest.mark.slow
 def test_a_waiting_task_is_estimated_from_the_state_the_executing_task_leaves() -> None:
     """Compound: while carry holds the vase, cook (which needs an empty hand and knows no
     vase) was estimated from the world now and came out unsolvable, so every decision

@@ -46,6 +46,7 @@ def test_an_unsolvable_example_is_a_warning_naming_what_was_left_out(tmp_path: P
     assert "['at', 'vaze', 'kitchen']" in text
 
 
+@pytest.mark.slow
 def test_connected_without_travel_time_still_connects_the_places(tmp_path: Path) -> None:
     """A domain without action costs keeps ``connected``: the docs add it "when the domain declares" it."""
     from planners.examples import example_context
@@ -185,6 +186,7 @@ def test_extra_facts_that_are_not_tuples_of_strings_are_refused(tmp_path: Path) 
     assert info.value.file == str(folder / "task.py")
 
 
+@pytest.mark.slow
 def test_a_task_toml_with_a_byte_order_mark_is_checked_like_any(tmp_path: Path,
                                                                capsys: pytest.CaptureFixture[str]) -> None:
     from experiments.cli import main
@@ -384,6 +386,7 @@ def test_a_suspension_when_that_contradicts_itself_is_refused(tmp_path: Path) ->
     assert "suspension[0]: `when` asks for ['holding', '$robot', '$item'] and for its negation" in str(info.value)
 
 
+@pytest.mark.slow
 def test_an_upper_case_scenario_object_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Before: [objects.Cup] ran, but the plan moved "cup": the robot never held Cup and its hazard never fired."""
     from experiments.cli import main

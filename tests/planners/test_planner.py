@@ -63,6 +63,7 @@ def test_cache_is_bounded_lru() -> None:
     assert planner.solve(texts[2]).cached
 
 
+@pytest.mark.slow
 def test_up_problem_repeat_is_cached(pddl_files: tuple[Path, Path]) -> None:
     _, _, problem = load_problem(*pddl_files)
     planner = Planner()

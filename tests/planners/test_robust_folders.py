@@ -78,6 +78,7 @@ def test_a_deep_domain_is_refused(tmp_path: Path) -> None:
         load_domain(d)
 
 
+@pytest.mark.slow
 def test_a_problem_of_another_domain_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Before: planned silently against the domain given."""
     d, p = _files(tmp_path, DOMAIN, "\n" + _problem("(q o)", domain="other"))
@@ -208,6 +209,7 @@ def test_a_task_py_that_is_a_device_is_refused(folder: Path) -> None:
         load_task(folder, use_cache=False)
 
 
+@pytest.mark.slow
 def test_a_domain_that_is_a_device_is_refused(folder: Path) -> None:
     (folder / "domain.pddl").unlink()
     os.symlink("/dev/zero", folder / "domain.pddl")
@@ -215,6 +217,7 @@ def test_a_domain_that_is_a_device_is_refused(folder: Path) -> None:
         load_task(folder)
 
 
+@pytest.mark.slow
 def test_a_warning_is_given_every_time_not_only_before_the_check_is_cached(
         folder: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Before: the [example]'s warnings came from the checks a cached folder skips: shown once."""

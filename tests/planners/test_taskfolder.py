@@ -147,6 +147,7 @@ def test_folder_of_folders_and_store_loader(tmp_path: Path) -> None:
         load_task_folder(empty)
 
 
+@pytest.mark.slow
 def test_task_types_with_user_folder(tmp_path: Path) -> None:
     folder = _copy(tmp_path, "cook")
     _edit(folder / "task.toml", 'name = "cook"', 'name = "cook_pasta"')

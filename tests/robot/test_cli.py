@@ -22,6 +22,7 @@ def test_world_json_and_picture(tmp_path: Path, capsys: pytest.CaptureFixture[st
     assert png.read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("world", shipped_worlds())
 def test_world_json_describes_every_part_of_the_world(world: str, capsys: pytest.CaptureFixture[str]) -> None:
     spec = load_world(world)

@@ -71,6 +71,7 @@ def test_stop_brings_the_base_to_rest(paper) -> None:
     assert sim.poll("d1", stage, 10.0).state is SkillState.FAILED
 
 
+@pytest.mark.slow
 def test_person_asked_to_follow_ends_near_the_destination(paper) -> None:
     sim = Simulation(paper)
     status, now = run(sim, nav("john", add=[["met", "robot", "john"]]), 0.0)
@@ -112,6 +113,7 @@ def test_told_to_wait_stops_a_walking_person(paper) -> None:
     assert sim.people["john"].pose != here
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("posture", ["standing", "sitting"])
 def test_a_person_told_to_wait_in_a_doorway_steps_out_of_it(paper, posture: str) -> None:
     """Nobody waits standing in a doorway: told to wait there, a standing person steps to
