@@ -387,6 +387,21 @@ def test_a_doc_names_only_what_exists(doc: str) -> None:
     assert not problems, "\n".join(map(str, problems))
 
 
+def test_the_strategy_levels_the_docs_are_held_to_are_the_command_lines_too() -> None:
+    """The docs are checked against tasker.task's levels; the CLI's choices and the sweep's levels
+    (typed again in experiments/) must be the same, or a doc could be right and the command refuse it."""
+    from experiments.cli import build_parser
+    from experiments.inputs import strategy
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    run = {o: set(a.choices) for a in sub.choices["run"]._actions if a.choices for o in a.option_strings}
+    for flag, key in (("--suspension", "suspension"), ("--update", "update"), ("--policy", "policy")):
+        assert run[flag] == set(_levels()[key]), flag
+    assert set(strategy.SUSPENSION_VALUES) == set(_levels()["suspension"])
+    assert set(strategy.STRATEGY_VALUES) == set(_levels()["update"])
+    assert set(strategy.POLICY_VALUES) == set(_levels()["policy"])
+
+
 def test_the_registrys_lists_are_marked_for_checking() -> None:
     """The README's list of the scheduler registry, and docs/model.md's of the indexed ones, are
     checked as complete: they carry the mark."""
