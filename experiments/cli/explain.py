@@ -28,6 +28,7 @@ EXAMPLES = """\
 examples:
   tasker explain out/paper --agent d3                 # d3's last problem, plan and what moved it
   tasker explain out/paper --agent d1 --at 60         # the problem d1 planned from at t = 60 s
+  tasker explain out/carry --agent d1 --at 40         # the suspension d1 planned when help was asked at 40 s
   tasker explain out/run --agent d2 --out /tmp/d2     # domain.pddl, problem.pddl, plan, explain.txt"""
 
 
@@ -47,7 +48,8 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--agent", default=None, help="agent id: d1, d2, ... (required; without it the error lists the "
                                                  "run's agents that planned)")
     p.add_argument("--at", type=non_negative_seconds, default=None,
-                   help="simulated time in s (default: the agent's last plan)")
+                   help="simulated time in s, with what the loop did at once in answer to what happened then "
+                        "(default: the agent's last plan)")
     p.add_argument("--out", default=None, help="write domain.pddl, problem.pddl, plan and explain.txt here")
 
 

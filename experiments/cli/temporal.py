@@ -41,11 +41,11 @@ def plan_temporal(args: argparse.Namespace, domain_text: str, problem_text: str,
                   stages_of: Callable[[PlanResult], tuple[Stage, ...] | str]) -> int:
     """Solve a temporal DOMAIN + PROBLEM; print the timed plan (or JSON) and, for a task folder's domain,
     its stages (``stages_of``: ``tasker plan``'s own, the stages or why there are none)."""
-    from planners.planner import DEFAULT_PLANNER
+    from planners.schedules import CLI_PLANNER
     from planners.temporal.portfolio import TemporalPlanner
     from planners.temporal.reading import parse
 
-    names = engines_of(args.planner, DEFAULT_PLANNER)
+    names = engines_of(args.planner, CLI_PLANNER)
     problem = parse(domain_text, problem_text, args.domain, args.problem)
     result = TemporalPlanner(names, timeout=args.timeout).solve(problem)
     if args.json:

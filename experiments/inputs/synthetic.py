@@ -29,6 +29,7 @@ from tasker.store import TaskStore
 from tasker.support import reader
 from tasker.support.reader import Table, check_name
 from tasker.synthetic import SyntheticTask, TimedExecutor
+from tasker.task import Strategy
 from tasker.trace import Trace
 
 if TYPE_CHECKING:
@@ -144,6 +145,11 @@ def load(path: str | Path) -> SyntheticScenario:
     return scenario
 
 
+SYNTHETIC_STRATEGY = Strategy("static", "static")
+"""What synthetic tasks do: they run their timed stages, never a planner.  The loop is told so,
+and its ``run`` event says so, as ``run.json`` does."""
+
+
 def build(scenario: SyntheticScenario, *, seed: int, scheduler: str | None = None, mode: str | None = None,
           trace: Trace | None = None) -> SimulationLoop:
     """A ready-to-run loop for ``scenario`` (requests and changes scheduled)."""
@@ -153,6 +159,7 @@ def build(scenario: SyntheticScenario, *, seed: int, scheduler: str | None = Non
         store, schedulers.create(scheduler or scenario.scheduler, **options), seed=seed, trace=trace,
         mode=Mode(mode or scenario.mode), s_freq=scenario.s_freq, rates=scenario.rates,
         core=TimedExecutor(seed=seed, jitter=scenario.jitter), horizon=scenario.horizon,
+        strategy=SYNTHETIC_STRATEGY,
     )
     from tasker.requester import Requester
 

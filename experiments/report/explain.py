@@ -5,8 +5,11 @@ A run's ``problems/`` folder (written by :func:`write_problems` from the journal
 genSusp — solved or not — the domain and the problem as PDDL that any planner, and
 unified-planning's default ``PDDLReader``, reads; ``index.json`` lists them by agent,
 simulated time and purpose.  :func:`explain` picks the problem in force for an agent
-at a time (the last one planned at or before it) and pairs it with the trace events
-that moved the agent: ``decision``, ``command``, ``transition`` and ``end``.
+at a time and pairs it with the trace events that moved the agent: ``decision``,
+``command``, ``transition`` and ``end``.  "At a time" means the instant the trace shows
+there: what happened at ``T`` and what the loop did at once in answer, one tick after
+another (:func:`instant_end`) — a request at 40.0, the decision and ``susp`` at 40.001,
+``genSusp`` planned at 40.002 are all "at 40".
 
 A run folder is data someone may send: it is read only inside itself.  Every file
 ``index.json`` names is resolved inside ``problems/`` (an absolute path, ``..`` or a link
@@ -17,6 +20,7 @@ and a damaged one is named as damaged.
 
 from __future__ import annotations
 
+import bisect
 import difflib
 import json
 import math
@@ -33,6 +37,9 @@ PROBLEMS = "problems"
 INDEX = "index.json"
 MOVING_EVENTS = (ev.Decision, ev.CommandSent, ev.Transition, ev.TaskEnded)
 """The trace events that move an agent, which :func:`explain` lists."""
+TICK_S = 0.001
+"""The loop's tick (:class:`tasker.loop.SimulationLoop`'s default resolution): a message between the
+harmoniser and an agent takes one, so what answers an event at ``T`` happens at ``T`` + 1, 2, … ms."""
 
 
 class ExplainError(reader.InputError):
@@ -94,6 +101,8 @@ class Explanation:
     problem: str
     plan: str | None
     events: tuple[ev.Event, ...]
+    until: float | None = None
+    """The end of the instant ``at`` (:func:`instant_end`); None without ``at``."""
 
     def text(self) -> str:
         """The explanation as one readable text (what ``tasker explain`` prints)."""
@@ -103,6 +112,8 @@ class Explanation:
         head = [f"; {self.agent} ({e['task_type']}): {e['purpose']} at t={e['t']:g} s, {e['status']}"
                 + (f" [{e['label']}]" if e.get("label") else ""),
                 f"; files: {PROBLEMS}/{e['domain']}, {PROBLEMS}/{e['problem']}"]
+        if self.at is not None and self.until is not None and self.until > self.at:
+            head.append(f"; at t={self.at:g} s: with what the loop did at once in answer, up to t={self.until:g} s")
         return "\n".join([*head, "", "; ---- domain", self.domain.rstrip(), "", "; ---- problem",
                           self.problem.rstrip(), "", "; ---- plan", plan.rstrip(), "",
                           "; ---- what moved the agent (trace)", *_event_lines(self.events)]) + "\n"
@@ -251,6 +262,26 @@ def load_trace(run_dir: Path) -> Timeline:
         raise ExplainError(str(exc).replace(str(inside), str(path), 1)) from None
 
 
+def instant_end(tl: Timeline, at: float) -> float:
+    """The last time of the instant ``at``.  When something happened at ``at`` (or ``at`` falls inside
+    such an instant), the instant goes on over the events that follow tick after tick (:data:`TICK_S`)
+    without a pause: a request at 40.0 is decided at 40.001 and the executing agent plans its
+    suspension at 40.002, so a user asking about t = 40 means that genSusp, which the trace shows
+    there, not the plan the agent had before.  The next pause (here the planning time) ends it.
+    When nothing happened at ``at``, the instant is ``at`` alone."""
+    gap = TICK_S * 1.5  # more than one tick: a pause (1.5: the float noise of a time in seconds)
+    times = [e.t for e in tl.events]
+    i = bisect.bisect_right(times, at)
+    if i == 0 or at - times[i - 1] > gap:
+        return at
+    end = at
+    for t in times[i:]:
+        if t - end > gap:
+            break
+        end = t
+    return end
+
+
 def moved(tl: Timeline, agent: str, until: float | None = None) -> list[ev.Event]:
     """The decision, command, transition and end events about ``agent`` (up to ``until``)."""
     out: list[ev.Event] = []
@@ -279,7 +310,10 @@ def explain(run_dir: str | Path, agent: str, at: float | None = None) -> Explana
         hint = f"; did you mean {near[0]!r}?" if near else ""
         raise ExplainError(f"{run / PROBLEMS / INDEX}: agent {agent!r} planned nothing; agents that planned: "
                            f"{', '.join(agents)}{hint}")
-    chosen = [e for e in mine if at is None or float(e["t"]) <= at]
+    timeline = load_trace(run)
+    until = None if at is None else instant_end(timeline, at)
+    # the index keeps the loop's float times (0.1 + 0.2 …), the trace rounds to 1 µs: compare as the trace writes
+    chosen = [e for e in mine if until is None or round(float(e["t"]), 6) <= round(until, 6)]
     if not chosen:
         times = ", ".join(f"{float(e['t']):g}" for e in mine)
         raise ExplainError(f"{run / PROBLEMS / INDEX}: {agent} had not planned yet at t={at:g} s; it planned at "
@@ -289,7 +323,7 @@ def explain(run_dir: str | Path, agent: str, at: float | None = None) -> Explana
     domain = _read(folder, entry["domain"], "domain")
     problem = _read(folder, entry["problem"], "problem")
     plan = _read(folder, entry["plan_file"], "plan_file") if entry.get("plan_file") else None
-    return Explanation(agent, at, entry, domain, problem, plan, tuple(moved(load_trace(run), agent, at)))
+    return Explanation(agent, at, entry, domain, problem, plan, tuple(moved(timeline, agent, until)), until)
 
 
 def write(ex: Explanation, out: Path) -> list[Path]:

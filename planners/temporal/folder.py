@@ -19,6 +19,7 @@ unchanged, and does the temporal work for a temporal one:
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 import time
 from collections import OrderedDict
@@ -29,7 +30,7 @@ from typing import TYPE_CHECKING
 from planners import checks
 from planners.checks import CheckedDomain, DefinitionError, PddlError
 from planners.problem import DomainModel
-from planners.results import PlanResult, PlanStatus
+from planners.results import Failure, PlanResult, PlanStatus
 from planners.schema import DomainSchema
 from planners.temporal.reading import is_temporal, parse, tolerant
 from planners.temporal.results import TimedStep
@@ -147,12 +148,13 @@ class FolderPlanner:
                 self._cache.move_to_end(key)
                 self.hits += 1
         if known is not None:
-            return PlanResult(known.status, known.plan, known.cost, known.planner, 0.0, True, known.message)
+            return dataclasses.replace(known, wall_time_s=0.0, cached=True)
         start = time.perf_counter()
         try:
             problem = parse(text.domain, text.problem, self.domain_file, f"{self.domain_file.parent}/<problem>")
         except PddlError as exc:
-            return PlanResult(PlanStatus.ERROR, None, None, self.name, time.perf_counter() - start, message=str(exc))
+            return PlanResult(PlanStatus.ERROR, None, None, self.name, time.perf_counter() - start, message=str(exc),
+                              failure=Failure.INPUT)
         result = self._planner.solve(problem, self.timeout if timeout is None else timeout,
                                      accept=lambda plan: overlap(plan, self.domain_file)).to_plan_result()
         if result.status in (PlanStatus.SOLVED, PlanStatus.UNSOLVABLE):

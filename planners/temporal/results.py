@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 from fractions import Fraction
 
-from planners.results import PlanResult, PlanStatus
+from planners.results import Failure, PlanResult, PlanStatus
 
 
 class Outcome(StrEnum):
@@ -125,11 +125,12 @@ class TemporalResult:
         """The classical path's result type: steps in start-time order, cost = the makespan."""
         if self.plan is None:
             status = self.status if self.status is not PlanStatus.SOLVED else PlanStatus.ERROR
-            return PlanResult(status, None, None, self.engine or "temporal", self.wall_time_s, message=self.message)
+            return PlanResult(status, None, None, self.engine or "temporal", self.wall_time_s, message=self.message,
+                              failure=Failure.ENGINE if status is PlanStatus.ERROR else None)
         makespan = self.makespan
         assert makespan is not None
         return PlanResult(PlanStatus.SOLVED, tuple(s.step for s in self.plan), float(makespan), self.engine,
-                          self.wall_time_s, message=self.message)
+                          self.wall_time_s, message=self.message, search=self.engine)
 
     def to_json(self) -> dict[str, object]:
         """``tasker plan --json`` for a temporal problem: the classical keys (``plan`` as steps in

@@ -12,6 +12,8 @@ import pytest
 from experiments.run.runner import run_scenario
 from planners.bundled import ENV_VAR
 
+pytestmark = pytest.mark.slow  # its fixture runs the scenario in MuJoCo twice
+
 FOLDER = Path(__file__).parent / "fixtures" / "bring_water"
 
 @pytest.fixture(scope="module", params=["static", "planned"])

@@ -56,6 +56,7 @@ def test_every_bundled_task_moves(tasks: dict[str, PddlTaskType]) -> None:
     assert {t.name for t in moving(tasks)} == set(domains.bundled_names())  # the tests below are not vacuous
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", BUNDLED)
 def test_a_closed_door_is_opened_on_the_way(tasks: dict[str, PddlTaskType], name: str) -> None:
     task = tasks[name]
@@ -67,6 +68,7 @@ def test_a_closed_door_is_opened_on_the_way(tasks: dict[str, PddlTaskType], name
     assert len(opens(plan.stages)) == 1 and plan.stages[0] is opens(plan.stages)[0], steps(plan.stages)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", BUNDLED)
 def test_an_open_door_is_passed_not_opened(tasks: dict[str, PddlTaskType], name: str) -> None:
     task = tasks[name]
@@ -103,6 +105,7 @@ def test_suspension_closes_the_door_it_opened(tasks: dict[str, PddlTaskType], na
     assert not ctx_1.world.holds("open", DOOR) or apply(ctx_1.world, susp.stages).facts.isdisjoint({("open", DOOR)})
 
 
+@pytest.mark.slow
 def test_compound_scenario_nobody_is_shut_in(tasks: dict[str, PddlTaskType]) -> None:
     """carry_object's suspension closes the bedroom door from inside: every task still finishes (a task
     that must pass opens it), and carry leaves the door closed, as it found it ([problem] restore)."""

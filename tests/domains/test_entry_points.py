@@ -5,6 +5,8 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import pytest
+
 import domains
 from tasker.store import TaskStore
 
@@ -15,6 +17,7 @@ def test_default_store_has_the_bundled_task_types() -> None:
     assert store.source("cook").startswith("entry point")
 
 
+@pytest.mark.slow
 def test_store_loads_a_pddl_task_folder_a_user_points_at(tmp_path: Path) -> None:
     shutil.copytree(domains.BUNDLED / "guide_human", tmp_path / "escort", ignore=shutil.ignore_patterns("__pycache__"))
     toml = tmp_path / "escort" / "task.toml"

@@ -54,6 +54,7 @@ def test_the_bundled_names_are_found() -> None:
     assert len(names) > 10  # a broken loader must not make the test below vacuous
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("package", PACKAGES)
 def test_no_module_names_a_bundled_task_action_or_predicate(package: str) -> None:
     names = bundled_names()

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+import pytest
+
 from planners.pddl_task import PddlTaskType
 from planners.validate import state_after, validate_plan
 from tasker.stage import Purpose, StageKind
@@ -32,6 +34,7 @@ def test_stages_follow_the_skill_contract(task: PddlTaskType) -> None:
             assert s.data["text"] and "{" not in s.data["text"]
 
 
+@pytest.mark.slow
 def test_effects_match_ups_simulator(task: PddlTaskType) -> None:
     """data["add"]/["delete"] applied to the world give the state UP's SequentialSimulator gives."""
     ctx = make_ctx(task)
@@ -43,6 +46,7 @@ def test_effects_match_ups_simulator(task: PddlTaskType) -> None:
         assert init == state_after(problem, steps(plan.stages), k), f"after {k} stage(s)"
 
 
+@pytest.mark.slow
 def test_partial_execution_plans_only_the_remaining_work(task: PddlTaskType) -> None:
     ctx = make_ctx(task)
     plan = task.update_task(ctx)
@@ -59,6 +63,7 @@ def test_partial_execution_plans_only_the_remaining_work(task: PddlTaskType) -> 
         assert not set(steps(again.stages)) & set(full[:k]), "work already done is planned again"
 
 
+@pytest.mark.slow
 def test_suspension_depends_on_the_interruption_point(task: PddlTaskType) -> None:
     ctx = make_ctx(task)
     exe = task.update_task(ctx)

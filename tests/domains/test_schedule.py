@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+import pytest
+
 from planners.examples import StraightLineMotion
 from planners.pddl_task import PddlTaskType
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
@@ -40,6 +42,7 @@ def test_unreachable_is_infinite(task: PddlTaskType) -> None:
     assert p.cost == math.inf and p.c_time == math.inf
 
 
+@pytest.mark.slow
 def test_request_sp_completion_cost(task: PddlTaskType) -> None:
     ctx = make_ctx(task)
     near = task.request_sp(ctx, SPRequest(SP_COMPLETION, {"pose": ctx.world.poses["robot"]}))

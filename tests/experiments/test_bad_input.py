@@ -325,6 +325,7 @@ def test_another_kind_of_file_is_named_for_what_it_is(argv: list[str], expected:
     assert expected in err and "tasks: missing" not in err, err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("text", [
     'kind = "robot"\nworld = "paper"\n[[world_events]]\nt = 3.0\nposture = ["peter", "fallen"]\n',
     'kind = "synthetic"\n[tasks.a]\nstages = [{ action = "x", duration = 2.0 }]\n',

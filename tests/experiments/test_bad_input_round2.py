@@ -100,6 +100,7 @@ def days_out(tmp_path: Path) -> Path:
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("sql", "fragment"), [
     ("UPDATE runs SET metrics = '{\"a\": " + "[" * 5000 + "]" * 5000 + "}'", "nested more than 64 deep"),
     ("UPDATE runs SET metrics = '{\"a\": 1" + "0" * 400 + "}'", "expected a 64-bit integer"),

@@ -219,6 +219,7 @@ def test_verbose_shows_the_traceback_of_an_internal_error(monkeypatch: pytest.Mo
     assert "Traceback" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scenario", [SYNTHETIC, "paper"])
 def test_a_run_stopped_by_ctrl_c_keeps_what_ran(scenario: str, monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
                                                 capsys: pytest.CaptureFixture[str]) -> None:
@@ -250,6 +251,7 @@ def test_quiet_run_prints_the_summary_only(tmp_path: Path, capsys: pytest.Captur
     assert len(out.strip().splitlines()) == 1 and err == ""
 
 
+@pytest.mark.slow
 def test_check_lists_every_problem(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["new", "one", str(tmp_path / "tasks" / "one")]) == 0
     assert main(["new", "two", str(tmp_path / "tasks" / "two")]) == 0
@@ -275,6 +277,7 @@ def test_check_lists_every_problem(tmp_path: Path, capsys: pytest.CaptureFixture
     assert f"{len(problems)} problems" in out
 
 
+@pytest.mark.slow
 def test_check_passes_the_shipped_files(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["check", str(ROOT / "domains"), str(ROOT / "experiments" / "inputs" / "scenarios"),
                  str(ROOT / "robot" / "worlds"), str(ROOT / "experiments" / "sweep" / "specs"),
@@ -289,6 +292,7 @@ def _modules_after(code: str, tmp_path: Path) -> set[str]:
     return set(json.loads(out.stdout.strip().splitlines()[-1]))
 
 
+@pytest.mark.slow
 def test_help_and_a_warm_plan_stay_clear_of_heavy_imports(tmp_path: Path) -> None:
     mods = _modules_after("import experiments.cli as c; c.build_parser().format_help()", tmp_path)
     assert not {m for m in mods if m.split(".")[0] in ("unified_planning", "ConfigSpace", "scipy", "mujoco",
@@ -323,6 +327,7 @@ def test_sweep_jobs_carry_absolute_task_paths(tmp_path: Path, files: dict[str, s
     assert jobs and all(j.task_paths == (str((tmp_path / "tasks").resolve()),) for j in jobs)
 
 
+@pytest.mark.slow
 def test_doubtful_input_is_one_warning_line_in_the_cli_format(tmp_path: Path,
                                                               capsys: pytest.CaptureFixture[str]) -> None:
     scn = tmp_path / "late.toml"
@@ -344,6 +349,7 @@ def test_run_takes_the_policy_and_hazard_waiting_factors(tmp_path: Path) -> None
     assert main(["run", "synthetic_demo", "--policy", "lenient", "--out", str(out)]) == 2
 
 
+@pytest.mark.slow
 def test_a_task_ended_by_an_exception_counts_as_failed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                                                        capsys: pytest.CaptureFixture[str]) -> None:
     """Cause ``error`` is a failure (``tasker.trace.FAILED``): ``--strict`` exits 1 and the
@@ -378,6 +384,7 @@ def test_day_stopped_by_ctrl_c_says_how_to_go_on(monkeypatch: pytest.MonkeyPatch
     assert f"the days that ended are in {out / 'days.db'}: run the same command again to go on" in err
 
 
+@pytest.mark.slow
 def test_strategy_options_on_a_synthetic_scenario_warn(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Before: ``--suspension planned`` on a synthetic scenario ran static without a word."""
     assert main(["run", SYNTHETIC, "--out", str(tmp_path / "a"), "--no-pictures", "--suspension", "planned"]) == 0

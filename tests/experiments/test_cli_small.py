@@ -47,6 +47,7 @@ def test_every_cost_and_world_example_names_places_its_world_has() -> None:
             assert all(n in places for n in names), (line, sorted(places))
 
 
+@pytest.mark.slow
 def test_plan_without_a_task_folder_shows_no_made_up_stages(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     from planners.scaffold import scaffold
 
@@ -70,6 +71,7 @@ def test_plan_without_a_task_folder_shows_no_made_up_stages(tmp_path: Path, caps
     assert "[blocking, skill=manipulate, 5 s]" in capsys.readouterr().out  # its own folder: its stages
 
 
+@pytest.mark.slow
 def test_check_folder_and_scenario_is_check_scenario_with_path(tmp_path: Path,
                                                                capsys: pytest.CaptureFixture[str]) -> None:
     from planners.scaffold import scaffold
@@ -117,6 +119,7 @@ def test_huge_or_misplaced_options_are_bad_input(argv: list[str], fragment: str,
     assert fragment in last and "internal error" not in err and len(last) < 300, err
 
 
+@pytest.mark.slow
 def test_an_fsm_ends_with_one_newline_and_its_note_is_one_line(tmp_path: Path,
                                                                capsys: pytest.CaptureFixture[str]) -> None:
     from planners.scaffold import scaffold

@@ -66,6 +66,7 @@ def test_the_original_model_is_in_metres_and_counts_the_approach_only_in_cc(guid
     assert q.cost == pytest.approx(0.15 * g) and q.c_time == pytest.approx(g) and q.cps == 0.3
 
 
+@pytest.mark.slow
 def test_our_model_is_seconds_that_add() -> None:
     """Ours on the same geometry: cTime is the plan's seconds (the legs at the robot's speed plus
     turning and what is said), cost = cps * (age + cTime); the comparison adds them as Alg. 2 says."""

@@ -14,6 +14,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import pytest
+
 from experiments.cli import main
 from experiments.metrics.store import ResultStore
 
@@ -26,6 +28,7 @@ def _spec(path: Path, seeds: int) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_a_sweep_and_a_day_on_a_cluster_share_the_database_and_resume(tmp_path: Path) -> None:
     from distributed import LocalCluster
 

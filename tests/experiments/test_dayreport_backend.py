@@ -61,6 +61,7 @@ def test_failure_rows_are_the_robots_and_a_day_stored_before_renewals_made_none(
     assert "| failed tasks not served by their renewals (robot) | 0.50 ± 6.35 | 0.00 ± 0.00 |" in robot
 
 
+@pytest.mark.slow
 def test_a_stopped_run_resumes_from_its_database(tmp_path: Path) -> None:
     from experiments.metrics.store import ResultStore
 
@@ -84,6 +85,7 @@ def _crash_on_seed_2(job: Job, **kw: Any) -> tuple[dict[str, Any], dict[str, Any
     return day_runner.day_job(job, **kw)
 
 
+@pytest.mark.slow
 def test_a_day_that_fails_is_listed_and_the_others_go_on(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(day_runner, "day_job", _crash_on_seed_2)  # the worker imports it from this module
     results = day_runner.run_days("tabsa-short", 3, ["fifo"], workers=1, db=tmp_path / "d.db")
@@ -100,6 +102,7 @@ def _bad_input_on_seed_2(job: Job, **kw: Any) -> tuple[dict[str, Any], dict[str,
     return _crash_on_seed_2(job, **kw)
 
 
+@pytest.mark.slow
 def test_a_day_failing_on_bad_input_lists_its_message_and_a_bug_its_traceback(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(day_runner, "day_job", _bad_input_on_seed_2)
@@ -126,6 +129,7 @@ def test_a_protocol_whose_days_cannot_be_drawn_fails_before_any_day(
     assert not (out / "days.db").exists()
 
 
+@pytest.mark.slow
 def test_the_command_writes_database_log_and_table(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "out"
     assert _day_main(["--protocol", "tabsa-short", "--days", "2", "--schedulers", "lookahead", "fifo",
@@ -137,6 +141,7 @@ def test_the_command_writes_database_log_and_table(tmp_path: Path, capsys: pytes
     assert "| metric | lookahead | fifo |" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_an_older_days_log_is_kept_by_resume(tmp_path: Path) -> None:
     out = tmp_path / "out"
     old = {**day_runner.run_day("tabsa-short", 1, "fifo"), "completed": -1}
@@ -191,6 +196,7 @@ def test_strategies_on_the_synthetic_backend_are_refused(capsys: pytest.CaptureF
     assert "suspension" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_days_run_on_a_dask_cluster(tmp_path: Path) -> None:
     from distributed import LocalCluster
 
@@ -258,6 +264,7 @@ def test_an_output_that_cannot_be_written_is_refused_before_any_day(
         assert sorted(p.name for p in out.iterdir()) == [name]  # no day ran, nothing written
 
 
+@pytest.mark.slow
 def test_resuming_with_a_changed_protocol_is_refused_and_keeps_the_stored_days(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """--resume kept the days of the protocol as it was and ran the others from the edited file:
@@ -292,6 +299,7 @@ def test_a_folder_given_as_the_protocol_is_named_a_folder(tmp_path: Path, capsys
     assert f"{tmp_path / 'my_protocols'}: is a directory, expected a file" in err and "Traceback" not in err
 
 
+@pytest.mark.slow
 def test_a_second_run_into_the_same_out_leaves_the_running_ones_days(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Without --resume, a second 'tasker day' into the OUT of a running one deleted its days.db

@@ -120,6 +120,7 @@ def test_every_scheduler_runs_every_task_type_synthetic(name: str) -> None:
     assert finished == {"transport", "fall", "pick_place"}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", schedulers.names())
 def test_every_scheduler_runs_every_task_type_robot(tiny_protocol: protocol.Protocol, name: str) -> None:
     m = day_runner.run_day(tiny_protocol.source, 1, name, "robot")
@@ -130,6 +131,7 @@ def test_every_scheduler_runs_every_task_type_robot(tiny_protocol: protocol.Prot
     assert m["dead_falls"] == 0 and m["travel_m"] > 0
 
 
+@pytest.mark.slow
 def test_a_robot_day_runs_under_the_strategy_it_is_given(tiny_protocol: protocol.Protocol, tmp_path: Path) -> None:
     from experiments.inputs.strategy import Strategy
 
@@ -205,6 +207,7 @@ def _unreachable(motion, places, spec) -> list[tuple[str, str]]:  # type: ignore
             if not motion.estimate(spec.places[a], spec.places[b]).reachable]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["tabsa", "tabsa-short"])
 def test_no_spot_walls_the_robot_in(name: str) -> None:
     """Where the day's people stand must not wall the robot in: they hold their site's spots
@@ -230,6 +233,7 @@ def test_no_spot_walls_the_robot_in(name: str) -> None:
     assert not walls, "\n".join(walls)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["tabsa", "tabsa-short"])
 def test_a_person_at_any_spot_can_be_reached(name: str) -> None:
     """A person at a spot (standing, to be guided; or fallen, to be helped) can be approached
@@ -256,6 +260,7 @@ def test_a_person_at_any_spot_can_be_reached(name: str) -> None:
     assert not shut, "\n".join(shut)
 
 
+@pytest.mark.slow
 def test_a_failed_fall_is_requested_again_and_served(tiny_protocol: protocol.Protocol, tmp_path: Path,
                                                      monkeypatch: pytest.MonkeyPatch) -> None:
     """The fall's first help fails (its approach finds no pose, as when people crowd round the
@@ -288,6 +293,7 @@ def test_a_failed_fall_is_requested_again_and_served(tiny_protocol: protocol.Pro
     assert (f["requested"], f["completed"], f["failed"], f["renewals"]) == (1, 1, 0, 1) and m["dead_falls"] == 0
 
 
+@pytest.mark.slow
 def test_a_terminated_request_is_not_requested_again(tiny_protocol: protocol.Protocol, tmp_path: Path,
                                                      monkeypatch: pytest.MonkeyPatch) -> None:
     """A requester cancels the fall (its scenario id, ``dK``) after its task failed and before

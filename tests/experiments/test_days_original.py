@@ -69,6 +69,7 @@ def test_a_pick_and_place_takes_the_latest_of_three_deadlines(original: protocol
     assert (call, deadline) == (round(min(c for c, _ in pairs), 1), round(max(d for _, d in pairs), 1))
 
 
+@pytest.mark.slow
 def test_the_work_of_a_day_is_tabsas_share_of_it(original: protocol.Protocol) -> None:
     """TaBSA's day asks about 0.7 of its four hours in work before travel; ours (tabsa) about 0.2."""
     def share(proto: protocol.Protocol) -> float:
@@ -145,6 +146,7 @@ def test_a_type_that_is_not_preemptive_runs_blocking_from_its_first_stage(origin
         is StageKind.SUSPENDABLE
 
 
+@pytest.mark.slow
 def test_no_scheduler_interrupts_a_fall_or_a_pick_and_place_of_tabsas_day() -> None:
     """The type's own property, whatever the scheduler asks: srtf asks falls and pick-and-places to
     suspend for any shorter task; they run on, and only transports suspend."""
@@ -289,6 +291,7 @@ def _day(name: str, seed: int, dead: int) -> dict[str, object]:
             "switches": 0, "longest_order": 0, "anytime_decisions": 0, "ending": "all done", "per_type": {}}
 
 
+@pytest.mark.slow
 def test_verdicts_come_from_the_registered_direction_and_need_enough_days() -> None:
     many = [_day("lookahead", s, 0) for s in range(1, 13)] + [_day("edf", s, 1) for s in range(1, 13)]
     text = day_table.table(many)
@@ -301,6 +304,7 @@ def test_verdicts_come_from_the_registered_direction_and_need_enough_days() -> N
 
 # -- the pictures -------------------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_a_day_run_writes_its_pictures_and_a_page_that_shares_plotly(tmp_path: Path) -> None:
     from experiments.days import pictures
     from experiments.days.runner import run_days
@@ -369,6 +373,7 @@ def test_drawn_work_sets_the_stage_and_the_estimate_and_blocks_a_non_preemptive_
     assert wrapper_for({"other": ((), True)})(_Folder()).__class__ is _Folder  # type: ignore[arg-type]
 
 
+@pytest.mark.slow
 def test_a_robot_day_of_tabsas_protocol_takes_the_drawn_work(tmp_path: Path) -> None:
     """A 25-minute robot day, one request of each type: the help, the pick and the place last what
     was drawn, and a fall or a pick-and-place runs blocking from its first stage."""

@@ -17,6 +17,7 @@ ROOT = Path(__file__).resolve().parents[2]
 GENERATED = ("docs/results.md",)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("doc", GENERATED)
 def test_a_generated_document_still_describes_this_code(doc: str) -> None:
     prov = pv.parse((ROOT / doc).read_text(encoding="utf-8"))

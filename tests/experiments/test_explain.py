@@ -59,6 +59,7 @@ def _read(domain: str, problem: str):  # noqa: ANN202 - a UP Problem
     return PDDLReader().parse_problem_string(domain, problem)  # default settings, as any user would
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("task", [t for t in task_types() if isinstance(t, PddlTaskType)], ids=lambda t: t.name)
 def test_portable_pddl_is_read_by_a_default_reader_and_plans_map_back(task: PddlTaskType) -> None:
     ctx = example_context(task, strategy=Strategy("planned", "planned"), motion=StraightLineMotion())
@@ -86,6 +87,7 @@ def test_journal_records_only_inside_the_block() -> None:
     assert [(r.agent, r.purpose, r.status) for r in journal] == [(ctx.agent, "upTsk", "solved")]
 
 
+@pytest.mark.slow
 def test_unsolvable_uptsk_is_explained_with_pddl_a_planner_confirms(unsolvable_run: Path, tmp_path: Path) -> None:
     index = json.loads((unsolvable_run / "problems" / "index.json").read_text())
     assert [(e["agent"], e["purpose"], e["status"]) for e in index] == [("d1", "upTsk", "unsolvable")]
@@ -103,16 +105,23 @@ def test_unsolvable_uptsk_is_explained_with_pddl_a_planner_confirms(unsolvable_r
     assert "transition upTsk -> end" in text and "end (failed): upTsk unsolvable" in text
 
 
-def test_explain_picks_the_problem_in_force(tmp_path: Path) -> None:
-    run = tmp_path / "run"
+def _problems(run: Path, task_type: str, calls: list[tuple[float, str]]) -> Path:
+    """A run folder's ``problems/``: one solved call of d1 per ``(t, purpose)``, file ``N.pddl`` holding
+    ``; problem N``."""
     (run / "problems").mkdir(parents=True)
     entries = []
-    for n, (t, purpose) in enumerate([(0.5, "upTsk"), (40.0, "genSusp"), (80.0, "upTsk")], start=1):
+    for n, (t, purpose) in enumerate(calls, start=1):
         (run / "problems" / f"{n}.pddl").write_text(f"; problem {n}\n")
-        entries.append({"n": n, "t": t, "agent": "d1", "task_type": "cook", "purpose": purpose, "label": "",
-                        "status": "solved", "domain": "cook.domain.pddl", "problem": f"{n}.pddl", "message": ""})
-    (run / "problems" / "cook.domain.pddl").write_text("; domain\n")
+        entries.append({"n": n, "t": t, "agent": "d1", "task_type": task_type, "purpose": purpose, "label": "",
+                        "status": "solved", "domain": f"{task_type}.domain.pddl", "problem": f"{n}.pddl",
+                        "message": ""})
+    (run / "problems" / f"{task_type}.domain.pddl").write_text("; domain\n")
     (run / "problems" / "index.json").write_text(json.dumps(entries))
+    return run
+
+
+def test_explain_picks_the_problem_in_force(tmp_path: Path) -> None:
+    run = _problems(tmp_path / "run", "cook", [(0.5, "upTsk"), (40.0, "genSusp"), (80.0, "upTsk")])
     assert explain.explain(run, "d1").entry["n"] == 3
     assert explain.explain(run, "d1", at=45.0).entry["n"] == 2
     assert explain.explain(run, "d1", at=0.5).problem == "; problem 1\n"
@@ -122,6 +131,59 @@ def test_explain_picks_the_problem_in_force(tmp_path: Path) -> None:
         explain.explain(run, "d11")
 
 
+def _instant_run(folder: Path) -> Path:
+    """A run folder as ``tasker run carry`` writes one, cut down: d1 plans at 0.002; a fall is requested
+    at 40.0, Alg. 2 sends ``susp`` at 40.001, d1 plans its suspension at 40.002 and runs it from 40.052;
+    d1 plans again at 80.1 (the loop's float: 80.10000000000001)."""
+    run = _problems(folder / "run", "carry_object", [(0.002, "upTsk"), (40.002, "genSusp"),
+                                                     (80.10000000000001, "upTsk")])
+    events = [{"t": 0.0, "event": "run"},
+              {"t": 0.001, "event": "command", "agent": "d1", "flag": "start"},
+              {"t": 0.002, "event": "transition", "agent": "d1", "from": "compSP", "to": "upTsk"},
+              {"t": 0.502, "event": "transition", "agent": "d1", "from": "upTsk", "to": "exeTsk"},
+              {"t": 40.0, "event": "request", "agent": "d2", "task_type": "human_fell"},
+              {"t": 40.001, "event": "decision", "algorithm": "alg2", "dac": "d2", "exeDA": "d1", "switch": True},
+              {"t": 40.001, "event": "command", "agent": "d1", "flag": "susp"},
+              {"t": 40.002, "event": "transition", "agent": "d1", "from": "exeTsk", "to": "genSusp"},
+              {"t": 40.052, "event": "transition", "agent": "d1", "from": "genSusp", "to": "exeSusp"},
+              {"t": 80.1, "event": "transition", "agent": "d1", "from": "compSP", "to": "upTsk"}]
+    (run / "trace.jsonl").write_text("".join(json.dumps(complete(e)) + "\n" for e in events))
+    return run
+
+
+def test_at_a_time_is_the_instant_the_trace_shows_there(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 39: ``--at 40`` gave the upTsk of t = 0.002, not the genSusp the trace shows at 40: the
+    answer to what happened at T comes a tick or two later (40.001, 40.002), and is part of T."""
+    run = _instant_run(tmp_path)
+    at40 = explain.explain(run, "d1", at=40.0)
+    assert (at40.entry["purpose"], at40.entry["t"], at40.until) == ("genSusp", 40.002, 40.002)
+    assert [type(e).__name__ for e in at40.events][-3:] == ["Decision", "CommandSent", "Transition"]
+    assert at40.events[-1].t == 40.002  # not the exeSusp of 40.052: the planning time is a pause
+    assert explain.explain(run, "d1", at=40.001).entry["purpose"] == "genSusp"
+    before = explain.explain(run, "d1", at=39.999)
+    assert (before.entry["purpose"], before.until) == ("upTsk", 39.999)
+    assert explain.explain(run, "d1", at=60.0).entry["purpose"] == "genSusp"
+    assert explain.explain(run, "d1", at=80.1).entry["n"] == 3  # 80.10000000000001 is 80.1 in the trace
+    assert cli_main(["explain", str(run), "--agent", "d1", "--at", "40"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("; d1 (carry_object): genSusp at t=40.002 s, solved\n")
+    assert "; at t=40 s: with what the loop did at once in answer, up to t=40.002 s" in out
+    assert "t=    40.002 transition exeTsk -> genSusp" in out and "40.052" not in out
+
+
+@pytest.mark.slow
+def test_at_the_interruption_of_a_real_run_explains_its_suspension(tmp_path: Path,
+                                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    """The carry scenario asks for help at t = 40 while d1 carries the vase (issue 39's example)."""
+    out = tmp_path / "carry"
+    run_scenario("carry", out=out, pictures=False)
+    assert cli_main(["explain", str(out), "--agent", "d1", "--at", "40"]) == 0
+    text = capsys.readouterr().out
+    assert re.match(r"; d1 \(carry_object\): genSusp at t=40\.00\d s, solved", text), text[:200]
+    assert "transition exeTsk -> genSusp" in text
+
+
+@pytest.mark.slow
 def test_explain_without_an_agent_names_the_agents_of_the_run(unsolvable_run: Path,
                                                               capsys: pytest.CaptureFixture[str]) -> None:
     """Before: argparse's bare "the following arguments are required: --agent", whatever the folder held."""

@@ -40,6 +40,8 @@ from tasker.stage import Stage
 from tasker.trace import INAPPLICABLE
 from tasker.world import WorldState
 
+pytestmark = pytest.mark.slow  # each test runs a robot scenario to its end
+
 ROOT = Path(__file__).resolve().parents[2]
 FOLDER = ROOT / "experiments" / "sweep" / "specs" / "tasks" / "water_plants"
 WATER = ROOT / "experiments" / "sweep" / "specs" / "scenarios" / "water_plants.toml"

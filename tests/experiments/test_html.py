@@ -31,6 +31,7 @@ def _names(fig: Any) -> set[str]:
     return {t.name for t in fig.data}
 
 
+@pytest.mark.slow
 def test_the_run_writes_a_self_contained_page(tmp_path: Path) -> None:
     run_scenario(DEMO, out=tmp_path)
     page = (tmp_path / "report.html").read_text(encoding="utf-8")
@@ -43,6 +44,7 @@ def test_the_run_writes_a_self_contained_page(tmp_path: Path) -> None:
     assert "synthetic-demo" in page
 
 
+@pytest.mark.slow
 def test_same_run_same_bytes(events: list[dict[str, Any]], tmp_path: Path) -> None:
     world = load_world("paper")
     trajectory = [(0.0, 1.0, 1.0, 0.0), (5.0, 2.0, 1.5, 0.5), (9.0, 3.0, 2.0, 1.0)]
@@ -53,6 +55,7 @@ def test_same_run_same_bytes(events: list[dict[str, Any]], tmp_path: Path) -> No
     assert (a / "report.html").read_bytes() == (b / "report.html").read_bytes()
 
 
+@pytest.mark.slow
 def test_timeline_separates_costs_rates_roles_and_hazards(events: list[dict[str, Any]]) -> None:
     trace = [*events, {"t": 3.0, **HAZARD, "status": "on"}, {"t": 9.0, **HAZARD, "status": "off"}]
     hazards = report_html.hazards_of(trace, None)

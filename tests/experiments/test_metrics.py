@@ -91,6 +91,20 @@ def test_suspension_suspended_and_resumption_times_by_hand() -> None:
     assert m["totals"]["finished"] == 2 and m["totals"]["failed"] == 0
 
 
+def test_a_suspension_that_ends_the_task_is_not_a_time_to_wait() -> None:
+    """``suspension_s`` is entering genSusp to entering wait (docs/metrics.md): a suspension made for a
+    ``term``, which ends the task instead, counts as a suspension but gives no such time.  (A planted
+    bug that dropped the ``wait`` filter passed every test before this one.)"""
+    b = suspended_twice_started()
+    b.events = b.events[:-2]  # d1 does not finish at 40: it is terminated while it runs
+    b.cmd(35, "d1", "term").go(35, "d1", "exeTsk", "genSusp", "exeSusp").go(38, "d1", "exeSusp", "end")
+    b.add(38, "end", agent="d1", task_type="cook", reason="terminated", cause="term")
+    m = metrics.compute(b.events)
+    assert m["tasks"]["d1"]["suspensions"] == 2
+    assert m["tasks"]["d1"]["suspension_s"] == [2.0]  # 10.5 -> 12.5; not 35 -> 38, which ended the task
+    assert m["totals"]["suspension_s"] == {"mean": 2.0, "max": 2.0}
+
+
 def test_a_susp_followed_by_a_start_of_the_same_agent_is_no_switch() -> None:
     b = Build().request(0, "d1").cmd(0, "d1", "start").cmd(5, "d1", "susp").cmd(6, "d1", "start")
     b.cmd(7, "d1", "susp").cmd(8, "d2", "start")

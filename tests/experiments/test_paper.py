@@ -22,6 +22,8 @@ from experiments.paper.report import Config, run_one
 from experiments.run.runner import run_scenario
 from tasker.trace import read
 
+pytestmark = pytest.mark.slow  # every test reads whole runs of the paper scenarios
+
 COST_STEPS = (1, 4)  # indices of the steps Alg. 2 decides by comparing costs and that happen
 HOLDING = (0, 1, 4, 5, 6)  # the steps that follow from the costs and the scenario's events
 KNIFE_EDGE = 0.1  # a cost step must win by at least this fraction of c_wait beyond the hysteresis

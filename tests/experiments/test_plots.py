@@ -34,6 +34,7 @@ TINY = completed([
 ])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("plot", [plots.timeline, plots.gantt])
 def test_plots_of_the_demo(plot: Any, events: list[dict[str, Any]], tmp_path: Path) -> None:
     out = plot(events, tmp_path / "sub" / "p.png")
@@ -47,6 +48,7 @@ def test_plots_of_empty_and_tiny_traces(plot: Any, trace: list[dict[str, Any]], 
     assert is_png(plot(trace, tmp_path / "p.png"))
 
 
+@pytest.mark.slow
 def test_same_events_same_bytes(events: list[dict[str, Any]], tmp_path: Path) -> None:
     a = plots.timeline(events, tmp_path / "a.png").read_bytes()
     b = plots.timeline(events, tmp_path / "b.png").read_bytes()
@@ -85,12 +87,14 @@ def test_state_spans_from_transitions(events: list[dict[str, Any]]) -> None:
     assert spans["d1"][-1][2] == 69.5  # ends at its end transition, not at the given end
 
 
+@pytest.mark.slow
 def test_world_path(tmp_path: Path) -> None:
     trajectory = [(0.0, 4.0, 3.0, 0.0), (1.0, 3.0, 2.5, 0.3), (2.0, 2.0, 2.0, 0.6)]
     assert is_png(plots.world_path("paper", trajectory, tmp_path / "w.png"), 10_000)
     assert is_png(plots.world_path("flat", [], tmp_path / "w0.png"), 10_000)
 
 
+@pytest.mark.slow
 def test_all_plots(events: list[dict[str, Any]], tmp_path: Path) -> None:
     assert [p.name for p in plots.all_plots(events, tmp_path)] == ["timeline.png", "gantt.png"]
 

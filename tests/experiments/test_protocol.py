@@ -225,6 +225,7 @@ def test_holm_adjustment() -> None:
     assert stats.holm([0.01, 0.04, 0.03]) == pytest.approx([0.03, 0.06, 0.06])
 
 
+@pytest.mark.slow
 def test_table_has_every_scheduler_and_the_paired_tests(tabsa: protocol.Protocol) -> None:
     results = day_runner.run_days(TABSA, 3, ["lookahead", "simple2"], workers=1)
     text = day_table.table(results)

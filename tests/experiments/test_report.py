@@ -170,6 +170,7 @@ def test_errors_and_unpaired_runs_are_left_out_of_the_comparison(rows: list[RunR
     assert ("a", "x") not in pairs
 
 
+@pytest.mark.slow
 def test_report_files(tmp_path: Path, rows: list[RunRow]) -> None:
     db = tmp_path / "r.db"
     with ResultStore(db) as store:
@@ -195,6 +196,7 @@ def test_report_of_a_missing_database_is_an_error(tmp_path: Path) -> None:
         build_report(tmp_path / "missing.db", tmp_path / "out")
 
 
+@pytest.mark.slow
 def test_host_dependent_metrics_are_reported_without_a_verdict(tmp_path: Path, rows: list[RunRow]) -> None:
     timed = [RunRow(r.scenario, r.seed, r.strategy, r.status, r.record,
                     {**r.metrics, "wall_time_s": 2.0 + r.seed if r.strategy == PLANNED else 1.0 + r.seed,

@@ -41,6 +41,7 @@ def first_start(tmp_path: Path, john: str, alice: str) -> str:
                 if e["event"] == "command" and e["flag"] == "start")
 
 
+@pytest.mark.slow
 def test_a_deadline_written_in_a_scenario_file_orders_edf(tmp_path: Path) -> None:
     """EDF starts the later request first when its deadline is earlier; without deadlines, the first."""
     assert first_start(tmp_path, ", deadline = 500.0", ", deadline = 100.0") == "d2"

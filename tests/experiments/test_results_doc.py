@@ -208,6 +208,7 @@ def test_a_spec_runs_each_strategy_with_each_tree_of_a_scenario(tmp_path: Path) 
         load_spec(p)
 
 
+@pytest.mark.slow
 def test_sweep_runs_a_limit_and_says_how_long_the_rest_takes(tmp_path: Path,
                                                               capsys: pytest.CaptureFixture[str]) -> None:
     from experiments.cli import main

@@ -33,6 +33,7 @@ def _stored(db: Path) -> list[tuple[str, int, str]]:
         return sorted((r.strategy, r.seed, r.status.value) for r in store.rows())
 
 
+@pytest.mark.slow
 def test_a_day_run_again_goes_on_and_keeps_what_is_stored(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "out"
     assert cli_main([*DAY, "--days", "1", "--out", str(out)]) == 0
@@ -44,6 +45,7 @@ def test_a_day_run_again_goes_on_and_keeps_what_is_stored(tmp_path: Path, capsys
     assert not (out / "days.db.lock").exists()  # the lease goes with the run
 
 
+@pytest.mark.slow
 def test_retry_errors_keeps_the_days_stored_as_ok(tmp_path: Path) -> None:
     out = tmp_path / "out"
     assert cli_main([*DAY, "--days", "1", "--out", str(out)]) == 0
@@ -57,6 +59,7 @@ def test_retry_errors_keeps_the_days_stored_as_ok(tmp_path: Path) -> None:
         assert [r.worker for r in store.rows() if r.seed == 1] == ["kept"]
 
 
+@pytest.mark.slow
 def test_overwrite_is_the_one_way_to_start_afresh(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "out"
     assert cli_main([*DAY, "--days", "1", "--first-seed", "5", "--out", str(out)]) == 0
@@ -67,6 +70,7 @@ def test_overwrite_is_the_one_way_to_start_afresh(tmp_path: Path, capsys: pytest
     assert "--overwrite: and --resume contradict each other" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_days_of_a_changed_protocol_are_refused_naming_overwrite(tmp_path: Path,
                                                                   capsys: pytest.CaptureFixture[str]) -> None:
     from experiments.days import pipeline
@@ -99,6 +103,7 @@ def _full_disk(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(store_mod.sqlite3, "connect", connect)
 
 
+@pytest.mark.slow
 def test_a_first_write_that_fails_leaves_nothing_that_blocks_the_next_run(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "out"
@@ -112,6 +117,7 @@ def test_a_first_write_that_fails_leaves_nothing_that_blocks_the_next_run(
     assert _stored(out / "days.db") == [("scheduler=fifo", 1, "ok")]
 
 
+@pytest.mark.slow
 def test_an_empty_database_file_counts_as_none(tmp_path: Path) -> None:
     """What an older tasker's failed first write left: an empty file, and ``--resume`` refused it."""
     out = tmp_path / "out"
@@ -140,6 +146,7 @@ def spec() -> SweepSpec:
     return SweepSpec((str(standin.DEMO),), (1, 2), (Strategy(),))
 
 
+@pytest.mark.slow
 def test_sweep_overwrite_and_the_lease_file(tmp_path: Path, spec: SweepSpec,
                                             capsys: pytest.CaptureFixture[str]) -> None:
     db = tmp_path / "r.db"

@@ -102,6 +102,21 @@ def test_cli_runs_a_synthetic_scenario(tmp_path: Path, capsys: pytest.CaptureFix
     assert "4 tasks" in capsys.readouterr().out
 
 
+def test_a_synthetic_runs_trace_and_run_json_name_the_same_strategy(tmp_path: Path) -> None:
+    """Issue 39: the trace's ``run`` event said planned while run.json said static. Synthetic tasks run
+    their timed stages (static); every stage plan in the trace says so too."""
+    from experiments.run.runner import run_scenario
+
+    run_scenario("synthetic_demo", out=tmp_path, pictures=False)
+    events = [json.loads(line) for line in (tmp_path / "trace.jsonl").read_text().splitlines()]
+    settings = json.loads((tmp_path / "run.json").read_text())["settings"]
+    assert events[0]["event"] == "run"
+    assert (events[0]["update"], events[0]["suspension"]) == ("static", "static")
+    assert (settings["update"], settings["suspension"]) == ("static", "static")
+    plans = [e for e in events if e["event"] == "plan"]
+    assert plans and {e["strategy"] for e in plans} == {"static"}
+
+
 @pytest.mark.parametrize(("line", "name"), [('name = "fetch_demo"', "fetch_demo"), ('name = "../up"', "mine"),
                                             ("name = 3", "mine"), ("", "mine"), ('name = "', "mine")])
 def test_a_scenario_names_its_output_folder_when_its_name_is_a_plain_folder_name(

@@ -80,6 +80,7 @@ def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
         proc.wait(timeout=30)
 
 
+@pytest.mark.slow
 def test_a_task_requested_over_http_runs_to_its_end(server: Server) -> None:
     status, said = server.call("POST", "/requests", JOHN)
     assert status == 201, said
@@ -96,6 +97,7 @@ def test_a_task_requested_over_http_runs_to_its_end(server: Server) -> None:
     assert {p["name"] for p in done["people"]} == {"john", "alice", "peter", "sara"}
 
 
+@pytest.mark.slow
 def test_malformed_and_unknown_requests_are_refused_with_a_clear_4xx(server: Server) -> None:
     status, said = server.call("POST", "/requests", raw=b'{"task": ')
     assert status == 400 and said["detail"].startswith("POST /requests: the body is not valid JSON")
@@ -118,6 +120,7 @@ def test_malformed_and_unknown_requests_are_refused_with_a_clear_4xx(server: Ser
     assert "example" not in body  # a world alone has no request to show (a scenario's first one is: unit test)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(shutil.which("chromium") is None,
                     reason="Debian's chromium is not installed (apt-get install chromium): the live page is not "
                            "checked in a browser here")
@@ -149,6 +152,7 @@ def test_the_live_page_draws_the_apartment_the_robot_and_the_queue(server: Serve
     assert drawn["walls"] > 5000 and drawn["furniture"] > 5000 and drawn["robot"] > 50 and drawn["people"] > 100, drawn
 
 
+@pytest.mark.slow
 def test_sigint_writes_the_run_and_a_session_that_replays_byte_for_byte(server: Server, tmp_path: Path) -> None:
     """Every kind of arrival (a request with a priority, a world event, a change, a termination) is
     in the session, and the replay of the saved scenario is the live trace, byte for byte."""

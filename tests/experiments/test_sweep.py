@@ -140,6 +140,7 @@ def test_store_keeps_the_first_result_of_a_key(tmp_path: Path) -> None:
 # ----------------------------------------------------------------------------------------- running
 
 
+@pytest.mark.slow
 def test_failing_runs_are_stored_as_errors_and_retried_only_when_asked(tmp_path: Path, small_spec: SweepSpec) -> None:
     db = tmp_path / "r.db"
     first = run_sweep(small_spec, db, workers=2, run_fn=standin.flaky_run, progress=False)
@@ -156,6 +157,7 @@ def test_failing_runs_are_stored_as_errors_and_retried_only_when_asked(tmp_path:
         assert store.keys(Status.OK) == _all_keys(small_spec)
 
 
+@pytest.mark.slow
 def test_a_job_that_kills_its_worker_is_stored_as_an_error_and_the_sweep_goes_on(tmp_path: Path) -> None:
     db = tmp_path / "r.db"
     spec = SweepSpec(("demo",), (1, 2, 3, 4, 5, 6), (Strategy("static", "static"),),
@@ -181,6 +183,7 @@ def test_a_job_that_kills_its_worker_is_stored_as_an_error_and_the_sweep_goes_on
         assert [r.key for r in rows if r.status is Status.ERROR] == [crasher]
 
 
+@pytest.mark.slow
 def test_a_job_that_kills_its_dask_worker_is_stored_as_an_error(tmp_path: Path) -> None:
     import dask
     from distributed import LocalCluster
@@ -198,6 +201,7 @@ def test_a_job_that_kills_its_dask_worker_is_stored_as_an_error(tmp_path: Path) 
     assert error.error and error.error.startswith("worker process died") and "KilledWorker" in error.error
 
 
+@pytest.mark.slow
 def test_sweep_on_dask_stopped_half_way_and_resumed(tmp_path: Path, small_spec: SweepSpec) -> None:
     from distributed import LocalCluster
 
@@ -268,6 +272,7 @@ def _stored(db: Path) -> int:
         return 0
 
 
+@pytest.mark.slow
 def test_sweep_killed_mid_way_loses_nothing_and_resumes(tmp_path: Path, small_spec: SweepSpec) -> None:
     db, script = tmp_path / "r.db", tmp_path / "killed.py"
     script.write_text(_KILLED_SWEEP)
@@ -295,6 +300,7 @@ def test_sweep_killed_mid_way_loses_nothing_and_resumes(tmp_path: Path, small_sp
     assert all(before[r.key] == r for r in rows if r.key in before)
 
 
+@pytest.mark.slow
 def test_default_run_fn_runs_the_scenario_randomised(tmp_path: Path) -> None:
     spec = SweepSpec((str(standin.DEMO),), (1, 2), STRATEGIES)
     summary = run_sweep(spec, tmp_path / "r.db", workers=2, progress=False)
@@ -319,6 +325,7 @@ def test_bad_arguments_are_errors(tmp_path: Path, small_spec: SweepSpec) -> None
         run_sweep([job, job], tmp_path / "r.db", run_fn=standin.run)
 
 
+@pytest.mark.slow
 def test_sweep_and_report_commands(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     import argparse
 

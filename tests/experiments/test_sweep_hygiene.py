@@ -88,6 +88,7 @@ def _wait_for(condition, proc: subprocess.Popen[bytes], timeout: float = 60.0) -
         time.sleep(0.1)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_kill_9_of_the_driver_leaves_no_process_behind(tmp_path: Path) -> None:
     proc = _start_driver(tmp_path, tmp_path / "r.db", seeds=6, sleep=60.0)
@@ -109,6 +110,7 @@ def test_kill_9_of_the_driver_leaves_no_process_behind(tmp_path: Path) -> None:
             os.kill(pid, signal.SIGKILL)  # only what this test started, should the assertion fail
 
 
+@pytest.mark.slow
 def test_a_second_driver_on_the_same_database_is_refused(tmp_path: Path) -> None:
     db = tmp_path / "r.db"
     spec = SweepSpec(("demo",), tuple(range(4)), (Strategy("static", "static"),), sources={"demo": str(standin.DEMO)})
@@ -154,6 +156,7 @@ def test_relative_spec_path_resolves_to_absolute_sources(tmp_path: Path, monkeyp
     assert all(Path(j.source).is_absolute() and Path(j.source).is_file() for j in spec.jobs())
 
 
+@pytest.mark.slow
 def test_dask_sweep_with_a_relative_spec_path_and_workers_started_elsewhere(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from distributed import LocalCluster

@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from experiments.run.runner import run_scenario
 
 SCENARIO = """\
@@ -54,6 +56,7 @@ def _run(tmp_path: Path, text: str) -> tuple[list[dict], list[dict]]:
     return events, samples
 
 
+@pytest.mark.slow
 def test_a_world_event_after_an_agent_happens_when_its_task_finishes(tmp_path: Path) -> None:
     events, samples = _run(tmp_path, SCENARIO)
     end = next(e for e in events if e["event"] == "end" and e["agent"] == "d1")
@@ -69,6 +72,7 @@ def test_a_world_event_after_an_agent_happens_when_its_task_finishes(tmp_path: P
     assert abs(last[0] - 3.0) < 1e-6 and abs(last[1] - 6.0) < 1e-6
 
 
+@pytest.mark.slow
 def test_a_world_event_after_an_agent_that_does_not_finish_never_happens(tmp_path: Path) -> None:
     text = SCENARIO + '\n[[terminations]]\nt = 2.0\nagent = "d1"\n'
     events, samples = _run(tmp_path, text)

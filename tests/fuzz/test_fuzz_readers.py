@@ -48,12 +48,14 @@ def scratch(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return tmp_path_factory.mktemp("fuzz")
 
 
+@pytest.mark.slow
 @examples(300)
 @given(st.text(max_size=300) | st.binary(max_size=300).map(lambda b: b.decode("latin-1")))
 def test_random_text_is_toml_or_a_clean_error(text: str) -> None:
     _reads_cleanly(lambda: reader.loads(text, "f.toml"))
 
 
+@pytest.mark.slow
 @examples(300)
 @given(st.text(alphabet="[]{}\",:0123456789.eE-+ aZ\\ntrueflsn", max_size=300))
 def test_random_text_is_json_or_a_clean_error(text: str) -> None:
@@ -66,6 +68,7 @@ def _write(scratch: Path, name: str, data: bytes) -> Path:
     return p
 
 
+@pytest.mark.slow
 @examples(120)
 @given(mutated(SEEDS["synthetic"].read_bytes()))
 def test_a_mutated_synthetic_scenario(scratch: Path, data: bytes) -> None:
@@ -131,6 +134,7 @@ def test_a_mutated_task_toml(scratch: Path, data: bytes) -> None:
     _reads_cleanly(lambda: read_task_toml(p))
 
 
+@pytest.mark.slow
 @examples(20)
 @given(mutated(SEEDS["domain"].read_bytes()))
 def test_a_mutated_domain(scratch: Path, data: bytes) -> None:
@@ -140,6 +144,7 @@ def test_a_mutated_domain(scratch: Path, data: bytes) -> None:
     _reads_cleanly(lambda: load_domain(p), seconds=20.0)
 
 
+@pytest.mark.slow
 @examples(200)
 @given(st.text(alphabet="() ;-?:abcdefxyz\n", max_size=400))
 def test_random_pddl_text_passes_the_cheap_checks_or_is_refused(text: str) -> None:

@@ -17,6 +17,7 @@ def _run(argv: list[str]) -> int:
     return main(argv)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["depot", "miconic", "safe_road"])
 def test_plan_on_up_classical_problems(name: str, up_pddl: Path, capsys: pytest.CaptureFixture[str]) -> None:
     d, p = up_pddl / name / "domain.pddl", up_pddl / name / "problem.pddl"
@@ -37,12 +38,14 @@ def test_plan_human_output(pddl_files: tuple[Path, Path], capsys: pytest.Capture
     assert "stages: none shown: domain 'delivery' is no task folder's" in out and "0 s]" not in out
 
 
+@pytest.mark.slow
 def test_plan_with_another_planner(pddl_files: tuple[Path, Path], capsys: pytest.CaptureFixture[str]) -> None:
     assert _run(["plan", *map(str, pddl_files), "--planner", "fast-downward-opt", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["cost"] == 6 and out["planner"] == "fast-downward-opt"
 
 
+@pytest.mark.slow
 def test_plan_unsolvable_exits_1(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     d, p = tmp_path / "d.pddl", tmp_path / "p.pddl"
     d.write_text(DOMAIN)
@@ -51,6 +54,7 @@ def test_plan_unsolvable_exits_1(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert json.loads(capsys.readouterr().out)["status"] == "unsolvable"
 
 
+@pytest.mark.slow
 def test_plan_timeout_exits_1(up_pddl: Path, capsys: pytest.CaptureFixture[str]) -> None:
     d, p = up_pddl / "citycar" / "domain.pddl", up_pddl / "citycar" / "problem.pddl"
     assert _run(["plan", str(d), str(p), "--timeout", "0.5", "--json"]) == 1
@@ -70,6 +74,7 @@ def test_domains_lists_bundled(capsys: pytest.CaptureFixture[str]) -> None:
         assert name in out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["mermaid", "dot"])
 @pytest.mark.parametrize("purpose", ["upTsk", "genSusp"])
 def test_fsm(fmt: str, purpose: str, capsys: pytest.CaptureFixture[str]) -> None:
@@ -89,6 +94,7 @@ def test_fsm_static_and_unknown_task(capsys: pytest.CaptureFixture[str]) -> None
     assert "did you mean 'guide_human'?" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_plan_with_another_planner_prints_no_warnings(pddl_files: tuple[Path, Path],
                                                       capfd: pytest.CaptureFixture[str]) -> None:
     assert _run(["plan", *map(str, pddl_files), "--planner", "fast-downward-opt"]) == 0
@@ -144,6 +150,7 @@ def test_new_refuses_a_bad_name_and_a_full_folder(tmp_path: Path, capsys: pytest
     assert "argument DIR" in capsys.readouterr().err and (tmp_path / "b" / "keep.txt").read_text() == "mine"
 
 
+@pytest.mark.slow
 def test_plan_says_when_the_domains_task_folder_does_not_load(tmp_path: Path,
                                                               capsys: pytest.CaptureFixture[str]) -> None:
     """Before: the stages printed as "skill=-, 0 s", silently, as if the domain were no task's."""

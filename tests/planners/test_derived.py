@@ -39,6 +39,7 @@ def _loaded(folder: Path) -> tuple[object, list[str]]:
     return task, [str(w.message) for w in caught]
 
 
+@pytest.mark.slow
 def test_a_goal_that_leaves_its_own_hazard_on_is_warned_about_and_restore_asks_it_back(tmp_path: Path) -> None:
     _, said = _loaded(_folder(tmp_path, "no_restore", drop=("restore",)))
     assert any("the goal leaves on what the [example]'s plan turned on: door_open: (open door1)" in s for s in said)
@@ -49,6 +50,7 @@ def test_a_goal_that_leaves_its_own_hazard_on_is_warned_about_and_restore_asks_i
     assert ("not", "open", "door1") in goal  # closed when it first planned: closed at its goal
 
 
+@pytest.mark.slow
 def test_a_branch_whose_stage_cannot_run_is_warned_about(tmp_path: Path) -> None:
     """A branch that puts the object down wherever the robot is: not a surface in every state."""
     folder = _folder(tmp_path, "bad_branch", edit={
@@ -117,6 +119,7 @@ def test_a_guided_person_is_left_in_a_safe_role() -> None:
     assert task.derived_goal(waiting, waiting.world)[0] == []
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("edit", "message"), [
     ({'told_to_wait = [["told_to_wait", "$person"]]': 'told_to_wait = [["told_to_wait", "$person"]]\n'
       'bad = 1'}, "unknown key 'bad'"),

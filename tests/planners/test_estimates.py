@@ -294,6 +294,7 @@ def test_a_leg_through_a_door_the_plan_opens_is_timed_with_the_door_open(tasks: 
     assert motion.ignoring > 0
 
 
+@pytest.mark.slow
 def test_paper_scenario_trace_does_not_depend_on_what_earlier_runs_cached() -> None:
     """The estimator's cache lives as long as the task type: a second run in the same process
     (warm caches) must write the same trace, byte for byte, as the first."""
@@ -425,6 +426,7 @@ def test_people_in_the_way_slow_a_leg_but_never_cut_it(tasks: dict[str, PddlTask
     assert all(math.isinf(walled[k]) for k in into)  # no estimate_ignoring_people: nothing to fall back on
 
 
+@pytest.mark.slow
 def test_a_waiting_task_is_estimated_from_the_state_the_executing_task_leaves() -> None:
     """Compound: while carry holds the vase, cook (which needs an empty hand and knows no
     vase) was estimated from the world now and came out unsolvable, so every decision

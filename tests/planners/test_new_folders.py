@@ -31,6 +31,7 @@ def _line_of(path: Path, fragment: str) -> int:
     return next(n for n, s in enumerate(path.read_text().splitlines(), 1) if fragment in s)
 
 
+@pytest.mark.slow
 def test_an_unsolvable_example_is_a_warning_naming_what_was_left_out(tmp_path: Path) -> None:
     """Before: `tasker check` said "the [example] solved".  A warning, not a refusal: the
     folder's requests may still be solvable in a run's world, and one that is not ends alone
@@ -45,6 +46,7 @@ def test_an_unsolvable_example_is_a_warning_naming_what_was_left_out(tmp_path: P
     assert "['at', 'vaze', 'kitchen']" in text
 
 
+@pytest.mark.slow
 def test_connected_without_travel_time_still_connects_the_places(tmp_path: Path) -> None:
     """A domain without action costs keeps ``connected``: the docs add it "when the domain declares" it."""
     from planners.examples import example_context
@@ -61,6 +63,7 @@ def test_connected_without_travel_time_still_connects_the_places(tmp_path: Path)
     assert [s.action for s in plan.stages] == ["navigate", "pick", "navigate", "put_down"]
 
 
+@pytest.mark.slow
 def test_a_domain_constant_that_is_also_a_world_object(tmp_path: Path) -> None:
     """``(:constants kitchen - place)``: the world's kitchen is that constant, declared once,
     and facts over it are kept (before: UP's "Name kitchen already defined!")."""
@@ -76,6 +79,7 @@ def test_a_domain_constant_that_is_also_a_world_object(tmp_path: Path) -> None:
     assert [s.action for s in task.update_task(ctx).stages] == ["navigate", "pick", "navigate", "put_down"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("old", "new"), [
     ('goal = [["at", "$item", "$destination"]', 'goal = [["at", "$item", "$destination", "$robot"]'),
     ('when = [["holding", "$robot", "$item"]]', 'when = [["holds", "$robot", "$item"]]'),
@@ -90,6 +94,7 @@ def test_a_bad_literal_names_its_line(tmp_path: Path, old: str, new: str) -> Non
     assert f"task.toml:{info.value.line}: " in str(info.value)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("old", "new", "at"), [
     ('goal = [["at", "$item", "$destination"]', 'goal = [["at", "$item", "$destinaton"]', "goal = "),
     ('args = ["$robot", "$item", "$at:item"] }', 'args = ["$robot", "$itm", "$at:item"] }', "update = ["),
@@ -121,6 +126,7 @@ def test_an_argument_default_that_does_not_fit_is_refused(tmp_path: Path, old: s
     assert "args[1].default: " in str(info.value) and fragment in str(info.value)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("hook", "fragment", "line"), [
     ("def extra_facts(ctx, world):\n    raise RuntimeError('boom')\n", "RuntimeError: boom", 2),
     ("def extra_facts(ctx, world):\n    return None\n", "TypeError: 'NoneType' object is not iterable", None),
@@ -149,6 +155,7 @@ def test_a_failing_task_py_hook_is_named_before_any_run(tmp_path: Path, hook: st
     assert text.startswith(where) and fragment in text and "will end with cause error" in text
 
 
+@pytest.mark.slow
 def test_check_args_raising_anything_but_bad_request_names_task_py(tmp_path: Path) -> None:
     from tasker.errors import BadRequest
 
@@ -165,6 +172,7 @@ def test_check_args_raising_anything_but_bad_request_names_task_py(tmp_path: Pat
     assert issubclass(BadRequest, ValueError)
 
 
+@pytest.mark.slow
 def test_extra_facts_that_are_not_tuples_of_strings_are_refused(tmp_path: Path) -> None:
     """Before: ``"hand_empty robot"`` became a tuple of letters, silently left out of the problem."""
     folder = _new(tmp_path)
@@ -178,6 +186,7 @@ def test_extra_facts_that_are_not_tuples_of_strings_are_refused(tmp_path: Path) 
     assert info.value.file == str(folder / "task.py")
 
 
+@pytest.mark.slow
 def test_a_task_toml_with_a_byte_order_mark_is_checked_like_any(tmp_path: Path,
                                                                capsys: pytest.CaptureFixture[str]) -> None:
     from experiments.cli import main
@@ -188,6 +197,7 @@ def test_a_task_toml_with_a_byte_order_mark_is_checked_like_any(tmp_path: Path,
     assert main(["check", str(folder)]) == 0, capsys.readouterr()
 
 
+@pytest.mark.slow
 def test_an_example_object_of_an_undeclared_type_is_named(tmp_path: Path) -> None:
     """Before: "task.toml [example] problem:27:19: unknown object or invalid expression: vase",
     a line of the generated problem, not of task.toml."""
@@ -200,6 +210,7 @@ def test_an_example_object_of_an_undeclared_type_is_named(tmp_path: Path) -> Non
     assert "objects.vase: 'itme' is not a type of domain.pddl; did you mean 'item'?" in str(info.value)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("old", "new", "fragment"), [
     ("(increase (total-cost) (travel-time ?from ?to))",
      "(increase (total-cost) (travel-time ?from ?to)) (decrease (battery ?r) 1)",
@@ -248,6 +259,7 @@ def test_either_types_and_derived_predicates_are_refused_plainly(tmp_path: Path,
     assert fragment in str(err) and "Expected" not in str(err)
 
 
+@pytest.mark.slow
 def test_pddl_names_in_task_toml_ignore_case_as_in_pddl(tmp_path: Path) -> None:
     """Before: ``[actions.Put_Down]`` gave "no entry for domain action(s) ['put_down']" and
     ``["HAND_EMPTY", ...]`` "unknown predicate": the domain's names are read in lower case."""
@@ -276,6 +288,7 @@ def test_pddl_names_in_task_toml_ignore_case_as_in_pddl(tmp_path: Path) -> None:
         load_task(folder, use_cache=False)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["domain.pddl", "task.py"])
 def test_a_file_that_is_not_utf8_is_named_with_the_line_of_the_byte(tmp_path: Path, name: str) -> None:
     """Before: Python's "'utf-8' codec can't decode byte 0xe9 in position 183" (domain.pddl: no
@@ -302,6 +315,7 @@ def test_tasker_plan_names_the_line_of_a_non_utf8_byte(tmp_path: Path, capsys: p
     assert f"argument PROBLEM: {problem}:1: is not UTF-8 text (byte 0xe9)" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("text", "fragment"), [
     ("Here is {itme}", "unknown placeholder {itme}; did you mean '{item}'? (placeholders name a parameter of "
                        "put_down (r, i, p) or a request argument (item, destination)"),
@@ -322,6 +336,7 @@ def test_a_say_text_placeholder_is_checked_at_load(tmp_path: Path, text: str, fr
     load_task(folder, use_cache=False)
 
 
+@pytest.mark.slow
 def test_a_folder_reached_twice_is_one_task_type_and_a_real_clash_names_both(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Before: $TASKER_TASKS and --path naming the same folder (or a folder and its parent) gave
@@ -342,6 +357,7 @@ def test_a_folder_reached_twice_is_one_task_type_and_a_real_clash_names_both(
     assert f"'guide_human' by {bundled} and {(other / 'task.toml').resolve()}" in str(info.value)
 
 
+@pytest.mark.slow
 def test_a_suspension_branch_without_when_before_the_last_is_refused(tmp_path: Path) -> None:
     """Before: accepted, and the branches after it were silently never chosen (the held item was never put down)."""
     folder = _new(tmp_path)
@@ -357,6 +373,7 @@ def test_a_suspension_branch_without_when_before_the_last_is_refused(tmp_path: P
     load_task(folder, use_cache=False)  # a conditional branch is not always eligible: the others are reachable
 
 
+@pytest.mark.slow
 def test_a_suspension_when_that_contradicts_itself_is_refused(tmp_path: Path) -> None:
     """Before: accepted, and the branch was silently never chosen (no state has a fact and its negation)."""
     folder = _new(tmp_path)
@@ -369,6 +386,7 @@ def test_a_suspension_when_that_contradicts_itself_is_refused(tmp_path: Path) ->
     assert "suspension[0]: `when` asks for ['holding', '$robot', '$item'] and for its negation" in str(info.value)
 
 
+@pytest.mark.slow
 def test_an_upper_case_scenario_object_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Before: [objects.Cup] ran, but the plan moved "cup": the robot never held Cup and its hazard never fired."""
     from experiments.cli import main
@@ -382,6 +400,7 @@ def test_an_upper_case_scenario_object_is_refused(tmp_path: Path, capsys: pytest
            "them in lower case: write 'cup'" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_a_binding_of_the_wrong_kind_for_the_world_is_a_warning(tmp_path: Path) -> None:
     """Before: kind = "device" for the held item ran silently: the robot "held" the vase only symbolically."""
     from experiments.inputs import scenario as scenarios
@@ -414,6 +433,7 @@ def test_check_says_when_the_example_was_not_solved(tmp_path: Path, capsys: pyte
     assert f"{folder / 'task.py'}:2: a hook fails on the [example]: ValueError: boom" in out.err
 
 
+@pytest.mark.slow
 def test_an_example_the_planner_does_not_finish_in_time_is_a_warning(tmp_path: Path) -> None:
     """Before: a timeout on the [example] passed silently and `tasker check` said "solved"."""
     folder = _new(tmp_path)

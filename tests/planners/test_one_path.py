@@ -45,6 +45,7 @@ def test_engine_refuses_unknown_params() -> None:
         OneshotPlanner(name="tasker-fd", params={"timeout": -1.0})
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("goal, solved", [("(item-at cup c)", True), ("(holding cup) (item-at cup c)", False)])
 def test_engine_and_facade_agree_and_the_engine_logs(goal: str, solved: bool, tmp_path: Path) -> None:
     d, p = tmp_path / "d.pddl", tmp_path / "p.pddl"
@@ -116,6 +117,7 @@ def _writer(root: str, n: int) -> None:
         cache.record("race", f"{i:064d}", {"pid": os.getpid()})
 
 
+@pytest.mark.slow
 def test_concurrent_writers_leave_whole_markers(cache_dir: Path) -> None:
     ctx = multiprocessing.get_context("spawn")
     procs = [ctx.Process(target=_writer, args=(str(cache_dir), 20)) for _ in range(3)]
@@ -131,6 +133,7 @@ def test_concurrent_writers_leave_whole_markers(cache_dir: Path) -> None:
     assert not list((cache_dir / "race").rglob(".tmp-*"))
 
 
+@pytest.mark.slow
 def test_task_folder_example_is_solved_once_per_content(cache_dir: Path, tmp_path: Path,
                                                         monkeypatch: pytest.MonkeyPatch) -> None:
     import planners.loader as loader

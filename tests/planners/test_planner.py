@@ -29,6 +29,7 @@ def test_engine_is_registered_and_found_by_name(pddl_files: tuple[Path, Path]) -
     assert check.valid and check.cost == 6
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["tasker-fd", "fast-downward-opt"])
 def test_planner_by_name_same_optimal_cost(name: str, pddl_files: tuple[Path, Path]) -> None:
     _, _, problem = load_problem(*pddl_files)
@@ -62,6 +63,7 @@ def test_cache_is_bounded_lru() -> None:
     assert planner.solve(texts[2]).cached
 
 
+@pytest.mark.slow
 def test_up_problem_repeat_is_cached(pddl_files: tuple[Path, Path]) -> None:
     _, _, problem = load_problem(*pddl_files)
     planner = Planner()

@@ -6,6 +6,7 @@ exit status and no word, or a contradiction accepted without a warning.
 
 from __future__ import annotations
 
+import json
 import os
 import warnings
 from pathlib import Path
@@ -62,9 +63,12 @@ def test_a_very_deep_goal_is_refused_with_its_line(tmp_path: Path, depth: int,
     assert "nested more than 32 deep" in err and "internal error" not in err
 
 
-def test_a_goal_nested_within_the_limit_plans(tmp_path: Path) -> None:
+def test_a_goal_nested_within_the_limit_plans(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     d, p = _files(tmp_path, DOMAIN, _problem("(and " * 20 + "(q o)" + ")" * 20))
     assert load_problem(d, p)[2] is not None
+    assert cli_main(["plan", str(d), str(p), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["status"] == "solved" and out["plan"] == [["act", "o"]]
 
 
 def test_a_deep_domain_is_refused(tmp_path: Path) -> None:
@@ -74,6 +78,7 @@ def test_a_deep_domain_is_refused(tmp_path: Path) -> None:
         load_domain(d)
 
 
+@pytest.mark.slow
 def test_a_problem_of_another_domain_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Before: planned silently against the domain given."""
     d, p = _files(tmp_path, DOMAIN, "\n" + _problem("(q o)", domain="other"))
@@ -97,6 +102,7 @@ def _edit(path: Path, old: str, new: str) -> None:
     path.write_text(text.replace(old, new, 1))
 
 
+@pytest.mark.slow
 def test_an_argument_declared_twice_is_refused(folder: Path) -> None:
     """Before: accepted; the request's value went to whichever declaration came first."""
     toml = folder / "task.toml"
@@ -105,6 +111,7 @@ def test_an_argument_declared_twice_is_refused(folder: Path) -> None:
         load_task(folder, use_cache=False)
 
 
+@pytest.mark.slow
 def test_choices_must_fit_the_type_and_duplicates_warn(folder: Path) -> None:
     toml = folder / "task.toml"
     _edit(toml, '# choices = ["living", "kitchen"]', 'choices = ["living", 5]')
@@ -135,6 +142,7 @@ def test_one_fact_bound_twice(folder: Path) -> None:
     assert len(task.meaning.bindings) == 1
 
 
+@pytest.mark.slow
 def test_a_fact_bound_differently_by_two_folders_is_refused(folder: Path, tmp_path: Path) -> None:
     """The world reads a bound fact from the first binding that covers it: the other was silently ignored."""
     from planners.bundled import task_types
@@ -149,6 +157,7 @@ def test_a_fact_bound_differently_by_two_folders_is_refused(folder: Path, tmp_pa
     assert {t.name for t in task_types([folder])} >= {"fetch", "carry_object"}  # alike: accepted
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("key", "old", "new", "fragment"), [
     ("timeout", "timeout_s = 10.0", "timeout_s = 1e300", "task.timeout_s: expected a number <= 86400"),
     ("cps", "cps = 1.0", "cps = 1" + "0" * 400, "schedule.cps: expected a 64-bit integer"),
@@ -167,6 +176,7 @@ def test_numbers_and_nesting_out_of_range_are_refused_where_read(folder: Path, k
     assert fragment in str(info.value) and str(folder / "task.toml") in str(info.value)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("body", "fragment"), [
     ("import sys\nsys.exit(4)\n", "task.py:2: called sys.exit(4) on import"),
     ("import sys\nsys.exit()\n", "task.py:2: called sys.exit() on import"),
@@ -181,6 +191,7 @@ def test_a_task_py_that_exits_on_import_is_named(folder: Path, body: str, fragme
     assert f"tasker domains: error: {folder / 'task.py'}" in err and fragment in err
 
 
+@pytest.mark.slow
 def test_a_hook_that_exits_is_an_error_of_its_task(folder: Path) -> None:
     """sys.exit() in a hook at run time ended tasker; now it is an exception the agent contains."""
     (folder / "task.py").write_text("import sys\n\ndef check_terminate(ctx, world):\n    sys.exit(3)\n")
@@ -191,12 +202,14 @@ def test_a_hook_that_exits_is_an_error_of_its_task(folder: Path) -> None:
     assert issubclass(HookExited, Exception)
 
 
+@pytest.mark.slow
 def test_a_task_py_that_is_a_device_is_refused(folder: Path) -> None:
     os.symlink("/dev/zero", folder / "task.py")
     with pytest.raises(DefinitionError, match="task.py: is not a regular file"):
         load_task(folder, use_cache=False)
 
 
+@pytest.mark.slow
 def test_a_domain_that_is_a_device_is_refused(folder: Path) -> None:
     (folder / "domain.pddl").unlink()
     os.symlink("/dev/zero", folder / "domain.pddl")
@@ -204,6 +217,7 @@ def test_a_domain_that_is_a_device_is_refused(folder: Path) -> None:
         load_task(folder)
 
 
+@pytest.mark.slow
 def test_a_warning_is_given_every_time_not_only_before_the_check_is_cached(
         folder: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Before: the [example]'s warnings came from the checks a cached folder skips: shown once."""
@@ -235,6 +249,7 @@ def hook_job(job: Any) -> tuple[dict[str, Any], dict[str, Any]]:
     return {}, {}
 
 
+@pytest.mark.slow
 def test_a_hook_that_kills_its_process_is_named_in_the_sweep(folder: Path) -> None:
     """Before: 'worker process died (exit code 7) ... (a crash in native code, os._exit, or the OOM killer)'."""
     from experiments.inputs.strategy import Strategy
@@ -252,6 +267,7 @@ def test_a_hook_that_kills_its_process_is_named_in_the_sweep(folder: Path) -> No
     assert f"in the task.py hook check_args of {folder / 'task.py'}" in row.error
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["robot", "deadline", "priority", "death_at"])
 def test_a_reserved_argument_name_is_refused(folder: Path, name: str) -> None:
     """Before: an argument named deadline was stripped from the folder's own arguments by the request
@@ -269,6 +285,7 @@ def test_the_reserved_names_cover_the_request_fields() -> None:
     assert set(FIELD_NAMES) <= set(RESERVED_ARGS)
 
 
+@pytest.mark.slow
 def test_one_condition_declared_as_two_hazards_is_refused(folder: Path) -> None:
     """Before: accepted; every hazard metric counted the held item twice."""
     toml = folder / "task.toml"

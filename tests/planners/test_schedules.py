@@ -143,7 +143,7 @@ def test_the_trace_records_whether_the_plan_is_optimal_and_which_search_made_it(
     from planners.bundled import task_types
     from planners.examples import StraightLineMotion, example_context
     from planners.pddl_task import PddlTaskType
-    from tasker.agent import VOLATILE_INFO
+    from tasker.stagerun import VOLATILE_INFO
 
     task = next(t for t in task_types() if t.name == "carry_object")
     assert isinstance(task, PddlTaskType)

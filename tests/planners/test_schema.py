@@ -73,6 +73,7 @@ def _domains() -> list[Path]:
     return shipped + classical
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", _domains(), ids=lambda p: p.parent.name)
 def test_schema_matches_unified_planning(path: Path) -> None:
     text = path.read_text()
@@ -112,6 +113,7 @@ print(sorted({m.split('.')[0] for m in sys.modules} & {'unified_planning', 'pypa
 """
 
 
+@pytest.mark.slow
 def test_remembered_task_folders_load_without_unified_planning(tmp_path: Path) -> None:
     """First load checks with unified-planning and records it; the next process reads the
     domains with Fast Downward's parser only (about a second less start-up)."""

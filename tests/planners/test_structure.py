@@ -5,6 +5,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import pytest
+
 import planners
 
 ROOT = Path(planners.__file__).parent
@@ -35,6 +37,7 @@ def test_no_two_planners_modules_import_each_other() -> None:
     assert pairs == []
 
 
+@pytest.mark.slow
 def test_the_engine_and_the_facade_meet_only_in_registration() -> None:
     graph = _imports()
     assert "planners.registration" in graph["planners.engine"] and "planners.registration" in graph["planners.planner"]

@@ -70,6 +70,7 @@ TOML_CASES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("old", "new", "fragment"), TOML_CASES)
 def test_bad_task_toml(old: str, new: str, fragment: str, tmp_path: Path) -> None:
     folder = _copy(tmp_path)
@@ -109,6 +110,7 @@ def test_bad_domain_in_folder_names_domain(tmp_path: Path) -> None:
     assert info.value.file.endswith("domain.pddl") and info.value.line is not None
 
 
+@pytest.mark.slow
 def test_axioms_fall_back_to_an_optimal_search_that_handles_them(tmp_path: Path) -> None:
     folder = _copy(tmp_path)
     _edit(folder / "domain.pddl", "(not (following ?h)))\n    :effect (and (not (at ?r ?from))",
@@ -121,6 +123,7 @@ def test_axioms_fall_back_to_an_optimal_search_that_handles_them(tmp_path: Path)
     assert [s.action for s in plan.stages][:2] == ["approach", "greet"]
 
 
+@pytest.mark.slow
 def test_bad_task_py(tmp_path: Path) -> None:
     folder = _copy(tmp_path, "carry_object")
     (folder / "task.py").write_text("def extra_facts(ctx, world)\n    return []\n")
@@ -144,6 +147,7 @@ def test_folder_of_folders_and_store_loader(tmp_path: Path) -> None:
         load_task_folder(empty)
 
 
+@pytest.mark.slow
 def test_task_types_with_user_folder(tmp_path: Path) -> None:
     folder = _copy(tmp_path, "cook")
     _edit(folder / "task.toml", 'name = "cook"', 'name = "cook_pasta"')

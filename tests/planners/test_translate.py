@@ -54,6 +54,7 @@ def _fresh_caches() -> None:
     translate_module._parsed_domain.cache_clear()
 
 
+@pytest.mark.slow
 def test_reuse_is_byte_identical_on_every_bundled_domain() -> None:
     seen: dict[str, set[str]] = {}
     for label, text in _bundled_problems():
@@ -65,6 +66,7 @@ def test_reuse_is_byte_identical_on_every_bundled_domain() -> None:
     assert len(seen) == len(task_types()) and all(len(p) >= 3 for p in seen.values()), "many problems per domain"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("domain", "problem"), _classical())
 def test_reuse_is_byte_identical_on_classical_problems(domain: str, problem: str) -> None:
     reference = translate(domain, problem, reuse=False)

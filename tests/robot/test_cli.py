@@ -11,6 +11,7 @@ from experiments.cli import main as cli
 from robot.spec import load_world, shipped_worlds
 
 
+@pytest.mark.slow
 def test_world_json_and_picture(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     png = tmp_path / "paper.png"
     assert cli(["world", "paper", "--json", "--out", str(png)]) == 0
@@ -21,6 +22,7 @@ def test_world_json_and_picture(tmp_path: Path, capsys: pytest.CaptureFixture[st
     assert png.read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("world", shipped_worlds())
 def test_world_json_describes_every_part_of_the_world(world: str, capsys: pytest.CaptureFixture[str]) -> None:
     spec = load_world(world)

@@ -15,6 +15,8 @@ import re
 import shutil
 from pathlib import Path
 
+import pytest
+
 import domains
 from robot.recording import read_trajectory
 from robot.sim import Simulation
@@ -67,6 +69,7 @@ def _run(tmp_path: Path, task: str, paths: tuple[str, ...]) -> Path:
     return out / "trajectory.jsonl"
 
 
+@pytest.mark.slow
 def test_an_escort_folder_with_its_own_predicates_moves_people_as_guide_human(tmp_path: Path) -> None:
     folder = escort_folder(tmp_path)
     _, escort, _ = read_trajectory(_run(tmp_path, "escort", (str(folder),)))

@@ -83,6 +83,7 @@ def _assert_same(a: Roadmap, b: Roadmap) -> None:
 # -- the roadmap ---------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("milestones", [SMALL, None], ids=["small", "default"])
 def test_roadmap_from_disk_is_the_grown_one(cache: Path, paper: WorldSpec, scene: Scene,
                                             monkeypatch: pytest.MonkeyPatch, milestones: int | None) -> None:
@@ -157,6 +158,7 @@ def _grow_into(root: str) -> None:
     Roadmap.for_world(spec, Scene(spec, tiago.robot_dimensions()[2]), 1, SMALL)
 
 
+@pytest.mark.slow
 def test_concurrent_roadmap_writers_leave_one_whole_entry(cache: Path, paper: WorldSpec, scene: Scene,
                                                            monkeypatch: pytest.MonkeyPatch) -> None:
     ctx = multiprocessing.get_context("spawn")
@@ -173,6 +175,7 @@ def test_concurrent_roadmap_writers_leave_one_whole_entry(cache: Path, paper: Wo
 # -- the robot's dimensions ----------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_robot_from_disk_is_the_measured_one_without_pinocchio_or_coal(cache: Path) -> None:
     code = ("import hashlib, json, sys\nfrom robot.tiago import mujoco_source, robot_dimensions\n"
             "text, assets = mujoco_source()\n"

@@ -34,6 +34,7 @@ def _scene(world: str, people: bool, toggle_one: bool) -> Scene:
     return scene
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("toggle_one", [False, True], ids=["doors-as-shipped", "one-door-toggled"])
 @pytest.mark.parametrize("people", [False, True], ids=["empty", "with-people"])
 @pytest.mark.parametrize("world", shipped_worlds())
@@ -62,6 +63,7 @@ def test_table_routes_equal_a_search_per_start(world: str, people: bool, toggle_
         assert table.searches == 0
 
 
+@pytest.mark.slow
 def test_all_pairs_table_is_scipy_dijkstra_from_each_node(paper) -> None:  # type: ignore[no-untyped-def]
     scene = _scene("paper", people=False, toggle_one=True)
     planner = BasePlanner(paper, scene, table_after=0)

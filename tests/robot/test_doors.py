@@ -203,6 +203,7 @@ def _through(planner: BasePlanner, name: str, lows: list[Point], highs: list[Poi
     return len(legs[0]) * len(legs[1])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("which", _worlds())
 def test_points_either_side_of_an_open_door_go_through_it(which: str | int) -> None:
     """Points in front of the leaf, beside it within the doorway's width and beyond the jambs

@@ -116,6 +116,7 @@ def _world_with_robot_in_the_doorway(paper: WorldSpec) -> WorldSpec:
     return dataclasses.replace(paper, people=people, robot=dataclasses.replace(paper.robot, pose=ROBOT))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("to", ["living", "peter"])
 def test_navigate_leaves_the_doorway_in_mujoco(paper, to: str) -> None:
     sim = Simulation(_world_with_robot_in_the_doorway(paper))
@@ -128,6 +129,7 @@ def test_navigate_leaves_the_doorway_in_mujoco(paper, to: str) -> None:
     assert status.state is SkillState.SUCCEEDED, status
 
 
+@pytest.mark.slow
 def test_navigate_retries_a_failed_replan_once_the_doorway_clears(paper) -> None:
     """Peter steps into the only door of the bedroom while the robot drives there (no path:
     it brakes), then walks on: the robot re-plans at the next check and gets there, rather
@@ -176,6 +178,7 @@ def _blocked_bedroom(paper: WorldSpec, walk: tuple[tuple[float, float, float], .
     return status, now
 
 
+@pytest.mark.slow
 def test_navigate_blocked_at_its_start_waits_for_the_way_to_clear(paper) -> None:
     """No path when the stage begins (someone in the doorway) is not a failure yet: the skill
     waits as it does when blocked en route, and drives once Peter walks on."""
@@ -217,6 +220,7 @@ def test_a_person_who_follows_the_robot_never_blocks_its_way(paper) -> None:
     assert not motion.estimate(start, goal).reachable
 
 
+@pytest.mark.slow
 def test_a_person_is_approached_from_their_side_of_a_wall() -> None:
     """Full TaBSA day, seed 2: p13 fell 0.4 m north of the living/kitchen wall; from the
     living room the robot went to a pose 0.9 m from them through the wall (living-room
@@ -238,6 +242,7 @@ def test_a_person_is_approached_from_their_side_of_a_wall() -> None:
         assert scene.sees(pose[:2], (4.21, 4.9))
 
 
+@pytest.mark.slow
 def test_bystanders_make_room_for_help(paper) -> None:
     """The bedroom case of ``test_approach_tries_a_farther_ring_when_the_near_one_is_shut``:
     p lies between the bed and the wall, q and r stand at both ends, so no pose the robot
@@ -279,6 +284,7 @@ def test_bystanders_make_room_for_help(paper) -> None:
     assert math.dist((sim.people["q"].x, sim.people["q"].y), (9.6, 4.6)) < 1e-6
 
 
+@pytest.mark.slow
 def test_nobody_makes_room_by_stepping_into_a_dead_end() -> None:
     """Full day, seed 8: people making room for someone fallen at the entrance of the
     corridor between the bed and the bathroom wall stepped to the nearest free spot — in

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import random
 
+import pytest
+
 from robot.drive import DriveLimits
 from robot.estimator import MotionEstimator
 from robot.motion import BasePlanner, open_planner
@@ -12,6 +14,7 @@ from robot.spec import WorldSpec
 from robot.tiago import robot_dimensions
 
 
+@pytest.mark.slow
 def test_remembered_estimates_equal_fresh_ones_as_the_scene_changes(paper: WorldSpec) -> None:
     rng = random.Random(7)
     scene = Scene(paper, robot_dimensions()[2])

@@ -67,6 +67,7 @@ def _random_free(scene: Scene, rng: np.random.Generator) -> tuple[float, float]:
             return p
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("table_after", [0, None], ids=["door-table", "searched"])
 @pytest.mark.parametrize(("doorway", "close_one"), [(True, True), (True, False), (False, True)],
                          ids=["doorway+closed", "doorway", "closed"])
@@ -88,6 +89,7 @@ def test_fast_costs_equal_the_plain_search(world: str, doorway: bool, close_one:
     assert reached >= asked // 5
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("world", shipped_worlds())
 def test_memos_follow_the_scene_under_one_planner(world: str) -> None:
     """Doors toggled and people moved between queries of one long-lived planner: every answer

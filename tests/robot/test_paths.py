@@ -33,6 +33,7 @@ def _points(spec, scene: Scene, n: int = 8, seed: int = 3) -> list[tuple[float, 
     return pts
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("people", [False, True], ids=["empty", "with-people"])
 @pytest.mark.parametrize("world", shipped_worlds())
 def test_costs_are_within_a_few_percent_of_the_true_shortest_path(world: str, people: bool) -> None:
@@ -123,6 +124,7 @@ def _fingerprint_cmd(seeds: list[int]) -> list[str]:
     return [sys.executable, "-c", code]
 
 
+@pytest.mark.slow
 def test_seed_zero_roadmap_never_depends_on_what_ran_before() -> None:
     def run(seeds: list[int]) -> list[str]:
         done = subprocess.run(_fingerprint_cmd(seeds), capture_output=True, text=True, cwd=ROOT, check=True,

@@ -80,6 +80,7 @@ def _walked(sim: Simulation, name: str, until: float) -> list[tuple[float, float
     return pts
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("world_name", shipped_worlds())
 def test_a_scripted_walk_across_rooms_goes_through_doorways(world_name: str) -> None:
     spec = load_world(world_name)
@@ -93,6 +94,7 @@ def test_a_scripted_walk_across_rooms_goes_through_doorways(world_name: str) -> 
     assert math.dist(pts[-1], b) < 1e-6
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("world_name", shipped_worlds())
 def test_a_walk_event_goes_through_doorways_at_the_person_s_speed(world_name: str) -> None:
     spec = load_world(world_name)

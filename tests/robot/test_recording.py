@@ -68,6 +68,7 @@ def test_bad_files_and_rates_are_refused(tmp_path) -> None:
         read_trajectory(bad)
 
 
+@pytest.mark.slow
 def test_skipping_still_ticks_changes_nothing(paper, monkeypatch) -> None:
     """The same drive and waits with and without skipping: identical samples and physics."""
     def scenario(sim: Simulation) -> tuple[list[str], object]:

@@ -38,6 +38,7 @@ def test_protocols(paper) -> None:
     assert "robot" in snap.poses and "kitchen" in snap.poses
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("a", "b"), [("hall", "kitchen"), ("kitchen", "bedroom"), ("bedroom", "stove"),
                                       ("stove", "bathroom"), ("bathroom", "alice_destination")])
 def test_estimates_match_mujoco_time(paper, a: str, b: str) -> None:
@@ -70,6 +71,7 @@ def test_stop_brings_the_base_to_rest(paper) -> None:
     assert sim.poll("d1", stage, 10.0).state is SkillState.FAILED
 
 
+@pytest.mark.slow
 def test_person_asked_to_follow_ends_near_the_destination(paper) -> None:
     sim = Simulation(paper)
     status, now = run(sim, nav("john", add=[["met", "robot", "john"]]), 0.0)
@@ -111,6 +113,7 @@ def test_told_to_wait_stops_a_walking_person(paper) -> None:
     assert sim.people["john"].pose != here
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("posture", ["standing", "sitting"])
 def test_a_person_told_to_wait_in_a_doorway_steps_out_of_it(paper, posture: str) -> None:
     """Nobody waits standing in a doorway: told to wait there, a standing person steps to
@@ -264,6 +267,7 @@ def test_equal_facts_keys_mean_equal_facts(paper) -> None:
     assert max(len(p) for p in poses.values()) > 5
 
 
+@pytest.mark.slow
 def test_people_not_stepped_while_still_are_where_stepping_them_puts_them(paper, monkeypatch) -> None:
     """Still people are not stepped (``Person._idle_after``), the world syncs and re-examines
     only people touched since it last looked: the same samples as stepping, syncing and

@@ -158,8 +158,8 @@ class Exploding(Scheduler):
         return Decision(min(view.candidates, key=lambda c: c.order).id) if view.exe is None else Decision()
 
 
-def test_a_scheduler_that_raises_is_recorded_and_changes_nothing() -> None:
-    schedulers.register("exploding", Exploding)
+def test_a_scheduler_that_raises_is_recorded_and_changes_nothing(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(schedulers._registry, "exploding", Exploding)  # gone after the test: others read names()
     loop = make_loop([SyntheticTask("t", [st("a", 1)])], scheduler="exploding")
     loop.request(0.0, "t")
     tr = loop.run()

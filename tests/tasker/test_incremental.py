@@ -70,6 +70,7 @@ def test_bundled_synthetic_scenario_same_trace(scheduler: str) -> None:
     assert harm._index is None or len(harm._index) == 0  # every task ended: none left in the heap
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scheduler", schedulers.names())
 @pytest.mark.parametrize(("protocol", "seed"), [("tabsa", 1), ("tabsa", 7), ("tabsa-short", 2), ("tabsa-short", 5)])
 def test_synthetic_days_same_trace(protocol: str, seed: int, scheduler: str) -> None:
@@ -157,6 +158,7 @@ def program_loop(scheduler: str, requests: list[Any], changes: list[Any], terms:
     return loop
 
 
+@pytest.mark.slow
 @settings(max_examples=30, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st_.lists(request, min_size=1, max_size=10), st_.lists(change, max_size=6), st_.lists(terminate, max_size=3))
 def test_random_programs_same_trace_with_every_scheduler(requests: list[Any], changes: list[Any],
@@ -191,6 +193,7 @@ key_op = st_.one_of(
 )
 
 
+@pytest.mark.slow
 @settings(max_examples=600, derandomize=True, deadline=None)
 @given(st_.lists(key_op, max_size=60), st_.sampled_from(INDEXED))
 @example([("report", 0, "a", 1.0, True), ("report", 1, "a", 1.0, False), ("decide",), ("leave", 0), ("back", 0)],

@@ -81,6 +81,7 @@ def test_no_task_becomes_exe_da_a_third_time_within_the_window(scheduler: str) -
         assert held[0]["held"]["count"] == 2 and held[0]["held"]["window_s"] == WINDOW
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scheduler", [n for n in schedulers.names()
                                        if schedulers.create(n).preemptive and n not in UNMOVED])
 def test_the_scenario_thrashes_without_the_guard(scheduler: str) -> None:

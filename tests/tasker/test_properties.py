@@ -41,6 +41,7 @@ from __future__ import annotations
 from collections import Counter, defaultdict
 from typing import Any
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st_
 
@@ -129,6 +130,7 @@ def check_trace(events: list[dict[str, Any]]) -> None:
                     assert ran == [s["action"] for s in e["stages"]], f"{agent}: exeSusp ran {ran} of {e['stages']}"
 
 
+@pytest.mark.slow
 @settings(max_examples=2500, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st_.lists(ops, min_size=1, max_size=25), st_.sampled_from(["alg2", "priority", "fifo", "srtf", "edf"]))
 def test_random_interleavings_keep_the_invariants(program: list[tuple[Any, ...]], scheduler: str) -> None:

@@ -19,6 +19,11 @@ DOC = Path(__file__).parents[2] / "docs" / "trace.md"
 def test_encoding_is_canonical() -> None:
     line = encode({"t": 1.0000004, "event": "x", "c": float("inf"), "d": -0.0, "e": (1, 2), "f": {"b": 1}})
     assert line == '{"t":1.0,"event":"x","c":"inf","d":0.0,"e":[1,2],"f":{"b":1}}'
+    # six decimals, no more and no fewer: each value below is written otherwise at 5 or 7 decimals
+    line = encode({"t": 2.7182818, "event": "x", "a": 0.1234567, "b": -0.0000004, "c": 12.3456789,
+                   "d": [1.2345674], "e": {"f": -3.0000006}, "g": float("-inf"), "h": 7})
+    assert line == ('{"t":2.718282,"event":"x","a":0.123457,"b":0.0,"c":12.345679,"d":[1.234567],'
+                    '"e":{"f":-3.000001},"g":"-inf","h":7}')
     with pytest.raises(TypeError, match="cannot put a object"):
         encode({"t": 0, "event": "x", "o": object()})
 
