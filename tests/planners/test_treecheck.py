@@ -326,7 +326,6 @@ def test_a_fact_another_task_type_makes_is_seen(tmp_path: Path) -> None:
 
 def test_every_tree_of_a_folder_gets_its_report_named_where_it_is_written() -> None:
     from planners.treecheck import reports
-
     from robot.spec import load_world, shipped_worlds
 
     known = [f for name in shipped_worlds() for f in load_world(name).facts]  # the door branch reads door_at
