@@ -353,7 +353,7 @@ class Estimator:
     def _door_check(self, world: WorldState) -> Callable[[Stage], bool] | None:
         """Does a stage travel between places joined by a ``door_between`` fact through a door closed now
         (a door the plan opens)?  Through an open door a leg is timed like any other."""
-        pairs = closed_door_pairs(world)
+        pairs = closed_door_pairs(world, opens_doors=self.task.domain.opens_doors)
         if not pairs:
             return None
         task = self.task
@@ -417,10 +417,10 @@ class Estimator:
         as_is: Callable[[Pose, Pose], Any] | None = getattr(motion, "estimate_ignoring_people", None)
         opened: Callable[[Pose, Pose], Any] | None = getattr(motion, "estimate_ignoring_doors", None)
         if as_is is None or opened is None:
-            return travel_table(world, motion, self.task.spec.travel_s)
+            return travel_table(world, motion, self.task.spec.travel_s, opens_doors=self.task.domain.opens_doors)
         places = tuple(sorted((n, tuple(world.poses.get(n, ()))) for n, t in world.objects.items()
                               if t == PLACE_TYPE))
-        through_door = frozenset(closed_door_pairs(world))
+        through_door = frozenset(closed_door_pairs(world, opens_doors=self.task.domain.opens_doors))
         closed: tuple[str, ...] = tuple(getattr(motion, "closed_doors", tuple)())
         key = (places, through_door, closed)
         with self._lock:

@@ -396,7 +396,8 @@ class PddlTaskType(TaskType):
     def static_update(self, ctx: TaskContext) -> StagePlan:
         """The template ``exeTsk`` (Alg. 3): fixed stages, variants chosen by ``ctx.suspended``."""
         world = self.world_of(ctx)
-        stages = self._template_stages(ctx, world, travel_table(world, ctx.motion, self.spec.travel_s))
+        travel = travel_table(world, ctx.motion, self.spec.travel_s, opens_doors=self.domain.opens_doors)
+        stages = self._template_stages(ctx, world, travel)
         return StagePlan(stages, Purpose.UP_TSK, strategy="static", sim_time=self.spec.static_time_s,
                          note="template exeTsk" + (" (suspended variant)" if ctx.suspended else ""))
 
@@ -408,7 +409,7 @@ class PddlTaskType(TaskType):
         """The decision list ``exeSusp`` (eq. 47): the first branch whose condition holds."""
         world = self.world_of(ctx)
         branch, b = self.branch(ctx, world)
-        travel = travel_table(world, ctx.motion, self.spec.travel_s)
+        travel = travel_table(world, ctx.motion, self.spec.travel_s, opens_doors=self.domain.opens_doors)
         stages = self.builder.from_templates(branch.stages, b, travel, ctx.suspended)
         return StagePlan(stages, Purpose.GEN_SUSP, strategy="static", sim_time=self.spec.static_time_s,
                          note=f"decision tree: {branch.label or ('save' if not stages else 'branch')}",
@@ -424,7 +425,7 @@ class PddlTaskType(TaskType):
         here = place_of(world, robot)
         if here is None:
             return ""
-        travel = travel_table(world, ctx.motion, self.spec.travel_s)
+        travel = travel_table(world, ctx.motion, self.spec.travel_s, opens_doors=self.domain.opens_doors)
         named = {a for lit in goal for a in lit[1:]}
         places = {a for a in named if world.objects.get(a) == PLACE_TYPE}
         places |= {p for a in named - places - {robot} if (p := place_of(world, a)) is not None}
@@ -462,7 +463,7 @@ class PddlTaskType(TaskType):
     def problem_text(self, ctx: TaskContext, world: WorldState, goal: list[Literal],
                      extra: list[Literal]) -> tuple[PddlText, frozenset[Literal], dict[tuple[str, str], float]]:
         """The PDDL text, its init facts and the travel table for a goal in a world."""
-        travel = travel_table(world, ctx.motion, self.spec.travel_s)
+        travel = travel_table(world, ctx.motion, self.spec.travel_s, opens_doors=self.domain.opens_doors)
         for lit in goal:
             self.domain.check_literal(lit, f"goal of task {self.name!r}")
         text, init = render_problem(self.domain, world, goal, extra_facts=extra, travel=travel, name=self.name)

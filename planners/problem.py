@@ -46,6 +46,10 @@ class DomainModel:
         self.functions = set(schema.functions)
         self.constants: dict[str, str] = dict(schema.constants)
         self.actions = {a.name: a for a in schema.actions}
+        self.opens_doors = "door_between" in self.predicates and any(
+            e.fluent == "open" and e.positive for a in schema.actions for e in a.effects)
+        """The domain models doors its plans may open: a ``door_between`` predicate and an action that adds
+        ``open``.  In a domain that does not, a closed door is a wall (:func:`closed_door_pairs`)."""
         # render_problem's answers by everything they are made of (a pure function of these)
         self.rendered: OrderedDict[tuple[Any, ...], tuple[str, frozenset[Fact]]] = OrderedDict()
         self.rendered_lock = threading.Lock()
@@ -100,12 +104,14 @@ class DomainModel:
         return add, [d for d in delete if d not in add]
 
 
-def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float) -> dict[tuple[str, str], float]:
+def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float, *,
+                 opens_doors: bool) -> dict[tuple[str, str], float]:
     """Seconds between every ordered pair of places; ``inf`` when the motion model says unreachable
     (walled off, or behind a closed door: people in the way only slow a leg, :func:`_past_people`).
 
     Without a motion model (or a pose) the declared ``travel_s`` is used, never zero.
-    Pairs joined by a ``door_between`` fact whose door is closed now (no ``open`` fact) are timed
+    When the domain ``opens_doors`` (:attr:`DomainModel.opens_doors`), pairs joined by a
+    ``door_between`` fact whose door is closed now (no ``open`` fact) are timed
     with the motion model's optional ``estimate_ignoring_doors`` (``robot.estimator.MotionEstimator``
     has it): the plan may open it.  Through an open door a leg is timed like any other, people
     and all (:func:`closed_door_pairs`).  A motion model
@@ -114,7 +120,7 @@ def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float)
     places = sorted(n for n, t in world.objects.items() if t == PLACE_TYPE)
     # places joined by a door the domain models and closed now: the plan decides whether to open it,
     # so their travel time is the geometry's with the door open (if the motion model can say it)
-    through_door = closed_door_pairs(world)
+    through_door = closed_door_pairs(world, opens_doors=opens_doors)
     ignoring_doors = getattr(motion, "estimate_ignoring_doors", None)
     out: dict[tuple[str, str], float] = {}
     table = getattr(motion, "table", None)  # a whole matrix in one pass (robot.estimator.MotionEstimator)
@@ -138,8 +144,12 @@ def travel_table(world: WorldState, motion: MotionModel | None, travel_s: float)
     return out
 
 
-def closed_door_pairs(world: WorldState) -> set[tuple[str, str]]:
-    """Ordered pairs of places a ``door_between`` fact joins through a door that is not ``open`` now."""
+def closed_door_pairs(world: WorldState, *, opens_doors: bool) -> set[tuple[str, str]]:
+    """Ordered pairs of places a ``door_between`` fact joins through a door that is not ``open`` now, when
+    the domain ``opens_doors``; none when it does not (its plans cannot open one: a closed door is a wall,
+    timed as the motion model says, and the world's door facts describe the house, not the task)."""
+    if not opens_doors:
+        return set()
     return {(f[2], f[3]) for f in world.matching("door_between") if len(f) == 4 and ("open", f[1]) not in world.facts}
 
 

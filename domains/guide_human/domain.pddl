@@ -1,5 +1,7 @@
 ; guide_human: approach a person, greet, ask them to follow, guide them, say goodbye.
 ; Costs are expected durations in seconds; travel-time comes from the motion model.
+; The robot remembers a door it opened (opened_by_robot) until it closes it: its suspension tree
+; closes such a door, never one it found open.
 ; A door found closed on the way is opened with an empty hand (as in carry_object): the robot
 ; goes to a door's place (approach_door, or guide), opens it and passes it alone
 ; (approach_through) or with the person (guide_through).
@@ -15,6 +17,7 @@
     (door_between ?d - door ?from ?to - place)
     (door_at ?d - door ?p - place)
     (open ?d - door)
+    (opened_by_robot ?d - door)
     (hand_empty ?r - robot)
     (greeted ?h - person)
     (following ?h - person)
@@ -77,12 +80,12 @@
   (:action open_door
     :parameters (?r - robot ?d - door ?p - place)
     :precondition (and (at ?r ?p) (door_at ?d ?p) (hand_empty ?r) (not (open ?d)))
-    :effect (and (open ?d) (increase (total-cost) 6)))
+    :effect (and (open ?d) (opened_by_robot ?d) (increase (total-cost) 6)))
 
   (:action close_door
     :parameters (?r - robot ?d - door ?p - place)
     :precondition (and (at ?r ?p) (door_at ?d ?p) (hand_empty ?r) (open ?d))
-    :effect (and (not (open ?d)) (increase (total-cost) 6)))
+    :effect (and (not (open ?d)) (not (opened_by_robot ?d)) (increase (total-cost) 6)))
 
   (:action guide_through
     :parameters (?r - robot ?h - person ?d - door ?from ?to - place)

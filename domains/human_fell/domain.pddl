@@ -1,4 +1,6 @@
 ; human_fell: reach a person who fell, check that they are conscious, call for help.
+; The robot remembers a door it opened (opened_by_robot) until it closes it: its suspension tree
+; closes such a door, never one it found open.
 ; A door found closed on the way is opened with an empty hand (as in carry_object): the robot
 ; goes to a door's place (approach_door), opens it and passes it (approach_through).
 (define (domain human_fell)
@@ -13,6 +15,7 @@
     (door_between ?d - door ?from ?to - place)
     (door_at ?d - door ?p - place)
     (open ?d - door)
+    (opened_by_robot ?d - door)
     (hand_empty ?r - robot)
     (fallen ?h - person)
     (checked ?h - person)
@@ -59,10 +62,10 @@
   (:action open_door
     :parameters (?r - robot ?d - door ?p - place)
     :precondition (and (at ?r ?p) (door_at ?d ?p) (hand_empty ?r) (not (open ?d)))
-    :effect (and (open ?d) (increase (total-cost) 6)))
+    :effect (and (open ?d) (opened_by_robot ?d) (increase (total-cost) 6)))
 
   (:action close_door
     :parameters (?r - robot ?d - door ?p - place)
     :precondition (and (at ?r ?p) (door_at ?d ?p) (hand_empty ?r) (open ?d))
-    :effect (and (not (open ?d)) (increase (total-cost) 6)))
+    :effect (and (not (open ?d)) (not (opened_by_robot ?d)) (increase (total-cost) 6)))
 )

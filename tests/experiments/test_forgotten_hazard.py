@@ -1,7 +1,8 @@
 """Held-out checks of issue 26 on a user's task folder whose tree forgets a hazard.
 
-``experiments/sweep/specs/tasks/water_plants`` declares the tap it turns on as a hazard
-(``tap_running``) and writes a ``[[suspension]]`` tree that only puts the can down.  Run in
+``tests/domains/fixtures/water_plants_forgets_tap`` (water_plants as it was first written)
+declares the tap it turns on as a hazard (``tap_running``) and writes a ``[[suspension]]`` tree
+that only puts the can down.  Run in
 ``experiments/sweep/specs/scenarios/water_plants.toml`` (Peter falls while the tap runs):
 
 * ``derived`` plans to what the folder declares, so when the interrupting task starts its
@@ -43,7 +44,7 @@ from tasker.world import WorldState
 pytestmark = pytest.mark.slow  # each test runs a robot scenario to its end
 
 ROOT = Path(__file__).resolve().parents[2]
-FOLDER = ROOT / "experiments" / "sweep" / "specs" / "tasks" / "water_plants"
+FOLDER = ROOT / "tests" / "domains" / "fixtures" / "water_plants_forgets_tap"
 WATER = ROOT / "experiments" / "sweep" / "specs" / "scenarios" / "water_plants.toml"
 PATHS = (str(FOLDER),)
 AFTER_S = 45.0  # the horizon after the interruption: enough for every suspension here to reach wait

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import replace
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -33,7 +34,7 @@ from planners.results import PlanResult, PlanStatus
 from tasker.messages import SP_COMPLETION, CompletionCost, SPRequest
 from tasker.stage import Stage
 from tasker.task import TaskContext
-from tasker.world import Pose, WorldState
+from tasker.world import MotionEstimate, Pose, WorldState
 from tests.domains.conftest import MOTION, make_ctx
 
 
@@ -350,7 +351,7 @@ def test_the_robots_first_leg_is_timed_from_where_it_is_not_from_its_place() -> 
     poses = {"a": (0.0, 0.0, 0.0), "b": (10.0, 0.0, 0.0), "c": (0.0, 10.0, 0.0), "robot": (6.0, 0.0, 0.0)}
     world = WorldState(frozenset({("at", "robot", "a")}), poses, objects)
     motion = StraightLineMotion()
-    table = travel_table(world, motion, 12.0)
+    table = travel_table(world, motion, 12.0, opens_doors=False)
     assert table["a", "b"] == pytest.approx(motion.estimate(poses["robot"], poses["b"]).time_s)
     assert table["a", "c"] == pytest.approx(motion.estimate(poses["robot"], poses["c"]).time_s)
     assert table["b", "c"] == pytest.approx(motion.estimate(poses["b"], poses["c"]).time_s)  # other legs as before
@@ -418,11 +419,11 @@ def test_people_in_the_way_slow_a_leg_but_never_cut_it(tasks: dict[str, PddlTask
     ctx = make_ctx(tasks["guide_human"])
     world = ctx.world
     bedroom = world.poses["bedroom"]
-    table = travel_table(world, _Crowded(bedroom), 10.0)
-    free = travel_table(world, StraightLineMotion(), 10.0)
+    table = travel_table(world, _Crowded(bedroom), 10.0, opens_doors=True)
+    free = travel_table(world, StraightLineMotion(), 10.0, opens_doors=True)
     into = [(a, b) for (a, b) in table if b == "bedroom"]
     assert into and all(table[k] == pytest.approx(free[k]) for k in into)
-    walled = travel_table(world, StraightLineMotion(blocked=frozenset({bedroom})), 10.0)
+    walled = travel_table(world, StraightLineMotion(blocked=frozenset({bedroom})), 10.0, opens_doors=True)
     assert all(math.isinf(walled[k]) for k in into)  # no estimate_ignoring_people: nothing to fall back on
 
 
@@ -450,3 +451,41 @@ def test_a_waiting_task_is_estimated_from_the_state_the_executing_task_leaves() 
     effects = h.handover("d2")
     assert effects is not None and any(f[0] == "hand_empty" for f in effects.add)
     assert h.handover("d1") is None  # the executing task assumes nothing about itself
+
+
+class _ShutDoor:
+    """A motion model with one closed door on the way from ``a`` to ``b``: ``estimate`` finds no path,
+    ``estimate_ignoring_doors`` the path with the door open (robot.estimator.MotionEstimator's pair)."""
+
+    def __init__(self) -> None:
+        self.free = StraightLineMotion()
+
+    def estimate(self, start: Pose, goal: Pose) -> object:
+        if {start[0], goal[0]} == {0.0, 10.0}:
+            return MotionEstimate(False, math.inf, math.inf, None)
+        return self.free.estimate(start, goal)
+
+    def estimate_ignoring_doors(self, start: Pose, goal: Pose) -> object:
+        return self.free.estimate(start, goal)
+
+
+def test_a_closed_door_is_a_wall_for_a_domain_that_cannot_open_it(tasks: dict[str, PddlTaskType]) -> None:
+    """The world's door facts describe the house; only a domain whose plans can open a door times a leg
+    through a closed one as open (water_plants once planned through a door it had no action to open,
+    and its move failed on the spot)."""
+    from planners.loader import load_task
+    from planners.problem import travel_table
+
+    objects = {"robot": "robot", "d": "door", "a": "place", "b": "place"}
+    poses = {"a": (0.0, 0.0, 0.0), "b": (10.0, 0.0, 0.0)}
+    facts = frozenset({("door_between", "d", "a", "b"), ("door_between", "d", "b", "a")})
+    world = WorldState(facts, poses, objects)
+    assert math.isinf(travel_table(world, _ShutDoor(), 5.0, opens_doors=False)["a", "b"])
+    assert travel_table(world, _ShutDoor(), 5.0, opens_doors=True)["a", "b"] == pytest.approx(
+        StraightLineMotion().estimate(poses["a"], poses["b"]).time_s)
+    opened = WorldState(facts | {("open", "d")}, poses, objects)  # an open door: the leg as the model times it
+    assert travel_table(opened, StraightLineMotion(), 5.0, opens_doors=True)["a", "b"] == pytest.approx(
+        StraightLineMotion().estimate(poses["a"], poses["b"]).time_s)
+    assert all(tasks[n].domain.opens_doors for n in ("cook", "carry_object", "guide_human", "human_fell"))
+    plants = load_task(Path(__file__).resolve().parents[2] / "experiments/sweep/specs/tasks/water_plants")
+    assert not plants.domain.opens_doors

@@ -32,7 +32,7 @@ from planners.treecheck import (
 from tasker.world import WorldState
 
 FIXTURE = Path(__file__).with_name("fixtures") / "hot_pot"
-SPEC_TASKS = Path(__file__).resolve().parents[2] / "experiments" / "sweep" / "specs" / "tasks"
+FORGETS_TAP = Path(__file__).resolve().parents[2] / "tests" / "domains" / "fixtures" / "water_plants_forgets_tap"
 DOMAINS = Path(__file__).resolve().parents[2] / "domains"
 
 COUNTER = """\
@@ -133,8 +133,8 @@ def test_the_same_tree_passes_where_the_counter_is_free(tmp_path: Path) -> None:
     assert _held_points(rep) == [("planned", 2), ("planned", 3)]
 
 
-def test_a_forgotten_hazard_is_named_on_the_shipped_water_plants() -> None:
-    task = _load(SPEC_TASKS / "water_plants")
+def test_a_forgotten_hazard_is_named_on_water_plants_as_first_written() -> None:
+    task = _load(FORGETS_TAP)
     rep = report(task)
     bad = rep.failing()
     # the tap runs while the can fills: before fill (stage 5) and before turn_off (stage 6)

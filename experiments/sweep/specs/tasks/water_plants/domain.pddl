@@ -1,5 +1,9 @@
 ; water_plants: fetch the watering can, fill it at the tap, water the plants.
-; The tap is a device of the world: it runs until the robot turns it off.
+; The tap is a device of the world: it runs until the robot turns it off.  The can goes down only
+; on a clear surface: `surface` is a fact of the world file, `clear` the world's own (no movable
+; object rests there).  Picking the can up clears its place, as in the bundled domains: a plan
+; assumes one thing a spot (the world, read afresh at each planning call, says otherwise when
+; something else stands there too).
 (define (domain water_plants)
   (:requirements :strips :typing :negative-preconditions :action-costs)
   (:types locatable place - object
@@ -9,6 +13,8 @@
     (connected ?from ?to - place)
     (holding ?r - robot ?c - can)
     (hand_empty ?r - robot)
+    (surface ?p - place)
+    (clear ?p - place)
     (tap_on ?t - tap)
     (full ?c - can)
     (watered ?pl - plant))
@@ -25,13 +31,13 @@
   (:action pick
     :parameters (?r - robot ?c - can ?p - place)
     :precondition (and (at ?r ?p) (at ?c ?p) (hand_empty ?r))
-    :effect (and (holding ?r ?c) (not (hand_empty ?r)) (not (at ?c ?p))
+    :effect (and (holding ?r ?c) (not (hand_empty ?r)) (not (at ?c ?p)) (clear ?p)
                  (increase (total-cost) 6)))
 
   (:action put_down
     :parameters (?r - robot ?c - can ?p - place)
-    :precondition (and (at ?r ?p) (holding ?r ?c))
-    :effect (and (at ?c ?p) (hand_empty ?r) (not (holding ?r ?c))
+    :precondition (and (at ?r ?p) (holding ?r ?c) (surface ?p) (clear ?p))
+    :effect (and (at ?c ?p) (not (clear ?p)) (hand_empty ?r) (not (holding ?r ?c))
                  (increase (total-cost) 5)))
 
   (:action turn_on
