@@ -52,7 +52,7 @@ TOML_CASES = [
     ('stages = [{ action = "ask_to_wait", args = ["$robot", "$person", "$at:robot"] }]', 'stages = []',
      "suspension[0]: static and planned must pursue the same goal"),
     ('label = "save"\ngoal = []', 'label = "save"\npolicy = "conditional"\ngoal = []',
-     "suspension[2].policy: a branch"),
+     "suspension[3].policy: a branch"),
     ('[static]', '[[static.suspension]]\nstages = []\n\n[static]', "[[static.suspension]] is gone"),
     ('budget_s = 0', 'budget = 0', "hazards[0].budget_s: missing (required)"),
     ('fact = ["following", "$person"]\nbudget_s', 'fact = ["folowing", "$person"]\nbudget_s',
