@@ -86,6 +86,7 @@ def _chosen(rep: TreeReport) -> set[str]:
     return {r.label for r in rep.runs if r.policy == "strict"}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(FOLDERS))
 def test_every_tree_of_the_folder_is_complete_on_its_example(name: str) -> None:
     task, got = _reports(name)
@@ -102,6 +103,7 @@ def _stages_where(rep: TreeReport, label: str) -> list[tuple[str, ...]]:
     return [r.stages for r in rep.runs if r.label == label]
 
 
+@pytest.mark.slow
 def test_water_plants_trees_turn_the_tap_off_and_put_the_can_down_in_either_order() -> None:
     _, (tap_first, can_first) = _reports("water_plants")
     both = [("navigate(robot bathroom bathroom)", "turn_off(robot tap bathroom)",
@@ -121,6 +123,7 @@ def test_hot_pot_trees_put_the_pot_on_the_nearest_spot_or_back_on_the_stove() ->
         ("navigate_through(robot living_kitchen living stove)", "put_pot(robot pot stove)")]
 
 
+@pytest.mark.slow
 def test_guide_humans_arrive_tree_is_complete_where_a_door_is_on_the_way(tmp_path: Path) -> None:
     """The [example] has no door (four estimator tests pin its plans); a copy whose kitchen is through
     an open door, as the paper world's rooms are, reads the branch that passes it."""

@@ -119,6 +119,7 @@ def _fake_runs(todo: list[Any], workers: int, done: Any = None) -> dict[Any, Any
     return {job: {"steps": [step(k, k != 3 or job[2] == 1) for k in range(1, 8)], "predictions": []} for job in todo}
 
 
+@pytest.mark.slow
 def test_tasker_paper_rewrites_the_readme_block_from_the_tables_it_wrote(tmp_path: Path,
                                                                          monkeypatch: pytest.MonkeyPatch) -> None:
     from experiments.paper import report

@@ -86,6 +86,7 @@ def test_the_pilot_sizes_each_cells_tests_and_n_per_scenario_is_clamped() -> Non
     assert by[("hh [default]", "planned")].outcome.kind == BINARY
 
 
+@pytest.mark.slow
 def test_the_document_is_deterministic_declares_first_answers_per_cell_and_ends_with_its_provenance() -> None:
     targeted = ex.by_cell(_rows(range(1, 31)))
     arms = {"targeted": targeted, "untargeted": ex.by_cell(_rows(range(1, 7), cells=(("cr", None),))),
@@ -105,6 +106,7 @@ def test_the_document_is_deterministic_declares_first_answers_per_cell_and_ends_
     assert "## genSusp's planner wall time, cold caches" in text and "| planned | 90 | 20.0 | 20.0 |" in text
 
 
+@pytest.mark.slow
 def test_the_hypotheses_can_fail() -> None:
     weak = ex.by_cell(_rows(range(1, 61), cells=(("cr", None),)))
     for r in weak:  # static unsafe in 3 of 60 seeds, planned never: 0.05 < 0.10

@@ -166,6 +166,7 @@ stages = []
         assert all(r.complete for r in report(task).runs_of(1))  # the strict branch puts it back
 
 
+@pytest.mark.slow
 def test_the_bundled_cook_tree_leaves_the_cooker_on_only_within_its_budget() -> None:
     rep = report(_load(DOMAINS / "cook"))
     held = rep.runs_of(0)  # "short interruption, hot pan held: put it down, leave the cooker" (60 s)
@@ -324,6 +325,7 @@ def test_a_fact_another_task_type_makes_is_seen(tmp_path: Path) -> None:
     assert unseen_conditions(task, others=[_load(maker)]) == ()
 
 
+@pytest.mark.slow
 def test_every_tree_of_a_folder_gets_its_report_named_where_it_is_written() -> None:
     from planners.treecheck import reports
     from robot.spec import load_world, shipped_worlds
