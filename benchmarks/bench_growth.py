@@ -1,0 +1,181 @@
+"""Benchmark: how the cost of a synthetic day grows with its length and with its queue.
+
+    python benchmarks/bench_growth.py                      # or: python benchmarks/run_all.py growth
+    python benchmarks/bench_growth.py --quick              # fewer sizes and seeds, no baseline
+    python benchmarks/bench_growth.py --protocol FILE.toml --schedulers alg2 edf --base 60ed0ea
+
+Days of a protocol (default ``tabsa-original``, TaBSA's day) on the synthetic backend,
+made longer at the same request rate (1, 2, 4, 8 h) and, in one hour, busier (9 to 144
+requests; :mod:`daysize`), under ``tabsa-simple``, ``alg2``, ``edf`` and ``lookahead``.
+Each size is the sum over seeds 1..N of the CPU seconds (``time.process_time``, the best
+of two runs of each day) of building and running the day, in a process of its own.  The
+baseline is the commit before the cost work (``--base``, default 60ed0ea), checked out
+with ``git archive`` into a temporary folder and run the same way in the same run
+(``PYTHONPATH`` first on that folder).  A series stops after a size that took more than
+``--budget`` CPU seconds (the next would take longer still): its later sizes print ``-``.
+
+Printed per scheduler and dimension: CPU seconds per size (now, and the baseline's),
+the *work* (trace events, summed over the seeds: what the day produced), the exponent
+of cost against size (least squares on the logarithms; 1 is linear) and against the
+work, and the ratio of the cost for four times the size (2 -> 8 h; 36 -> 144 requests).
+Target (issue 38): a day four times as long costs at most 5 times as much.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+SCHEDULERS = ("tabsa-simple", "alg2", "edf", "lookahead")
+HOURS = (1.0, 2.0, 4.0, 8.0)
+REQUESTS = (9, 18, 36, 72, 144)
+TARGET = 5.0
+
+
+# -- the worker: one series in one process, on whatever tree PYTHONPATH puts first ---------------------
+
+def _day(protocol: str, scheduler: str, seed: int, hours: float | None, requests: int | None) -> tuple[float, int]:
+    sys.path.insert(0, str(HERE))
+    from daysize import sized
+
+    from experiments.days import pipeline
+
+    proto = sized(protocol, hours, requests)
+    start = time.process_time()
+    loop = pipeline.make(proto, seed, scheduler=scheduler).build()
+    events = len(loop.run().events)
+    return time.process_time() - start, events
+
+
+def worker(args: argparse.Namespace) -> int:
+    sizes = [float(x) if args.dimension == "hours" else int(x) for x in args.sizes.split(",")]
+    for size in sizes:
+        cpu, work = 0.0, 0
+        for seed in range(1, args.seeds + 1):
+            runs = [_day(args.protocol, args.scheduler, seed, size if args.dimension == "hours" else None,
+                         int(size) if args.dimension == "requests" else None) for _ in range(args.repeat)]
+            cpu += min(r[0] for r in runs)
+            work += runs[0][1]
+        print(json.dumps({"size": size, "cpu": cpu, "work": work}), flush=True)
+        if cpu > args.budget:
+            break
+    return 0
+
+
+# -- the driver ---------------------------------------------------------------------------------------
+
+def series(tree: Path, protocol: str, scheduler: str, dimension: str, sizes: tuple[float, ...], seeds: int,
+           repeat: int, budget: float) -> dict[float, tuple[float, int]]:
+    """``size -> (CPU s, work)`` of one series run on ``tree``."""
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", "--protocol", protocol,
+           "--schedulers", scheduler, "--dimension", dimension, "--sizes", ",".join(f"{s:g}" for s in sizes),
+           "--seeds", str(seeds), "--repeat", str(repeat), "--budget", str(budget)]
+    done = subprocess.run(cmd, env=env, cwd=tree, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"{scheduler} on {tree}: {done.stderr[-1500:]}")
+    out = {}
+    for line in done.stdout.splitlines():
+        row = json.loads(line)
+        out[float(row["size"])] = (float(row["cpu"]), int(row["work"]))
+    return out
+
+
+def exponent(xs: list[float], ys: list[float]) -> float:
+    """The slope of log y against log x (least squares): 1 is linear, 2 quadratic."""
+    lx, ly = [math.log(x) for x in xs], [math.log(y) for y in ys]
+    mx, my = sum(lx) / len(lx), sum(ly) / len(ly)
+    var = sum((x - mx) ** 2 for x in lx)
+    return sum((x - mx) * (y - my) for x, y in zip(lx, ly, strict=True)) / var if var else math.nan
+
+
+def checkout(commit: str, into: Path) -> Path:
+    """``commit``'s files (``git archive``) in ``into``."""
+    archive = subprocess.run(["git", "archive", commit], cwd=ROOT, capture_output=True, check=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
+    return into
+
+
+def report(name: str, dimension: str, now: dict[float, tuple[float, int]],
+           base: dict[float, tuple[float, int]] | None, sizes: tuple[float, ...]) -> bool:
+    """Print one series; True if it meets the target (or cannot be judged)."""
+    unit = "h" if dimension == "hours" else " req"
+    print(f"  {name:14} {dimension:8} " + "  ".join(f"{s:>8g}{unit}" for s in sizes))
+    rows = [("now CPU s", now)] + ([("60ed0ea CPU s" if base is not None else "", base)] if base is not None else [])
+    for label, data in rows:
+        cells = [f"{data[s][0]:>10.3f}" if s in data else f"{'-':>10}" for s in sizes]
+        print(f"  {'':14} {label:>14} " + "  ".join(cells))
+    print(f"  {'':14} {'work (events)':>14} " + "  ".join(f"{now[s][1]:>10d}" if s in now else f"{'-':>10}"
+                                                          for s in sizes))
+    ok = True
+    for label, data in rows:
+        have = [s for s in sizes if s in data]
+        if len(have) < 2:
+            continue
+        e_size = exponent(have, [data[s][0] for s in have])
+        e_work = exponent([float(now[s][1]) for s in have if s in now], [data[s][0] for s in have if s in now])
+        big, small = sizes[-1], sizes[-1] / 4
+        ratio = data[big][0] / data[small][0] if big in data and small in data else math.nan
+        work = now[big][1] / now[small][1] if big in now and small in now else math.nan
+        verdict = ""
+        if label == "now CPU s" and dimension == "hours" and not math.isnan(ratio):
+            verdict = "OK" if ratio <= TARGET else f"ABOVE TARGET ({TARGET:g}x)"
+            ok = ratio <= TARGET
+        print(f"  {'':14} {label:>14} exponent {e_size:4.2f} against size, {e_work:4.2f} against work; "
+              f"x4 size ({small:g} -> {big:g}): cost x{ratio:.2f}, work x{work:.2f} {verdict}")
+    return ok
+
+
+def main(argv: list[str]) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--protocol", default="tabsa-original")
+    p.add_argument("--schedulers", nargs="+", default=list(SCHEDULERS))
+    p.add_argument("--seeds", type=int, default=3)
+    p.add_argument("--repeat", type=int, default=2)
+    p.add_argument("--budget", type=float, default=60.0, help="CPU s after which a series stops")
+    p.add_argument("--base", default="60ed0ea", help="the commit to compare with ('' for none)")
+    p.add_argument("--quick", action="store_true", help="sizes 2 and 8 h, 36 and 144 requests, 1 seed, no base")
+    p.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    p.add_argument("--dimension", help=argparse.SUPPRESS)
+    p.add_argument("--sizes", help=argparse.SUPPRESS)
+    args = p.parse_args(argv)
+    if args.worker:
+        args.scheduler = args.schedulers[0]
+        return worker(args)
+    hours, requests = HOURS, REQUESTS
+    if args.quick:
+        hours, requests, args.seeds, args.repeat, args.base = (2.0, 8.0), (36, 144), 1, 1, ""
+    print(f"cost growth of synthetic days of {args.protocol}: CPU seconds, sum over seeds 1-{args.seeds} "
+          f"(best of {args.repeat}); commit {_head()}; load average {os.getloadavg()[0]:.2f}")
+    ok = True
+    with tempfile.TemporaryDirectory(prefix="tasker-base-") as tmp:
+        base_tree = checkout(args.base, Path(tmp)) if args.base else None
+        for name in args.schedulers:
+            for dimension, sizes in (("hours", hours), ("requests", requests)):
+                sizes_f = tuple(float(s) for s in sizes)
+                now = series(ROOT, args.protocol, name, dimension, sizes_f, args.seeds, args.repeat, args.budget)
+                base = (series(base_tree, args.protocol, name, dimension, sizes_f, args.seeds, args.repeat,
+                               args.budget) if base_tree is not None else None)
+                ok = report(name, dimension, now, base, sizes_f) and ok
+    print("target (a day four times as long costs at most 5 times as much): " + ("met" if ok else "NOT MET"))
+    return 0
+
+
+def _head() -> str:
+    done = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True)
+    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT, capture_output=True,
+                           text=True).stdout.strip()
+    return done.stdout.strip() + (" (with uncommitted changes)" if dirty else "")
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
