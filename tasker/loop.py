@@ -48,6 +48,11 @@ class SimulationLoop:
     ``harmoniser.hazards``, e.g. to a :meth:`tasker.meaning.Monitor.active` built on this loop).
     """
 
+    parking: bool = True
+    """Park waiting agents whose task says what its estimate reads (:mod:`tasker.parking`): they are
+    not stepped while it holds.  False (on an instance before :meth:`run`, or the class) steps every
+    agent whenever it asks: the reference computation, kept callable; traces are the same either way."""
+
     def __init__(
         self,
         store: TaskStore,
@@ -284,7 +289,7 @@ class SimulationLoop:
         self._push(self._tick, _TIMER, None)
         if self.world is not None:
             self._push(self._tick, _WORLD, None)
-        self.lot = self._lot()
+        self.lot = self._lot() if self.parking else None
         self._versions = (getattr(self.core, "version", None), getattr(self.world, "version", None))
 
     @property
