@@ -497,7 +497,7 @@ class TaskHarmoniser:
         return {} if c_time is None else {"predicted_s": c_time}
 
     def _c_time(self, agent_id: str) -> float | None:
-        cand = self._cands.get(agent_id)
+        cand = self._cands.raw.get(agent_id)  # a parked agent's cTime does not age: not aged to be read
         c_time = getattr(cand.params, "c_time", None) if cand is not None else None
         return float(c_time) if isinstance(c_time, int | float) else None
 

@@ -116,7 +116,8 @@ class CandidateIndex:
         touched, self._touched = self._touched, 0
         if 2 * touched > len(self) and 2 * len(self._dirty) > len(self):
             return False
-        self.refresh(cands)
+        # a key that never reads the cost is keyed on the candidates as reported, not aged (ReportedCandidates)
+        self.refresh(getattr(cands, "raw", cands) if self.scheduler.key_cost is False else cands)
         return True
 
     def refresh(self, cands: Mapping[str, Candidate]) -> None:
