@@ -32,10 +32,14 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 SCHEDULERS = ("tabsa-simple", "alg2", "edf", "lookahead")
+README_DAY = ("tabsa-simple", "tabsa-simple2", "tabsa-distance", "tabsa-scheduler", "edf", "lookahead", "alg2",
+              "simple", "simple2", "distance")
+"""The schedulers of the README's ``tasker day`` commands."""
 HOURS = (1.0, 2.0, 4.0, 8.0)
 REQUESTS = (9, 18, 36, 72, 144)
 TARGET = 5.0
@@ -69,6 +73,108 @@ def worker(args: argparse.Namespace) -> int:
         if cpu > args.budget:
             break
     return 0
+
+
+def one_day(protocol: str, scheduler: str, hours: float) -> None:
+    """Worker: the CPU seconds of :func:`experiments.days.runner.run_day` (draw, run, metrics) of one day."""
+    sys.path.insert(0, str(HERE))
+    from daysize import sized
+
+    from experiments.days.runner import run_day
+
+    start = time.process_time()
+    run_day(sized(protocol, hours), 1, scheduler)
+    print(json.dumps({"cpu": time.process_time() - start}), flush=True)
+
+
+def eight_hours(tree: Path, protocol: str, scheduler: str, limit: float) -> float | None:
+    """CPU seconds of an 8-hour day (seed 1) on ``tree``; None past ``limit`` CPU seconds."""
+    import resource
+
+    def cap() -> None:
+        resource.setrlimit(resource.RLIMIT_CPU, (int(limit) + 1, int(limit) + 1))
+
+    cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", "--one-day", "--protocol", protocol,
+           "--schedulers", scheduler]
+    done = subprocess.run(cmd, env={**os.environ, "PYTHONPATH": str(tree)}, cwd=tree, capture_output=True, text=True,
+                          preexec_fn=cap)
+    if done.returncode != 0:
+        return None
+    return float(json.loads(done.stdout.splitlines()[-1])["cpu"])
+
+
+def print_eight_hours(base: Path | None, limit: float) -> None:
+    print(f"an 8-hour synthetic day (seed 1, run_day: draw, run, metrics) of each scheduler of the README's "
+          f"`tasker day`, CPU seconds (> {limit:g}: stopped at that)")
+    for protocol in ("tabsa-original", "tabsa"):
+        for name in README_DAY:
+            now = eight_hours(ROOT, protocol, name, limit)
+            old = eight_hours(base, protocol, name, limit) if base is not None else None
+            print(f"  {protocol:15} {name:16} now {_cell(now, limit)}"
+                  + (f"   60ed0ea {_cell(old, limit)}" if base is not None else ""), flush=True)
+
+
+def _cell(value: float | None, limit: float) -> str:
+    return f"{value:9.2f}" if value is not None else f"{'>' + format(limit, 'g'):>9}"
+
+
+def budget_study(protocol: str, hours: float, seed: int, every: int, factor: int) -> dict[str, Any]:
+    """What the look-ahead's node budget does to its decisions: the problems of every ``every``-th
+    decision of a day (as :meth:`LookAhead.problem` built them), decided again with ``factor`` times
+    the budget; prints how often the first job differs and the objective of the default's choice
+    over the larger budget's (both orders evaluated on the same problem: 1 means as good)."""
+    sys.path.insert(0, str(HERE))
+    from daysize import sized
+
+    from experiments.days import pipeline
+    from tasker.schedulers import lookahead
+
+    seen: list[Any] = []
+    build = lookahead.LookAhead.problem
+
+    def recording(self: Any, view: Any) -> Any:
+        prob, jobs = build(self, view)
+        seen.append((prob, self.node_budget, self.hysteresis))
+        return prob, jobs
+
+    lookahead.LookAhead.problem = recording  # type: ignore[method-assign]
+    try:
+        pipeline.make(sized(protocol, hours), seed, scheduler="lookahead").build().run()
+    finally:
+        lookahead.LookAhead.problem = build  # type: ignore[method-assign]
+
+    def decide(prob: Any, budget: int, hysteresis: float) -> tuple[list[int], bool]:
+        if not prob.has_exe:
+            order, _, _, exact = lookahead.solve(prob, node_budget=budget)
+            return order, exact
+        keep, keep_obj, n1, e1 = lookahead.solve(prob, node_budget=max(1, budget // 2), fixed_first=0)
+        alt, alt_obj, _, e2 = lookahead.solve(prob, node_budget=budget - n1, exclude_first=0)
+        return (alt if alt_obj < hysteresis * keep_obj else keep), e1 and e2
+
+    sample = [x for x in seen if x[0].n >= 3][::every]
+    differ = exact = 0
+    ratios = []
+    for prob, budget, hysteresis in sample:
+        small, was_exact = decide(prob, budget, hysteresis)
+        big, _ = decide(prob, budget * factor, hysteresis)
+        exact += was_exact
+        differ += small[0] != big[0]
+        ratios.append(prob.evaluate(small) / prob.evaluate(big))
+    return {"decisions": len(seen), "sampled": len(sample), "jobs_mean": sum(p.n for p, _, _ in sample)
+            / max(1, len(sample)), "jobs_max": max((p.n for p, _, _ in sample), default=0), "exact": exact,
+            "first_differs": differ, "ratio_mean": sum(ratios) / max(1, len(ratios)),
+            "ratio_worst": max(ratios, default=1.0), "ratio_best": min(ratios, default=1.0),
+            "budget": sample[0][1] if sample else 0, "factor": factor}
+
+
+def print_budget_study(protocol: str) -> None:
+    r = budget_study(protocol, 4.0, 1, every=10, factor=10)
+    print(f"look-ahead node budget on the day's own decisions ({protocol}, 4 h, seed 1; every 10th decision with "
+          f"3 jobs or more): {r['sampled']} of {r['decisions']} decisions, {r['jobs_mean']:.1f} jobs on average "
+          f"(at most {r['jobs_max']}); with the default budget ({r['budget']} nodes) the search ended on its own in "
+          f"{r['exact']}; with {r['factor']}x the budget the first job differs in {r['first_differs']}, and the "
+          f"default's order costs x{r['ratio_mean']:.4f} the larger budget's on average (worst x{r['ratio_worst']:.4f},"
+          f" best x{r['ratio_best']:.4f})")
 
 
 # -- the driver ---------------------------------------------------------------------------------------
@@ -144,14 +250,30 @@ def main(argv: list[str]) -> int:
     p.add_argument("--budget", type=float, default=60.0, help="CPU s after which a series stops")
     p.add_argument("--base", default="60ed0ea", help="the commit to compare with ('' for none)")
     p.add_argument("--quick", action="store_true", help="sizes 2 and 8 h, 36 and 144 requests, 1 seed, no base")
+    p.add_argument("--budget-study", action="store_true",
+                   help="only: what the look-ahead's node budget does to a 4-hour day's decisions (seed 1)")
+    p.add_argument("--eight-hours", action="store_true",
+                   help="only: an 8-hour day of each scheduler of the README's `tasker day` (tabsa-original, tabsa)")
     p.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    p.add_argument("--one-day", action="store_true", help=argparse.SUPPRESS)
     p.add_argument("--dimension", help=argparse.SUPPRESS)
     p.add_argument("--sizes", help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     if args.worker:
         args.scheduler = args.schedulers[0]
+        if args.one_day:
+            one_day(args.protocol, args.scheduler, 8.0)
+            return 0
         return worker(args)
-    hours, requests = HOURS, REQUESTS
+    if args.eight_hours:
+        with tempfile.TemporaryDirectory(prefix="tasker-base-") as tmp:
+            print_eight_hours(checkout(args.base, Path(tmp)) if args.base else None, args.budget)
+        return 0
+    if args.budget_study:
+        print_budget_study(args.protocol)
+        return 0
+    hours: tuple[float, ...] = HOURS
+    requests: tuple[int, ...] = REQUESTS
     if args.quick:
         hours, requests, args.seeds, args.repeat, args.base = (2.0, 8.0), (36, 144), 1, 1, ""
     print(f"cost growth of synthetic days of {args.protocol}: CPU seconds, sum over seeds 1-{args.seeds} "
@@ -167,6 +289,8 @@ def main(argv: list[str]) -> int:
                                args.budget) if base_tree is not None else None)
                 ok = report(name, dimension, now, base, sizes_f) and ok
     print("target (a day four times as long costs at most 5 times as much): " + ("met" if ok else "NOT MET"))
+    if "lookahead" in args.schedulers and not args.quick:
+        print_budget_study(args.protocol)
     return 0
 
 
