@@ -11,8 +11,8 @@ Each size is the sum over seeds 1..N of the CPU seconds (``time.process_time``, 
 of two runs of each day) of building and running the day, in a process of its own.  The
 baseline is the commit before the cost work (``--base``, default 60ed0ea), checked out
 with ``git archive`` into a temporary folder and run the same way in the same run
-(``PYTHONPATH`` first on that folder).  A series stops after a size that took more than
-``--budget`` CPU seconds (the next would take longer still): its later sizes print ``-``.
+(``PYTHONPATH`` first on that folder).  A series stops when it has spent ``--budget`` CPU
+seconds: the size it was running and the later ones print ``-``.
 
 Printed per scheduler and dimension: CPU seconds per size (now, and the baseline's),
 the *work* (trace events, summed over the seeds: what the day produced), the exponent
@@ -62,16 +62,20 @@ def _day(protocol: str, scheduler: str, seed: int, hours: float | None, requests
 
 def worker(args: argparse.Namespace) -> int:
     sizes = [float(x) if args.dimension == "hours" else int(x) for x in args.sizes.split(",")]
+    spent = 0.0
     for size in sizes:
         cpu, work = 0.0, 0
         for seed in range(1, args.seeds + 1):
-            runs = [_day(args.protocol, args.scheduler, seed, size if args.dimension == "hours" else None,
-                         int(size) if args.dimension == "requests" else None) for _ in range(args.repeat)]
+            runs = []
+            for _ in range(args.repeat):
+                runs.append(_day(args.protocol, args.scheduler, seed, size if args.dimension == "hours" else None,
+                                 int(size) if args.dimension == "requests" else None))
+                spent += runs[-1][0]
+                if spent > args.budget:  # this size costs too much to finish: the series stops before it
+                    return 0
             cpu += min(r[0] for r in runs)
             work += runs[0][1]
         print(json.dumps({"size": size, "cpu": cpu, "work": work}), flush=True)
-        if cpu > args.budget:
-            break
     return 0
 
 
@@ -87,17 +91,22 @@ def one_day(protocol: str, scheduler: str, hours: float) -> None:
     print(json.dumps({"cpu": time.process_time() - start}), flush=True)
 
 
-def eight_hours(tree: Path, protocol: str, scheduler: str, limit: float) -> float | None:
-    """CPU seconds of an 8-hour day (seed 1) on ``tree``; None past ``limit`` CPU seconds."""
+def _cpu_cap(limit: float) -> Any:
+    """A ``preexec_fn`` that limits the child to ``limit`` CPU seconds (then the system stops it)."""
     import resource
 
     def cap() -> None:
         resource.setrlimit(resource.RLIMIT_CPU, (int(limit) + 1, int(limit) + 1))
 
+    return cap
+
+
+def eight_hours(tree: Path, protocol: str, scheduler: str, limit: float) -> float | None:
+    """CPU seconds of an 8-hour day (seed 1) on ``tree``; None past ``limit`` CPU seconds."""
     cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", "--one-day", "--protocol", protocol,
            "--schedulers", scheduler]
     done = subprocess.run(cmd, env={**os.environ, "PYTHONPATH": str(tree)}, cwd=tree, capture_output=True, text=True,
-                          preexec_fn=cap)
+                          preexec_fn=_cpu_cap(limit))
     if done.returncode != 0:
         return None
     return float(json.loads(done.stdout.splitlines()[-1])["cpu"])
@@ -186,8 +195,8 @@ def series(tree: Path, protocol: str, scheduler: str, dimension: str, sizes: tup
     cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", "--protocol", protocol,
            "--schedulers", scheduler, "--dimension", dimension, "--sizes", ",".join(f"{s:g}" for s in sizes),
            "--seeds", str(seeds), "--repeat", str(repeat), "--budget", str(budget)]
-    done = subprocess.run(cmd, env=env, cwd=tree, capture_output=True, text=True)
-    if done.returncode != 0:
+    done = subprocess.run(cmd, env=env, cwd=tree, capture_output=True, text=True, preexec_fn=_cpu_cap(2 * budget))
+    if done.returncode != 0 and not done.stdout.strip():  # a run past the cap ends the series where it is
         raise RuntimeError(f"{scheduler} on {tree}: {done.stderr[-1500:]}")
     out = {}
     for line in done.stdout.splitlines():
@@ -247,7 +256,7 @@ def main(argv: list[str]) -> int:
     p.add_argument("--schedulers", nargs="+", default=list(SCHEDULERS))
     p.add_argument("--seeds", type=int, default=3)
     p.add_argument("--repeat", type=int, default=2)
-    p.add_argument("--budget", type=float, default=60.0, help="CPU s after which a series stops")
+    p.add_argument("--budget", type=float, default=400.0, help="CPU s after which a series stops")
     p.add_argument("--base", default="60ed0ea", help="the commit to compare with ('' for none)")
     p.add_argument("--quick", action="store_true", help="sizes 2 and 8 h, 36 and 144 requests, 1 seed, no base")
     p.add_argument("--budget-study", action="store_true",
