@@ -88,8 +88,8 @@ class Simulation:
         self._objects = self._object_types()
         # the last snapshot's facts, under the facts_key they were made for (snapshot)
         self._snapped: tuple[tuple[Any, ...], frozenset[Fact], tuple[tuple[str, Pose | None], ...]] | None = None
-        # the last facts_key, under what it was made from: (tick, version, people's revision)
-        self._key: tuple[tuple[int, int, int], tuple[Any, ...]] | None = None
+        # the last facts_key, under what it was made from: (version, people's revision, robot x, y)
+        self._key: tuple[tuple[int, int, float, float], tuple[Any, ...]] | None = None
         self.facts: set[Fact] = set(self.spec.facts)
         # devices are where their place is
         self.facts |= {("at", d.name, d.place) for d in self.spec.devices.values()}
@@ -506,10 +506,10 @@ class Simulation:
         it or stand within ``TOGETHER`` of it) — exactly what :meth:`_facts_now` reads of
         poses.  A monitor that asks only when this changes misses nothing, and skips the
         ticks in which nobody changed place (the robot driving across a room, say)."""
-        made = (self._ticks, self.version, self.people.revision.n)  # nothing else moves anyone
+        rx, ry, _ = self.mj.pose()
+        made = (self.version, self.people.revision.n, rx, ry)  # nothing else moves anyone: equal, the same key
         if self._key is not None and self._key[0] == made:
             return self._key[1]
-        rx, ry, _ = self.mj.pose()
         here = self.nearest_place(rx, ry)
         hypot = math.hypot
         key = (self.version, here, tuple(

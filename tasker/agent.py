@@ -33,7 +33,9 @@ from tasker import events as ev
 from tasker import fsm, securing
 from tasker.conditions import Latched
 from tasker.errors import AgentEnded, ConfigError, FSMError, PlanningFailed
+from tasker.inputs import Parking
 from tasker.messages import Command, Flag, FsmState, Report, ScheduleParams, SPRequest
+from tasker.parking import ParkedReports, parking
 from tasker.protocols import CoreAgent, SkillState
 from tasker.stage import Purpose, Stage, StagePlan
 from tasker.stagerun import UNCONTAINED, StageRunner, check_goal, describe, emit_plan
@@ -58,7 +60,7 @@ class Rates:
                 raise ConfigError(f"Rates.{name} must be a positive number of Hz, got {v!r}")
 
 
-class DynamicAgent:
+class DynamicAgent(ParkedReports):
     """A task's dynamic agent.  Created by the harmoniser's ``pf_initDA``.
 
     ``report`` is the agent's report buffer; the harmoniser reads it and sends
@@ -89,7 +91,9 @@ class DynamicAgent:
         self._on_report = on_report
         self._waker = waker
         self.state = S.INIT_COMM
-        self.report: Report | None = None
+        self._report: Report | None = None
+        self.offer: Parking | None = None  # set by a report the loop may let age (ParkedReports.park)
+        self._parked = self._next = self._clock = self._aged = None
         self.end_reason: str | None = None
         self.next_wake = ctx.request_time
         self._inbox: list[Command] = []
@@ -151,6 +155,8 @@ class DynamicAgent:
             raise AgentEnded(self.id, self.end_reason or "ended")
         if self._params_at == now:
             return self._params
+        if self._parked is not None and self._clock is not None and self._clock() == now:
+            return self.report.params if self.report is not None else None  # reported now, aged
         if self._fresh is not None and self._fresh[0] == now:
             return self._fresh[1]
         try:
@@ -213,6 +219,9 @@ class DynamicAgent:
         if self.state is S.END:
             self.next_wake = math.inf
             return
+        if self._parked is not None:  # stepped directly, not by its loop: its reports stop aging here
+            self.unpark(self._clock() if self._clock is not None else None)
+        self.offer = None
         self._params_at = self._fresh = None  # stepping may change what the parameters depend on
         try:
             self.refresh(now)
@@ -266,6 +275,7 @@ class DynamicAgent:
         self._params_at = now
         self._publish()
         self.next_wake = _next_tick_of(now, self.rates.rep_rate)
+        self.offer = None if self._inbox else parking(self.task, self.ctx, self._params, now)
 
     def _terminate(self, now: float) -> None:
         """``term [ic_term]``: end with the latched reason and cause."""
@@ -530,8 +540,8 @@ class DynamicAgent:
     def _publish(self) -> None:
         """pf^report: write the report buffer; tell the harmoniser only if it changed (newData)."""
         report = Report(self.state, self._params, self._ack, self.end_reason if self.state is S.END else None)
-        if report != self.report:
-            self.report = report
+        if report != self._report:
+            self._report = report
             if self._on_report is not None:
                 self._on_report(self)
 

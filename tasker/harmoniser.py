@@ -47,7 +47,7 @@ from tasker.errors import AgentEnded, ConfigError, InvariantViolation, TaskerErr
 from tasker.messages import Command, Flag, FsmState, ScheduleParams, SPRequest
 from tasker.oscillation import OscillationGuard
 from tasker.schedulers.base import Candidate, Scheduler, ScheduleView, UnattendedHazard
-from tasker.schedulers.index import CandidateIndex, IdleCandidates
+from tasker.schedulers.index import CandidateIndex, IdleAgents, IdleCandidates, ReportedCandidates
 from tasker.securing import HazardSource, HazardWatch, suspend_estimate
 from tasker.task import Effects
 from tasker.trace import Trace
@@ -100,16 +100,14 @@ class TaskHarmoniser:
     """
 
     incremental: bool = True
-    """Keep the candidates of an :attr:`~tasker.schedulers.base.Scheduler.indexed`
-    scheduler in a heap updated on each report (:mod:`tasker.schedulers.index`), so a
-    decision does not scan every waiting agent.  False (on an instance or the class)
-    scans, as every unindexed scheduler does: the reference computation, kept
-    callable; decisions and traces are the same either way."""
+    """Keep the candidates of an :attr:`~tasker.schedulers.base.Scheduler.indexed` scheduler in a heap
+    updated on each report (:mod:`tasker.schedulers.index`), so a decision does not scan every waiting
+    agent.  False (on an instance or the class) scans, as every unindexed scheduler does: the reference
+    computation, kept callable; decisions and traces are the same either way."""
 
     scan_below: int = 32
-    """With no more waiting agents than this, a decision scans them even when
-    :attr:`incremental`: a short scan is cheaper than keeping the heap.  Reports
-    still mark their agents, so the heap is exact again as soon as it is used."""
+    """With no more waiting agents than this, and none parked (:mod:`tasker.parking`), a decision scans
+    them: a short scan is cheaper than the heap, which reports keep exact for when it is used."""
 
     def __init__(
         self,
@@ -145,13 +143,13 @@ class TaskHarmoniser:
         self._suspensions: dict[tuple[float, str, str], float] = {}  # _suspension_of's answers
         self.exe_da: str | None = None
         self.irr_da: str | None = None
-        self._idle: dict[str, None] = {}  # D_r, in request order
+        self._idle = IdleAgents()  # D_r, in request order (its version counts changes: ScheduleView.generation)
         self._requests: list[tuple[str, Request]] = []
         self._terms: list[tuple[str, str]] = []
         self._ended: list[str] = []
         self._new_data = False
         self._in_cmd: set[str] = set()
-        self._cands: dict[str, Candidate] = {}
+        self._cands = ReportedCandidates(self.agents, self._idle)  # by agent; a parked agent's aged when read
         self._index: CandidateIndex | None = None  # built at the first indexed decision
         self._order: dict[str, int] = {}
         self._seq = 0
@@ -274,18 +272,19 @@ class TaskHarmoniser:
         name = self.scheduler.name
         for _ in range(len(self._idle) + 2):  # each retry follows an agent that ended while asked
             exe = self._cands.get(self.exe_da) if self.exe_da is not None else None
-            index = self._candidate_index() if len(self._idle) > self.scan_below else None
+            index = self._candidate_index() if len(self._idle) > self.scan_below or self._cands.parked else None
             if index is not None and index.ready(self._cands) and not index.needs_scan(self._idle):
                 lowest = index.lowest(self._idle)
                 if lowest is None:
                     return
                 view = ScheduleView(now=now, exe=exe, candidates=IdleCandidates(self._idle, self._cands),
                                     req_sp=self._req_sp, fresh=self._fresh, lowest=self._cands[lowest])
-            else:
-                candidates = [c for a in self._idle if (c := self._cands.get(a)) is not None]
-                if not candidates:
+            else:  # the idle agents' candidates (aged, unless the scheduler reads no waiting cost)
+                candidates = self._cands.of(self._idle, aged=self.scheduler.reads_cost)
+                if candidates is None:
                     return
-                view = ScheduleView(now=now, exe=exe, candidates=candidates, req_sp=self._req_sp, fresh=self._fresh)
+                view = ScheduleView(now=now, exe=exe, candidates=candidates, req_sp=self._req_sp, fresh=self._fresh,
+                                    generation=self._idle.version)
             if self.scheduler.reads_harmoniser:  # what a whole-queue scheduler weighs beyond the reports
                 view = replace(view, suspension=self._suspension_of if exe is not None else None,
                                hazards=self._unattended())
@@ -358,7 +357,7 @@ class TaskHarmoniser:
         if not (self.incremental and self.scheduler.indexed):
             return None
         if self._index is None or self._index.scheduler is not self.scheduler:  # first use, or a new scheduler
-            self._index = CandidateIndex(self.scheduler)
+            self._index = CandidateIndex(self.scheduler, self.agents)
             for agent in self._cands:
                 self._index.touch(agent)
         return self._index
@@ -438,7 +437,7 @@ class TaskHarmoniser:
         if self.irr_da is not None:  # a switch already under way: the hazard goes first
             self._idle[self.irr_da] = None
         del self._idle[agent]
-        self._idle = dict.fromkeys(sorted(self._idle, key=lambda a: self._order.get(a, 0)))
+        self._idle.sort(key=lambda a: self._order.get(a, 0))
         self.irr_da = agent
         self._roles_dirty = True
 
@@ -469,7 +468,7 @@ class TaskHarmoniser:
         self._trace.emit(ev.SecureChanged(now, agent, "done"))
         self._securing = None
         self._idle[agent] = None
-        self._idle = dict.fromkeys(sorted(self._idle, key=lambda a: self._order.get(a, 0)))
+        self._idle.sort(key=lambda a: self._order.get(a, 0))
         self.exe_da = None
         self._roles_dirty = True
 
@@ -498,7 +497,7 @@ class TaskHarmoniser:
         return {} if c_time is None else {"predicted_s": c_time}
 
     def _c_time(self, agent_id: str) -> float | None:
-        cand = self._cands.get(agent_id)
+        cand = self._cands.raw.get(agent_id)  # a parked agent's cTime does not age: not aged to be read
         c_time = getattr(cand.params, "c_time", None) if cand is not None else None
         return float(c_time) if isinstance(c_time, int | float) else None
 
@@ -565,6 +564,10 @@ class TaskHarmoniser:
 
     def _fresh(self, agent_id: str) -> ScheduleParams | None:
         return self.agents[agent_id].fresh_params(self.now)
+
+    def park(self, agent_id: str, parked: bool) -> None:
+        """The loop parked or woke ``agent_id`` (:mod:`tasker.parking`): its candidate is keyed anew."""
+        self._cands.park(agent_id, parked, self._index)
 
     def _on_report(self, agent: DynamicAgent) -> None:
         """A report buffer changed (newData, eq. 37)."""

@@ -28,6 +28,7 @@ from tasker import events as ev
 from tasker.agent import DynamicAgent, Rates
 from tasker.errors import ConfigError, RunAborted, WorldError
 from tasker.harmoniser import HazardSource, Mode, Request, TaskHarmoniser
+from tasker.parking import AFTER, BEFORE, Key, Lot
 from tasker.protocols import CoreAgent, World
 from tasker.schedulers.base import Scheduler
 from tasker.store import TaskStore
@@ -46,6 +47,11 @@ class SimulationLoop:
     hold (all passed to the harmoniser; ``hazards`` may also be set later on
     ``harmoniser.hazards``, e.g. to a :meth:`tasker.meaning.Monitor.active` built on this loop).
     """
+
+    parking: bool = True
+    """Park waiting agents whose task says what its estimate reads (:mod:`tasker.parking`): they are
+    not stepped while it holds.  False (on an instance before :meth:`run`, or the class) steps every
+    agent whenever it asks: the reference computation, kept callable; traces are the same either way."""
 
     def __init__(
         self,
@@ -86,7 +92,7 @@ class SimulationLoop:
         self.harmoniser = TaskHarmoniser(scheduler, self._make_agent, trace=self.trace, mode=Mode(mode),
                                          s_freq=s_freq, hazard_waiting=self.hazard_waiting, hazards=hazards,
                                          secure_over_higher=secure_over_higher)
-        self._heap: list[tuple[int, int, int, Any]] = []
+        self._heap: list[tuple[int, int, Any, Any, int, Any]] = []  # (tick, phase, key..., seq, item)
         self._seq = itertools.count()
         self._tick = 0
         self._pending_events = 0
@@ -95,6 +101,8 @@ class SimulationLoop:
         self.aborted: str | None = None  # why the run was aborted, if it was
         self.all_agents: list[DynamicAgent] = []  # every agent created, ended ones included
         self.observers: list[Callable[[float], None]] = []  # called after each tick, e.g. tasker.meaning.Monitor
+        self.lot: Lot | None = None  # the parked agents (tasker.parking); None: every agent is stepped
+        self._versions: tuple[Any, Any] = (None, None)
 
     # -- time ---------------------------------------------------------------------------------
 
@@ -106,8 +114,8 @@ class SimulationLoop:
         # the first tick at or after t (a hair of tolerance absorbs float noise in t / resolution)
         return max(self._tick, math.ceil(t / self.resolution - 1e-6))
 
-    def _push(self, tick: int, phase: int, item: Any) -> None:
-        heapq.heappush(self._heap, (tick, phase, next(self._seq), item))
+    def _push(self, tick: int, phase: int, item: Any, key: Key = (0, ())) -> None:
+        heapq.heappush(self._heap, (tick, phase, key[0], key[1], next(self._seq), item))
 
     # -- scenario -----------------------------------------------------------------------------
 
@@ -125,7 +133,7 @@ class SimulationLoop:
         for that tick: its order among the tick's actions cannot depend on when it was added.  A
         live controller injects what arrives there, so that a scenario holding the same action at
         that time replays the run byte for byte (``tasker serve``)."""
-        due = {tick for tick, phase, _, _ in self._heap if phase == _EVENT}
+        due = {entry[0] for entry in self._heap if entry[1] == _EVENT}
         tick = max(self._to_tick(t), self._tick + 1)
         while tick in due:
             tick += 1
@@ -209,13 +217,66 @@ class SimulationLoop:
         self._heap.clear()
         return RunAborted(reason)
 
-    def _wake(self, agent: DynamicAgent, tick: int) -> None:
+    def _wake(self, agent: DynamicAgent, tick: int, key: Key | None = None) -> None:
+        """Step ``agent`` at ``tick``; ``key`` sorts it among that tick's agents (default: after those
+        already woken for it)."""
         token = self._tokens.get(agent.id, 0) + 1
         self._tokens[agent.id] = token
-        self._push(tick, _AGENT, (agent, token))
+        self._push(tick, _AGENT, (agent, token), key if key is not None else (self._tick, (0, next(self._seq))))
 
     def _wake_next_tick(self, agent: DynamicAgent) -> None:
+        if self.lot is not None and agent.id in self.lot.members:  # a command or new arguments: step it again
+            self.lot.leave(agent.id)
+            self.harmoniser.park(agent.id, False)
         self._wake(agent, self._tick + 1)
+
+    def _lot(self) -> Lot | None:
+        """The lot of parked agents (:mod:`tasker.parking`), when waiting agents' report ticks are ticks
+        of the harmoniser's timer (so that a report no one steps changes no decision's moment)."""
+        res = self.resolution
+        period = 1.0 / (self.rates.rep_rate * res)
+        q = round(period)
+        timer = max(1, round(1.0 / (self.harmoniser.s_freq * res)))
+        if self._tick != 0 or q < 2 or abs(period - q) > 1e-9 * q or q % timer:
+            return None
+        return Lot(q, res, self._seq)
+
+    def _after_step(self, agent: DynamicAgent, tick: int, stepped: Key) -> None:
+        """Wake ``agent`` when it asks (at ``stepped``'s place for a report tick), or park it."""
+        lot = self.lot
+        target = max(tick + 1, self._to_tick(agent.next_wake))
+        if lot is None:
+            self._wake(agent, target)
+            return
+        key = lot.key(tick, stepped, target)
+        if agent.offer is not None and lot.park(agent, tick, key, target):
+            self._tokens[agent.id] = self._tokens.get(agent.id, 0) + 1  # no wake of it stands
+            self.harmoniser.park(agent.id, True)
+        else:
+            self._wake(agent, target, key)
+
+    def _check_inputs(self, always: bool = False) -> None:
+        """Step again, where their reports fall, the parked agents whose inputs changed."""
+        lot = self.lot
+        if lot is None or not lot.members:
+            return
+        versions = (getattr(self.core, "version", None), getattr(self.world, "version", None))
+        if versions == self._versions and not always:
+            return
+        self._versions = versions
+        for agent_id in lot.changed():
+            if lot.repark(agent_id):
+                self.harmoniser.park(agent_id, True)
+            else:
+                self._leave(agent_id)
+
+    def _leave(self, agent_id: str) -> None:
+        assert self.lot is not None
+        left = self.lot.leave(agent_id)
+        if left is not None:
+            _, tick, key = left
+            self._wake(self.harmoniser.agents[agent_id], tick, key)
+            self.harmoniser.park(agent_id, False)
 
     # -- running --------------------------------------------------------------------------------
 
@@ -228,6 +289,8 @@ class SimulationLoop:
         self._push(self._tick, _TIMER, None)
         if self.world is not None:
             self._push(self._tick, _WORLD, None)
+        self.lot = self._lot() if self.parking else None
+        self._versions = (getattr(self.core, "version", None), getattr(self.world, "version", None))
 
     @property
     def planner_calls(self) -> list[dict[str, Any]]:
@@ -256,7 +319,7 @@ class SimulationLoop:
     def _run(self, until: float | None) -> Trace:
         stop_tick = self._to_tick(until) if until is not None else None
         horizon_tick = self._to_tick(self.horizon)
-        harm = self.harmoniser
+        harm, lot = self.harmoniser, self.lot
         tokens, heap, pop = self._tokens, self._heap, heapq.heappop
         isfinite = math.isfinite
         while self._heap:
@@ -265,34 +328,53 @@ class SimulationLoop:
             tick = self._heap[0][0]
             if stop_tick is not None and tick > stop_tick:
                 self._tick = stop_tick
+                if lot is not None:
+                    lot.tick, lot.cur = stop_tick, BEFORE
                 break
             if tick > horizon_tick:
                 self._tick = horizon_tick
+                if lot is not None:
+                    lot.tick, lot.cur = horizon_tick, BEFORE
                 self.trace.emit(ev.RunStopped(self.now, "horizon reached", None, sorted(harm.agents)))
                 break
             self._tick = tick
             now = tick * self.resolution
             harm.now = now
             timer = False
+            if lot is not None:
+                lot.tick, lot.cur = tick, BEFORE
+                for agent_id in lot.due(tick):  # its ic_term may answer otherwise from now on
+                    self._leave(agent_id)
             while heap and heap[0][0] == tick:
-                _, phase, _, item = pop(heap)
+                _, phase, k1, k2, _, item = pop(heap)
                 if phase == _AGENT:
                     agent, token = item
                     if token != tokens.get(agent.id) or agent.ended:
                         continue
+                    if lot is not None:
+                        lot.place(tick, (k1, k2))
+                        lot.cur = (k1, k2)
                     agent.step(now)
                     if isfinite(agent.next_wake):
-                        self._wake(agent, max(tick + 1, self._to_tick(agent.next_wake)))
+                        self._after_step(agent, tick, (k1, k2))
+                    self._check_inputs()
                 elif phase == _EVENT:
                     self._pending_events -= 1
                     item()
+                    self._check_inputs()
                 elif phase == _WORLD:
                     assert self.world is not None
                     self._advance_world(now)
                     self._push(tick + max(1, round(1.0 / (self.world.rate_hz * self.resolution))), _WORLD, None)
+                    self._check_inputs(always=True)
                 else:
                     timer = True
                     self._push(tick + max(1, round(1.0 / (harm.s_freq * self.resolution))), _TIMER, None)
+            if lot is not None:
+                lot.place(tick, AFTER)
+                lot.cur = AFTER
+                for agent_id in lot.effects(tick):  # reported a new estimate: keyed anew
+                    harm.park(agent_id, True)
             harm.step(now, timer)
             for observe in self.observers:
                 observe(now)

@@ -25,6 +25,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from tasker.errors import ConfigError
+from tasker.inputs import EstimateInputs
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
 from tasker.protocols import RUNNING, SUCCEEDED, SkillStatus, failed
 from tasker.stage import Purpose, Stage, StagePlan
@@ -153,6 +154,15 @@ class SyntheticTask(TaskType):
             return "no longer needed"
         return None
 
+    def estimate_inputs(self, ctx: TaskContext) -> EstimateInputs | None:
+        """Besides the agent's own context, the estimate reads the robot's pose (the executor's
+        ``version`` counts its changes), and ``ic_term`` the clock against ``cancel_at``.  None with
+        a ``cost_fn`` (its cost need not be the model's) or while a stage runs (its progress is time)."""
+        if self.cost_fn is not None or ctx.stage_started is not None:
+            return None
+        at = ctx.args["cancel_at"]
+        return EstimateInputs(self._robot_pose(ctx), math.inf if at is None else float(at))
+
 
 class TimedExecutor:
     """A core agent whose skills take their stage's ``duration`` of simulated time.
@@ -161,7 +171,8 @@ class TimedExecutor:
     ``[1 - jitter, 1 + jitter]`` with a generator seeded by ``(seed, agent, stage)``,
     so runs vary with the seed and repeat exactly for the same seed.  A stage whose
     ``data`` has ``"fail"`` fails with that reason when its time is up.  ``pose`` is
-    the site of the last stage run (its ``data["site"]``), for travel estimates.
+    the site of the last stage run (its ``data["site"]``), for travel estimates; ``version``
+    counts its changes (what a parked agent's estimate reads, :mod:`tasker.inputs`).
     """
 
     def __init__(self, seed: int = 0, jitter: float = 0.0) -> None:
@@ -169,10 +180,21 @@ class TimedExecutor:
             raise ConfigError(f"jitter must be in [0, 1), got {jitter}")
         self.seed = seed
         self.jitter = jitter
-        self.pose: Pose | None = None
+        self.version = 0  # counts the changes of pose (what estimates read: tasker.inputs)
+        self._pose: Pose | None = None
         self._running: dict[str, tuple[Stage, float]] = {}
         self._count: dict[str, int] = {}
         self.log: list[tuple[float, str, str, str]] = []
+
+    @property
+    def pose(self) -> Pose | None:
+        return self._pose
+
+    @pose.setter
+    def pose(self, value: Pose | None) -> None:
+        if value != self._pose:
+            self.version += 1
+        self._pose = value
 
     def begin(self, agent: str, stage: Stage, now: float) -> None:
         if self._running and agent not in self._running:

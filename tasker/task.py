@@ -15,6 +15,7 @@ hook                   called in (paper)                 returns
 ``update_task``        ``upTsk``                         the ``exeTsk`` :class:`~tasker.stage.StagePlan`
 ``generate_suspension`` ``genSusp``                      the ``exeSusp`` :class:`~tasker.stage.StagePlan`
 ``check_terminate``    ``compSP``, ``exeTsk``, ``wait``   a reason to end itself (``ic_term``) or None
+``estimate_inputs``    ``compSP``, ``wait``              what the two above read (:mod:`tasker.inputs`)
 ``on_stage_done``      after each completed stage        nothing
 ``leaves``             another agent's estimate          the facts it would leave changed
                        (:attr:`TaskContext.handover`)     (:class:`Effects`) or None
@@ -31,6 +32,8 @@ Which hook when:
   say how urgent the task is; ``request_sp`` when the answer to ``cc`` depends on where
   the robot starts (the default ignores the pose).
 * ``check_terminate`` when the task can become pointless on its own (the person got up).
+* ``estimate_inputs`` when you can say what ``compute_params`` and ``check_terminate`` read:
+  a waiting agent is then not stepped while none of it changes (its cost aged in closed form).
 * ``initialise`` for per-agent set-up, never ``__init__``: one instance serves every agent,
   so per-agent state lives in ``ctx.memory``.
 * ``on_stage_done`` to note progress; ``leaves`` when what the task changes matters to the
@@ -54,6 +57,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from tasker.errors import BadRequest, ConfigError
+from tasker.inputs import EstimateInputs
 from tasker.meaning import NO_MEANING, Meaning
 from tasker.messages import CompletionCost, CostParams, ScheduleParams, SPRequest
 from tasker.stage import Purpose, Stage, StagePlan
@@ -311,6 +315,16 @@ class TaskType:
         remaining = ctx.remaining if ctx.plan is not None else ()
         c_time = sum(s.duration for s in remaining)
         return CostParams(self.name, cost=ctx.age + c_time, cps=1.0, c_time=c_time)
+
+    def estimate_inputs(self, ctx: TaskContext) -> EstimateInputs | None:
+        """Override to say what :meth:`compute_params` and :meth:`check_terminate` read besides the clock.
+
+        Asked after a waiting agent (``compSP``, ``wait``) reported: while the returned key is
+        unchanged (and before its ``until``), the agent is not stepped and its cost is aged in
+        closed form (:mod:`tasker.inputs`), which requires the model's cost, ``cps * (ctx.age +
+        c_time)``.  The key may read ``ctx`` and what the core agent's and the world's ``version``
+        counters cover.  Default: None (not said): the agent computes its parameters at every report."""
+        return None
 
     def request_sp(self, ctx: TaskContext, request: SPRequest) -> Any:
         """Override to answer the harmoniser's argument-dependent request ``[spID, args]`` (eqs. 20-23).

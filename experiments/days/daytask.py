@@ -21,6 +21,8 @@ from tasker.synthetic import SyntheticTask
 from tasker.task import ArgSpec, TaskContext
 
 SUSP, BLOCK = StageKind.SUSPENDABLE, StageKind.BLOCKING
+_ESTIMATES = "_estimates"
+"""``ctx.memory`` key of the estimates remembered per start pose (:meth:`DayTask._c_time`)."""
 _RESUME_STAGES = ("go_back", "apologise", "pick_again")
 
 
@@ -157,9 +159,19 @@ class DayTask(SyntheticTask):
         started = ctx.plan is not None and not ctx.memory.get("waiting", False)
         if started and start is None:
             return self._remaining(ctx)  # executing: what is left of the current plan
-        # not started, waiting, or asked "from another pose" (i.e. resumed later): the plan it would build
-        stages = self._build(ctx, start, resume=started or ctx.suspended)
-        return sum(s.duration for s in stages) + self.planning_time
+        # not started, waiting, or asked "from another pose" (i.e. resumed later): the plan it would build,
+        # remembered per start while what _build reads of the agent (plan, stage, arguments, resume point) holds
+        resume = started or ctx.suspended
+        memo: tuple[Any, int, Any, Any, dict[tuple[Pose | None, bool], float]] | None = ctx.memory.get(_ESTIMATES)
+        reached = ctx.memory.get("reached")
+        if memo is None or memo[0] is not ctx.plan or memo[1] != ctx.stage_index or memo[2] is not ctx.args \
+                or memo[3] != reached:
+            memo = ctx.memory[_ESTIMATES] = (ctx.plan, ctx.stage_index, ctx.args, reached, {})
+        c_time = memo[4].get((start, resume))
+        if c_time is None:
+            stages = self._build(ctx, start, resume=resume)
+            c_time = memo[4][start, resume] = sum(s.duration for s in stages) + self.planning_time
+        return c_time
 
     def _end_pose(self, ctx: TaskContext) -> Pose | None:
         return ctx.args["dest"] if ctx.args["dest"] is not None else ctx.args["site"]

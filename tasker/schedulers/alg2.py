@@ -59,6 +59,7 @@ class Alg2(Scheduler):
     name = "alg2"
     preemptive = True
     indexed = True  # dac is the lowest queue_key: the harmoniser may find it without a scan
+    key_cost = True  # select_key is (class, cost, request order)
 
     def __init__(self, classes: Sequence[Sequence[str]] = (), hysteresis: float = 1.0) -> None:
         if not isinstance(hysteresis, int | float) or not 0 < hysteresis <= 1:

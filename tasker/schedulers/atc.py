@@ -35,10 +35,32 @@ class ApparentTardinessCost(Scheduler):
 
     name = "atc"
     preemptive = True
+    reads_cost = False  # cTime, deadline and priority or cps
 
     def __init__(self, k: float = 2.0, weight: str = "priority") -> None:
         self.k = number(self.name, "k", k, low=0.0, high=math.inf, low_open=True, high_open=True)
         self.weight = choice(self.name, "weight", weight, WEIGHTS)
+        # per ScheduleView.generation: the candidates' time-free parts and the sum of their finite cTimes
+        self._parts: tuple[int, list[tuple[Candidate, float, float, float | None]], float, int] | None = None
+
+    def _time_free(self, view: ScheduleView) -> tuple[list[tuple[Candidate, float, float, float | None]], float, int]:
+        """Each candidate with ``(w/p, log(w/p), deadline - cTime)`` and the sum and count of the finite
+        cTimes (summed in the candidates' order, as :meth:`schedule` sums them), kept per generation."""
+        parts = self._parts
+        if parts is not None and view.generation is not None and parts[0] == view.generation:
+            return parts[1], parts[2], parts[3]
+        rows, times = [], []
+        for c in view.candidates:
+            p = self.cost_params(c, self.name)
+            base = ratio(weight_of(self, c, self.weight), p.c_time)
+            log = -math.inf if base == 0.0 else math.inf if math.isinf(base) else math.log(base)
+            rows.append((c, base, log, None if p.deadline is None else p.deadline - p.c_time))
+            if math.isfinite(p.c_time):
+                times.append(p.c_time)
+        total = sum(times)
+        if view.generation is not None:
+            self._parts = (view.generation, rows, total, len(times))
+        return rows, total, len(times)
 
     def log_index(self, c: Candidate, now: float, p_mean: float) -> tuple[float, float]:
         """``(log I_j(now), w_j / p_j)``."""
@@ -63,14 +85,30 @@ class ApparentTardinessCost(Scheduler):
         return (-ratio(weight_of(self, c, self.weight), self.cost_params(c, self.name).c_time), c.order)
 
     def schedule(self, view: ScheduleView) -> Decision:
-        if not view.candidates:
+        rows, total, count = self._time_free(view)
+        if not rows:
             return NO_CHANGE
         exe = view.exe
-        jobs = [*view.candidates, *([exe] if exe is not None else [])]
-        times = [t for c in jobs if math.isfinite(t := self.cost_params(c, self.name).c_time)]
-        p_mean = sum(times) / len(times) if times else 0.0
-        keys = {c.id: self.log_index(c, view.now, p_mean) for c in jobs}
-        best = min(view.candidates, key=lambda c: (-keys[c.id][0], -keys[c.id][1], c.order))
+        t_exe = self.cost_params(exe, self.name).c_time if exe is not None else math.inf
+        if math.isfinite(t_exe):  # the sum of every finite cTime, the executing task's last (sum() order)
+            total, count = total + t_exe, count + 1
+        p_mean = total / count if count else 0.0
+        keys: dict[str, tuple[float, float]] = {}
+        now, kp = view.now, self.k * p_mean
+        best, best_key = rows[0][0], None
+        for c, base, log, d_minus_p in rows:  # log_index, with its time-free parts kept
+            if base == 0.0 or math.isinf(base):
+                key = (log, base)
+            else:
+                slack = math.inf if d_minus_p is None else max(0.0, d_minus_p - now)
+                discount = 0.0 if slack == 0.0 else slack / kp if p_mean > 0 else math.inf
+                key = (log - discount, base)
+            keys[c.id] = key
+            order = (-key[0], -key[1], c.order)
+            if best_key is None or order < best_key:
+                best, best_key = c, order
+        if exe is not None:
+            keys[exe.id] = self.log_index(exe, now, p_mean)
         record: dict[str, Any] = {"algorithm": self.name, "dac": best.id, "exeDA": exe.id if exe else None,
                                   "k": self.k, "p_mean": p_mean, "log_atc_dac": keys[best.id][0],
                                   "wspt_dac": keys[best.id][1]}

@@ -66,6 +66,11 @@ class ScheduleView:
       harmoniser would announce in that ``susp`` (``expected_s``); ``inf`` if it cannot
       be planned.  May raise :class:`~tasker.errors.AgentEnded` like ``req_sp``;
     * ``hazards``: the hazards that hold now and are unattended (:class:`UnattendedHazard`).
+
+    ``generation`` (None: not kept) changes whenever ``candidates`` may have: an agent became or
+    stopped being idle, or an idle one reported (a cost aging while its agent is parked,
+    :mod:`tasker.parking`, is no report).  A scheduler may keep what it derived from the
+    candidates while it is unchanged.
     """
 
     now: float
@@ -76,6 +81,7 @@ class ScheduleView:
     lowest: Candidate | None = None
     suspension: Callable[[str], float] | None = None
     hazards: Sequence[UnattendedHazard] = ()
+    generation: int | None = None
 
     def best(self, key: Callable[[Candidate], Any]) -> Candidate | None:
         """The candidate with the lowest ``key`` (None if there is none).
@@ -129,6 +135,19 @@ class Scheduler:
     """Option values an experiment sweeps, as the algorithm's authors swept them (empty: none)."""
     indexed: ClassVar[bool] = False
     reads_harmoniser: ClassVar[bool] = False
+
+    reads_cost: ClassVar[bool] = True
+    """False for a scheduler whose :meth:`schedule` never reads a waiting candidate's ``cost``: the
+    harmoniser then hands it the candidates as last reported, without aging the cost of those
+    whose agent is parked (:mod:`tasker.parking`), which would cost a new candidate per tick."""
+    key_cost: ClassVar[bool | None] = None
+    """How :meth:`select_key` reads a candidate's ``cost``, for the harmoniser's index of the candidates
+    whose cost ages while their agent is parked (:mod:`tasker.parking`): False, never; True, the key is
+    ``(*key_prefix(c), cost, c.order)``; None (not said): such a candidate is keyed anew at every decision."""
+
+    def key_prefix(self, c: Candidate) -> tuple[Any, ...]:
+        """What :meth:`select_key` puts before the cost, when :attr:`key_cost` is True."""
+        return tuple(self.select_key(c)[:-2])
 
     def outranks(self, a: Candidate, b: Candidate) -> bool:
         """Whether ``a``'s priority class is above ``b``'s, in this scheduler's own terms (hazard-aware

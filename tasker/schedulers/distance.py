@@ -15,6 +15,7 @@ Tasks without an ``endPose`` score 0.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from tasker.schedulers.base import NO_CHANGE, Candidate, Decision, Scheduler, ScheduleView
 from tasker.schedulers.simple import priority
@@ -23,9 +24,11 @@ from tasker.schedulers.simple import priority
 class DistanceOverDuration(Scheduler):
     name = "distance"
     preemptive = True
+    reads_cost = False  # priority, cTime and endPose
 
     def __init__(self) -> None:
         self._here: tuple[float, ...] | None = None  # end pose of the last task seen executing
+        self._best: tuple[int, Any, Candidate] | None = None  # (generation, here, best): the last scan's answer
 
     def score(self, c: Candidate, here: tuple[float, ...] | None) -> float:
         p = self.cost_params(c, self.name)
@@ -38,10 +41,15 @@ class DistanceOverDuration(Scheduler):
         exe = view.exe
         if exe is not None:
             self._here = self.cost_params(exe, self.name).end_pose
-        if not view.candidates:
-            return NO_CHANGE
         here = self._here
-        best = min(view.candidates, key=lambda c: (-priority(self, c), self.score(c, here), c.order))
+        seen = self._best
+        if seen is not None and view.generation is not None and seen[:2] == (view.generation, here):
+            best = seen[2]  # the same candidates (ScheduleView.generation) from the same place
+        else:
+            if not view.candidates:
+                return NO_CHANGE
+            best = min(view.candidates, key=lambda c: (-priority(self, c), self.score(c, here), c.order))
+            self._best = None if view.generation is None else (view.generation, here, best)
         if exe is None:
             return Decision(best.id)
         p_dac, p_exe = priority(self, best), priority(self, exe)

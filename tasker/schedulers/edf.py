@@ -14,6 +14,7 @@ class EarliestDeadlineFirst(Scheduler):
     name = "edf"
     preemptive = True
     indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
+    key_cost = False  # select_key never reads the cost
 
     def deadline(self, c: Candidate) -> float:
         d = self.cost_params(c, self.name).deadline

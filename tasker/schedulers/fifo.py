@@ -9,6 +9,7 @@ class Fifo(Scheduler):
     name = "fifo"
     preemptive = False
     indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
+    key_cost = False  # select_key never reads the cost
 
     def schedule(self, view: ScheduleView) -> Decision:
         if view.exe is not None:

@@ -91,12 +91,41 @@ class Problem:
         return self.hazard_weight * sum(s - d for d in due if s > d) if due else 0.0
 
     def evaluate(self, order: Sequence[int]) -> float:
+        return self.evaluate_from(order, 0, (self.now, 0.0, -1))
+
+    def prefixes(self, order: Sequence[int]) -> list[tuple[float, float, int]]:
+        """``(t, total, prev)`` of :meth:`evaluate` before each position of ``order`` (and after the last)."""
         t, total, prev = self.now, 0.0, -1
+        out = [(t, total, prev)]
         for j in order:
             if self.hazards_left_on:
                 total += self.wait_cost(j, t)
             t += self.first[j] if prev < 0 else self.after[prev][j]
             total += self.cost(j, t)
+            prev = j
+            out.append((t, total, prev))
+        return out
+
+    def evaluate_from(self, order: Sequence[int], m: int, state: tuple[float, float, int]) -> float:
+        """:meth:`evaluate` of ``order`` from position ``m``, ``state`` being its ``(t, total, prev)`` there:
+        the same operations in the same order, so the same float as evaluating it whole."""
+        t, total, prev = state
+        first, after, now, hazards = self.first, self.after, self.now, self.hazards_left_on
+        weight, deadline, budget = self.weight, self.deadline, self.budget
+        lw, hw = self.lateness_weight, self.hazard_weight
+        for k in range(m, len(order)):
+            j = order[k]
+            if hazards:
+                total += self.wait_cost(j, t)
+            t += first[j] if prev < 0 else after[prev][j]
+            w = weight[j]  # Problem.cost, inlined
+            late = t - deadline[j]
+            out = w * (t - now)
+            if late > 0:
+                out += lw * w * late
+                if late > budget[j]:
+                    out += hw * (late - budget[j])
+            total += out
             prev = j
         return total
 
@@ -124,6 +153,7 @@ def _improve(p: Problem, order: list[int], allowed_first: set[int], budget: int)
     improved = True
     while improved:
         improved = False
+        prefix = p.prefixes(order)  # a move changes the order from min(i, k) on: evaluated from there
         for i in range(p.n):
             for k in range(p.n):
                 if i == k:
@@ -135,7 +165,8 @@ def _improve(p: Problem, order: list[int], allowed_first: set[int], budget: int)
                 if used >= budget:
                     return order, best, used
                 used += 1
-                v = p.evaluate(cand)
+                m = min(i, k)
+                v = p.evaluate_from(cand, m, prefix[m])
                 if v < best - 1e-9 * max(1.0, abs(best)):
                     order, best, improved = cand, v, True
                     break

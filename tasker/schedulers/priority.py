@@ -18,6 +18,7 @@ class FixedPriority(Scheduler):
     name = "priority"
     preemptive = True
     indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
+    key_cost = False  # select_key never reads the cost
 
     def __init__(self, priorities: Mapping[str, int] | None = None, default: int = 0) -> None:
         if priorities is not None and not isinstance(priorities, Mapping):

@@ -31,6 +31,7 @@ class LongestFirst(Scheduler):
     name = "simple"
     preemptive = True
     indexed = True  # the lowest key runs: the harmoniser may find it without a scan
+    key_cost = False  # select_key never reads the cost
 
     def __init__(self, hesitance: float = 0.5) -> None:
         if not isinstance(hesitance, int | float) or not 0 <= hesitance:

@@ -9,6 +9,7 @@ class ShortestJobFirst(Scheduler):
     name = "sjf"
     preemptive = False
     indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
+    key_cost = False  # select_key never reads the cost
 
     def queue_key(self, c: Candidate) -> tuple[float, int]:
         return (self.cost_params(c, self.name).c_time, c.order)

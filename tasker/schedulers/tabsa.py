@@ -59,6 +59,7 @@ class TabsaAgent(Scheduler):
 
     name = "tabsa-agent"
     preemptive = True
+    reads_cost = False  # durations (cTime) and distances (endPose) only
 
     def __init__(self, *, non_preemptive: Sequence[str] = (), estimates: str = "events") -> None:
         self.non_preemptive = frozenset(names(self.name, "non_preemptive", non_preemptive))
@@ -66,6 +67,7 @@ class TabsaAgent(Scheduler):
         self._est: dict[str, tuple[float, float]] = {}  # agent -> (estimated duration s, distance m)
         self._last_exe: str | None = None
         self._here: tuple[float, ...] | None = None  # the robot's position as the view tells it
+        self._seen: tuple[int, str | None, str, bool] | None = None  # (generation, exeDA, best, any): the last scan
 
     # -- what a subclass defines -------------------------------------------------------------------------
     def score(self, duration: float, distance: float) -> float:
@@ -80,11 +82,30 @@ class TabsaAgent(Scheduler):
     # -- the decision ------------------------------------------------------------------------------------
     def schedule(self, view: ScheduleView) -> Decision:
         exe = view.exe
-        jobs = sorted([*view.candidates, *([exe] if exe is not None else [])], key=lambda c: c.order)
-        if not view.candidates:
-            return NO_CHANGE
-        refreshed = self.refresh(jobs, exe)
-        record: dict[str, Any] = {"algorithm": self.name, "exeDA": exe.id if exe is not None else None,
+        exe_id = exe.id if exe is not None else None
+        seen, best = self._seen, None
+        if seen is not None and view.generation is not None and seen[:2] == (view.generation, exe_id) \
+                and self.estimates == "events" and exe_id == self._last_exe:
+            # the same candidates and exeDA as at the last decision: nothing arrived, nothing to refresh
+            if not seen[3]:
+                return NO_CHANGE
+            refreshed, best = False, seen[2]
+            if exe is not None:
+                self._here = self._exe_pose(exe)
+        else:
+            jobs = sorted([*view.candidates, *([exe] if exe is not None else [])], key=lambda c: c.order)
+            if not view.candidates:
+                self._seen = None if view.generation is None else (view.generation, exe_id, "", False)
+                return NO_CHANGE
+            refreshed = self.refresh(jobs, exe)
+            best = exe_id if exe_id is not None else jobs[0].id
+            best_score = self._score_of(best)
+            for c in jobs:  # strictly better only: the executing task, then the earliest request, wins ties
+                s = self._score_of(c.id)
+                if s > best_score:
+                    best, best_score = c.id, s
+            self._seen = None if view.generation is None else (view.generation, exe_id, best, True)
+        record: dict[str, Any] = {"algorithm": self.name, "exeDA": exe_id,
                                   "estimates": self.estimates, "refreshed": refreshed}
         if exe is not None and exe.task_type in self.non_preemptive:  # my_agents.py: not preemptive
             record.update(rule="non-preemptive", dac=None, switch=False)
@@ -92,28 +113,29 @@ class TabsaAgent(Scheduler):
         if exe is not None and self.hesitate(view, exe, record):
             record.update(rule="hesitance", dac=None, switch=False)
             return Decision(None, record)
-        best = exe if exe is not None else jobs[0]
-        best_score = self._score(best)
-        for c in jobs:  # strictly better only: the executing task, then the earliest request, wins ties
-            s = self._score(c)
-            if s > best_score:
-                best, best_score = c, s
-        switch = exe is None or best.id != exe.id
-        record.update(rule=self.rule, dac=best.id, switch=switch)
-        for role, who in (("dac", best), ("exeDA", exe)):
+        switch = exe is None or best != exe_id
+        record.update(rule=self.rule, dac=best, switch=switch)
+        for role, who in (("dac", best), ("exeDA", exe_id)):
             if who is not None:
-                record[f"score_{role}"] = self._score(who)
+                record[f"score_{role}"] = self._score_of(who)
                 for k in self.fields:
-                    record[f"{k}_{role}"] = self._est[who.id][_FIELD[k]]
-        return Decision(best.id if switch else None, record)
+                    record[f"{k}_{role}"] = self._est[who][_FIELD[k]]
+        return Decision(best if switch else None, record)
 
     rule: ClassVar[str] = ""
     fields: ClassVar[tuple[str, ...]] = ("duration",)
     """The estimates the score reads, recorded for the candidate and the executing task."""
 
     def _score(self, c: Candidate) -> float:
-        duration, distance = self._est[c.id]
+        return self._score_of(c.id)
+
+    def _score_of(self, agent: str) -> float:
+        duration, distance = self._est[agent]
         return self.score(duration, distance)
+
+    def _exe_pose(self, exe: Candidate) -> tuple[float, ...] | None:
+        pose = self.cost_params(exe, self.name).end_pose
+        return tuple(pose) if pose is not None else self._here
 
     def refresh(self, jobs: Sequence[Candidate], exe: Candidate | None) -> bool:
         """TaBSA's ``System.update_jobs`` (my_system.py): every job's estimates are re-read when a
@@ -123,9 +145,7 @@ class TabsaAgent(Scheduler):
         changed = self._last_exe is not None and self._last_exe != exe_id
         self._last_exe = exe_id
         if exe is not None:
-            pose = self.cost_params(exe, self.name).end_pose
-            if pose is not None:
-                self._here = tuple(pose)
+            self._here = self._exe_pose(exe)
         if self.estimates == "reports" or arrived or changed:
             here = self._here
             self._est = {c.id: (self.cost_params(c, self.name).c_time, self._distance(c, here)) for c in jobs}

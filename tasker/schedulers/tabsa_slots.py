@@ -116,23 +116,35 @@ class TabsaScheduler(TabsaAgent):
         self._rejected: list[str] = []
         self._count = 0
         self._last: str | None = None
+        # (generation, exeDA, job ids, how many, the latest): the jobs of the last decision
+        self._jobs: tuple[int, str | None, frozenset[str], int, str] | None = None
 
     def schedule(self, view: ScheduleView) -> Decision:
         exe = view.exe
-        if not view.candidates:
-            return NO_CHANGE
-        jobs = sorted([*view.candidates, *([exe] if exe is not None else [])], key=lambda c: c.order)
-        self.refresh(jobs, exe)
-        record: dict[str, Any] = {"algorithm": self.name, "exeDA": exe.id if exe is not None else None}
+        exe_id = exe.id if exe is not None else None
+        seen = self._jobs
+        if seen is not None and view.generation is not None and seen[:2] == (view.generation, exe_id) \
+                and self.estimates == "events":  # the same jobs as at the last decision: nothing to refresh
+            present, count, last = seen[2], seen[3], seen[4]
+            if exe is not None:
+                self._here = self._exe_pose(exe)
+        else:
+            if not view.candidates:
+                return NO_CHANGE
+            jobs = sorted([*view.candidates, *([exe] if exe is not None else [])], key=lambda c: c.order)
+            self.refresh(jobs, exe)
+            present, count, last = frozenset(c.id for c in jobs), len(jobs), jobs[-1].id
+            self._jobs = None if view.generation is None else (view.generation, exe_id, present, count, last)
+        record: dict[str, Any] = {"algorithm": self.name, "exeDA": exe_id}
         if exe is not None and exe.task_type in self.non_preemptive:
             record.update(rule="non-preemptive", dac=None, switch=False)
             return Decision(None, record)
         rebuilt = False
-        if len(jobs) != self._count:
+        if count != self._count:
             rebuilt = self.update(jobs, view.now, update_old=False)
-        elif jobs[-1].id != self._last:
+        elif last != self._last:
             rebuilt = self.update(jobs, view.now, update_old=True)
-        self._count, self._last = len(jobs), jobs[-1].id
+        self._count, self._last = count, last
         record["rebuilt"] = rebuilt
         if rebuilt:
             record["slots"] = [[s.job, s.start, s.stop] for s in self._slots]
@@ -141,7 +153,6 @@ class TabsaScheduler(TabsaAgent):
         if slot is None:
             record.update(rule="no slot due", dac=None, switch=False)
             return Decision(None, record)
-        present = {c.id for c in jobs}
         dac = slot.job if slot.job in present else None
         switch = dac is not None and (exe is None or dac != exe.id)
         record.update(rule="slot", dac=dac, slot_dac=[slot.start, slot.stop], switch=switch)

@@ -40,6 +40,7 @@ class WeightedShortestFirst(Scheduler):
     name = "wspt"
     preemptive = True
     indexed = True  # the lowest select_key runs: the harmoniser may find it without a scan
+    key_cost = False  # select_key never reads the cost
 
     def __init__(self, weight: str = "priority") -> None:
         self.weight = choice(self.name, "weight", weight, WEIGHTS)

@@ -1,0 +1,318 @@
+"""Benchmark: how the cost of a synthetic day grows with its length and with its queue.
+
+    python benchmarks/bench_growth.py                      # or: python benchmarks/run_all.py growth
+    python benchmarks/bench_growth.py --quick              # fewer sizes and seeds, no baseline
+    python benchmarks/bench_growth.py --protocol FILE.toml --schedulers alg2 edf --base 60ed0ea
+
+Days of a protocol (default ``tabsa-original``, TaBSA's day) on the synthetic backend,
+made longer at the same request rate (1, 2, 4, 8 h) and, in one hour, busier (9 to 144
+requests; :mod:`daysize`), under ``tabsa-simple``, ``alg2``, ``edf`` and ``lookahead``.
+Each size is the sum over seeds 1..N of the CPU seconds (``time.process_time``, the best
+of two runs of each day, of six for a day under half a CPU second) of building and running the
+day, in a process of its own.  The
+baseline is the commit before the cost work (``--base``, default 60ed0ea), checked out
+with ``git archive`` into a temporary folder and run the same way in the same run
+(``PYTHONPATH`` first on that folder).  A series stops when it has spent ``--budget`` CPU
+seconds: the size it was running and the later ones print ``-``.
+
+Printed per scheduler and dimension: CPU seconds per size (now, and the baseline's),
+the *work* (trace events, summed over the seeds: what the day produced), the exponent
+of cost against size (least squares on the logarithms; 1 is linear) and against the
+work, and the ratio of the cost for four times the size (2 -> 8 h; 36 -> 144 requests).
+Target (issue 38): a day four times as long costs at most 5 times as much.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+SCHEDULERS = ("tabsa-simple", "alg2", "edf", "lookahead")
+README_DAY = ("tabsa-simple", "tabsa-simple2", "tabsa-distance", "tabsa-scheduler", "edf", "lookahead", "alg2",
+              "simple", "simple2", "distance")
+"""The schedulers of the README's ``tasker day`` commands."""
+HOURS = (1.0, 2.0, 4.0, 8.0)
+REQUESTS = (9, 18, 36, 72, 144)
+TARGET = 5.0
+SHORT_S, SHORT_REPEAT = 0.5, 6
+"""A day shorter than this many CPU seconds is run up to this many times (the best counts): its time is
+small against the noise of a shared machine."""
+
+
+# -- the worker: one series in one process, on whatever tree PYTHONPATH puts first ---------------------
+
+def _day(protocol: str, scheduler: str, seed: int, hours: float | None, requests: int | None) -> tuple[float, int]:
+    sys.path.insert(0, str(HERE))
+    from daysize import sized
+
+    from experiments.days import pipeline
+
+    proto = sized(protocol, hours, requests)
+    start = time.process_time()
+    loop = pipeline.make(proto, seed, scheduler=scheduler).build()
+    events = len(loop.run().events)
+    return time.process_time() - start, events
+
+
+def worker(args: argparse.Namespace) -> int:
+    sizes = [float(x) if args.dimension == "hours" else int(x) for x in args.sizes.split(",")]
+    spent = 0.0
+    for size in sizes:
+        cpu, work = 0.0, 0
+        for seed in range(1, args.seeds + 1):
+            runs: list[tuple[float, int]] = []
+            while len(runs) < args.repeat or (len(runs) < SHORT_REPEAT and min(r[0] for r in runs) < SHORT_S):
+                runs.append(_day(args.protocol, args.scheduler, seed, size if args.dimension == "hours" else None,
+                                 int(size) if args.dimension == "requests" else None))
+                spent += runs[-1][0]
+                if spent > args.budget:  # this size costs too much to finish: the series stops before it
+                    return 0
+            cpu += min(r[0] for r in runs)
+            work += runs[0][1]
+        print(json.dumps({"size": size, "cpu": cpu, "work": work}), flush=True)
+    return 0
+
+
+def one_day(protocol: str, scheduler: str, hours: float) -> None:
+    """Worker: the CPU seconds of :func:`experiments.days.runner.run_day` (draw, run, metrics) of one day."""
+    sys.path.insert(0, str(HERE))
+    from daysize import sized
+
+    from experiments.days.runner import run_day
+
+    start = time.process_time()
+    run_day(sized(protocol, hours), 1, scheduler)
+    print(json.dumps({"cpu": time.process_time() - start}), flush=True)
+
+
+def _cpu_cap(limit: float) -> Any:
+    """A ``preexec_fn`` that limits the child to ``limit`` CPU seconds (then the system stops it)."""
+    import resource
+
+    def cap() -> None:
+        resource.setrlimit(resource.RLIMIT_CPU, (int(limit) + 1, int(limit) + 1))
+
+    return cap
+
+
+def eight_hours(tree: Path, protocol: str, scheduler: str, limit: float) -> float | None:
+    """CPU seconds of an 8-hour day (seed 1) on ``tree``; None past ``limit`` CPU seconds."""
+    cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", "--one-day", "--protocol", protocol,
+           "--schedulers", scheduler]
+    done = subprocess.run(cmd, env={**os.environ, "PYTHONPATH": str(tree)}, cwd=tree, capture_output=True, text=True,
+                          preexec_fn=_cpu_cap(limit))
+    if done.returncode != 0:
+        return None
+    return float(json.loads(done.stdout.splitlines()[-1])["cpu"])
+
+
+def print_eight_hours(base: Path | None, limit: float) -> None:
+    print(f"an 8-hour synthetic day (seed 1, run_day: draw, run, metrics) of each scheduler of the README's "
+          f"`tasker day`, CPU seconds (> {limit:g}: stopped at that)")
+    for protocol in ("tabsa-original", "tabsa"):
+        for name in README_DAY:
+            now = eight_hours(ROOT, protocol, name, limit)
+            old = eight_hours(base, protocol, name, limit) if base is not None else None
+            print(f"  {protocol:15} {name:16} now {_cell(now, limit)}"
+                  + (f"   60ed0ea {_cell(old, limit)}" if base is not None else ""), flush=True)
+
+
+def _cell(value: float | None, limit: float) -> str:
+    return f"{value:9.2f}" if value is not None else f"{'>' + format(limit, 'g'):>9}"
+
+
+def budget_study(protocol: str, hours: float, seed: int, every: int, factor: int) -> dict[str, Any]:
+    """What the look-ahead's node budget does to its decisions: the problems of every ``every``-th
+    decision of a day (as :meth:`LookAhead.problem` built them), decided again with ``factor`` times
+    the budget; prints how often the first job differs and the objective of the default's choice
+    over the larger budget's (both orders evaluated on the same problem: 1 means as good)."""
+    sys.path.insert(0, str(HERE))
+    from daysize import sized
+
+    from experiments.days import pipeline
+    from tasker.schedulers import lookahead
+
+    seen: list[Any] = []
+    build = lookahead.LookAhead.problem
+
+    def recording(self: Any, view: Any) -> Any:
+        prob, jobs = build(self, view)
+        seen.append((prob, self.node_budget, self.hysteresis))
+        return prob, jobs
+
+    lookahead.LookAhead.problem = recording  # type: ignore[method-assign]
+    try:
+        pipeline.make(sized(protocol, hours), seed, scheduler="lookahead").build().run()
+    finally:
+        lookahead.LookAhead.problem = build  # type: ignore[method-assign]
+
+    def decide(prob: Any, budget: int, hysteresis: float) -> tuple[list[int], bool]:
+        if not prob.has_exe:
+            order, _, _, exact = lookahead.solve(prob, node_budget=budget)
+            return order, exact
+        keep, keep_obj, n1, e1 = lookahead.solve(prob, node_budget=max(1, budget // 2), fixed_first=0)
+        alt, alt_obj, _, e2 = lookahead.solve(prob, node_budget=budget - n1, exclude_first=0)
+        return (alt if alt_obj < hysteresis * keep_obj else keep), e1 and e2
+
+    sample = [x for x in seen if x[0].n >= 3][::every]
+    differ = exact = 0
+    ratios = []
+    for prob, budget, hysteresis in sample:
+        small, was_exact = decide(prob, budget, hysteresis)
+        big, _ = decide(prob, budget * factor, hysteresis)
+        exact += was_exact
+        differ += small[0] != big[0]
+        ratios.append(prob.evaluate(small) / prob.evaluate(big))
+    return {"decisions": len(seen), "sampled": len(sample), "jobs_mean": sum(p.n for p, _, _ in sample)
+            / max(1, len(sample)), "jobs_max": max((p.n for p, _, _ in sample), default=0), "exact": exact,
+            "first_differs": differ, "ratio_mean": sum(ratios) / max(1, len(ratios)),
+            "ratio_worst": max(ratios, default=1.0), "ratio_best": min(ratios, default=1.0),
+            "budget": sample[0][1] if sample else 0, "factor": factor}
+
+
+def print_budget_study(protocol: str) -> None:
+    r = budget_study(protocol, 4.0, 1, every=10, factor=10)
+    print(f"look-ahead node budget on the day's own decisions ({protocol}, 4 h, seed 1; every 10th decision with "
+          f"3 jobs or more): {r['sampled']} of {r['decisions']} decisions, {r['jobs_mean']:.1f} jobs on average "
+          f"(at most {r['jobs_max']}); with the default budget ({r['budget']} nodes) the search ended on its own in "
+          f"{r['exact']}; with {r['factor']}x the budget the first job differs in {r['first_differs']}, and the "
+          f"default's order costs x{r['ratio_mean']:.4f} the larger budget's on average (worst x{r['ratio_worst']:.4f},"
+          f" best x{r['ratio_best']:.4f})")
+
+
+# -- the driver ---------------------------------------------------------------------------------------
+
+def series(tree: Path, protocol: str, scheduler: str, dimension: str, sizes: tuple[float, ...], seeds: int,
+           repeat: int, budget: float) -> dict[float, tuple[float, int]]:
+    """``size -> (CPU s, work)`` of one series run on ``tree``."""
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", "--protocol", protocol,
+           "--schedulers", scheduler, "--dimension", dimension, "--sizes", ",".join(f"{s:g}" for s in sizes),
+           "--seeds", str(seeds), "--repeat", str(repeat), "--budget", str(budget)]
+    done = subprocess.run(cmd, env=env, cwd=tree, capture_output=True, text=True, preexec_fn=_cpu_cap(2 * budget))
+    if done.returncode != 0 and not done.stdout.strip():  # a run past the cap ends the series where it is
+        raise RuntimeError(f"{scheduler} on {tree}: {done.stderr[-1500:]}")
+    out = {}
+    for line in done.stdout.splitlines():
+        row = json.loads(line)
+        out[float(row["size"])] = (float(row["cpu"]), int(row["work"]))
+    return out
+
+
+def exponent(xs: list[float], ys: list[float]) -> float:
+    """The slope of log y against log x (least squares): 1 is linear, 2 quadratic."""
+    lx, ly = [math.log(x) for x in xs], [math.log(y) for y in ys]
+    mx, my = sum(lx) / len(lx), sum(ly) / len(ly)
+    var = sum((x - mx) ** 2 for x in lx)
+    return sum((x - mx) * (y - my) for x, y in zip(lx, ly, strict=True)) / var if var else math.nan
+
+
+def checkout(commit: str, into: Path) -> Path:
+    """``commit``'s files (``git archive``) in ``into``."""
+    archive = subprocess.run(["git", "archive", commit], cwd=ROOT, capture_output=True, check=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
+    return into
+
+
+def report(name: str, dimension: str, now: dict[float, tuple[float, int]],
+           base: dict[float, tuple[float, int]] | None, sizes: tuple[float, ...]) -> bool:
+    """Print one series; True if it meets the target (or cannot be judged)."""
+    unit = "h" if dimension == "hours" else " req"
+    print(f"  {name:14} {dimension:8} " + "  ".join(f"{s:>8g}{unit}" for s in sizes))
+    rows = [("now CPU s", now)] + ([("60ed0ea CPU s" if base is not None else "", base)] if base is not None else [])
+    for label, data in rows:
+        cells = [f"{data[s][0]:>10.3f}" if s in data else f"{'-':>10}" for s in sizes]
+        print(f"  {'':14} {label:>14} " + "  ".join(cells))
+    print(f"  {'':14} {'work (events)':>14} " + "  ".join(f"{now[s][1]:>10d}" if s in now else f"{'-':>10}"
+                                                          for s in sizes))
+    ok = True
+    for label, data in rows:
+        have = [s for s in sizes if s in data]
+        if len(have) < 2:
+            continue
+        e_size = exponent(have, [data[s][0] for s in have])
+        e_work = exponent([float(now[s][1]) for s in have if s in now], [data[s][0] for s in have if s in now])
+        big, small = sizes[-1], sizes[-1] / 4
+        ratio = data[big][0] / data[small][0] if big in data and small in data else math.nan
+        work = now[big][1] / now[small][1] if big in now and small in now else math.nan
+        verdict = ""
+        if label == "now CPU s" and dimension == "hours" and not math.isnan(ratio):
+            verdict = "OK" if ratio <= TARGET else f"ABOVE TARGET ({TARGET:g}x)"
+            ok = ratio <= TARGET
+        print(f"  {'':14} {label:>14} exponent {e_size:4.2f} against size, {e_work:4.2f} against work; "
+              f"x4 size ({small:g} -> {big:g}): cost x{ratio:.2f}, work x{work:.2f} {verdict}")
+    return ok
+
+
+def main(argv: list[str]) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--protocol", default="tabsa-original")
+    p.add_argument("--schedulers", nargs="+", default=list(SCHEDULERS))
+    p.add_argument("--seeds", type=int, default=3)
+    p.add_argument("--repeat", type=int, default=2)
+    p.add_argument("--budget", type=float, default=400.0, help="CPU s after which a series stops")
+    p.add_argument("--base", default="60ed0ea", help="the commit to compare with ('' for none)")
+    p.add_argument("--quick", action="store_true", help="sizes 2 and 8 h, 36 and 144 requests, 1 seed, no base")
+    p.add_argument("--budget-study", action="store_true",
+                   help="only: what the look-ahead's node budget does to a 4-hour day's decisions (seed 1)")
+    p.add_argument("--eight-hours", action="store_true",
+                   help="only: an 8-hour day of each scheduler of the README's `tasker day` (tabsa-original, tabsa)")
+    p.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    p.add_argument("--one-day", action="store_true", help=argparse.SUPPRESS)
+    p.add_argument("--dimension", help=argparse.SUPPRESS)
+    p.add_argument("--sizes", help=argparse.SUPPRESS)
+    args = p.parse_args(argv)
+    if args.worker:
+        args.scheduler = args.schedulers[0]
+        if args.one_day:
+            one_day(args.protocol, args.scheduler, 8.0)
+            return 0
+        return worker(args)
+    if args.eight_hours:
+        with tempfile.TemporaryDirectory(prefix="tasker-base-") as tmp:
+            print_eight_hours(checkout(args.base, Path(tmp)) if args.base else None, args.budget)
+        return 0
+    if args.budget_study:
+        print_budget_study(args.protocol)
+        return 0
+    hours: tuple[float, ...] = HOURS
+    requests: tuple[int, ...] = REQUESTS
+    if args.quick:
+        hours, requests, args.seeds, args.repeat, args.base = (2.0, 8.0), (36, 144), 1, 1, ""
+    print(f"cost growth of synthetic days of {args.protocol}: CPU seconds, sum over seeds 1-{args.seeds} "
+          f"(best of {args.repeat}); commit {_head()}; load average {os.getloadavg()[0]:.2f}")
+    ok = True
+    with tempfile.TemporaryDirectory(prefix="tasker-base-") as tmp:
+        base_tree = checkout(args.base, Path(tmp)) if args.base else None
+        for name in args.schedulers:
+            for dimension, sizes in (("hours", hours), ("requests", requests)):
+                sizes_f = tuple(float(s) for s in sizes)
+                now = series(ROOT, args.protocol, name, dimension, sizes_f, args.seeds, args.repeat, args.budget)
+                base = (series(base_tree, args.protocol, name, dimension, sizes_f, args.seeds, args.repeat,
+                               args.budget) if base_tree is not None else None)
+                ok = report(name, dimension, now, base, sizes_f) and ok
+    print("target (a day four times as long costs at most 5 times as much): " + ("met" if ok else "NOT MET"))
+    if "lookahead" in args.schedulers and not args.quick:
+        print_budget_study(args.protocol)
+    return 0
+
+
+def _head() -> str:
+    done = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True)
+    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT, capture_output=True,
+                           text=True).stdout.strip()
+    return done.stdout.strip() + (" (with uncommitted changes)" if dirty else "")
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,42 @@
+"""Days answer as they did before the cost work: traces and day metrics of commit 60ed0ea, byte for byte.
+
+``data/day-answers-60ed0ea.txt`` holds the fingerprints ``benchmarks/day_answers.py --robot``
+printed on 60ed0ea (the commit before issue 38): the SHA-256 of each day's trace (and, on the
+robot, trajectory) and of its day metrics.  A few cheap days are checked at every run; every
+synthetic day, and the robot's, with ``-m slow``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+REFERENCE = Path(__file__).resolve().parent / "data" / "day-answers-60ed0ea.txt"
+
+
+sys.path.insert(0, str(ROOT / "benchmarks"))
+day_answers = importlib.import_module("day_answers")  # the script, with daysize beside it
+REF = {line.split("  ", 1)[1]: line.split("  ", 1)[0] for line in REFERENCE.read_text().splitlines()}
+CASES = {case.label: case for case in day_answers.cases(robot=True)}
+QUICK = ["synthetic tabsa-original alg2 1", "synthetic tabsa-original tabsa-simple 2", "synthetic tabsa edf 1",
+         "synthetic tabsa-short lookahead 2", "synthetic tabsa-rush tabsa-scheduler 1"]
+
+
+def test_the_reference_holds_every_case() -> None:
+    assert set(REF) == set(CASES)
+    assert len(CASES) == 184
+
+
+@pytest.mark.parametrize("label", QUICK)
+def test_a_day_answers_as_on_60ed0ea(label: str) -> None:
+    assert day_answers.fingerprint(CASES[label]).split("  ")[0] == REF[label]
+
+
+@pytest.mark.slow  # about 3 CPU minutes (the robot's five: one more)
+@pytest.mark.parametrize("label", sorted(set(CASES) - set(QUICK)))
+def test_every_day_answers_as_on_60ed0ea(label: str) -> None:
+    assert day_answers.fingerprint(CASES[label]).split("  ")[0] == REF[label]
