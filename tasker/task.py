@@ -55,6 +55,7 @@ from typing import Any, Literal
 
 from tasker.errors import BadRequest, ConfigError
 from tasker.meaning import NO_MEANING, Meaning
+from tasker.memory import AgentMemory
 from tasker.messages import CompletionCost, CostParams, ScheduleParams, SPRequest
 from tasker.stage import Purpose, Stage, StagePlan
 from tasker.world import Fact
@@ -205,7 +206,9 @@ class TaskContext:
     world: Any = None
     core: Any = None
     motion: Any = None
-    memory: dict[str, Any] = field(default_factory=dict)
+    memory: AgentMemory = field(default_factory=AgentMemory)
+    """The agent's memory: the framework's typed fields (``memory.interruption_s``, :mod:`tasker.memory`)
+    and the task type's own keys (``memory["key"]``); a plain ``dict`` given here is wrapped."""
     plan: StagePlan | None = None
     stage_index: int = 0
     done: list[Stage] = field(default_factory=list)
@@ -220,6 +223,10 @@ class TaskContext:
     hazards: Callable[[], Sequence[tuple[str, tuple[str, ...]]]] | None = None
     """The hazards this agent owns that hold now, as ``(hazard name, ground fact)`` (set by the loop
     from the harmoniser's hazard source; None without one): what a derived suspension turns off."""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.memory, AgentMemory):  # a caller's plain dict: the same keys, typed fields empty
+            self.memory = AgentMemory(self.memory)
 
     @property
     def current(self) -> Stage | None:
