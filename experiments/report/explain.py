@@ -31,6 +31,7 @@ from typing import Any
 
 from experiments.trace.timeline import Timeline
 from tasker import events as ev
+from tasker.errors import ExplainError as ExplainError  # defined there; re-exported here
 from tasker.support import reader
 
 PROBLEMS = "problems"
@@ -40,11 +41,6 @@ MOVING_EVENTS = (ev.Decision, ev.CommandSent, ev.Transition, ev.TaskEnded)
 TICK_S = 0.001
 """The loop's tick (:class:`tasker.loop.SimulationLoop`'s default resolution): a message between the
 harmoniser and an agent takes one, so what answers an event at ``T`` happens at ``T`` + 1, 2, … ms."""
-
-
-class ExplainError(reader.InputError):
-    """A run folder, agent or time that ``tasker explain`` cannot explain (a damaged file of the
-    run folder is named with its line and field, as every reader's errors are)."""
 
 
 # ----------------------------------------------------------------------------------------- writing

@@ -22,7 +22,7 @@ from experiments.inputs.actions import NO_REQUESTS, TimedAction, read_actions
 from experiments.inputs.crossref import arg_problem, arg_types, check_robot, validate_request, world_objects
 from experiments.inputs.fields import ScenarioError
 from experiments.inputs.robot_scenario import RobotScenario
-from tasker.errors import TaskerError
+from tasker.errors import Refused as Refused  # defined there; re-exported here
 from tasker.support.reader import InputError, Table
 from tasker.task import TaskType
 
@@ -33,18 +33,6 @@ the session is stopping."""
 REQUEST_FIELDS = ("priority", "deadline")
 """Schedule parameters a request body may give beside ``args`` (they are request arguments,
 :mod:`experiments.inputs.request_fields`, and are moved into ``args``)."""
-
-
-class Refused(TaskerError, ValueError):
-    """Something asked over HTTP that the session does not do; ``str()`` is the whole message
-    (``where: field: message``), :meth:`to_json` the body of the 4xx answer."""
-
-    def __init__(self, status: int, where: str, message: str, field: str = "") -> None:
-        self.status, self.where, self.field, self.message = status, where, field, message
-        super().__init__(f"{where}: {field}: {message}" if field else f"{where}: {message}")
-
-    def to_json(self) -> dict[str, Any]:
-        return {"detail": str(self), "field": self.field, "message": self.message}
 
 
 def _located(exc: InputError, where: str, prefix: str) -> Refused:
