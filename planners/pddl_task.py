@@ -157,16 +157,15 @@ class PddlTaskType(TaskType):
 
     # -- hooks ----------------------------------------------------------------------
 
-    def validate_args(self, args: Mapping[str, Any]) -> dict[str, Any]:
-        """As :meth:`TaskType.validate_args`, except that the cost model's arguments stay out of a
-        request that does not give them (it gets the default model, and its trace says what was
-        asked), and the original model needs its factors."""
-        out = super().validate_args(args)
+    def adjust_args(self, given: Mapping[str, Any], args: dict[str, Any]) -> None:
+        """The cost model's arguments stay out of a request that does not give them (it gets the
+        default model, and its trace says what was asked), and the original model needs its factors."""
+        out = args
         model = self.spec.original_costs
         if model is None:
-            return out
+            return
         for name in model.args:
-            if args.get(name) is None:
+            if given.get(name) is None:
                 out.pop(name, None)
         if out.get(COST_MODEL_ARG) == ORIGINAL:
             missing = [f[1:] for f in model.factors or () if f[1:] not in out]
@@ -176,7 +175,6 @@ class PddlTaskType(TaskType):
         elif any(f[1:] in out for f in model.factors or ()):
             raise BadRequest(f"task {self.name!r}: the factors {[f[1:] for f in model.factors or ()]} apply only with "
                              f"{COST_MODEL_ARG} = {ORIGINAL!r}")
-        return out
 
     def check_args(self, args: dict[str, Any]) -> None:
         if "check_args" in self.hooks:

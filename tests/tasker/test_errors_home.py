@@ -37,7 +37,7 @@ OLD_HOMES = {
 
 
 def _exception_classes_outside_errors() -> list[tuple[str, str]]:
-    """Classes whose bases name an error (``...Error``, ``Exception``, an errors-module class) outside tasker/errors.py."""
+    """Classes outside tasker/errors.py whose bases name an error (``...Error``, ``Exception``, a class of it)."""
     known = {name for name, obj in vars(errors).items() if inspect.isclass(obj) and issubclass(obj, BaseException)}
     known |= {"Exception", "ValueError", "RuntimeError", "KeyError", "TypeError", "BaseException"}
     found = []
