@@ -65,8 +65,9 @@ from tasker.errors import BadRequest, ConfigError
 from tasker.meaning import NO_MEANING, Meaning
 from tasker.memory import AgentMemory
 from tasker.messages import CompletionCost, CostParams, ScheduleParams, SPRequest
+from tasker.protocols import CoreAgent
 from tasker.stage import Purpose, Stage, StagePlan
-from tasker.world import Fact
+from tasker.world import Fact, MotionModel
 
 Leaving = Literal["suspend", "complete"]
 """How a task is left, for :meth:`TaskType.leaves`: suspended now, or completed."""
@@ -212,8 +213,8 @@ class TaskContext:
     strategy: Strategy = field(default_factory=Strategy)
     now: float = 0.0
     world: Any = None
-    core: Any = None
-    motion: Any = None
+    core: CoreAgent | None = None
+    motion: MotionModel | None = None
     memory: AgentMemory = field(default_factory=AgentMemory)
     """The agent's memory: the framework's typed fields (``memory.interruption_s``, :mod:`tasker.memory`)
     and the task type's own keys (``memory["key"]``); a plain ``dict`` given here is wrapped."""

@@ -23,7 +23,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import tasker
 from experiments.inputs import fields, synthetic
@@ -34,6 +34,7 @@ from experiments.inputs.request_fields import asked_for
 from experiments.metrics import run as metrics
 from experiments.report.explain import INDEX, write_problems
 from experiments.run.options import RunOptions
+from experiments.run.simulation import SimulatedWorld
 from experiments.run.targeting import Targeter
 from experiments.trace.timeline import Timeline
 from tasker import events as ev
@@ -47,6 +48,9 @@ from tasker.requester import Requester
 from tasker.store import TaskStore
 from tasker.task import Strategy, TaskType
 from tasker.trace import FAILED, Trace
+
+if TYPE_CHECKING:
+    from robot.spec import WorldSpec
 
 
 @dataclass(frozen=True)
@@ -62,7 +66,7 @@ class RunResult:
 
 
 def build_robot(scn: scenarios.RobotScenario, options: RunOptions, *, trace: Trace | None = None,
-                task_wrapper: Callable[[TaskType], TaskType] | None = None) -> tuple[SimulationLoop, Any]:
+                task_wrapper: Callable[[TaskType], TaskType] | None = None) -> tuple[SimulationLoop, SimulatedWorld]:
     """The loop and the simulation for a robot scenario, with every request and event scheduled
     (:func:`build_robot_actions`)."""
     loop, sim, _ = build_robot_actions(scn, options, trace=trace, task_wrapper=task_wrapper)
@@ -71,7 +75,7 @@ def build_robot(scn: scenarios.RobotScenario, options: RunOptions, *, trace: Tra
 
 def build_robot_actions(scn: scenarios.RobotScenario, options: RunOptions, *, trace: Trace | None = None,
                         task_wrapper: Callable[[TaskType], TaskType] | None = None
-                        ) -> tuple[SimulationLoop, Any, Actions]:
+                        ) -> tuple[SimulationLoop, SimulatedWorld, Actions]:
     """The loop, the simulation and the :class:`Actions` of a robot scenario, every action scheduled.
 
     ``options`` (:class:`~experiments.run.options.RunOptions`, whose ``seed`` must be set) choose
@@ -150,7 +154,7 @@ class Actions:
     arrives.  The K-th request scheduled is the scenario's ``dK`` (what ``terminate``, ``change``
     and ``after`` name); :meth:`agents` says which agents were made for it."""
 
-    def __init__(self, loop: SimulationLoop, sim: Any, made: _Made) -> None:
+    def __init__(self, loop: SimulationLoop, sim: SimulatedWorld, made: _Made) -> None:
         self.loop, self.sim, self._made = loop, sim, made
         self.requests = 0
 
@@ -268,7 +272,7 @@ class _Made:
             self.loop.at(when, lambda: self.submit(sid, a, renews=e.agent))
 
 
-def _action(loop: SimulationLoop, sim: Any, made: _Made, a: TimedAction, sid: str) -> Callable[[], None]:
+def _action(loop: SimulationLoop, sim: SimulatedWorld, made: _Made, a: TimedAction, sid: str) -> Callable[[], None]:
     """What happens at ``a.t``; ``sid``: the scenario's id of the latest request (``a``'s own if it is one)."""
     f = a.fields
     requester = made.requester
@@ -531,8 +535,8 @@ def _clear_outputs(out: Path) -> None:
 
 
 def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Trace,
-          trajectory: tuple[tuple[float, float, float, float], ...], world: Any, pictures: bool,
-          sim: Any = None, journal: Any = ()) -> None:
+          trajectory: tuple[tuple[float, float, float, float], ...], world: WorldSpec | None, pictures: bool,
+          sim: SimulatedWorld | None = None, journal: Any = ()) -> None:
     out.mkdir(parents=True, exist_ok=True)
     _clear_outputs(out)
     trace.write(out / "trace.jsonl")
