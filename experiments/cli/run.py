@@ -134,7 +134,7 @@ def _run(args: argparse.Namespace) -> int:
     from experiments.trace.timeline import Timeline
 
     tl = Timeline(result.trace.typed)
-    print(summary.headline(label, tl, result.metrics, float(result.record["wall_time_s"])))
+    print(summary.headline(label, tl, result.metrics, result.record.wall_time_s))
     if not args.quiet:
         for line in summary.ends(tl) + summary.safety(tl, result.metrics):
             print(line)

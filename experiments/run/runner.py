@@ -34,6 +34,7 @@ from experiments.inputs.request_fields import asked_for
 from experiments.metrics import run as metrics
 from experiments.report.explain import INDEX, write_problems
 from experiments.run.options import RunOptions
+from experiments.run.records import PlannerConfig, RunRecord, RunSettings
 from experiments.run.simulation import SimulatedWorld
 from experiments.run.targeting import Targeter
 from experiments.trace.timeline import Timeline
@@ -57,7 +58,7 @@ if TYPE_CHECKING:
 class RunResult:
     """What one run produced: its record, its metrics and its trace."""
 
-    record: dict[str, Any]
+    record: RunRecord
     metrics: dict[str, Any]
     trace: Trace
     trajectory: tuple[tuple[float, float, float, float], ...] = ()
@@ -338,7 +339,7 @@ def _after(loop: SimulationLoop, made: _Made, sid: str, event: Callable[[], None
 def run_scenario(source: str | Path | scenarios.RobotScenario, options: RunOptions | None = None, *,
                  out: Path | None = None, progress: bool = False, pictures: bool = True,
                  task_wrapper: Callable[[TaskType], TaskType] | None = None,
-                 live: Callable[[SimulationLoop, Any, Actions], scenarios.RobotScenario] | None = None,
+                 live: Callable[[SimulationLoop, SimulatedWorld, Actions], scenarios.RobotScenario] | None = None,
                  **changes: Any) -> RunResult:
     """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced.
 
@@ -390,7 +391,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, options: RunOptio
     error: BaseException | None = None
     with _journal(kind) as journal:  # the PDDL of every planning call, for problems/
         try:
-            if live is not None and actions is not None:
+            if live is not None and actions is not None and sim is not None:
                 spec_json = {"kind": "robot", **live(loop, sim, actions).to_json()}
             else:
                 _run(loop, progress)
@@ -406,34 +407,30 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, options: RunOptio
         trajectory = tuple(sim.trajectory)
         world_spec = sim.spec
     calls = loop.planner_calls
-    record = {
-        "scenario": spec_json, "seed": run_seed,
-        "settings": {"scheduler": loop.harmoniser.scheduler.name, "mode": loop.harmoniser.mode.value,
-                     # synthetic task types have only static strategies: say what was used
-                     "update": "static" if kind == "synthetic" else (opts.update or loop.strategy.update),
-                     "suspension": "static" if kind == "synthetic" else (opts.suspension or loop.strategy.suspension),
-                     "randomized": opts.randomize,
-                     "policy": None if kind == "synthetic" else loop.strategy.policy,
-                     "hazard_waiting": opts.hazard_waiting,
-                     **({"tree": opts.tree} if opts.tree is not None else {}),
-                     **({"interruption": opts.interruption.to_json()} if opts.interruption and opts.randomize else {}),
-                     **({"perturbation": opts.perturbation.to_json()} if opts.perturbation and opts.randomize
-                        else {})},
-        "planner": _planner_config() if kind == "robot" else None,
-        "host": platform.node(), "platform": platform.platform(), "python": sys.version.split()[0],
-        "date": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "tasker_version": tasker.__version__,
-        "wall_time_s": round(wall, 3),
-    }
+    settings = RunSettings(
+        loop.harmoniser.scheduler.name, loop.harmoniser.mode.value,
+        # synthetic task types have only static strategies: say what was used
+        update="static" if kind == "synthetic" else (opts.update or loop.strategy.update),
+        suspension="static" if kind == "synthetic" else (opts.suspension or loop.strategy.suspension),
+        randomized=opts.randomize, policy=None if kind == "synthetic" else loop.strategy.policy,
+        hazard_waiting=opts.hazard_waiting, tree=opts.tree,
+        interruption=opts.interruption.to_json() if opts.interruption and opts.randomize else None,
+        perturbation=opts.perturbation.to_json() if opts.perturbation and opts.randomize else None)
+    record = RunRecord(
+        spec_json, run_seed, settings, _planner_config() if kind == "robot" else None,
+        host=platform.node(), platform=platform.platform(), python=sys.version.split()[0],
+        date=_dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), tasker_version=tasker.__version__,
+        wall_time_s=round(wall, 3))
     reason = ""
     if error is None:
         metrics = _metrics(trace, calls, wall)
     else:
         if isinstance(error, KeyboardInterrupt):
-            reason, record["status"] = f"interrupted by the user at t={loop.now:g} s", "interrupted"
+            reason, status = f"interrupted by the user at t={loop.now:g} s", "interrupted"
         else:
             reason = error.reason if isinstance(error, RunAborted) else f"{type(error).__name__}: {error}"
-            record["status"] = "aborted"
-        record["error"] = reason
+            status = "aborted"
+        record = dataclasses.replace(record, status=status, error=reason)
         try:
             metrics = _metrics(trace, calls, wall)
         except Exception as exc:  # metrics of a cut trace may not compute: say so, keep the rest
@@ -481,12 +478,11 @@ def _run(loop: SimulationLoop, progress: bool) -> None:
                 break
 
 
-def _planner_config() -> dict[str, Any]:
+def _planner_config() -> PlannerConfig:
     from planners.pddl_task import default_planner
 
     p = default_planner()
-    return {"engine": getattr(p, "name", "tasker-fd"), "unified_planning": _version("unified-planning"),
-            "up_fast_downward": _version("up-fast-downward")}
+    return PlannerConfig(getattr(p, "name", "tasker-fd"), _version("unified-planning"), _version("up-fast-downward"))
 
 
 def _version(dist: str) -> str | None:
@@ -534,7 +530,7 @@ def _clear_outputs(out: Path) -> None:
             problems.rmdir()
 
 
-def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Trace,
+def _save(out: Path, record: RunRecord, metrics_: dict[str, Any], trace: Trace,
           trajectory: tuple[tuple[float, float, float, float], ...], world: WorldSpec | None, pictures: bool,
           sim: SimulatedWorld | None = None, journal: Any = ()) -> None:
     out.mkdir(parents=True, exist_ok=True)
@@ -542,7 +538,7 @@ def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Tr
     trace.write(out / "trace.jsonl")
     if sim is not None:  # poses and postures at a fixed rate (robot.recording)
         sim.write_trajectory(out / "trajectory.jsonl")
-    (out / "run.json").write_text(json.dumps(record, indent=2, sort_keys=True, default=str) + "\n")
+    (out / "run.json").write_text(json.dumps(record.to_json(), indent=2, sort_keys=True, default=str) + "\n")
     (out / "metrics.json").write_text(json.dumps(metrics_, indent=2, sort_keys=True) + "\n")
     write_problems(out / "problems", journal)
     if not pictures:
@@ -553,7 +549,7 @@ def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Tr
     tl = Timeline(trace.typed)  # read once by every picture
     plots.timeline(tl, out / "timeline.png")
     plots.gantt(tl, out / "gantt.png")
-    report_html.write_run(out, tl, record=record, metrics=metrics_, world=world, trajectory=trajectory)
+    report_html.write_run(out, tl, record=record.to_json(), metrics=metrics_, world=world, trajectory=trajectory)
     if world is not None:
         plots.world_path(world, list(trajectory), out / "world.png", events=tl,
                          recording=getattr(sim, "recording", None))
