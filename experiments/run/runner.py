@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 import tasker
 from experiments.inputs import fields, synthetic
 from experiments.inputs import scenario as scenarios
-from experiments.inputs.actions import TimedAction
+from experiments.inputs.actions import Change, ModeSwitch, Request, Terminate, TimedAction, WorldEvent
 from experiments.inputs.perturbation import TOGGLE, TargetDraw, named
 from experiments.inputs.request_fields import asked_for
 from experiments.metrics import run as metrics
@@ -143,8 +143,8 @@ def build_robot_actions(scn: scenarios.RobotScenario, options: RunOptions, *, tr
     loop.harmoniser.hazards = monitor.active  # hazard-aware waiting learns of hazards from the monitor
     actions = Actions(loop, sim, _Made(loop, Requester(store, loop.harmoniser, "scenario")))
     for a in sorted([*from_world, *scn.actions], key=lambda a: a.t):  # stable: the world file's first at a tie
-        if a.kind == "request":
-            store.validate(a.fields["task"], a.fields["args"])  # bad requests fail before the run
+        if isinstance(a.payload, Request):
+            store.validate(a.payload.task, a.payload.args)  # bad requests fail before the run
         actions.schedule(a)
     return loop, sim, actions
 
@@ -243,7 +243,7 @@ class _Made:
     def __init__(self, loop: SimulationLoop, requester: Requester) -> None:
         self.loop, self.requester = loop, requester
         self.agents: dict[str, list[str]] = {}
-        self._renewable: dict[str, tuple[str, TimedAction]] = {}  # agent -> (its scenario id, its request)
+        self._renewable: dict[str, tuple[str, Request]] = {}  # agent -> (its scenario id, its request)
         self._terminated: set[str] = set()  # scenario ids a requester terminated: never renewed
         loop.trace.subscribe(self._watch)
 
@@ -256,38 +256,40 @@ class _Made:
         self._terminated.add(sid)
         self.requester.terminate(self.current(sid), reason)
 
-    def submit(self, sid: str, a: TimedAction, renews: str | None = None) -> None:
+    def submit(self, sid: str, a: Request, renews: str | None = None) -> None:
         if renews is not None and sid in self._terminated:
             return
-        agent = self.requester.request(a.fields["task"], a.fields["args"], renews=renews)
+        agent = self.requester.request(a.task, a.args, renews=renews)
         self.agents.setdefault(sid, []).append(agent)
-        if "renew" in a.fields:
+        if a.renew is not None:
             self._renewable[agent] = (sid, a)
 
     def _watch(self, e: ev.Event) -> None:
         if not isinstance(e, ev.TaskEnded) or e.cause not in FAILED or e.agent not in self._renewable:
             return
         sid, a = self._renewable.pop(e.agent)
-        when = e.t + float(a.fields["renew"]["after_s"])
-        if when < float(a.fields["renew"]["until"]):
+        assert a.renew is not None
+        when = e.t + a.renew.after_s
+        if when < a.renew.until:
             self.loop.at(when, lambda: self.submit(sid, a, renews=e.agent))
 
 
 def _action(loop: SimulationLoop, sim: SimulatedWorld, made: _Made, a: TimedAction, sid: str) -> Callable[[], None]:
     """What happens at ``a.t``; ``sid``: the scenario's id of the latest request (``a``'s own if it is one)."""
-    f = a.fields
+    p = a.payload
     requester = made.requester
-    if a.kind == "request":
-        return lambda: made.submit(sid, a)  # through the public requester, as any user's requests
-    if a.kind == "terminate":
-        return lambda: made.terminate(f["agent"], f["reason"])
-    if a.kind == "change":
-        return lambda: synthetic._change(loop, requester, made.current(f["agent"]), f["args"])
-    if a.kind == "mode":
-        return lambda: loop.harmoniser.set_mode(f["mode"])
+    if isinstance(p, Request):
+        return lambda: made.submit(sid, p)  # through the public requester, as any user's requests
+    if isinstance(p, Terminate):
+        return lambda: made.terminate(p.agent, p.reason)
+    if isinstance(p, Change):
+        return lambda: synthetic._change(loop, requester, made.current(p.agent), p.args)
+    if isinstance(p, ModeSwitch):
+        return lambda: loop.harmoniser.set_mode(p.mode)
+    assert isinstance(p, WorldEvent)
 
     def world_event() -> None:
-        what, value = f["what"], f["value"]
+        what, value = p.what, p.value
         if what == "posture":
             sim.people[value[0]].set_posture(value[1])
         elif what == "walk":
@@ -306,11 +308,11 @@ def _action(loop: SimulationLoop, sim: SimulatedWorld, made: _Made, a: TimedActi
             sim.apply(add=value)
         else:
             sim.apply(delete=value)
-        loop.trace.emit(ev.WorldChanged(loop.now, what, value, f.get("note", "")))
+        loop.trace.emit(ev.WorldChanged(loop.now, what, value, "" if p.note is None else p.note))
 
-    if "after" not in f:
+    if p.after is None:
         return world_event
-    return _after(loop, made, f["after"], world_event)
+    return _after(loop, made, p.after, world_event)
 
 
 def _after(loop: SimulationLoop, made: _Made, sid: str, event: Callable[[], None]) -> Callable[[], None]:
