@@ -33,6 +33,7 @@ from tasker.support import reader
 from tasker.support.reader import InputWarning
 
 if TYPE_CHECKING:
+    from experiments.inputs.robot_scenario import RobotScenario
     from robot.spec import WorldSpec
 
 Fact = tuple[str, ...]
@@ -264,7 +265,7 @@ def world_facts(world: WorldSpec) -> list[Fact]:
     return out
 
 
-def scenario_facts(scn: Any) -> list[Fact]:
+def scenario_facts(scn: RobotScenario) -> list[Fact]:
     """What a robot scenario adds to its world: its objects at their places with their facts, its devices."""
     out: list[Fact] = []
     for name, o in scn.objects.items():

@@ -20,7 +20,7 @@ import json
 import platform
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -51,6 +51,8 @@ from tasker.task import Strategy, TaskType
 from tasker.trace import FAILED, Trace
 
 if TYPE_CHECKING:
+    from planners.pddl_task import PlanningRecord
+    from robot.recording import Recorder
     from robot.spec import WorldSpec
 
 
@@ -62,7 +64,7 @@ class RunResult:
     metrics: dict[str, Any]
     trace: Trace
     trajectory: tuple[tuple[float, float, float, float], ...] = ()
-    recording: Any = None
+    recording: Recorder | None = None
     """A robot run's :class:`robot.recording.Recorder` (``trajectory.jsonl`` is written from it); None if synthetic."""
 
 
@@ -195,7 +197,7 @@ def _with_trees(options: RunOptions, types: list[TaskType], default: Strategy,
     return out
 
 
-def _world_file_events(spec: Any, world: str) -> tuple[Any, list[TimedAction]]:
+def _world_file_events(spec: WorldSpec, world: str) -> tuple[WorldSpec, list[TimedAction]]:
     """The world file's own timed events (a person's ``events = [[t, posture]]``) taken out of the
     people and returned as world events, so they run — and are traced — as a scenario's do."""
     out = [TimedAction(float(t), "world", {"what": "posture", "value": [name, posture],
@@ -207,7 +209,7 @@ def _world_file_events(spec: Any, world: str) -> tuple[Any, list[TimedAction]]:
     return dataclasses.replace(spec, people=people), sorted(out, key=lambda a: a.t)
 
 
-def _with_objects(scn: scenarios.RobotScenario, spec: Any) -> Any:
+def _with_objects(scn: scenarios.RobotScenario, spec: WorldSpec) -> WorldSpec:
     """The world with the scenario's ``[objects]``: each gets its type, ``("at", name, place)``
     and its facts (its pose is its place's, see :meth:`robot.sim.Simulation.snapshot`); and with
     its ``[devices]``, as if the world file listed them."""
@@ -534,7 +536,7 @@ def _clear_outputs(out: Path) -> None:
 
 def _save(out: Path, record: RunRecord, metrics_: dict[str, Any], trace: Trace,
           trajectory: tuple[tuple[float, float, float, float], ...], world: WorldSpec | None, pictures: bool,
-          sim: SimulatedWorld | None = None, journal: Any = ()) -> None:
+          sim: SimulatedWorld | None = None, journal: Sequence[PlanningRecord] = ()) -> None:
     out.mkdir(parents=True, exist_ok=True)
     _clear_outputs(out)
     trace.write(out / "trace.jsonl")
