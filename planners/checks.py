@@ -25,7 +25,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from tasker.errors import TaskerError
+from tasker.errors import DefinitionError as DefinitionError  # defined there; re-exported here
+from tasker.errors import PddlError as PddlError
 from tasker.support import reader
 
 if TYPE_CHECKING:
@@ -65,40 +66,6 @@ def _lenient_names() -> Iterator[None]:
             yield
         finally:
             env.error_used_name = old
-
-
-class DefinitionError(TaskerError, ValueError):
-    """A task definition (PDDL file, ``task.toml``, ``task.py``) is malformed.
-
-    ``file`` names it, ``line``/``col`` locate the fault when known, ``reason`` says
-    what is wrong; ``str()`` gives ``file:line:col: reason`` like a compiler.
-    """
-
-    def __init__(self, file: str | Path, reason: str, line: int | None = None, col: int | None = None) -> None:
-        self.file = str(file)
-        self.reason = reason
-        self.line = line
-        self.col = col
-        where = self.file + (f":{line}" if line is not None else "") + (f":{col}" if col is not None else "")
-        super().__init__(f"{where}: {reason}")
-
-
-class PddlError(DefinitionError):
-    """A PDDL domain or problem is malformed or needs a feature no planner here supports.
-
-    ``reader_only`` marks legal PDDL that only unified-planning's reader cannot read
-    (``(either ...)`` types, ``:derived`` predicates, a predicate naming a parameter twice, a name
-    glued to a variable, action costs without ``(= (total-cost) 0)``): ``tasker plan`` then reads
-    the task with Fast Downward's translator (:mod:`planners.plan_files`); task folders, which need
-    UP's model, refuse it.
-    Any other refusal is an error in the PDDL, which the translator must not be left to
-    accept (it takes an undeclared type for an empty one, for one).
-    """
-
-    def __init__(self, file: str | Path, reason: str, line: int | None = None, col: int | None = None,
-                 *, reader_only: bool = False) -> None:
-        super().__init__(file, reason, line, col)
-        self.reader_only = reader_only
 
 
 def _read(path: str | Path) -> str:

@@ -15,11 +15,9 @@ from planners.taskspec import Literal
 from tasker.errors import PlanningFailed
 from tasker.meaning import Hazard, bind, matches
 from tasker.meaning import holds as holds_literal
+from tasker.memory import INTERRUPTION_KEY as INTERRUPTION_KEY  # the old key, for code that imports it here
 from tasker.task import TaskContext
 from tasker.world import WorldState
-
-INTERRUPTION_KEY = "interruption_s"
-"""``ctx.memory`` key: expected length of an interruption (s); unknown means long."""
 
 
 def owned_hazards(task: EstimatedTask, ctx: TaskContext, world: WorldState) -> list[tuple[Hazard, Literal]]:
@@ -47,12 +45,12 @@ def goal(task: EstimatedTask, ctx: TaskContext, world: WorldState) -> tuple[list
 
     * every hazard this task owns (:func:`owned_hazards`) off — under the ``conditional``
       policy, a hazard whose ``budget_s`` is at least the expected interruption
-      (``ctx.memory["interruption_s"]``; unknown means long) may stay on;
+      (``ctx.memory.interruption_s``; unknown means long) may stay on;
     * the task's person in one of the ``safe`` roles of ``[people]``: if none holds, the
       role literal the planner reaches most cheaply (each is planned as the estimates plan);
     * the ``[derived] invariants``."""
-    expected = ctx.memory.get(INTERRUPTION_KEY)
-    length = math.inf if expected is None else float(expected)
+    expected = ctx.memory.interruption_s
+    length = math.inf if expected is None else expected
     out: list[Literal] = []
     said: list[str] = []
     for hz, fact in owned_hazards(task, ctx, world):

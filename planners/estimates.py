@@ -57,7 +57,7 @@ from planners.taskspec import Branch, Literal, TaskSpec
 from tasker.errors import PlanningFailed
 from tasker.stage import Purpose, Stage
 from tasker.task import TaskContext
-from tasker.world import Pose, WorldState
+from tasker.world import MotionModel, Pose, WorldState
 
 NAVIGATE = "navigate"
 """The skill whose stages are timed with the motion model (others by their duration)."""
@@ -127,7 +127,7 @@ class Estimate:
             raise ValueError(f"Estimate: c_time {self.c_time} does not fit source {self.source.value}")
 
 
-def walk(stages: Sequence[Stage], start: Pose | None, world: WorldState | None, motion: Any,
+def walk(stages: Sequence[Stage], start: Pose | None, world: WorldState | None, motion: MotionModel | None,
          elapsed: float = 0.0, through_door: Callable[[Stage], bool] | None = None) -> tuple[float, Pose | None]:
     """Seconds to run ``stages`` from ``start`` and the pose at the end; ``(inf, None)`` if a leg
     is unreachable.
@@ -341,8 +341,9 @@ class Estimator:
         stages = task.builder.from_templates(task.spec.static_update, Bindings(ctx.args, world), {}, ctx.suspended)
         return self._timed(stages, start, world, ctx.motion, Source.TEMPLATE, note=note)
 
-    def _timed(self, stages: Sequence[Stage], start: Pose | None, world: WorldState, motion: Any, source: Source,
-               *, elapsed: float = 0.0, steps: tuple[PlanStep, ...] | None = None, note: str = "") -> Estimate:
+    def _timed(self, stages: Sequence[Stage], start: Pose | None, world: WorldState, motion: MotionModel | None,
+               source: Source, *, elapsed: float = 0.0, steps: tuple[PlanStep, ...] | None = None,
+               note: str = "") -> Estimate:
         c_time, end = walk(stages, start, world, motion, elapsed, self._door_check(world))
         if steps is None:
             steps = tuple((s.action, *s.args) for s in stages)
@@ -405,7 +406,7 @@ class Estimator:
                 return (), result.status, f"planner error: {result.message}"
         return hit.steps, hit.status, ""
 
-    def reference_table(self, world: WorldState, motion: Any) -> Travel:
+    def reference_table(self, world: WorldState, motion: MotionModel | None) -> Travel:
         """Place-to-place seconds with nobody in the way, remembered per motion model and set
         of closed doors: the doors as they are, except that places a ``door_between`` fact joins
         through a closed door are timed with it open (the plan decides whether to open it).

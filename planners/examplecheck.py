@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 from planners.stages import Bindings, robot_name
 from tasker.errors import PlanningFailed
 from tasker.meaning import bind, matches
+from tasker.memory import AgentMemory
 from tasker.stage import Stage
 from tasker.task import Strategy, TaskContext
 from tasker.world import WorldState
@@ -55,7 +56,7 @@ def inapplicable_branches(task: PddlTaskType, ctx: TaskContext, exe: Sequence[St
     for k in range(len(exe) + 1):
         for policy in ("strict", "conditional"):
             c = replace(ctx, world=world, strategy=Strategy("planned", "static", policy), done=list(exe[:k]),
-                        interrupted=exe[k] if k < len(exe) else None, suspended=True, memory={})
+                        interrupted=exe[k] if k < len(exe) else None, suspended=True, memory=AgentMemory())
             branch, b = task.branch(c, world)
             if branch.label in seen or not branch.stages:
                 continue

@@ -10,10 +10,10 @@ from __future__ import annotations
 import math
 import random
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from tasker.task import Strategy, TaskContext
-from tasker.world import UNREACHABLE, MotionEstimate, Pose, WorldState
+from tasker.world import UNREACHABLE, MotionEstimate, MotionModel, Pose, WorldState
 
 if TYPE_CHECKING:
     from planners.pddl_task import PddlTaskType
@@ -45,7 +45,7 @@ def example_world(task: PddlTaskType) -> WorldState | None:
     return WorldState(frozenset(tuple(f) for f in ex.facts), dict(ex.poses), dict(ex.objects))
 
 
-def example_context(task: PddlTaskType, *, strategy: Strategy | None = None, motion: Any = None,
+def example_context(task: PddlTaskType, *, strategy: Strategy | None = None, motion: MotionModel | None = None,
                     world: WorldState | None = None) -> TaskContext | None:
     """A :class:`TaskContext` for the task's example request in its example world."""
     ex = task.spec.example

@@ -34,6 +34,7 @@ from planners.results import PlanStatus
 from planners.taskspec import TaskSpec, meaning_of, read_task_toml
 from planners.temporal.folder import domain_model, load_domain, load_problem_text, planner_for
 from tasker.errors import BadRequest
+from tasker.errors import HookExited as HookExited  # defined there; re-exported here
 from tasker.meaning import Binding
 from tasker.support import reader
 from tasker.world import WorldState
@@ -97,11 +98,6 @@ def _load_hooks(spec: TaskSpec) -> dict[str, Any]:
                 raise DefinitionError(path, f"{name}{inspect.signature(fn)}: a hook {name} takes "
                                             f"({_HOOK_PARAMS[name]})", fn.__code__.co_firstlineno) from None
     return {name: _guarded(fn, name, path) for name, fn in hooks.items()}
-
-
-class HookExited(DefinitionError):
-    """A ``task.py`` hook called ``sys.exit()``: an exception like any other the hook raises, so its
-    task ends alone (cause ``error``) and the message names the folder, not a bare exit status."""
 
 
 def _guarded(fn: Any, name: str, path: Path) -> Any:

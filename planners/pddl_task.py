@@ -43,7 +43,6 @@ from typing import Any
 
 from planners import derived, fallback, original_costs, stagecheck
 from planners.checks import DefinitionError
-from planners.derived import INTERRUPTION_KEY
 from planners.estimates import estimator_for, executing, forget_estimates
 from planners.planner import PddlText, Planner
 from planners.problem import (
@@ -56,11 +55,11 @@ from planners.problem import (
     travel_table,
 )
 from planners.results import PlanResult, PlanStatus
-from planners.stagecheck import PLANNED_FROM_KEY
 from planners.stages import Bindings, StageBuilder, place_of, robot_name
 from planners.taskspec import COST_MODEL_ARG, ORIGINAL, Branch, Literal, TaskSpec
 from tasker.errors import BadRequest, PlanningFailed, UnknownName
 from tasker.meaning import Hazard, bind, matches
+from tasker.memory import INTERRUPTION_KEY as INTERRUPTION_KEY  # the old key, for code that imports it here
 from tasker.messages import SP_COMPLETION, CompletionCost, CostParams, SPRequest
 from tasker.stage import Purpose, Stage, StagePlan
 from tasker.task import Effects, Leaving, TaskContext, TaskType
@@ -69,11 +68,7 @@ from tasker.world import Pose, WorldState
 PLANNING = ("planned", "derived")
 """The suspension strategies whose genSusp always plans (a suspension may be planned ahead for them)."""
 PLANS_REMEMBERED = 8
-"""How many plans ``PLANNED_FROM_KEY`` (:mod:`planners.stagecheck`) keeps per agent."""
-RESTORE_KEY = "_restore_baseline"
-"""``ctx.memory`` key: the facts of ``[problem] restore``'s patterns that held when the task first planned."""
-PREPLAN_KEY = "_suspension_planned_ahead"
-"""``ctx.memory`` key: (symbolic suspension problem, its plan's steps, empty if the goal held), or None: no plan."""
+"""How many plans ``ctx.memory.planned_from`` (:mod:`planners.stagecheck`) keeps per agent."""
 
 _shared_planner: Planner | None = None
 
@@ -162,16 +157,15 @@ class PddlTaskType(TaskType):
 
     # -- hooks ----------------------------------------------------------------------
 
-    def validate_args(self, args: Mapping[str, Any]) -> dict[str, Any]:
-        """As :meth:`TaskType.validate_args`, except that the cost model's arguments stay out of a
-        request that does not give them (it gets the default model, and its trace says what was
-        asked), and the original model needs its factors."""
-        out = super().validate_args(args)
+    def adjust_args(self, given: Mapping[str, Any], args: dict[str, Any]) -> None:
+        """The cost model's arguments stay out of a request that does not give them (it gets the
+        default model, and its trace says what was asked), and the original model needs its factors."""
+        out = args
         model = self.spec.original_costs
         if model is None:
-            return out
+            return
         for name in model.args:
-            if args.get(name) is None:
+            if given.get(name) is None:
                 out.pop(name, None)
         if out.get(COST_MODEL_ARG) == ORIGINAL:
             missing = [f[1:] for f in model.factors or () if f[1:] not in out]
@@ -181,7 +175,6 @@ class PddlTaskType(TaskType):
         elif any(f[1:] in out for f in model.factors or ()):
             raise BadRequest(f"task {self.name!r}: the factors {[f[1:] for f in model.factors or ()]} apply only with "
                              f"{COST_MODEL_ARG} = {ORIGINAL!r}")
-        return out
 
     def check_args(self, args: dict[str, Any]) -> None:
         if "check_args" in self.hooks:
@@ -216,7 +209,9 @@ class PddlTaskType(TaskType):
         """Remember the state ``plan`` was made from (``ctx.memory``, the last few plans: an estimate may
         plan a suspension on a copy of the context meanwhile), for :meth:`inapplicable`."""
         if isinstance(ctx.world, WorldState) and plan.stages:
-            made = ctx.memory.setdefault(PLANNED_FROM_KEY, [])
+            made = ctx.memory.planned_from
+            if made is None:
+                made = ctx.memory.planned_from = []
             made.append((plan.stages, ctx.world.facts))
             del made[:-PLANS_REMEMBERED]
         return plan
@@ -323,7 +318,9 @@ class PddlTaskType(TaskType):
             return []
         robot = robot_name(world)
         patterns = [p for pat in self.spec.restore if (p := bind(pat, ctx.args, robot)) is not None]
-        baseline = ctx.memory.setdefault(RESTORE_KEY, frozenset(f for p in patterns for f in matches(p, world.facts)))
+        baseline = ctx.memory.restore_baseline
+        if baseline is None:
+            baseline = ctx.memory.restore_baseline = frozenset(f for p in patterns for f in matches(p, world.facts))
         out: list[Literal] = []
         for pat in patterns:
             signature = self.domain.predicates.get(pat[0], ())
@@ -445,10 +442,10 @@ class PddlTaskType(TaskType):
 
         The first branch whose ``when`` holds in the world at interruption; a
         ``conditional`` branch only under ``ctx.strategy.policy == "conditional"`` and
-        when the expected interruption (``ctx.memory["interruption_s"]``; unknown = long)
+        when the expected interruption (``ctx.memory.interruption_s``; unknown = long)
         is at most its ``max_interruption_s``."""
-        expected = ctx.memory.get(INTERRUPTION_KEY)
-        length = math.inf if expected is None else float(expected)
+        expected = ctx.memory.interruption_s
+        length = math.inf if expected is None else expected
         base = Bindings(ctx.args, world)
         tree = self.spec.tree(ctx.strategy.tree)
         for br in tree:
@@ -495,7 +492,7 @@ class PddlTaskType(TaskType):
 
     def _preplan_suspension(self, ctx: TaskContext) -> None:
         """Plan the suspension of the state now, while ``exeTsk`` runs, once per symbolic state
-        (``ctx.memory[PREPLAN_KEY]``): a ``susp`` that arrives in the same state then finds its
+        (``ctx.memory.suspension_ahead``): a ``susp`` that arrives in the same state then finds its
         plan made and takes the static strategy's ``static_time_s``, not ``planning_time_s``.
         During a blocking stage, the state planned for is the one that stage leaves (its
         ``add``/``delete``): a ``susp`` is honoured only when it ends.
@@ -510,18 +507,18 @@ class PddlTaskType(TaskType):
         world, goal, branch = self.suspension_inputs(ctx)
         extra = self.suspension_facts(ctx, world)
         key = self._suspension_key(world, goal, extra, branch.label)
-        held = ctx.memory.get(PREPLAN_KEY)
+        held = ctx.memory.suspension_ahead
         if held is not None and held[0] == key:
             return
         steps, status, _ = estimator_for(self).plan(ctx, world, goal, extra)
-        ctx.memory[PREPLAN_KEY] = (key, steps) if status is PlanStatus.SOLVED else None
+        ctx.memory.suspension_ahead = (key, steps) if status is PlanStatus.SOLVED else None
 
     def _preplanned(self, ctx: TaskContext, world: WorldState, goal: list[Literal], extra: list[Literal],
                     label: str) -> StagePlan | None:
         """genSusp's plan if it was made already for this very symbolic state — by
         :meth:`_preplan_suspension`, or by an estimate of this suspension for another agent
         (:meth:`leaves`, the handover) — re-timed with the travel times of the moment."""
-        held = ctx.memory.get(PREPLAN_KEY)
+        held = ctx.memory.suspension_ahead
         if held is not None and held[0] == self._suspension_key(world, goal, extra, label):
             steps: tuple[tuple[str, ...], ...] = held[1]
         else:  # planned already for another agent's estimate of this very suspension (handover)?

@@ -26,6 +26,7 @@ import io
 from dataclasses import dataclass
 
 from planners.translate import TRANSLATE_LOCK, domain_sexp
+from tasker.errors import SchemaError as SchemaError  # defined there; re-exported here
 
 OBJECT_TYPE = "object"
 """PDDL's root type; a type of the schema only in domains that use it (see :func:`read_schema`)."""
@@ -70,10 +71,6 @@ class DomainSchema:
     actions: tuple[ActionModel, ...]
     constants: tuple[tuple[str, str], ...] = ()
     """The domain's ``(:constants ...)``: ``(name, type)``, ``""`` for an untyped one."""
-
-
-class SchemaError(ValueError):
-    """Fast Downward's parser refused the domain; the message is the parser's."""
 
 
 def read_schema(text: str) -> DomainSchema:

@@ -18,8 +18,6 @@ from tasker.task import TaskContext
 from tasker.trace import INAPPLICABLE
 from tasker.world import WorldState
 
-PLANNED_FROM_KEY = "_planned_from"
-"""``ctx.memory`` key: the last plans' stages, each with the facts it was made from."""
 LOCATION = "at"
 MOVERS = frozenset({"robot", "person"})
 """Object types whose ``at`` fact the world grounds from a pose (:func:`_assumed`)."""
@@ -91,7 +89,7 @@ def _projection(ctx: TaskContext, stage: Stage,
     world = ctx.world
     assert isinstance(world, WorldState)
     kinds = frozenset(f[0] for f in extra)
-    for stages, planned_facts in reversed(ctx.memory.get(PLANNED_FROM_KEY, ())):
+    for stages, planned_facts in reversed(ctx.memory.planned_from or ()):
         k = next((i for i, s in enumerate(stages) if s is stage), None)
         if k is None:
             continue

@@ -36,7 +36,6 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from planners import derived
-from planners.derived import INTERRUPTION_KEY
 from planners.examplecheck import _apply as apply_stage  # the example world after a stage, as its check walks it
 from planners.examplecheck import example_stages
 from planners.examples import example_context
@@ -45,6 +44,7 @@ from planners.problem import holds as holds_all
 from planners.stagecheck import LOCATION
 from planners.taskspec import DEFAULT_TREE, Branch, Literal
 from tasker.errors import PlanningFailed
+from tasker.memory import AgentMemory
 from tasker.stage import Stage
 from tasker.task import POLICIES, Strategy, TaskContext
 from tasker.world import Fact, WorldState
@@ -369,7 +369,8 @@ def _states(task: PddlTaskType, ctx: TaskContext, exes: Sequence[tuple[str, tupl
 def _run(task: PddlTaskType, ctx: TaskContext, state: _State, policy: str, interruption: float | None,
          tree: str | None = None) -> BranchRun:
     """The branch tree ``tree`` chooses in ``state`` under ``policy``, run stage by stage."""
-    memory = {} if interruption is None else {INTERRUPTION_KEY: interruption}
+    memory = AgentMemory()
+    memory.interruption_s = interruption
     c = replace(ctx, world=state.world, strategy=Strategy("planned", "static", policy, tree), done=list(state.done),
                 interrupted=None, suspended=True, memory=memory)
     try:

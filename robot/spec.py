@@ -19,8 +19,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from tasker.errors import WorldFileError as WorldFileError  # defined there; re-exported here
 from tasker.support import reader
-from tasker.support.reader import InputError, Table, check_name, check_number, check_numbers, suggest
+from tasker.support.reader import Table, check_name, check_number, check_numbers, suggest
 from tasker.world import Pose
 
 WORLDS_DIR = Path(__file__).with_name("worlds")
@@ -28,10 +29,6 @@ POSTURES = ("standing", "sitting", "fallen")
 
 Box = tuple[float, float, float, float]
 Bounds = tuple[tuple[float, float], tuple[float, float]]
-
-
-class WorldFileError(InputError):
-    """A world file is missing, unreadable or holds a field of the wrong shape (an :class:`InputError`)."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -244,7 +244,7 @@ class DynamicAgent(ParkedReports):
         for cmd in self._inbox:
             self._ack = cmd.seq
             if cmd.flag is Flag.SUSP and "expected_s" in cmd.data:  # how long the interruption is expected to last
-                self.ctx.memory["interruption_s"] = float(cmd.data["expected_s"])
+                self.ctx.memory.interruption_s = float(cmd.data["expected_s"])
             self._latched.receive(cmd.flag.value, cmd.data, self.state)
         self._inbox.clear()
 

@@ -25,11 +25,7 @@ from dataclasses import MISSING, dataclass, field
 from dataclasses import fields as dc_fields
 from typing import Any, ClassVar
 
-from tasker.errors import TaskerError
-
-
-class TraceError(TaskerError, ValueError):
-    """An event that is not one of :data:`KINDS` or whose fields are wrong."""
+from tasker.errors import TraceError as TraceError  # defined there; re-exported here
 
 
 def _json(name: str, doc: str, *, default: Any = MISSING) -> Any:

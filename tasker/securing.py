@@ -243,9 +243,9 @@ def suspension_estimate(agent: WatchedAgent, now: float, policy: str, interrupte
         raise AgentEnded(agent.id, agent.end_reason or "ended")
     try:
         agent.refresh(now)
-        memory = dict(agent.ctx.memory)
+        memory = agent.ctx.memory.copy()
         if expected_s is not None:
-            memory["interruption_s"] = float(expected_s)
+            memory.interruption_s = float(expected_s)
         ctx = replace(agent.ctx, memory=memory, done=list(agent.ctx.done), interrupted=interrupted,
                       suspended=True, strategy=replace(agent.ctx.strategy, suspension="static", policy=policy))
         plan = agent.task.generate_suspension(ctx)

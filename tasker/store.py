@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from tasker.errors import ConfigError, UnknownName
-from tasker.task import TaskType
+from tasker.task import TaskType, missing_hooks
 
 
 class TaskStore:
@@ -41,6 +41,10 @@ class TaskStore:
             raise ConfigError(f"{source}: expected a TaskType instance, got {type(task).__name__}")
         if not task.name or not task.name.replace("_", "").replace("-", "").isalnum():
             raise ConfigError(f"{source}: task type name must be a simple identifier, got {task.name!r}")
+        missing = missing_hooks(task)
+        if missing:
+            raise ConfigError(f"{source}: task type {task.name!r} ({type(task).__name__}) does not implement "
+                              f"{', '.join(missing)}, a hook every task type must override (tasker.task.TaskType)")
         if task.name in self._types:
             raise ConfigError(
                 f"task type {task.name!r} is registered twice: by {self._sources[task.name]} and by {source}"

@@ -20,6 +20,8 @@ hook                   called in (paper)                 returns
 ``leaves``             another agent's estimate          the facts it would leave changed
                        (:attr:`TaskContext.handover`)     (:class:`Effects`) or None
 ``check_args``         :meth:`TaskType.validate_args`     nothing; raise ``BadRequest``
+``adjust_args``        :meth:`TaskType.validate_args`     nothing; change the completed
+                       (after ``check_args``)             arguments in place
 =====================  ===============================  ===================================
 
 Which hook when:
@@ -37,7 +39,10 @@ Which hook when:
 * ``initialise`` for per-agent set-up, never ``__init__``: one instance serves every agent,
   so per-agent state lives in ``ctx.memory``.
 * ``on_stage_done`` to note progress; ``leaves`` when what the task changes matters to the
-  next task's estimates; ``check_args`` for checks the :class:`ArgSpec` types cannot make.
+  next task's estimates; ``check_args`` for checks the :class:`ArgSpec` types cannot make;
+  ``adjust_args`` when the completed arguments depend on what the request gave, not only on
+  its values (a default the request did not ask for left out; a wrapping type handing its
+  inner type the inner's arguments).
 
 ``update_task`` and ``generate_suspension`` may raise
 :class:`~tasker.errors.PlanningFailed`: the agent then ends (upTsk) with the reason in
@@ -45,23 +50,28 @@ the trace.  A task type that wants a fallback (e.g. a static suspension when the
 planner fails) does it inside the hook and says so in ``StagePlan.note``.
 
 The framework's own method :meth:`TaskType.validate_args` checks a request's arguments
-against the declared :class:`ArgSpec` tuple and then calls ``check_args``: extend the
-checks there, do not override it.
+against the declared :class:`ArgSpec` tuple and then calls ``check_args`` and ``adjust_args``:
+extend the checks there; it is ``typing.final``, so mypy refuses an override.
+``update_task`` is abstract: :meth:`tasker.store.TaskStore.register` refuses a type that does not
+implement it (:func:`missing_hooks`), when it is registered rather than when it first runs.
 """
 
 from __future__ import annotations
 
 import random
+from abc import abstractmethod
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, final
 
 from tasker.errors import BadRequest, ConfigError
 from tasker.inputs import EstimateInputs
 from tasker.meaning import NO_MEANING, Meaning
+from tasker.memory import AgentMemory
 from tasker.messages import CompletionCost, CostParams, ScheduleParams, SPRequest
+from tasker.protocols import CoreAgent
 from tasker.stage import Purpose, Stage, StagePlan
-from tasker.world import Fact
+from tasker.world import Fact, MotionModel
 
 Leaving = Literal["suspend", "complete"]
 """How a task is left, for :meth:`TaskType.leaves`: suspended now, or completed."""
@@ -207,9 +217,11 @@ class TaskContext:
     strategy: Strategy = field(default_factory=Strategy)
     now: float = 0.0
     world: Any = None
-    core: Any = None
-    motion: Any = None
-    memory: dict[str, Any] = field(default_factory=dict)
+    core: CoreAgent | None = None
+    motion: MotionModel | None = None
+    memory: AgentMemory = field(default_factory=AgentMemory)
+    """The agent's memory: the framework's typed fields (``memory.interruption_s``, :mod:`tasker.memory`)
+    and the task type's own keys (``memory["key"]``); a plain ``dict`` given here is wrapped."""
     plan: StagePlan | None = None
     stage_index: int = 0
     done: list[Stage] = field(default_factory=list)
@@ -224,6 +236,10 @@ class TaskContext:
     hazards: Callable[[], Sequence[tuple[str, tuple[str, ...]]]] | None = None
     """The hazards this agent owns that hold now, as ``(hazard name, ground fact)`` (set by the loop
     from the harmoniser's hazard source; None without one): what a derived suspension turns off."""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.memory, AgentMemory):  # a caller's plain dict: the same keys, typed fields empty
+            self.memory = AgentMemory(self.memory)
 
     @property
     def current(self) -> Stage | None:
@@ -267,11 +283,13 @@ class TaskType:
 
     # -- framework-owned ------------------------------------------------------------
 
+    @final
     def validate_args(self, args: Mapping[str, Any]) -> dict[str, Any]:
         """Check a request's arguments; return them completed with defaults.
 
         Raises :class:`~tasker.errors.BadRequest` naming the argument at fault.  The
-        framework's: do not override it; add checks in :meth:`check_args`, which it calls.
+        framework's (``typing.final``): add checks in :meth:`check_args` and adjustments in
+        :meth:`adjust_args`, which it calls in that order.
         """
         if not isinstance(args, Mapping):
             raise BadRequest(f"task {self.name!r}: arguments must be a mapping, got {type(args).__name__}")
@@ -290,6 +308,7 @@ class TaskType:
             else:
                 out[spec.name] = spec.default
         self.check_args(out)
+        self.adjust_args(args, out)
         return out
 
     # -- hooks ----------------------------------------------------------------------
@@ -298,6 +317,12 @@ class TaskType:
         """Override to check what the :class:`ArgSpec` types cannot (e.g. two arguments differ);
         raise :class:`~tasker.errors.BadRequest`.  Called by :meth:`validate_args` with the
         arguments already typed and completed.  Default: nothing more to check."""
+
+    def adjust_args(self, given: Mapping[str, Any], args: dict[str, Any]) -> None:
+        """Override to change the completed arguments ``args`` in place where they depend on what the
+        request ``given`` held, not only on its values (e.g. leave out an argument's default the
+        request did not ask for); raise :class:`~tasker.errors.BadRequest`.  Called by
+        :meth:`validate_args` after :meth:`check_args`.  Default: nothing."""
 
     def initialise(self, ctx: TaskContext) -> None:
         """Override to set up this agent's ``ctx.memory``; called once, in ``initComm``.
@@ -336,8 +361,10 @@ class TaskType:
             return CompletionCost(cc=params.cost, ccps=params.cps)
         raise NotImplementedError(f"task type {self.name!r} does not answer reqSP {request.sp_id!r}")
 
+    @abstractmethod
     def update_task(self, ctx: TaskContext) -> StagePlan:
-        """Override (required): build ``exeTsk`` from the world as it is now; called in ``upTsk``.
+        """Override (required: abstract, checked when the type is registered): build ``exeTsk`` from
+        the world as it is now; called in ``upTsk``.
 
         Return the stages still to run (none if the work is done already, R6), or raise
         :class:`~tasker.errors.PlanningFailed`, which ends the task with the reason traced."""
@@ -404,3 +431,24 @@ class TaskType:
         if how == "complete":
             return Effects.of(ctx.remaining) or None
         return None
+
+
+REQUIRED_HOOKS = ("update_task",)
+"""The hooks every task type must implement (abstract in :class:`TaskType`)."""
+
+
+def missing_hooks(task: TaskType) -> list[str]:
+    """The required hooks (:data:`REQUIRED_HOOKS`) ``task``'s class leaves abstract: what registration refuses."""
+    return [h for h in REQUIRED_HOOKS if getattr(getattr(type(task), h, None), "__isabstractmethod__", False)]
+
+
+def adjust_inner(inner: TaskType, own: frozenset[str], given: Mapping[str, Any], args: dict[str, Any]) -> None:
+    """:meth:`TaskType.adjust_args` of a type that wraps ``inner`` and adds the arguments ``own``:
+    ``inner`` adjusts its arguments, the wrapper's own follow them in ``args`` (the order a trace
+    records them in)."""
+    mine = {k: v for k, v in args.items() if k in own}
+    theirs = {k: v for k, v in args.items() if k not in own}
+    inner.adjust_args({k: v for k, v in given.items() if k not in own}, theirs)
+    args.clear()
+    args.update(theirs)
+    args.update(mine)

@@ -37,6 +37,7 @@ def _cases() -> list[Case]:
     import numpy as np
 
     from experiments.analysis.family import Contrast, Outcome
+    from experiments.inputs.actions import TimedAction
     from experiments.inputs.perturbation import Perturbation
     from experiments.inputs.scenario import InterruptionGrid
     from experiments.inputs.strategy import Strategy as SweepStrategy
@@ -218,6 +219,10 @@ def _cases() -> list[Case]:
         Case("Verdict.variants", lambda: Verdict("s", "ours", "1", "n", True, None, 3, None), ValueError,
              "held and variants go together"),
         Case("Verdict.held", lambda: Verdict("s", "ours", "1", "n", True, None, 4, 3), ValueError, "4 of 3 variants"),
+        Case("TimedAction.kind", lambda: TimedAction(1.0, "explode", {}), ConfigError,
+             r"TimedAction\.kind must be one of \['request', 'terminate', 'change', 'mode', 'world'\], got 'explode'"),
+        Case("TimedAction.fields", lambda: TimedAction(1.0, "terminate", {"agent": "d1"}), ConfigError,
+             r"TimedAction\('terminate'\)\.fields lacks 'reason' \(got \['agent'\]\)"),
         Case("RunOptions.level", lambda: RunOptions(suspension="never"), ValueError, "suspension: expected one of"),
         Case("RunOptions.seed", lambda: RunOptions(seed=-1), ValueError, "seed: expected an integer"),
         Case("RunOptions.tree", lambda: RunOptions(tree="cook:"), ValueError, "tree: expected NAME or TYPE:NAME"),

@@ -25,12 +25,16 @@ import functools
 import warnings
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from experiments.cli.args import EXIT_FAILED, EXIT_OK, error_text
 from experiments.cli.run import add_path_option, task_paths
 from tasker.support import reader
 from tasker.support.reader import InputWarning
+
+if TYPE_CHECKING:
+    from experiments.inputs.robot_scenario import RobotScenario
+    from robot.spec import WorldSpec
 
 Fact = tuple[str, ...]
 
@@ -249,7 +253,7 @@ class Checker:
         return out
 
 
-def world_facts(world: Any) -> list[Fact]:
+def world_facts(world: WorldSpec) -> list[Fact]:
     """What a world (:class:`robot.spec.WorldSpec`) can hold, as :class:`robot.sim.Simulation` reads it
     off: its facts, its devices at their places in their states, and its people's postures — any of
     whom may fall (a script or a world event), which the simulation says as ``(fallen name)``."""
@@ -261,7 +265,7 @@ def world_facts(world: Any) -> list[Fact]:
     return out
 
 
-def scenario_facts(scn: Any) -> list[Fact]:
+def scenario_facts(scn: RobotScenario) -> list[Fact]:
     """What a robot scenario adds to its world: its objects at their places with their facts, its devices."""
     out: list[Fact] = []
     for name, o in scn.objects.items():

@@ -12,6 +12,7 @@ import sys
 import warnings
 from pathlib import Path
 
+from experiments import facade
 from experiments.cli.args import (
     EXIT_FAILED,
     EXIT_INTERRUPTED,
@@ -92,7 +93,6 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 def _run(args: argparse.Namespace) -> int:
     from experiments.inputs import scenario as scenarios
     from experiments.run.options import RunOptions
-    from experiments.run.runner import run_scenario
     from tasker import schedulers
 
     if args.tree is not None and not all(p.isidentifier() for p in args.tree.split(":", 1)):
@@ -114,14 +114,12 @@ def _run(args: argparse.Namespace) -> int:
     made = not want.exists()
     out = writable_dir(want, "--out")
     try:
-        if paths:
-            from planners.bundled import task_types
-
-            task_types(paths)  # every folder checked now, before the run
         options = RunOptions(seed=args.seed, update=args.update, suspension=args.suspension, scheduler=args.scheduler,
                              mode=args.mode, randomize=args.randomize, task_paths=tuple(paths), policy=args.policy,
                              hazard_waiting=args.hazard_waiting, tree=args.tree)
-        result = run_scenario(path, options, out=out, progress=show_progress(args), pictures=not args.no_pictures)
+        # every task folder is checked before the run (experiments.facade.run_scenario)
+        result = facade.run_scenario(path, options, out=out, progress=show_progress(args),
+                                     pictures=not args.no_pictures)
     except RunInterrupted as exc:  # stopped while running: what ran is written (experiments.run.runner)
         print(f"tasker run: {exc.reason}; the trace so far, run.json and metrics.json are in {out}/",
               file=sys.stderr)
@@ -134,7 +132,7 @@ def _run(args: argparse.Namespace) -> int:
     from experiments.trace.timeline import Timeline
 
     tl = Timeline(result.trace.typed)
-    print(summary.headline(label, tl, result.metrics, float(result.record["wall_time_s"])))
+    print(summary.headline(label, tl, result.metrics, result.record.wall_time_s))
     if not args.quiet:
         for line in summary.ends(tl) + summary.safety(tl, result.metrics):
             print(line)

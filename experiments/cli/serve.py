@@ -82,4 +82,4 @@ def _serve(args: argparse.Namespace) -> int:
     print(f"tasker serve: stopped at t={round(session.t_stop or 0.0, 6)!r} s ({session.stop_reason}): "
           f"{describe(result)}; replay: tasker run {out / 'session.toml'}", flush=True)
     note(args, f"wrote {out}/")
-    return EXIT_OK if result.record.get("status") is None else EXIT_FAILED
+    return EXIT_OK if result.record.status is None else EXIT_FAILED

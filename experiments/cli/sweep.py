@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
+from experiments import facade
 from experiments.cli.args import (
     EXIT_FAILED,
     EXIT_OK,
@@ -130,7 +131,6 @@ def dask_scheduler(address: str | None) -> Iterator[None]:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-    from experiments.sweep.driver import run_sweep
     from experiments.sweep.spec import load_spec
 
     spec = load_spec(args.spec)
@@ -143,21 +143,13 @@ def _sweep(args: argparse.Namespace) -> int:
             raise UsageError("--seeds", str(exc)) from None
     paths = [*spec.task_paths, *(p for p in task_paths(args) if p not in spec.task_paths)]
     if paths:
-        from planners.bundled import task_types
-
-        task_types(paths)  # every task folder checked here, before any job
+        facade.check_task_paths(paths)  # every task folder checked here, before any job
         spec = dataclasses.replace(spec, task_paths=tuple(paths))
     writable_file(args.db, "--db")
-    if args.overwrite:
-        from experiments.metrics.store import remove
-        from experiments.sweep.driver import lease
-
-        with lease(args.db):  # a sweep still writing into it keeps its runs: this one stops instead
-            remove(args.db)
     with dask_scheduler(args.scheduler_address):
-        summary = run_sweep(spec, args.db, workers=args.workers, scheduler_address=args.scheduler_address,
-                            retry_errors=args.retry_errors, max_jobs=args.limit,
-                            progress=show_progress(args) and not args.no_progress)
+        summary = facade.run_sweep(spec, args.db, workers=args.workers, scheduler_address=args.scheduler_address,
+                               retry_errors=args.retry_errors, overwrite=args.overwrite, limit=args.limit,
+                               progress=show_progress(args) and not args.no_progress)
     print(f"{spec.name}: {summary.total} jobs; {summary.skipped} already stored, {summary.ran} run "
           f"({summary.ok} ok, {summary.errors} errors) in {summary.wall:.1f} s on {summary.backend} workers")
     if summary.not_run:
@@ -194,12 +186,10 @@ def _duration(seconds: float) -> str:
 
 
 def _report(args: argparse.Namespace) -> int:
-    from experiments.sweep.report import build_report
-
     if not Path(args.db).is_file():
         raise UsageError("--db", f"{args.db}: no such results database (write one with 'tasker sweep')")
     writable_dir(args.out, "--out")
-    files = build_report(args.db, args.out, plots=not args.no_plots)
+    files = facade.sweep_report(args.db, args.out, plots=not args.no_plots)
     print(f"report: {files.markdown}")
     note(args, f"tables: {files.summary_csv}, {files.paired_csv}; {len(files.plots)} plots in "
                f"{Path(args.out) / 'plots'}")

@@ -19,14 +19,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from experiments.cli.args import EXIT_FAILED, EXIT_OK, UsageError, did_you_mean, seed, show_progress, writable_file
+from tasker.errors import BadInput as BadInput  # defined there; re-exported here
 from tasker.world import MotionEstimate, MotionModel, Pose
 
 if TYPE_CHECKING:
     from robot.spec import WorldSpec
-
-
-class BadInput(UsageError):
-    """A command-line argument that names no place and is no ``x,y[,yaw]``."""
 
 
 def _pose(spec: WorldSpec, text: str, argument: str = "PLACE") -> Pose:

@@ -317,7 +317,8 @@ class Day:
         # the samples from memory, as the file would give them back: no write-and-read round trip
         result = run_scenario(self.scenario, seed=self.seed, out=None if out is None else Path(out), pictures=False,
                               request_fields=True, task_wrapper=wrapper_for(robot_work(self.protocol)), **settings)
-        return DayRun(list(result.trace.events), tuple(result.recording.samples_as_read()), result.record)
+        assert result.recording is not None  # a robot run always records
+        return DayRun(list(result.trace.events), tuple(result.recording.samples_as_read()), result.record.to_json())
 
     def build(self) -> Any:
         """The synthetic backend's ready loop (the robot at the start site)."""

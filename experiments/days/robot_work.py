@@ -26,7 +26,7 @@ from typing import Any
 
 from tasker.messages import CompletionCost, CostParams, ScheduleParams, SPRequest
 from tasker.stage import Stage, StageKind, StagePlan
-from tasker.task import ArgSpec, Effects, Leaving, TaskContext, TaskType
+from tasker.task import ArgSpec, Effects, Leaving, TaskContext, TaskType, adjust_inner
 
 SUFFIX = "_s"
 """A drawn duration's request argument: the action's name and this suffix (``call_help_s``)."""
@@ -54,16 +54,11 @@ class DrawnWork(TaskType):
         return getattr(self.inner, name)
 
     # -- arguments --------------------------------------------------------------------------------------
-    def validate_args(self, args: Mapping[str, Any]) -> dict[str, Any]:
-        own = {k: v for k, v in args.items() if k not in self._names} if isinstance(args, Mapping) else args
-        out = self.inner.validate_args(own)
-        for spec in self._own:
-            value = args.get(spec.name) if isinstance(args, Mapping) else None
-            out[spec.name] = None if value is None else spec.coerce(self.name, value)
-        return out
-
     def check_args(self, args: dict[str, Any]) -> None:
         self.inner.check_args({k: v for k, v in args.items() if k not in self._names})
+
+    def adjust_args(self, given: Mapping[str, Any], args: dict[str, Any]) -> None:
+        adjust_inner(self.inner, self._names, given, args)
 
     # -- the durations ----------------------------------------------------------------------------------
     def _drawn(self, ctx: TaskContext) -> dict[str, float]:

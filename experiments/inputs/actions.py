@@ -10,15 +10,17 @@ a task type takes) are checked by :mod:`experiments.inputs.crossref`.
 from __future__ import annotations
 
 import math
-from collections.abc import Collection
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 from experiments.inputs.fields import MODES, ScenarioError
 from experiments.inputs.request_fields import FIELD_NAMES
+from tasker.errors import ConfigError
 from tasker.support.reader import MAX_SECONDS, Table, check_name, suggest
 
-__all__ = ["NO_REQUESTS", "TABLES", "WORLD_EVENT_KINDS", "ScenarioError", "TimedAction", "located", "read_actions"]
+__all__ = ["NO_REQUESTS", "TABLES", "WORLD_EVENT_KINDS", "Change", "ModeSwitch", "Payload", "Renewal", "Request",
+           "ScenarioError", "Terminate", "TimedAction", "WorldEvent", "located", "read_actions"]
 
 WORLD_EVENT_KINDS = ("posture", "door", "walk", "add", "delete", "device", "move")
 """What a world event may do: a person's posture, a door, a person walking to a point, facts added or
@@ -30,16 +32,93 @@ TABLES = (("requests", "request"), ("terminations", "terminate"), ("changes", "c
 
 
 @dataclass(frozen=True)
+class Renewal:
+    """A request renewed ``after_s`` seconds after its agent ends, until ``until`` (a day's recurring need)."""
+
+    after_s: float
+    until: float
+
+
+@dataclass(frozen=True)
+class Request:
+    """``[[requests]]``: a task type and its arguments (``renew``: requested again after it ends)."""
+
+    task: str
+    args: dict[str, Any]
+    renew: Renewal | None = None
+
+
+@dataclass(frozen=True)
+class Terminate:
+    """``[[terminations]]``: the requester ends an agent's task, with a reason."""
+
+    agent: str
+    reason: str
+
+
+@dataclass(frozen=True)
+class Change:
+    """``[[changes]]``: the requester changes arguments of an agent's task."""
+
+    agent: str
+    args: dict[str, Any]
+
+
+@dataclass(frozen=True)
+class ModeSwitch:
+    """``[[mode_changes]]``: the harmoniser's mode (``IT`` or ``CT``) from now on."""
+
+    mode: str
+
+
+@dataclass(frozen=True)
+class WorldEvent:
+    """``[[world_events]]``: one of :data:`WORLD_EVENT_KINDS` (``what``) with its ``value``; ``note`` says
+    why (None: the file gave none), ``after`` waits for that agent's task to end."""
+
+    what: str
+    value: Any
+    note: str | None = None
+    after: str | None = None
+
+
+Payload = Request | Terminate | Change | ModeSwitch | WorldEvent
+"""What a timed action does, typed by its kind."""
+
+_PAYLOADS: dict[str, Callable[[Mapping[str, Any]], Payload]] = {
+    "request": lambda f: Request(f["task"], f["args"], None if f.get("renew") is None else Renewal(
+        float(f["renew"]["after_s"]), float(f["renew"]["until"]))),
+    "terminate": lambda f: Terminate(f["agent"], f["reason"]),
+    "change": lambda f: Change(f["agent"], f["args"]),
+    "mode": lambda f: ModeSwitch(f["mode"]),
+    "world": lambda f: WorldEvent(f["what"], f["value"], f.get("note"), f.get("after")),
+}
+
+
+@dataclass(frozen=True)
 class TimedAction:
     """One thing that happens at time ``t``: ``kind`` is request, terminate, change, mode or world.
 
-    ``origin`` is where it was written (``("requests", 2)``), for error messages.
+    ``fields`` is the action as the scenario file (and ``run.json``'s scenario, a saved live session)
+    writes it; :attr:`payload` is the same, typed by the kind (:data:`Payload`), for the code that
+    acts on it.  ``origin`` is where it was written (``("requests", 2)``), for error messages.
     """
 
     t: float
     kind: str
     fields: dict[str, Any] = field(default_factory=dict)
     origin: tuple[str, int] = field(default=("", -1), compare=False, repr=False)
+    payload: Payload = field(init=False, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        make = _PAYLOADS.get(self.kind)
+        if make is None:
+            raise ConfigError(f"TimedAction.kind must be one of {list(_PAYLOADS)}, got {self.kind!r}")
+        try:
+            payload = make(self.fields)
+        except (KeyError, TypeError) as exc:
+            raise ConfigError(f"TimedAction({self.kind!r}).fields lacks {exc} (got {sorted(self.fields)})") from None
+        object.__setattr__(self, "payload", payload)
 
 
 def read_actions(top: Table, *, task_names: Collection[str] | None = None,

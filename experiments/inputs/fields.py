@@ -11,7 +11,8 @@ from collections.abc import Iterable, Mapping
 from typing import Any
 
 from tasker import schedulers
-from tasker.support.reader import InputError, Table
+from tasker.errors import ScenarioError as ScenarioError  # defined there; re-exported here
+from tasker.support.reader import Table
 from tasker.task import TaskType
 
 TASKS_HINT = "to add a task type, add its folder with --path DIR or TASKER_TASKS (see 'tasker new')"
@@ -20,10 +21,6 @@ TASKS_HINT = "to add a task type, add its folder with --path DIR or TASKER_TASKS
 MODES = ("IT", "CT")
 STRATEGIES = ("planned", "static")
 POLICIES = ("strict", "conditional")
-
-
-class ScenarioError(InputError):
-    """A scenario file is malformed; the message names the file, the line and the field."""
 
 
 def scheduler(s: Table) -> str:

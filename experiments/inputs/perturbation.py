@@ -37,9 +37,12 @@ import math
 import random
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from experiments.inputs.actions import TimedAction
+
+if TYPE_CHECKING:
+    from robot.spec import WorldSpec
 
 KINDS = ("door", "move", "device", "bystander")
 NOTE = "perturbation"
@@ -183,7 +186,7 @@ def events(p: Perturbation, seed: str, around: float, *, doors: Mapping[str, tup
     return out
 
 
-def candidates(spec: Any, scenario_objects: Mapping[str, Mapping[str, Any]], actions: Sequence[TimedAction],
+def candidates(spec: WorldSpec, scenario_objects: Mapping[str, Mapping[str, Any]], actions: Sequence[TimedAction],
                people: Mapping[str, Mapping[str, Any]]) -> dict[str, Any]:
     """What a world (a :class:`robot.spec.WorldSpec`) and a scenario offer :func:`events`."""
     asked = named(actions)

@@ -20,7 +20,7 @@ from typing import Any
 
 from tasker.messages import CostParams, ScheduleParams, SPRequest
 from tasker.stage import Stage, StagePlan
-from tasker.task import ArgSpec, TaskContext, TaskType
+from tasker.task import ArgSpec, TaskContext, TaskType, adjust_inner
 
 FIELDS = (
     ArgSpec("deadline", "float", required=False, help="absolute simulated time the task should be done by"),
@@ -47,17 +47,13 @@ class WithRequestFields(TaskType):
             raise AttributeError(name)
         return getattr(self.inner, name)
 
-    def validate_args(self, args: Mapping[str, Any]) -> dict[str, Any]:
-        """The wrapped type checks its own arguments; this class checks :data:`FIELDS`."""
-        own = {k: v for k, v in args.items() if k not in _NAMES} if isinstance(args, Mapping) else args
-        out = self.inner.validate_args(own)
-        for spec in FIELDS:
-            value = args.get(spec.name) if isinstance(args, Mapping) else None
-            out[spec.name] = spec.default if value is None else spec.coerce(self.name, value)
-        return out
-
     def check_args(self, args: dict[str, Any]) -> None:
+        """The wrapped type checks its own arguments (the types of :data:`FIELDS` are checked already)."""
         self.inner.check_args({k: v for k, v in args.items() if k not in _NAMES})
+
+    def adjust_args(self, given: Mapping[str, Any], args: dict[str, Any]) -> None:
+        """The wrapped type adjusts its own arguments; :data:`FIELDS` follow them, as given."""
+        adjust_inner(self.inner, _NAMES, given, args)
 
     def initialise(self, ctx: TaskContext) -> None:
         self.inner.initialise(ctx)

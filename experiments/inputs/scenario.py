@@ -20,7 +20,7 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -33,6 +33,9 @@ from experiments.inputs.perturbation import Perturbation
 from experiments.inputs.robot_scenario import RobotScenario
 from tasker.support import reader
 from tasker.task import SUSPENSIONS
+
+if TYPE_CHECKING:
+    from robot.spec import WorldSpec
 
 __all__ = ["InterruptionGrid", "RobotScenario", "ScenarioError", "load", "randomize", "resolve", "kind_of", "SCENARIOS",
            "with_devices"]
@@ -178,7 +181,7 @@ def load(path: str | Path, *, check: bool = True, task_paths: Sequence[str] = ()
                                                                                       scheduler_options=options)
 
 
-def with_devices(scenario: RobotScenario, spec: Any) -> Any:
+def with_devices(scenario: RobotScenario, spec: WorldSpec) -> WorldSpec:
     """The world ``spec`` (a :class:`robot.spec.WorldSpec`) with the scenario's ``[devices]``, as if its
     file listed them; a name the world uses or a place it lacks is a :class:`ScenarioError` (a scenario
     loaded with its checks has been refused for these already, with the line)."""

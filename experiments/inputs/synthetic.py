@@ -14,7 +14,17 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from experiments.inputs import fields
-from experiments.inputs.actions import NO_REQUESTS, TABLES, TimedAction, located, read_actions
+from experiments.inputs.actions import (
+    NO_REQUESTS,
+    TABLES,
+    Change,
+    ModeSwitch,
+    Request,
+    Terminate,
+    TimedAction,
+    located,
+    read_actions,
+)
 from experiments.inputs.crossref import validate_request
 from experiments.inputs.fields import MODES, ScenarioError
 from experiments.inputs.filekinds import expect
@@ -136,8 +146,8 @@ def load(path: str | Path) -> SyntheticScenario:
             located(top, a).warn("t", f"t={a.t:g} is after the horizon ({scenario.horizon:g} s): it never happens")
     by_name = {t.name: t for t in tasks}
     for a in actions:
-        if a.kind == "request":
-            validate_request(located(top, a), by_name[a.fields["task"]], a.fields["args"])
+        if isinstance(a.payload, Request):
+            validate_request(located(top, a), by_name[a.payload.task], a.payload.args)
     try:
         build(scenario, seed=scenario.seed)  # the rest (changes, the scheduler) now, before any run
     except TaskerError as exc:
@@ -165,17 +175,15 @@ def build(scenario: SyntheticScenario, *, seed: int, scheduler: str | None = Non
 
     requester = Requester(store, loop.harmoniser, "scenario")
     for a in scenario.actions:
-        if a.kind == "request":
-            loop.request(a.t, a.fields["task"], a.fields["args"], requester="scenario")
-        elif a.kind == "terminate":
-            agent, reason = a.fields["agent"], a.fields["reason"]
-            loop.at(a.t, _terminate_event(requester, agent, reason))
-        elif a.kind == "change":
-            agent, args = a.fields["agent"], a.fields["args"]
-            loop.at(a.t, _change_event(loop, requester, agent, args))
-        else:
-            m = a.fields["mode"]
-            loop.at(a.t, _mode_event(loop, m))
+        p = a.payload
+        if isinstance(p, Request):
+            loop.request(a.t, p.task, p.args, requester="scenario")
+        elif isinstance(p, Terminate):
+            loop.at(a.t, _terminate_event(requester, p.agent, p.reason))
+        elif isinstance(p, Change):
+            loop.at(a.t, _change_event(loop, requester, p.agent, p.args))
+        elif isinstance(p, ModeSwitch):
+            loop.at(a.t, _mode_event(loop, p.mode))
     return loop
 
 

@@ -27,7 +27,7 @@ from enum import StrEnum
 from pathlib import Path
 from typing import Any
 
-from tasker.errors import TaskerError
+from tasker.errors import StoreError as StoreError  # defined there; re-exported here
 from tasker.support import reader
 
 SCHEMA_VERSION = 1
@@ -110,10 +110,6 @@ def remove(path: str | Path) -> bool:
         raise StoreError(f"{p}: is not a file, expected a results database")
     _remove(p)
     return True
-
-
-class StoreError(TaskerError, RuntimeError):
-    """The results database cannot be opened, does not have the expected schema, or holds a corrupt row."""
 
 
 class Status(StrEnum):

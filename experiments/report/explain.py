@@ -27,11 +27,15 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from experiments.trace.timeline import Timeline
 from tasker import events as ev
+from tasker.errors import ExplainError as ExplainError  # defined there; re-exported here
 from tasker.support import reader
+
+if TYPE_CHECKING:
+    from planners.pddl_task import PlanningRecord
 
 PROBLEMS = "problems"
 INDEX = "index.json"
@@ -40,11 +44,6 @@ MOVING_EVENTS = (ev.Decision, ev.CommandSent, ev.Transition, ev.TaskEnded)
 TICK_S = 0.001
 """The loop's tick (:class:`tasker.loop.SimulationLoop`'s default resolution): a message between the
 harmoniser and an agent takes one, so what answers an event at ``T`` happens at ``T`` + 1, 2, … ms."""
-
-
-class ExplainError(reader.InputError):
-    """A run folder, agent or time that ``tasker explain`` cannot explain (a damaged file of the
-    run folder is named with its line and field, as every reader's errors are)."""
 
 
 # ----------------------------------------------------------------------------------------- writing
@@ -58,32 +57,78 @@ def _plan_text(steps: Iterable[Sequence[str]], cost: float | None) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_problems(out: Path, journal: Sequence[Any]) -> Path | None:
+@dataclass(frozen=True)
+class ProblemEntry:
+    """One planning call of a run, as ``problems/index.json`` lists it: when, by whom, why
+    (``purpose``, ``label``), how it ended (``status``, ``message``), the files of its domain, problem
+    and plan (names inside ``problems/``), the names the portable PDDL renamed, the plan's steps in
+    the task's own names and its cost (``"inf"`` as a string when infinite)."""
+
+    n: int
+    t: float
+    agent: str
+    task_type: str
+    purpose: str
+    label: str
+    status: str
+    domain: str
+    problem: str
+    renamed: Mapping[str, str]
+    message: str
+    plan: tuple[tuple[str, ...], ...] | None
+    cost: float | str | None
+    plan_file: str | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        out: dict[str, Any] = {
+            "n": self.n, "t": self.t, "agent": self.agent, "task_type": self.task_type, "purpose": self.purpose,
+            "label": self.label, "status": self.status, "domain": self.domain, "problem": self.problem,
+            "renamed": dict(sorted(self.renamed.items())), "message": self.message,
+            "plan": [list(s) for s in self.plan] if self.plan is not None else None,
+            "cost": self.cost,
+        }
+        if self.plan_file is not None:
+            out["plan_file"] = self.plan_file
+        return out
+
+    @staticmethod
+    def json_cost(cost: float | None) -> float | str | None:
+        """A cost as the index holds it: a finite number, None, or ``"inf"`` (JSON has no infinity)."""
+        return cost if cost is None or math.isfinite(cost) else str(cost)
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, Any]) -> ProblemEntry:
+        """An entry :func:`experiments.report.explain.load_index` has checked (its strings and ``t``)."""
+        plan = data.get("plan")
+        return cls(n=int(data.get("n", 0)), t=float(data["t"]), agent=data["agent"], task_type=data["task_type"],
+                   purpose=data["purpose"], label=data.get("label") or "", status=data["status"],
+                   domain=data["domain"], problem=data["problem"], renamed=dict(data.get("renamed") or {}),
+                   message=data.get("message") or "",
+                   plan=None if plan is None else tuple(tuple(str(a) for a in s) for s in plan),
+                   cost=data.get("cost"), plan_file=data.get("plan_file"))
+
+
+def write_problems(out: Path, journal: Sequence[PlanningRecord]) -> Path | None:
     """Write a run's planning journal (:class:`planners.pddl_task.PlanningRecord`) to ``out``:
     ``<task_type>.domain.pddl``, ``NNN_<agent>_<purpose>.pddl`` (and ``.plan`` when solved)
     and ``index.json``.  Returns ``out``, or None when nothing was planned."""
     if not journal:
         return None
     out.mkdir(parents=True, exist_ok=True)
-    index = []
+    index: list[ProblemEntry] = []
     for n, r in enumerate(journal, start=1):
         domain_file = f"{r.task_type}.domain.pddl"
         (out / domain_file).write_text(r.pddl.domain, encoding="utf-8")
         stem = f"{n:03d}_{r.agent}_{r.purpose}"
         (out / f"{stem}.pddl").write_text(r.pddl.problem, encoding="utf-8")
-        entry: dict[str, Any] = {
-            "n": n, "t": r.t, "agent": r.agent, "task_type": r.task_type, "purpose": r.purpose,
-            "label": r.label, "status": r.status, "domain": domain_file, "problem": f"{stem}.pddl",
-            "renamed": dict(sorted(r.pddl.renamed.items())), "message": r.message,
-            "plan": [list(s) for s in r.plan] if r.plan is not None else None,
-            "cost": r.cost if r.cost is None or math.isfinite(r.cost) else str(r.cost),
-        }
         if r.plan is not None:
             (out / f"{stem}.plan").write_text(_plan_text((r.pddl.written(s) for s in r.plan), r.cost),
                                               encoding="utf-8")
-            entry["plan_file"] = f"{stem}.plan"
-        index.append(entry)
-    (out / INDEX).write_text(json.dumps(index, indent=1, sort_keys=True) + "\n", encoding="utf-8")
+        index.append(ProblemEntry(n, r.t, r.agent, r.task_type, r.purpose, r.label, r.status, domain_file,
+                                  f"{stem}.pddl", r.pddl.renamed, r.message, r.plan, ProblemEntry.json_cost(r.cost),
+                                  plan_file=None if r.plan is None else f"{stem}.plan"))
+    (out / INDEX).write_text(json.dumps([e.to_json() for e in index], indent=1, sort_keys=True) + "\n",
+                             encoding="utf-8")
     return out
 
 
@@ -96,7 +141,7 @@ class Explanation:
 
     agent: str
     at: float | None
-    entry: Mapping[str, Any]
+    entry: ProblemEntry
     domain: str
     problem: str
     plan: str | None
@@ -107,11 +152,11 @@ class Explanation:
     def text(self) -> str:
         """The explanation as one readable text (what ``tasker explain`` prints)."""
         e = self.entry
-        plan = self.plan if self.plan is not None else f"; no plan: {e['status']}" + (
-            f" ({e['message']})" if e.get("message") else "") + "\n"
-        head = [f"; {self.agent} ({e['task_type']}): {e['purpose']} at t={e['t']:g} s, {e['status']}"
-                + (f" [{e['label']}]" if e.get("label") else ""),
-                f"; files: {PROBLEMS}/{e['domain']}, {PROBLEMS}/{e['problem']}"]
+        plan = self.plan if self.plan is not None else f"; no plan: {e.status}" + (
+            f" ({e.message})" if e.message else "") + "\n"
+        head = [f"; {self.agent} ({e.task_type}): {e.purpose} at t={e.t:g} s, {e.status}"
+                + (f" [{e.label}]" if e.label else ""),
+                f"; files: {PROBLEMS}/{e.domain}, {PROBLEMS}/{e.problem}"]
         if self.at is not None and self.until is not None and self.until > self.at:
             head.append(f"; at t={self.at:g} s: with what the loop did at once in answer, up to t={self.until:g} s")
         return "\n".join([*head, "", "; ---- domain", self.domain.rstrip(), "", "; ---- problem",
@@ -318,11 +363,11 @@ def explain(run_dir: str | Path, agent: str, at: float | None = None) -> Explana
         times = ", ".join(f"{float(e['t']):g}" for e in mine)
         raise ExplainError(f"{run / PROBLEMS / INDEX}: {agent} had not planned yet at t={at:g} s; it planned at "
                            f"t = {times}")
-    entry = chosen[-1]
+    entry = ProblemEntry.from_json(chosen[-1])
     folder = _root(run) / PROBLEMS
-    domain = _read(folder, entry["domain"], "domain")
-    problem = _read(folder, entry["problem"], "problem")
-    plan = _read(folder, entry["plan_file"], "plan_file") if entry.get("plan_file") else None
+    domain = _read(folder, entry.domain, "domain")
+    problem = _read(folder, entry.problem, "problem")
+    plan = _read(folder, entry.plan_file, "plan_file") if entry.plan_file else None
     return Explanation(agent, at, entry, domain, problem, plan, tuple(moved(timeline, agent, until)), until)
 
 

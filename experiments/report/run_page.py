@@ -26,7 +26,7 @@ import json
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from experiments.metrics.exposure import Stretch
 from experiments.metrics.registry import host_dependent
@@ -36,6 +36,9 @@ from experiments.report.timeline_figures import gantt_figure, timeline_figure
 from experiments.report.world_figure import Sample, read_trajectory, world_figure
 from experiments.trace.timeline import Timeline
 from experiments.trace.timeline import timeline as timeline_of
+
+if TYPE_CHECKING:
+    from robot.spec import WorldSpec
 
 
 def _fmt(v: Any) -> str:
@@ -76,7 +79,8 @@ def _flatten(m: Mapping[str, Any], prefix: str = "") -> list[tuple[str, Any]]:
 
 
 def run_page(events: Source, *, record: Mapping[str, Any] | None = None,
-             metrics: Mapping[str, Any] | None = None, world: Any = None, trajectory: Sequence[Sample] = (),
+             metrics: Mapping[str, Any] | None = None, world: WorldSpec | None = None,
+             trajectory: Sequence[Sample] = (),
              people: Mapping[str, Sequence[tuple[float, float, float, str]]] | None = None,
              problems: Sequence[Mapping[str, Any]] = ()) -> str:
     """The HTML of a run's report (see the module docstring)."""
@@ -142,7 +146,8 @@ def _details(metrics: Mapping[str, Any] | None, problems: Sequence[Mapping[str, 
 
 
 def write_run(out: Path, events: Source, *, record: Mapping[str, Any] | None = None,
-              metrics: Mapping[str, Any] | None = None, world: Any = None, trajectory: Sequence[Sample] = ()) -> Path:
+              metrics: Mapping[str, Any] | None = None, world: WorldSpec | None = None,
+              trajectory: Sequence[Sample] = ()) -> Path:
     """Write ``out/report.html`` for a run; a recorded trajectory file in ``out`` wins over
     ``trajectory`` (the run's own), and ``out/problems/index.json`` is listed when present."""
     recorded = read_trajectory(out)

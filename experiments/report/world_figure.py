@@ -13,7 +13,7 @@ import json
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import plotly.graph_objects as go
 
@@ -22,6 +22,9 @@ from experiments.report.plots import Source
 from experiments.trace.timeline import Timeline
 from experiments.trace.timeline import timeline as timeline_of
 from tasker import events as ev
+
+if TYPE_CHECKING:
+    from robot.spec import WorldSpec
 
 _S = TypeVar("_S", bound=tuple[Any, ...])
 Sample = tuple[float, float, float, float]
@@ -105,8 +108,9 @@ def _at(samples: Sequence[_S], t: float) -> _S | None:
 _FILL = {"wall": "#444", "furniture": "#c8b48a", "door": "#7a4f2a"}
 
 
-def world_figure(world: Any, robot: Sequence[Sample], people: Mapping[str, Sequence[tuple[float, float, float, str]]],
-                 events: Source, hazards: Sequence[Stretch]) -> dict[str, Any]:
+def world_figure(world: WorldSpec, robot: Sequence[Sample],
+                 people: Mapping[str, Sequence[tuple[float, float, float, str]]], events: Source,
+                 hazards: Sequence[Stretch]) -> dict[str, Any]:
     """The world from above, a time slider over the trajectory: the robot, its path so far,
     people, the hazards on and the agent executing at that moment; red crosses where the robot
     was at each ``susp`` command.  A figure dict: its
@@ -169,7 +173,7 @@ def world_figure(world: Any, robot: Sequence[Sample], people: Mapping[str, Seque
     return out
 
 
-def _people_from_trace(world: Any, tl: Timeline) -> dict[str, list[tuple[float, float, float, str]]]:
+def _people_from_trace(world: WorldSpec, tl: Timeline) -> dict[str, list[tuple[float, float, float, str]]]:
     """Without recorded people: each at the world's initial pose, postures from ``world`` events."""
     out = {n: [(0.0, p.pose[0], p.pose[1], p.posture)] for n, p in world.people.items()}
     for e in tl.world:

@@ -20,20 +20,22 @@ import json
 import platform
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import tasker
 from experiments.inputs import fields, synthetic
 from experiments.inputs import scenario as scenarios
-from experiments.inputs.actions import TimedAction
+from experiments.inputs.actions import Change, ModeSwitch, Request, Terminate, TimedAction, WorldEvent
 from experiments.inputs.perturbation import TOGGLE, TargetDraw, named
 from experiments.inputs.request_fields import asked_for
 from experiments.metrics import run as metrics
 from experiments.report.explain import INDEX, write_problems
 from experiments.run.options import RunOptions
+from experiments.run.records import PlannerConfig, RunRecord, RunSettings
+from experiments.run.simulation import SimulatedWorld
 from experiments.run.targeting import Targeter
 from experiments.trace.timeline import Timeline
 from tasker import events as ev
@@ -48,21 +50,26 @@ from tasker.store import TaskStore
 from tasker.task import Strategy, TaskType
 from tasker.trace import FAILED, Trace
 
+if TYPE_CHECKING:
+    from planners.pddl_task import PlanningRecord
+    from robot.recording import Recorder
+    from robot.spec import WorldSpec
+
 
 @dataclass(frozen=True)
 class RunResult:
     """What one run produced: its record, its metrics and its trace."""
 
-    record: dict[str, Any]
+    record: RunRecord
     metrics: dict[str, Any]
     trace: Trace
     trajectory: tuple[tuple[float, float, float, float], ...] = ()
-    recording: Any = None
+    recording: Recorder | None = None
     """A robot run's :class:`robot.recording.Recorder` (``trajectory.jsonl`` is written from it); None if synthetic."""
 
 
 def build_robot(scn: scenarios.RobotScenario, options: RunOptions, *, trace: Trace | None = None,
-                task_wrapper: Callable[[TaskType], TaskType] | None = None) -> tuple[SimulationLoop, Any]:
+                task_wrapper: Callable[[TaskType], TaskType] | None = None) -> tuple[SimulationLoop, SimulatedWorld]:
     """The loop and the simulation for a robot scenario, with every request and event scheduled
     (:func:`build_robot_actions`)."""
     loop, sim, _ = build_robot_actions(scn, options, trace=trace, task_wrapper=task_wrapper)
@@ -71,7 +78,7 @@ def build_robot(scn: scenarios.RobotScenario, options: RunOptions, *, trace: Tra
 
 def build_robot_actions(scn: scenarios.RobotScenario, options: RunOptions, *, trace: Trace | None = None,
                         task_wrapper: Callable[[TaskType], TaskType] | None = None
-                        ) -> tuple[SimulationLoop, Any, Actions]:
+                        ) -> tuple[SimulationLoop, SimulatedWorld, Actions]:
     """The loop, the simulation and the :class:`Actions` of a robot scenario, every action scheduled.
 
     ``options`` (:class:`~experiments.run.options.RunOptions`, whose ``seed`` must be set) choose
@@ -138,8 +145,8 @@ def build_robot_actions(scn: scenarios.RobotScenario, options: RunOptions, *, tr
     loop.harmoniser.hazards = monitor.active  # hazard-aware waiting learns of hazards from the monitor
     actions = Actions(loop, sim, _Made(loop, Requester(store, loop.harmoniser, "scenario")))
     for a in sorted([*from_world, *scn.actions], key=lambda a: a.t):  # stable: the world file's first at a tie
-        if a.kind == "request":
-            store.validate(a.fields["task"], a.fields["args"])  # bad requests fail before the run
+        if isinstance(a.payload, Request):
+            store.validate(a.payload.task, a.payload.args)  # bad requests fail before the run
         actions.schedule(a)
     return loop, sim, actions
 
@@ -150,7 +157,7 @@ class Actions:
     arrives.  The K-th request scheduled is the scenario's ``dK`` (what ``terminate``, ``change``
     and ``after`` name); :meth:`agents` says which agents were made for it."""
 
-    def __init__(self, loop: SimulationLoop, sim: Any, made: _Made) -> None:
+    def __init__(self, loop: SimulationLoop, sim: SimulatedWorld, made: _Made) -> None:
         self.loop, self.sim, self._made = loop, sim, made
         self.requests = 0
 
@@ -190,7 +197,7 @@ def _with_trees(options: RunOptions, types: list[TaskType], default: Strategy,
     return out
 
 
-def _world_file_events(spec: Any, world: str) -> tuple[Any, list[TimedAction]]:
+def _world_file_events(spec: WorldSpec, world: str) -> tuple[WorldSpec, list[TimedAction]]:
     """The world file's own timed events (a person's ``events = [[t, posture]]``) taken out of the
     people and returned as world events, so they run — and are traced — as a scenario's do."""
     out = [TimedAction(float(t), "world", {"what": "posture", "value": [name, posture],
@@ -202,7 +209,7 @@ def _world_file_events(spec: Any, world: str) -> tuple[Any, list[TimedAction]]:
     return dataclasses.replace(spec, people=people), sorted(out, key=lambda a: a.t)
 
 
-def _with_objects(scn: scenarios.RobotScenario, spec: Any) -> Any:
+def _with_objects(scn: scenarios.RobotScenario, spec: WorldSpec) -> WorldSpec:
     """The world with the scenario's ``[objects]``: each gets its type, ``("at", name, place)``
     and its facts (its pose is its place's, see :meth:`robot.sim.Simulation.snapshot`); and with
     its ``[devices]``, as if the world file listed them."""
@@ -238,7 +245,7 @@ class _Made:
     def __init__(self, loop: SimulationLoop, requester: Requester) -> None:
         self.loop, self.requester = loop, requester
         self.agents: dict[str, list[str]] = {}
-        self._renewable: dict[str, tuple[str, TimedAction]] = {}  # agent -> (its scenario id, its request)
+        self._renewable: dict[str, tuple[str, Request]] = {}  # agent -> (its scenario id, its request)
         self._terminated: set[str] = set()  # scenario ids a requester terminated: never renewed
         loop.trace.subscribe(self._watch)
 
@@ -251,38 +258,40 @@ class _Made:
         self._terminated.add(sid)
         self.requester.terminate(self.current(sid), reason)
 
-    def submit(self, sid: str, a: TimedAction, renews: str | None = None) -> None:
+    def submit(self, sid: str, a: Request, renews: str | None = None) -> None:
         if renews is not None and sid in self._terminated:
             return
-        agent = self.requester.request(a.fields["task"], a.fields["args"], renews=renews)
+        agent = self.requester.request(a.task, a.args, renews=renews)
         self.agents.setdefault(sid, []).append(agent)
-        if "renew" in a.fields:
+        if a.renew is not None:
             self._renewable[agent] = (sid, a)
 
     def _watch(self, e: ev.Event) -> None:
         if not isinstance(e, ev.TaskEnded) or e.cause not in FAILED or e.agent not in self._renewable:
             return
         sid, a = self._renewable.pop(e.agent)
-        when = e.t + float(a.fields["renew"]["after_s"])
-        if when < float(a.fields["renew"]["until"]):
+        assert a.renew is not None
+        when = e.t + a.renew.after_s
+        if when < a.renew.until:
             self.loop.at(when, lambda: self.submit(sid, a, renews=e.agent))
 
 
-def _action(loop: SimulationLoop, sim: Any, made: _Made, a: TimedAction, sid: str) -> Callable[[], None]:
+def _action(loop: SimulationLoop, sim: SimulatedWorld, made: _Made, a: TimedAction, sid: str) -> Callable[[], None]:
     """What happens at ``a.t``; ``sid``: the scenario's id of the latest request (``a``'s own if it is one)."""
-    f = a.fields
+    p = a.payload
     requester = made.requester
-    if a.kind == "request":
-        return lambda: made.submit(sid, a)  # through the public requester, as any user's requests
-    if a.kind == "terminate":
-        return lambda: made.terminate(f["agent"], f["reason"])
-    if a.kind == "change":
-        return lambda: synthetic._change(loop, requester, made.current(f["agent"]), f["args"])
-    if a.kind == "mode":
-        return lambda: loop.harmoniser.set_mode(f["mode"])
+    if isinstance(p, Request):
+        return lambda: made.submit(sid, p)  # through the public requester, as any user's requests
+    if isinstance(p, Terminate):
+        return lambda: made.terminate(p.agent, p.reason)
+    if isinstance(p, Change):
+        return lambda: synthetic._change(loop, requester, made.current(p.agent), p.args)
+    if isinstance(p, ModeSwitch):
+        return lambda: loop.harmoniser.set_mode(p.mode)
+    assert isinstance(p, WorldEvent)
 
     def world_event() -> None:
-        what, value = f["what"], f["value"]
+        what, value = p.what, p.value
         if what == "posture":
             sim.people[value[0]].set_posture(value[1])
         elif what == "walk":
@@ -301,11 +310,11 @@ def _action(loop: SimulationLoop, sim: Any, made: _Made, a: TimedAction, sid: st
             sim.apply(add=value)
         else:
             sim.apply(delete=value)
-        loop.trace.emit(ev.WorldChanged(loop.now, what, value, f.get("note", "")))
+        loop.trace.emit(ev.WorldChanged(loop.now, what, value, "" if p.note is None else p.note))
 
-    if "after" not in f:
+    if p.after is None:
         return world_event
-    return _after(loop, made, f["after"], world_event)
+    return _after(loop, made, p.after, world_event)
 
 
 def _after(loop: SimulationLoop, made: _Made, sid: str, event: Callable[[], None]) -> Callable[[], None]:
@@ -334,7 +343,7 @@ def _after(loop: SimulationLoop, made: _Made, sid: str, event: Callable[[], None
 def run_scenario(source: str | Path | scenarios.RobotScenario, options: RunOptions | None = None, *,
                  out: Path | None = None, progress: bool = False, pictures: bool = True,
                  task_wrapper: Callable[[TaskType], TaskType] | None = None,
-                 live: Callable[[SimulationLoop, Any, Actions], scenarios.RobotScenario] | None = None,
+                 live: Callable[[SimulationLoop, SimulatedWorld, Actions], scenarios.RobotScenario] | None = None,
                  **changes: Any) -> RunResult:
     """Run a scenario (a shipped name, a path, or a loaded robot scenario) and return what it produced.
 
@@ -386,7 +395,7 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, options: RunOptio
     error: BaseException | None = None
     with _journal(kind) as journal:  # the PDDL of every planning call, for problems/
         try:
-            if live is not None and actions is not None:
+            if live is not None and actions is not None and sim is not None:
                 spec_json = {"kind": "robot", **live(loop, sim, actions).to_json()}
             else:
                 _run(loop, progress)
@@ -402,34 +411,30 @@ def run_scenario(source: str | Path | scenarios.RobotScenario, options: RunOptio
         trajectory = tuple(sim.trajectory)
         world_spec = sim.spec
     calls = loop.planner_calls
-    record = {
-        "scenario": spec_json, "seed": run_seed,
-        "settings": {"scheduler": loop.harmoniser.scheduler.name, "mode": loop.harmoniser.mode.value,
-                     # synthetic task types have only static strategies: say what was used
-                     "update": "static" if kind == "synthetic" else (opts.update or loop.strategy.update),
-                     "suspension": "static" if kind == "synthetic" else (opts.suspension or loop.strategy.suspension),
-                     "randomized": opts.randomize,
-                     "policy": None if kind == "synthetic" else loop.strategy.policy,
-                     "hazard_waiting": opts.hazard_waiting,
-                     **({"tree": opts.tree} if opts.tree is not None else {}),
-                     **({"interruption": opts.interruption.to_json()} if opts.interruption and opts.randomize else {}),
-                     **({"perturbation": opts.perturbation.to_json()} if opts.perturbation and opts.randomize
-                        else {})},
-        "planner": _planner_config() if kind == "robot" else None,
-        "host": platform.node(), "platform": platform.platform(), "python": sys.version.split()[0],
-        "date": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "tasker_version": tasker.__version__,
-        "wall_time_s": round(wall, 3),
-    }
+    settings = RunSettings(
+        loop.harmoniser.scheduler.name, loop.harmoniser.mode.value,
+        # synthetic task types have only static strategies: say what was used
+        update="static" if kind == "synthetic" else (opts.update or loop.strategy.update),
+        suspension="static" if kind == "synthetic" else (opts.suspension or loop.strategy.suspension),
+        randomized=opts.randomize, policy=None if kind == "synthetic" else loop.strategy.policy,
+        hazard_waiting=opts.hazard_waiting, tree=opts.tree,
+        interruption=opts.interruption.to_json() if opts.interruption and opts.randomize else None,
+        perturbation=opts.perturbation.to_json() if opts.perturbation and opts.randomize else None)
+    record = RunRecord(
+        spec_json, run_seed, settings, _planner_config() if kind == "robot" else None,
+        host=platform.node(), platform=platform.platform(), python=sys.version.split()[0],
+        date=_dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), tasker_version=tasker.__version__,
+        wall_time_s=round(wall, 3))
     reason = ""
     if error is None:
         metrics = _metrics(trace, calls, wall)
     else:
         if isinstance(error, KeyboardInterrupt):
-            reason, record["status"] = f"interrupted by the user at t={loop.now:g} s", "interrupted"
+            reason, status = f"interrupted by the user at t={loop.now:g} s", "interrupted"
         else:
             reason = error.reason if isinstance(error, RunAborted) else f"{type(error).__name__}: {error}"
-            record["status"] = "aborted"
-        record["error"] = reason
+            status = "aborted"
+        record = dataclasses.replace(record, status=status, error=reason)
         try:
             metrics = _metrics(trace, calls, wall)
         except Exception as exc:  # metrics of a cut trace may not compute: say so, keep the rest
@@ -477,12 +482,11 @@ def _run(loop: SimulationLoop, progress: bool) -> None:
                 break
 
 
-def _planner_config() -> dict[str, Any]:
+def _planner_config() -> PlannerConfig:
     from planners.pddl_task import default_planner
 
     p = default_planner()
-    return {"engine": getattr(p, "name", "tasker-fd"), "unified_planning": _version("unified-planning"),
-            "up_fast_downward": _version("up-fast-downward")}
+    return PlannerConfig(getattr(p, "name", "tasker-fd"), _version("unified-planning"), _version("up-fast-downward"))
 
 
 def _version(dist: str) -> str | None:
@@ -530,15 +534,15 @@ def _clear_outputs(out: Path) -> None:
             problems.rmdir()
 
 
-def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Trace,
-          trajectory: tuple[tuple[float, float, float, float], ...], world: Any, pictures: bool,
-          sim: Any = None, journal: Any = ()) -> None:
+def _save(out: Path, record: RunRecord, metrics_: dict[str, Any], trace: Trace,
+          trajectory: tuple[tuple[float, float, float, float], ...], world: WorldSpec | None, pictures: bool,
+          sim: SimulatedWorld | None = None, journal: Sequence[PlanningRecord] = ()) -> None:
     out.mkdir(parents=True, exist_ok=True)
     _clear_outputs(out)
     trace.write(out / "trace.jsonl")
     if sim is not None:  # poses and postures at a fixed rate (robot.recording)
         sim.write_trajectory(out / "trajectory.jsonl")
-    (out / "run.json").write_text(json.dumps(record, indent=2, sort_keys=True, default=str) + "\n")
+    (out / "run.json").write_text(json.dumps(record.to_json(), indent=2, sort_keys=True, default=str) + "\n")
     (out / "metrics.json").write_text(json.dumps(metrics_, indent=2, sort_keys=True) + "\n")
     write_problems(out / "problems", journal)
     if not pictures:
@@ -549,7 +553,7 @@ def _save(out: Path, record: dict[str, Any], metrics_: dict[str, Any], trace: Tr
     tl = Timeline(trace.typed)  # read once by every picture
     plots.timeline(tl, out / "timeline.png")
     plots.gantt(tl, out / "gantt.png")
-    report_html.write_run(out, tl, record=record, metrics=metrics_, world=world, trajectory=trajectory)
+    report_html.write_run(out, tl, record=record.to_json(), metrics=metrics_, world=world, trajectory=trajectory)
     if world is not None:
         plots.world_path(world, list(trajectory), out / "world.png", events=tl,
                          recording=getattr(sim, "recording", None))

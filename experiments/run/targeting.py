@@ -35,6 +35,7 @@ from typing import Any
 
 from experiments.inputs.actions import TimedAction
 from experiments.inputs.perturbation import NOTE, TOGGLE, TargetDraw
+from experiments.run.simulation import SimulatedWorld
 from robot.sim import CLEAR, DOOR_BETWEEN
 from tasker import events as ev
 from tasker.agent import DynamicAgent
@@ -59,8 +60,8 @@ class Target:
 class Targeter:
     """Aims one world change at the suspension tree's branch of a run (see the module docstring)."""
 
-    def __init__(self, loop: SimulationLoop, sim: Any, apply: Callable[[TimedAction], None], draw: TargetDraw,
-                 placed: float, asked: set[str]) -> None:
+    def __init__(self, loop: SimulationLoop, sim: SimulatedWorld, apply: Callable[[TimedAction], None],
+                 draw: TargetDraw, placed: float, asked: set[str]) -> None:
         self.loop, self.sim, self.apply, self.draw, self.placed = loop, sim, apply, draw, placed
         self.asked = asked
         self._armed = draw.timing == "during"
@@ -132,7 +133,7 @@ class Targeter:
         places = self.sim.spec.places
         if a not in places or b not in places:
             return []
-        est = self.sim.motion.estimate(tuple(places[a]), tuple(places[b]))
+        est = self.sim.motion.estimate((*places[a],), (*places[b],))
         return [(float(x), float(y)) for x, y in est.path] if est.reachable else []
 
     def _clutter(self, world: WorldState) -> list[str]:

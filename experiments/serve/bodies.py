@@ -16,15 +16,18 @@ import json
 import math
 import warnings
 from collections.abc import Iterable, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from experiments.inputs.actions import NO_REQUESTS, TimedAction, read_actions
 from experiments.inputs.crossref import arg_problem, arg_types, check_robot, validate_request, world_objects
 from experiments.inputs.fields import ScenarioError
 from experiments.inputs.robot_scenario import RobotScenario
-from tasker.errors import TaskerError
+from tasker.errors import Refused as Refused  # defined there; re-exported here
 from tasker.support.reader import InputError, Table
 from tasker.task import TaskType
+
+if TYPE_CHECKING:
+    from robot.spec import WorldSpec
 
 BAD, NOT_FOUND, CONFLICT, INVALID, UNAVAILABLE = 400, 404, 409, 422, 503
 """The HTTP statuses of a refusal: not JSON, no such agent, the agent has ended, a field is wrong,
@@ -33,18 +36,6 @@ the session is stopping."""
 REQUEST_FIELDS = ("priority", "deadline")
 """Schedule parameters a request body may give beside ``args`` (they are request arguments,
 :mod:`experiments.inputs.request_fields`, and are moved into ``args``)."""
-
-
-class Refused(TaskerError, ValueError):
-    """Something asked over HTTP that the session does not do; ``str()`` is the whole message
-    (``where: field: message``), :meth:`to_json` the body of the 4xx answer."""
-
-    def __init__(self, status: int, where: str, message: str, field: str = "") -> None:
-        self.status, self.where, self.field, self.message = status, where, field, message
-        super().__init__(f"{where}: {field}: {message}" if field else f"{where}: {message}")
-
-    def to_json(self) -> dict[str, Any]:
-        return {"detail": str(self), "field": self.field, "message": self.message}
 
 
 def _located(exc: InputError, where: str, prefix: str) -> Refused:
@@ -113,7 +104,7 @@ def read_world(body: Any, *, t: float, scn: RobotScenario, tasks: Iterable[TaskT
     return _checked(scn, "world_events", entry, t, where, tasks)
 
 
-def read_change(body: Any, *, where: str, task: TaskType, args: Mapping[str, Any], world: Any) -> dict[str, Any]:
+def read_change(body: Any, *, where: str, task: TaskType, args: Mapping[str, Any], world: WorldSpec) -> dict[str, Any]:
     """``PATCH /requests/{id}``: ``{"priority"?, "deadline"?, "args"?}`` — the arguments to change,
     checked as a ``[[changes]]`` entry is: the whole new set by the task type, and each one given
     that names a thing against the world (``world``: the run's :class:`robot.spec.WorldSpec`)."""

@@ -12,15 +12,18 @@ an item in a world without items, cooking without a pan).
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from experiments.inputs.crossref import arg_problem, arg_types, world_objects
 from experiments.inputs.robot_scenario import RobotScenario
 from experiments.serve import bodies
 from tasker.task import TaskType
 
+if TYPE_CHECKING:
+    from robot.spec import WorldSpec
 
-def task_types(scn: RobotScenario, tasks: Iterable[TaskType], world: Any) -> list[dict[str, Any]]:
+
+def task_types(scn: RobotScenario, tasks: Iterable[TaskType], world: WorldSpec) -> list[dict[str, Any]]:
     """For each task type: ``name``, ``args`` (name, type, required), ``example`` (arguments of a
     request the world takes, or ``None``) and ``refused`` (why there is none, or ``None``).
     ``world``: the session's :class:`robot.spec.WorldSpec`."""

@@ -15,10 +15,13 @@ from __future__ import annotations
 
 import html
 import json
-from typing import Any
+from typing import TYPE_CHECKING
 
 from experiments.report.page import figure_div, page
 from experiments.report.world_figure import world_figure
+
+if TYPE_CHECKING:
+    from robot.spec import WorldSpec
 
 POLL_MS = 300
 """How often the page asks for ``/state``."""
@@ -186,7 +189,7 @@ poll();
 """
 
 
-def live_page(world: Any, *, title: str) -> str:
+def live_page(world: WorldSpec, *, title: str) -> str:
     """The page's HTML for a session in ``world`` (a :class:`robot.spec.WorldSpec`)."""
     fig = world_figure(world, [(0.0, *world.robot.pose)], {}, [], [])
     fig["frames"] = []

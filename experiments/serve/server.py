@@ -27,6 +27,7 @@ from experiments.serve.app import create_app
 from experiments.serve.guard import allowed_hosts
 from experiments.serve.page import live_page
 from experiments.serve.session import LIVE_HORIZON, Session
+from experiments.trace.timeline import Timeline
 from tasker.errors import UsageError
 from tasker.support import reader
 
@@ -160,10 +161,12 @@ def serve(scenario: RobotScenario, *, what: str, speed: float, out: Path, host: 
 
 
 def describe(result: RunResult) -> str:
-    """How many tasks ran and how they ended, in words (for the command's last line)."""
-    ends = result.trace.of("end")
+    """How many tasks ran and how they ended, in words (for the command's last line), from the
+    run's timeline (the one reader of a trace)."""
+    tl = Timeline(result.trace.typed)
+    ends = [a.end for a in tl.agents.values() if a.end is not None]
     causes: dict[str, int] = {}
     for e in ends:
-        causes[e["cause"]] = causes.get(e["cause"], 0) + 1
+        causes[e.cause] = causes.get(e.cause, 0) + 1
     how = f" ({', '.join(f'{n} {c}' for c, n in sorted(causes.items()))})" if causes else ""
-    return f"{len(result.trace.of('request'))} tasks, {len(ends)} ended{how}"
+    return f"{len(tl.agents)} tasks, {len(ends)} ended{how}"

@@ -43,6 +43,7 @@ from typing import IO, Any
 from experiments.inputs.actions import TimedAction
 from experiments.inputs.robot_scenario import RobotScenario
 from experiments.run.runner import Actions, RunResult, run_scenario
+from experiments.run.simulation import SimulatedWorld
 from experiments.serve import bodies
 from experiments.serve.bodies import CONFLICT, NOT_FOUND, UNAVAILABLE, Refused
 from experiments.serve.examples import task_types
@@ -100,7 +101,7 @@ class _Drive:
     latest action's time, the wall clock's start and the last publication."""
 
     loop: SimulationLoop
-    sim: Any
+    sim: SimulatedWorld
     actions: Actions
     record: Record
     wall0: float
@@ -192,7 +193,7 @@ class Session:
         return [f"trace.jsonl ({len(self.lines)} events)" if n == "trace.jsonl" else n
                 for n in names if (self.out / n).is_file()] or ["nothing"]
 
-    def _drive(self, loop: SimulationLoop, sim: Any, actions: Actions) -> RobotScenario:
+    def _drive(self, loop: SimulationLoop, sim: SimulatedWorld, actions: Actions) -> RobotScenario:
         d = self._start(loop, sim, actions)
         horizon = min(self.scenario.horizon, LONGEST_S)
         while True:
@@ -211,7 +212,7 @@ class Session:
                 self._wake.wait(WAIT_S)
         return self._finish(d)
 
-    def _start(self, loop: SimulationLoop, sim: Any, actions: Actions) -> _Drive:
+    def _start(self, loop: SimulationLoop, sim: SimulatedWorld, actions: Actions) -> _Drive:
         """The record of the served scenario's own actions, the live trace opened, the loop at 0."""
         record = Record(self.scenario, self.task_paths)
         count = 0
@@ -364,7 +365,7 @@ class Session:
         elif isinstance(e, ev.Decision):
             self._decision = {"t": e.t, **e.data}
 
-    def _publish(self, loop: SimulationLoop, sim: Any, status: str, lag: float) -> None:
+    def _publish(self, loop: SimulationLoop, sim: SimulatedWorld, status: str, lag: float) -> None:
         state = snapshot(loop, sim, ended=self._ended, decision=self._decision, task_types=self._types)
         state.update(status=status, served=self.served, speed=self.speed, lag_s=lag, events=len(self.lines),
                      stop_reason=self.stop_reason)

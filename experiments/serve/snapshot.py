@@ -14,13 +14,14 @@ import dataclasses
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from experiments.run.simulation import SimulatedWorld
 from tasker.loop import SimulationLoop
 
 TRAIL = 400
 """The robot's trail is its last this many recorded samples (thinned to half)."""
 
 
-def snapshot(loop: SimulationLoop, sim: Any, *, ended: Mapping[str, Mapping[str, Any]],
+def snapshot(loop: SimulationLoop, sim: SimulatedWorld, *, ended: Mapping[str, Mapping[str, Any]],
              decision: Mapping[str, Any] | None, task_types: Sequence[Mapping[str, Any]] = ()) -> dict[str, Any]:
     """The state (JSON-ready once :func:`tasker.trace.encode` has rounded it; see the module docstring).
 

@@ -35,11 +35,7 @@ import tasker
 from experiments.metrics.store import ResultStore, RunRow, Status
 from experiments.sweep.spec import Job, SweepSpec, looks_like_path
 from experiments.sweep.workers import RunFn, run_dask, run_job, run_local
-from tasker.errors import TaskerError
-
-
-class SweepError(TaskerError, RuntimeError):
-    """A sweep cannot run (bad arguments, two jobs with the same key)."""
+from tasker.errors import SweepError as SweepError  # defined there; re-exported here
 
 
 @dataclass(frozen=True)

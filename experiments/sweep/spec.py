@@ -22,16 +22,12 @@ from experiments.inputs.scenario import InterruptionGrid
 from experiments.inputs.strategy import FACTOR_LEVELS, FACTORS, Strategy, expand
 from experiments.metrics.store import JobKey
 from experiments.run.options import RunOptions
+from tasker.errors import SpecError as SpecError  # defined there; re-exported here
 from tasker.support import reader
-from tasker.support.reader import InputError
 from tasker.task import DEFAULT_TREE
 
 MAX_JOBS = 100_000
 """A spec that expands to more jobs than this is refused (a typo such as ``seeds = 10000000``)."""
-
-
-class SpecError(InputError):
-    """A sweep spec is malformed; the message names the file, the line and the field."""
 
 
 @dataclass(frozen=True)

@@ -61,7 +61,7 @@ def run_job(job: Job) -> tuple[dict[str, Any], dict[str, Any]]:
     from experiments.run.runner import run_scenario  # imported in the worker, never shared across processes
 
     result = run_scenario(job.source, job.options())
-    return dict(result.record), dict(result.metrics)
+    return result.record.to_json(), dict(result.metrics)
 
 
 def execute(run_fn: RunFn, job: Job) -> Outcome:

@@ -24,7 +24,7 @@ from typing import IO, TYPE_CHECKING, Any
 from planners.results import PlanStatus
 from planners.temporal import engines
 from planners.temporal.results import Attempt, Outcome, TemporalResult, TimedStep
-from tasker.errors import TaskerError
+from tasker.errors import EngineNotInstalled as EngineNotInstalled  # defined there; re-exported here
 
 if TYPE_CHECKING:
     import unified_planning as up
@@ -35,10 +35,6 @@ LINE_CHARS = 160
 """A line of an engine's message longer than this is a debug dump, left out."""
 NO_GOAL = "(no goal)"
 """The ``engine`` of the empty plan of a problem that has no goal: no engine was asked."""
-
-
-class EngineNotInstalled(TaskerError):
-    """A temporal engine was named that is not installed here; the message says which package brings it."""
 
 
 class TemporalPlanner:

@@ -38,7 +38,8 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
-from tasker.errors import TaskerError
+from tasker.errors import InputError as InputError  # defined there; re-exported here
+from tasker.errors import located
 
 PathKey = tuple[str | int, ...]
 
@@ -52,41 +53,15 @@ _ASSIGN = re.compile(rf"^\s*({_KEY}(?:\s*\.\s*{_KEY})*)\s*=")
 _TOML_POS = re.compile(r"\(at line (\d+), column (\d+)\)")
 
 
-class InputError(TaskerError, ValueError):
-    """A user's file is malformed.  ``str()`` is ``file:line: field: message``.
-
-    ``InputError(text)`` with a single argument is a whole message (the older subclasses
-    :class:`~experiments.inputs.scenario.ScenarioError` and :class:`~robot.spec.WorldFileError`
-    were raised that way, and still may be).
-    """
-
-    def __init__(self, file: str | Path, message: str | None = None, *, line: int | None = None,
-                 field: str = "") -> None:
-        if message is None:
-            self.file, self.line, self.field, self.message = "", None, "", str(file)
-            super().__init__(str(file))
-            return
-        self.file = str(file)
-        self.line = line
-        self.field = field
-        self.message = message
-        super().__init__(_where(self.file, line, field, message))
-
-
 class InputWarning(UserWarning):
     """A user's file is accepted but probably not what was meant (a request after the horizon)."""
-
-
-def _where(file: str, line: int | None, field: str, message: str) -> str:
-    where = f"{file}:{line}" if line else file
-    return f"{where}: {field}: {message}" if field else f"{where}: {message}"
 
 
 def warn_at(file: str | Path, line: int | None, field: str, message: str) -> str:
     """Emit an :class:`InputWarning` about ``file`` (at ``line``, ``field`` when known); returns
     its text.  Located at the user's file and line, not at the code that found it, so Python
     shows that line."""
-    text = _where(str(file), line, field, message)
+    text = located(str(file), line, field, message)
     warnings.warn_explicit(InputWarning(text), InputWarning, str(file), line or 0, module="tasker.support.reader")
     return text
 

@@ -156,7 +156,7 @@ def _fake_result(causes: list[str]) -> Any:
 
     typed: list[ev.Event] = [ev.TaskRequested(0.0, f"a{k}", "t", {}, "test") for k in range(len(causes))]
     typed += [ev.TaskEnded(1.0, f"a{k}", "t", c, c) for k, c in enumerate(causes)]
-    return SimpleNamespace(trace=SimpleNamespace(typed=typed), record={"wall_time_s": 0.1}, metrics={})
+    return SimpleNamespace(trace=SimpleNamespace(typed=typed), record=SimpleNamespace(wall_time_s=0.1), metrics={})
 
 
 @pytest.mark.parametrize("strict, causes, status", [

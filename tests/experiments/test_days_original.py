@@ -18,6 +18,7 @@ from experiments.metrics import day as day_metrics_mod
 from tasker.errors import ConfigError
 from tasker.stage import StageKind
 from tasker.support.reader import InputError
+from tasker.task import TaskType
 from tests.experiments.events import complete
 
 PROTOCOLS = Path(__file__).resolve().parents[2] / "experiments" / "days" / "protocols"
@@ -323,7 +324,7 @@ def test_a_day_run_writes_its_pictures_and_a_page_that_shares_plotly(tmp_path: P
 
 # -- the robot backend's drawn work -------------------------------------------------------------------
 
-class _Folder:
+class _Folder(TaskType):
     """A stand-in for a task folder's type: one declared 18 s 'help' and a 5 s 'approach'."""
 
     class spec:  # noqa: N801 - the attribute a folder's type has
@@ -337,9 +338,6 @@ class _Folder:
         from tasker.meaning import NO_MEANING
 
         self.meaning = NO_MEANING
-
-    def validate_args(self, args: dict[str, object]) -> dict[str, object]:
-        return dict(args)
 
     def compute_params(self, ctx: object) -> object:
         from tasker.messages import CostParams

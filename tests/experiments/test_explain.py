@@ -122,8 +122,8 @@ def _problems(run: Path, task_type: str, calls: list[tuple[float, str]]) -> Path
 
 def test_explain_picks_the_problem_in_force(tmp_path: Path) -> None:
     run = _problems(tmp_path / "run", "cook", [(0.5, "upTsk"), (40.0, "genSusp"), (80.0, "upTsk")])
-    assert explain.explain(run, "d1").entry["n"] == 3
-    assert explain.explain(run, "d1", at=45.0).entry["n"] == 2
+    assert explain.explain(run, "d1").entry.n == 3
+    assert explain.explain(run, "d1", at=45.0).entry.n == 2
     assert explain.explain(run, "d1", at=0.5).problem == "; problem 1\n"
     with pytest.raises(explain.ExplainError, match="had not planned yet at t=0.1 s; it planned at t = 0.5, 40, 80"):
         explain.explain(run, "d1", at=0.1)
@@ -156,14 +156,14 @@ def test_at_a_time_is_the_instant_the_trace_shows_there(tmp_path: Path, capsys: 
     answer to what happened at T comes a tick or two later (40.001, 40.002), and is part of T."""
     run = _instant_run(tmp_path)
     at40 = explain.explain(run, "d1", at=40.0)
-    assert (at40.entry["purpose"], at40.entry["t"], at40.until) == ("genSusp", 40.002, 40.002)
+    assert (at40.entry.purpose, at40.entry.t, at40.until) == ("genSusp", 40.002, 40.002)
     assert [type(e).__name__ for e in at40.events][-3:] == ["Decision", "CommandSent", "Transition"]
     assert at40.events[-1].t == 40.002  # not the exeSusp of 40.052: the planning time is a pause
-    assert explain.explain(run, "d1", at=40.001).entry["purpose"] == "genSusp"
+    assert explain.explain(run, "d1", at=40.001).entry.purpose == "genSusp"
     before = explain.explain(run, "d1", at=39.999)
-    assert (before.entry["purpose"], before.until) == ("upTsk", 39.999)
-    assert explain.explain(run, "d1", at=60.0).entry["purpose"] == "genSusp"
-    assert explain.explain(run, "d1", at=80.1).entry["n"] == 3  # 80.10000000000001 is 80.1 in the trace
+    assert (before.entry.purpose, before.until) == ("upTsk", 39.999)
+    assert explain.explain(run, "d1", at=60.0).entry.purpose == "genSusp"
+    assert explain.explain(run, "d1", at=80.1).entry.n == 3  # 80.10000000000001 is 80.1 in the trace
     assert cli_main(["explain", str(run), "--agent", "d1", "--at", "40"]) == 0
     out = capsys.readouterr().out
     assert out.startswith("; d1 (carry_object): genSusp at t=40.002 s, solved\n")

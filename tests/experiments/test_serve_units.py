@@ -408,3 +408,19 @@ def test_a_replay_warns_of_a_repeated_request_only_while_its_twin_is_that_reques
         scenarios.load(tmp_path / "session.toml")
     said = [str(w.message) for w in caught if issubclass(w.category, InputWarning)]
     assert any("the same request as d1" in s for s in said) is warned, said
+
+
+def test_the_last_line_counts_the_tasks_and_their_ends_from_the_timeline() -> None:
+    """``describe`` reads the timeline; the expected line is counted here from the raw events."""
+    from collections import Counter
+
+    from experiments.run.runner import run_scenario
+    from experiments.serve.server import describe
+
+    result = run_scenario(Path(__file__).resolve().parents[2] / "experiments/inputs/scenarios/synthetic_demo.toml")
+    raw = list(result.trace.events)
+    causes = Counter(e["cause"] for e in raw if e["event"] == "end")
+    requests = sum(1 for e in raw if e["event"] == "request")
+    assert requests == 4 and sum(causes.values()) == 4
+    how = ", ".join(f"{n} {c}" for c, n in sorted(causes.items()))
+    assert describe(result) == f"{requests} tasks, {requests} ended ({how})"
