@@ -64,6 +64,7 @@ def _cases() -> list[Case]:
     from tasker.errors import ConfigError, FSMError
     from tasker.events import Decision, TraceError
     from tasker.fsm import FsmState, Transition
+    from tasker.inputs import EstimateInputs
     from tasker.meaning import Binding, Hazard, Meaning, People
     from tasker.messages import Command, CostParams, Flag
     from tasker.oscillation import OscillationGuard
@@ -81,6 +82,8 @@ def _cases() -> list[Case]:
     f0, f1, f2 = Fraction(0), Fraction(1), Fraction(2)
     return [
         Case("Rates", lambda: Rates(rep_rate=0.0), ConfigError, r"Rates\.rep_rate must be a positive number"),
+        Case("EstimateInputs.key", lambda: EstimateInputs(["a"]), TypeError, "key must be hashable"),
+        Case("EstimateInputs.until", lambda: EstimateInputs("k", float("nan")), TypeError, "until must be a time"),
         Case("Term", lambda: Term("why", "bored"), FSMError, "ic_term cause must be one of"),
         Case("Decision.algorithm", lambda: Decision(0.0, {"switch": False}), TraceError, "'algorithm' must be"),
         Case("Decision.switch", lambda: Decision(0.0, {"algorithm": "x", "switch": 1}), TraceError,
