@@ -9,7 +9,8 @@ days on the robot backend, and prints for each the SHA-256 of its trace
 (``trace.jsonl``; on the robot also ``trajectory.jsonl``) and of its day metrics
 (:func:`experiments.days.runner.run_day`, the host-dependent ``wall_time_s`` left out).
 ``diff`` the output of two commits.  The reference of the commit before the cost work
-is ``tests/experiments/data/day-answers-60ed0ea.txt`` (made with ``--robot`` on 60ed0ea);
+is ``tests/experiments/data/day-answers-f6c867e.txt`` (made with ``--robot`` on f6c867e, main
+just before the cost work was merged);
 ``tests/experiments/test_day_answers.py`` compares against it.
 
 Like ``answers.py``, not a ``bench_*`` script.  It uses nothing newer than that commit,
