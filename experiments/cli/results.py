@@ -28,6 +28,7 @@ examples:
   tasker results --pilot                      # only the pilot's 20 seeds; print the n it fixes
   tasker results --limit 60                   # 60 more runs, then say how long the rest takes
   tasker results --no-run --partial --markdown /tmp/interim.md   # an interim document from what is stored
+  tasker results --no-run --partial --replace  # ... in place of docs/results.md (it says how much is in)
   tasker results --replay household 7 fallback --tree cook:cooker --out out/replay   # one run again, every output
   tasker results --check                      # do docs/results.md's vouched-for traces still come out?"""
 
@@ -46,7 +47,11 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p.add_argument("--no-run", action="store_true", help="run nothing; write from what the databases hold")
     p.add_argument("--partial", action="store_true",
                    help="write the document even if the design is not complete (needs --markdown other than "
-                        f"{ex.MARKDOWN}: the committed document is only replaced by a complete one)")
+                        f"{ex.MARKDOWN}, or --replace: the committed document is only replaced by a complete one "
+                        "unless asked)")
+    p.add_argument("--replace", action="store_true",
+                   help=f"with --partial: replace {ex.MARKDOWN} with the interim document knowingly (it says so at "
+                        "its top, with how many runs of the design are in)")
     p.add_argument("--results", default=ex.RESULTS, metavar="DIR",
                    help=f"the folder of the arms' results databases, ARM.db (default {ex.RESULTS})")
     p.add_argument("--markdown", default=ex.MARKDOWN, help=f"the document to write (default {ex.MARKDOWN})")
@@ -69,9 +74,13 @@ def _results(args: argparse.Namespace) -> int:
         return _check(args)
     if args.replay is not None:
         return _replay(args, spec)
-    if args.partial and Path(args.markdown).resolve() == (ex.ROOT / experiment_paths.MARKDOWN).resolve():
+    if args.replace and not args.partial:
+        raise UsageError("--replace", "--replace only lets --partial write the committed document; a complete "
+                                      "document is written without it")
+    if (args.partial and not args.replace
+            and Path(args.markdown).resolve() == (ex.ROOT / experiment_paths.MARKDOWN).resolve()):
         raise UsageError("--partial", f"an interim document may not replace {experiment_paths.MARKDOWN}: "
-                                      "give --markdown PATH")
+                                      "give --markdown PATH, or --replace to replace it knowingly")
     root = Path(args.results)
     for arm in ex.ARMS:
         writable_file(str(ex.db_of(arm, root)), "--results")
@@ -99,13 +108,19 @@ def _results(args: argparse.Namespace) -> int:
 
 
 def _missing(spec: SweepSpec, plan: Plan, root: Path) -> int:
+    return sum(want - have for want, have in _progress(spec, plan, root).values())
+
+
+def _progress(spec: SweepSpec, plan: Plan, root: Path) -> dict[str, tuple[int, int]]:
+    """Per arm, the runs the declared design asks for and how many of them are stored."""
     from experiments.sweep import experiment as ex
 
-    out = 0
+    out = {}
     for arm in ex.ARMS:
         want = ex.arm_jobs(spec, arm, plan.n) + (ex.pilot_jobs(spec) if arm == "targeted" else [])
-        have = {r.key for r in ex.rows_of(ex.db_of(arm, root), want)}
-        out += len({j.key for j in want} - have)
+        keys = {j.key for j in want}
+        have = {r.key for r in ex.rows_of(ex.db_of(arm, root), want)} & keys
+        out[arm] = (len(keys), len(have))
     return out
 
 
@@ -135,8 +150,13 @@ def _write(args: argparse.Namespace, spec: SweepSpec, plan: Plan, root: Path, *,
     command = "tasker results" + (f" --workers {args.workers}" if args.workers != 1 else "")
     text = render(arms, plan, ex.cells(spec), command, pv.Provenance(commit, digests))
     if not complete:
-        text = ("> **Interim**: the declared design is not complete; these numbers are not the experiment's "
-                "answer.\n\n" + text)
+        progress = _progress(spec, plan, root)
+        done = ", ".join(f"{a} {have} of {want}" for a, (want, have) in progress.items())
+        text = ("> **Interim**: the declared design is not complete (runs stored: " + done + "; the targeted "
+                "arm's count includes the pilot). These numbers are not the experiment's answer: n was fixed by "
+                "the pilot and stopping before it is not part of the declaration, so every verdict below is "
+                "provisional and may change once the missing runs are in (`" + command + "` runs them and "
+                "writes the complete document).\n\n" + text)
     Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
     Path(args.markdown).write_text(text, encoding="utf-8")
     print(f"wrote {args.markdown} (" + ", ".join(f"{len(arms[a])} {a}" for a in ex.ARMS) + " runs)")

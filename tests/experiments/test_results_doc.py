@@ -230,6 +230,8 @@ def test_results_refuses_an_interim_document_in_place_of_the_committed_one(
 
     assert main(["results", "--no-run", "--partial"]) == 2
     assert "interim document may not replace" in capsys.readouterr().err
+    assert main(["results", "--no-run", "--replace"]) == 2
+    assert "--replace only lets --partial" in capsys.readouterr().err
     assert main(["results", "--replay", "nowhere", "1", "derived", "--out", "/tmp/x"]) == 2
     assert "no scenario 'nowhere'" in capsys.readouterr().err
     assert main(["results", "--replay", "household", "1", "fallback", "--tree", "x:y", "--out", "/tmp/x"]) == 2
@@ -247,3 +249,16 @@ def test_a_plain_run_is_vouched_for_by_its_scenario(monkeypatch: pytest.MonkeyPa
     prov = pv.Provenance("c", (pv.Digest("", "", "paper", -1, "", "c" * 64),))
     assert pv.verify(prov) == [] and calls == [("paper", None, "")]
     assert "| paper | tasker run | its own | its own settings |" in "\n".join(pv.render(prov))
+
+
+def test_the_progress_of_an_empty_store_is_every_run_missing(tmp_path: Path) -> None:
+    from experiments.cli.results import _missing, _progress
+    from experiments.sweep import experiment as ex
+
+    spec = ex.load()
+    plan = ex.size(spec, ex.db_of("targeted", tmp_path))
+    progress = _progress(spec, plan, tmp_path)
+    assert set(progress) == set(ex.ARMS)
+    assert all(have == 0 and want > 0 for want, have in progress.values())
+    assert _missing(spec, plan, tmp_path) == sum(want for want, _ in progress.values())
+    assert progress["targeted"][0] >= len({j.key for j in ex.pilot_jobs(spec)})
