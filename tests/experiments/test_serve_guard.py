@@ -304,6 +304,7 @@ def _dumps(value: Any) -> bytes:
     return json.dumps(value, ensure_ascii=True).encode()  # NaN and lone surrogates as JSON writes them
 
 
+@pytest.mark.slow  # 300 bodies; the guard's own cases above stay in the fast lane
 @settings(max_examples=300, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(body=JSON_VALUES | st.binary(max_size=40), where=st.sampled_from(["/requests", "/world", "/requests/d1"]))
 def test_fuzz_no_body_gets_a_5xx_and_what_passes_can_be_saved(body: Any, where: str) -> None:

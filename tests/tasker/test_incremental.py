@@ -61,7 +61,8 @@ def test_the_index_serves_the_key_picking_schedulers() -> None:
     assert not schedulers.create("lookahead").indexed and not schedulers.create("distance").indexed
 
 
-@pytest.mark.parametrize("scheduler", schedulers.names())
+@pytest.mark.parametrize("scheduler", [n if n != "lookahead-cpsat" else pytest.param(n, marks=pytest.mark.slow)
+                                       for n in schedulers.names()])
 def test_bundled_synthetic_scenario_same_trace(scheduler: str) -> None:
     scenario = synthetic.load(DEMO)
     indexed, scanned, harm = both_ways(lambda: synthetic.build(scenario, seed=1, scheduler=scheduler))

@@ -63,7 +63,7 @@ def parked_and_stepped(build: Any) -> tuple[str, str, Counter[str]]:
 
 @pytest.mark.parametrize("scheduler", [n if n != "lookahead-cpsat" else pytest.param(n, marks=pytest.mark.slow)
                                        for n in schedulers.names()])
-@pytest.mark.parametrize(("protocol", "seed"), [("tabsa", 3), ("tabsa-short", 5)])
+@pytest.mark.parametrize(("protocol", "seed"), [pytest.param("tabsa", 3, marks=pytest.mark.slow), ("tabsa-short", 5)])
 def test_synthetic_days_same_trace_parked(protocol: str, seed: int, scheduler: str) -> None:
     parked, stepped, seen = parked_and_stepped(days.make(protocol, seed, scheduler=scheduler).build)
     assert parked == stepped
