@@ -89,6 +89,11 @@ def test_a_hazard_of_another_agent_left_on_does_not_make_this_suspension_unsafe_
     b.add(1, "hazard", agent="d2", hazard="cooker_on", args=["cooker"], fact=["cooker_on", "cooker"], status="on")
     s = metrics.compute(_suspend(b, 5, "d1").events)["suspensions"]
     assert s["safe"] == 1
+    carried = _started().request(0, "d2")  # the same, but the robot holds d2's hot thing as d1 suspends
+    carried.add(1, "hazard", agent="d2", hazard="hot_pan_held", args=["robot", "pan"], fact=["holding", "robot", "pan"],
+                status="on", carried=True)
+    s = metrics.compute(_suspend(carried, 5, "d1").events)["suspensions"]
+    assert s["safe"] == 0 and s["episodes"][0]["left_on"] == ["hot_pan_held(robot, pan)"]
 
 
 def test_fallback_replanning_keeps_one_episode_with_both_plans() -> None:

@@ -167,6 +167,9 @@ def test_a_no_cors_text_plain_post_from_another_page_changes_nothing(method: str
     r = c.request(method, path, content=body or b"x", headers={"Content-Type": "text/plain", "Sec-Fetch-Site":
                                                                  "cross-site"})  # no Origin: the fetch metadata
     assert r.status_code == 403 and session.asks == []
+    r = c.request(method, path, content=body or b"x", headers={"Content-Type": "application/json",
+                                                                 "Sec-Fetch-Site": "same-site"})  # a sibling host
+    assert r.status_code == 403 and session.asks == []
 
 
 @pytest.mark.parametrize(("method", "path", "body"), ENDPOINTS)
