@@ -254,6 +254,25 @@ def report(name: str, dimension: str, now: dict[float, tuple[float, int]],
     return ok
 
 
+def print_queues(protocol: str, hours: tuple[float, ...] = (2.0, 8.0), seed: int = 1) -> None:
+    """What the look-ahead's search meets as the day grows: per day length, its decisions, the queue at each
+    (the length of the order it searched), and how many of its searches ended on their own (``exact``)."""
+    sys.path.insert(0, str(HERE))
+    from daysize import sized
+
+    from experiments.days import pipeline
+
+    print(f"the look-ahead's queue at its decisions ({protocol}, seed {seed}):")
+    for h in hours:
+        loop = pipeline.make(sized(protocol, h, None), seed, scheduler="lookahead").build()
+        decisions = [e for e in loop.run().events if e.get("event") == "decision" and "order" in e]
+        lengths = [len(e["order"]) for e in decisions]
+        exact = sum(1 for e in decisions if e.get("rule") == "exact")
+        print(f"  {h:g} h: {len(decisions)} decisions, queue {sum(lengths) / len(lengths):.1f} jobs on average "
+              f"(at most {max(lengths)}); the search ended on its own in {exact} ({100 * exact / len(decisions):.0f} %)"
+              if decisions else f"  {h:g} h: no decision")
+
+
 def main(argv: list[str]) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--protocol", default="tabsa-original")
@@ -267,6 +286,8 @@ def main(argv: list[str]) -> int:
                    help="only: what the look-ahead's node budget does to a 4-hour day's decisions (seed 1)")
     p.add_argument("--eight-hours", action="store_true",
                    help="only: an 8-hour day of each scheduler of the README's `tasker day` (tabsa-original, tabsa)")
+    p.add_argument("--queues", action="store_true",
+                   help="only: the look-ahead's queue at its decisions in a 2-hour and an 8-hour day (seed 1)")
     p.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     p.add_argument("--one-day", action="store_true", help=argparse.SUPPRESS)
     p.add_argument("--dimension", help=argparse.SUPPRESS)
@@ -284,6 +305,9 @@ def main(argv: list[str]) -> int:
         return 0
     if args.budget_study:
         print_budget_study(args.protocol)
+        return 0
+    if args.queues:
+        print_queues(args.protocol)
         return 0
     hours: tuple[float, ...] = HOURS
     requests: tuple[int, ...] = REQUESTS

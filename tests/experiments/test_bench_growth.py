@@ -1,0 +1,41 @@
+"""The growth benchmark's pieces still work, on tiny days (no benchmark is run as a test)."""
+
+from __future__ import annotations
+
+import importlib
+import math
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
+sys.path.insert(0, str(BENCHMARKS))
+bench_growth = importlib.import_module("bench_growth")
+daysize = importlib.import_module("daysize")
+
+
+def test_the_exponent_of_a_power_law_is_its_power() -> None:
+    xs = [1.0, 2.0, 4.0, 8.0]
+    assert bench_growth.exponent(xs, [3.0 * x for x in xs]) == pytest.approx(1.0)
+    assert bench_growth.exponent(xs, [0.5 * x ** 2.5 for x in xs]) == pytest.approx(2.5)
+    assert math.isnan(bench_growth.exponent([2.0, 2.0], [1.0, 5.0]))
+
+
+def test_a_longer_day_keeps_the_request_rate() -> None:
+    from experiments.days import pipeline
+
+    proto = pipeline.load("tabsa-original")
+    day = daysize.longer(proto, 4 * proto.length_s / 3600.0)
+    assert day.length_s == 4 * proto.length_s
+    for name, spec in proto.tasks.items():
+        assert day.tasks[name].count == max(1, round(spec.count * 4))
+    busy = daysize.busier(proto, 40, hours=1.0)
+    assert sum(s.count for s in busy.tasks.values()) == pytest.approx(40, abs=len(proto.tasks))
+
+
+def test_the_queue_study_reads_the_look_aheads_decisions(capsys: pytest.CaptureFixture[str]) -> None:
+    bench_growth.print_queues("tabsa-original", hours=(0.5,))
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("the look-ahead's queue at its decisions (tabsa-original, seed 1)")
+    assert out[1].startswith("  0.5 h: ") and "decisions, queue" in out[1] and "ended on its own" in out[1]
