@@ -90,8 +90,11 @@ class Test:
 
     @property
     def verdict(self) -> str:
-        """``identical``, ``too few pairs``, ``no significant difference``, or which arm the outcome's
-        registered direction favours (``treatment better`` / ``baseline better``)."""
+        """``no pairs`` (nothing to compare yet), ``identical``, ``too few pairs``, ``no significant
+        difference``, or which arm the outcome's registered direction favours (``treatment better`` /
+        ``baseline better``)."""
+        if self.effect.n == 0:
+            return "no pairs"
         if self.effect.informative == 0:
             return "identical"
         if not self.effect.enough:

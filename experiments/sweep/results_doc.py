@@ -160,12 +160,15 @@ def _answer(tests: Sequence[Test], cells: Sequence[str]) -> list[str]:
         hurts = [t for t in mine if t.verdict == "baseline better"]
         few = [t for t in mine if t.verdict == "too few pairs"]
         same = [t for t in mine if t.verdict == "identical"]
+        none = [t for t in mine if t.verdict == "no pairs"]
         parts = []
         if helps:
             parts.append("**helps**: " + "; ".join(f"{t.contrast.treatment} ({_effect(t)})" for t in helps))
         if hurts:
             parts.append("**loses**: " + "; ".join(f"{t.contrast.treatment} ({_effect(t)})" for t in hurts))
-        if not helps and not hurts:
+        if none:
+            parts.append("no pairs yet for " + ", ".join(t.contrast.treatment for t in none))
+        if not helps and not hurts and len(none) < len(mine):
             parts.append("no Holm-significant difference from static")
         if few:
             parts.append("too few discordant pairs for " + ", ".join(
@@ -174,6 +177,13 @@ def _answer(tests: Sequence[Test], cells: Sequence[str]) -> list[str]:
             parts.append("identical in every pair for " + ", ".join(t.contrast.treatment for t in same))
         out.append(f"* **{_name(c)}**: " + "; ".join(parts) + ".")
     return [*out, ""]
+
+
+def _held(held: bool, diffs: Sequence[float]) -> str:
+    """A hypothesis' verdict; with no pair it is not tested (an interim document before its arm ran)."""
+    if not diffs:
+        return "untested: no pairs yet"
+    return "**supported**" if held else "**not supported**"
 
 
 def _hypotheses(arms: Mapping[str, Sequence[RunRow]], cells: Sequence[str]) -> list[str]:
@@ -187,14 +197,14 @@ def _hypotheses(arms: Mapping[str, Sequence[RunRow]], cells: Sequence[str]) -> l
         lo, hi = _interval(diffs, f"{name}|{arm}", 0.95)
         held = bool(diffs) and mean >= ex.H1_MIN and lo > 0
         body.append([name, arm, f"{treatment} − static ≥ {ex.H1_MIN:g}, lower bound > 0", str(len(diffs)),
-                     f"{_fmt(mean)} [{_fmt(lo)}, {_fmt(hi)}] (95 %)", "**supported**" if held else "**not supported**"])
+                     f"{_fmt(mean)} [{_fmt(lo)}, {_fmt(hi)}] (95 %)", _held(held, diffs)])
     for arm in ("untargeted", "control"):
         diffs = [t - b for _, _, b, t in _pairs(_ok(arms.get(arm, ())), cells, "planned", SAFE)]
         mean = math.fsum(diffs) / len(diffs) if diffs else math.nan
         lo, hi = _interval(diffs, f"H2|{arm}", 0.90)
         held = bool(diffs) and -ex.H2_MARGIN < lo and hi < ex.H2_MARGIN
         body.append(["H2", arm, f"planned − static within ± {ex.H2_MARGIN:g} (TOST)", str(len(diffs)),
-                     f"{_fmt(mean)} [{_fmt(lo)}, {_fmt(hi)}] (90 %)", "**supported**" if held else "**not supported**"])
+                     f"{_fmt(mean)} [{_fmt(lo)}, {_fmt(hi)}] (90 %)", _held(held, diffs)])
     return [*out, *_table(["hypothesis", "arm", "claim", "pairs", "difference [interval]", "verdict"], body)]
 
 

@@ -119,7 +119,10 @@ def test_the_hypotheses_can_fail() -> None:
     assert "| 60 | 0.05 [" in h1 and "**not supported**" in h1
     h2 = {line.split("|")[2].strip(): line for line in text.splitlines() if line.startswith("| H2 |")}
     assert "**not supported**" in h2["control"]  # a difference of 0.33: outside ± 0.03
-    assert "**not supported**" in h2["untargeted"]  # no pairs at all: nothing shown equivalent
+    # no pairs at all (an interim document before the arm ran): nothing shown equivalent, and said so
+    assert "untested: no pairs yet" in h2["untargeted"] and "**supported**" not in h2["untargeted"]
+    untargeted = text[text.index("## The untargeted arm's family"):]
+    assert "| cr [default] | planned vs static | 0 | 0 | – [–, –] | 1.000 | 1.000 | no pairs |" in untargeted
 
 
 def test_a_damaged_provenance_block_is_named() -> None:
