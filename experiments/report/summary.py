@@ -75,7 +75,7 @@ def safety(tl: Timeline, metrics: Mapping[str, Any]) -> list[str]:
     nobody = [h for h in tl.hazards if h.owner is None]
     if nobody:
         reasons = Counter(unowned_reason(tl, h) for h in nobody)
-        shown = "; ".join(f"{n} {why}" if n > 1 else why for why, n in sorted(reasons.items()))
+        shown = "; ".join(f"{why} ({n})" if len(reasons) > 1 else why for why, n in sorted(reasons.items()))
         out.append(f"  nobody owns {len(nobody)} hazard episode{'' if len(nobody) == 1 else 's'} "
                    f"(no task is theirs to attend): {shown}")
     if not any(line.startswith(("  hazard", "  unsafe", "  carried")) for line in out):
