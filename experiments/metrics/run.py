@@ -68,7 +68,7 @@ def _task(a: AgentTimeline) -> dict[str, Any]:
         "suspension_s": [s.duration for s in a.suspensions if s.outcome == S.WAIT.value],
         "resumption_s": [r.duration for r in a.resumptions],
         "plans": len(a.plans), "plans_by": dict(sorted(plans_by.items())),
-        "static_fallbacks": sum(1 for p in a.plans if "fallback" in (p.note or "").lower()),
+        "static_fallbacks": sum(1 for p in a.plans if _static_fallback(p.strategy, p.note)),
         "stages": {status: closed.get(status, 0) for status in ("done", "stopped", "failed")},
         "stage_failures": [f"{r.action}: {r.reason or '?'}" for r in a.stages if r.status == "failed"],
     }
@@ -278,6 +278,16 @@ def safety(tl: Timeline) -> dict[str, Any]:
                                            for r in owned),
         "unowned_s": math.fsum(r["active_s"] for r in rows if r["agent"] is None),
     }
+
+
+def _static_fallback(strategy: str | None, note: str | None) -> bool:
+    """Whether a plan is a planned call that ran the static template instead: a plan of strategy
+    ``static`` whose note says it fell back (``fallback to static: ...``, planners.pddl_task), or a
+    ``fallback`` suspension whose planner timed out, so that the tree's branch ran.  A ``fallback``
+    suspension that ran its tree's branch because every stage could run is that strategy working,
+    not a fall back."""
+    text = (note or "").lower()
+    return (strategy == "static" and "fallback" in text) or (strategy == "fallback" and "timed out" in text)
 
 
 def suspensions(tl: Timeline) -> dict[str, Any]:

@@ -273,3 +273,18 @@ def test_time_after_the_owner_ended_is_apart_from_time_it_could_attend() -> None
     m = metrics.compute(b.events)["safety"]
     assert m["unattended_s"] == 4.0 + 18.0 and m["after_end_s"] == 18.0 and m["unattended_alive_s"] == 4.0
     assert m["unowned_s"] == 10.0
+
+
+@pytest.mark.parametrize(("strategy", "note", "counted"), [
+    ("static", "fallback to static: the planner timed out", True),
+    ("fallback", "fallback: the tree's branch runs as written (branch 'x')", False),
+    ("fallback", "fallback: put_down(robot pan counter) cannot run; planned to the derived goal (goal)", False),
+    ("fallback", "fallback: the stove is taken; the planner timed out, so the tree's branch runs", True),
+    ("planned", "planned to the branch's goal", False),
+    ("static", "the tree's branch 'pan held'", False),
+])
+def test_a_static_fallback_is_a_planned_call_that_ran_the_template(strategy: str, note: str, counted: bool) -> None:
+    b = Build().request(0, "d1").go(0, "d1", "initComm", "compSP", "upTsk")
+    b.add(0, "plan", agent="d1", purpose="upTsk", strategy=strategy, stages=[], note=note)
+    b.go(0, "d1", "upTsk", "exeTsk")
+    assert metrics.compute(b.end(1, "d1").events)["tasks"]["d1"]["static_fallbacks"] == int(counted)
