@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any, final
 
 from tasker import events as ev
@@ -37,6 +37,7 @@ from tasker.inputs import Parking
 from tasker.messages import Command, Flag, FsmState, Report, ScheduleParams, SPRequest
 from tasker.parking import ParkedReports, parking
 from tasker.protocols import CoreAgent, SkillState
+from tasker.rates import Rates, next_tick_of
 from tasker.stage import Purpose, Stage, StagePlan
 from tasker.stagerun import UNCONTAINED, StageRunner, check_goal, describe, emit_plan
 from tasker.task import TaskContext, TaskType
@@ -44,21 +45,6 @@ from tasker.trace import Trace
 
 S = FsmState
 _SUSPENDING = frozenset({S.GEN_SUSP, S.EXE_SUSP})
-
-@dataclass(frozen=True, slots=True)
-class Rates:
-    """The agent's rates in Hz: ``repRate``, ``taskExeRate`` and ``SPupRate`` of the paper."""
-
-    rep_rate: float = 1.0
-    task_exe_rate: float = 10.0
-    sp_up_rate: float = 1.0
-
-    def __post_init__(self) -> None:
-        for name in ("rep_rate", "task_exe_rate", "sp_up_rate"):
-            v = getattr(self, name)
-            if not isinstance(v, int | float) or not math.isfinite(v) or v <= 0:
-                raise ConfigError(f"Rates.{name} must be a positive number of Hz, got {v!r}")
-
 
 class DynamicAgent(ParkedReports):
     """A task's dynamic agent.  Created by the harmoniser's ``pf_initDA``.
@@ -274,7 +260,7 @@ class DynamicAgent(ParkedReports):
         self._params = self.task.compute_params(self.ctx)
         self._params_at = now
         self._publish()
-        self.next_wake = _next_tick_of(now, self.rates.rep_rate)
+        self.next_wake = next_tick_of(now, self.rates.rep_rate)
         self.offer = None if self._inbox else parking(self.task, self.ctx, self._params, now)
 
     def _terminate(self, now: float) -> None:
@@ -311,7 +297,7 @@ class DynamicAgent(ParkedReports):
             return
         self._runner = StageRunner(plan, self.id, self._trace)
         self._fire("planned", now)
-        self._next_sp = _next_tick_of(now, self.rates.sp_up_rate)
+        self._next_sp = next_tick_of(now, self.rates.sp_up_rate)
         self._enter_stage(now)
 
     def _enter_stage(self, now: float) -> None:
@@ -346,7 +332,7 @@ class DynamicAgent(ParkedReports):
         if in_task:
             self.ctx.stage_started = now
         runner.begin(self.core, self.state, now)
-        self.next_wake = _next_tick_of(now, self.rates.task_exe_rate)
+        self.next_wake = next_tick_of(now, self.rates.task_exe_rate)
 
     def _exe(self, now: float) -> None:
         """``exeTsk`` / ``exeSusp``: f^stage,k at taskExeRate, f^compSP at SPupRate (eq. 24)."""
@@ -377,9 +363,9 @@ class DynamicAgent(ParkedReports):
             self._params = self.task.compute_params(self.ctx)
             self._params_at = now
             self._publish()
-            self._next_sp = _next_tick_of(now, self.rates.sp_up_rate)
+            self._next_sp = next_tick_of(now, self.rates.sp_up_rate)
         if runner.running:
-            self.next_wake = _next_tick_of(now, self.rates.task_exe_rate)
+            self.next_wake = next_tick_of(now, self.rates.task_exe_rate)
 
     def _advance(self, now: float, stage: Stage) -> None:
         """``stage`` is over and done (it ran, or its effects held already): on to the next one."""
@@ -550,15 +536,6 @@ class DynamicAgent(ParkedReports):
         call = emit_plan(self._trace, now, self.id, self.ctx.task_type, self.state, expected, plan)
         if call is not None:
             self.planner_calls.append(call)
-
-
-def _next_tick_of(now: float, rate: float) -> float:
-    """The next instant of ``timer(rate)``: timers fire on one grid shared by every agent.
-
-    Aligning all agents' timers makes their reports arrive in the same tick, so the
-    harmoniser schedules once per period rather than once per agent.
-    """
-    return (math.floor(now * rate + 1e-9) + 1) / rate
 
 
 def _suspendable(agent: DynamicAgent) -> bool:
