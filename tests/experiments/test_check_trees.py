@@ -12,20 +12,11 @@ from pathlib import Path
 import pytest
 
 from experiments.cli import main
+from tests.planners.test_treecheck import COUNTER  # the counter tree the fixture's example breaks
 
 ROOT = Path(__file__).resolve().parents[2]
 HOT_POT = ROOT / "tests" / "planners" / "fixtures" / "hot_pot"
 BRING_WATER = ROOT / "tests" / "domains" / "fixtures" / "bring_water"
-COUNTER = """\
-[[suspension]]
-label = "pot held: put it on the counter"
-when = [["holding", "$robot", "$pot"]]
-goal = [["hand_empty", "$robot"]]
-stages = [
-  { action = "navigate", args = ["$robot", "$at:robot", "counter"] },
-  { action = "put_pot", args = ["$robot", "$pot", "counter"] },
-]
-"""
 
 
 def _counter_tree(tmp_path: Path) -> Path:
