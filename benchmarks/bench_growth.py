@@ -2,6 +2,7 @@
 
     python benchmarks/bench_growth.py                      # or: python benchmarks/run_all.py growth
     python benchmarks/bench_growth.py --quick              # fewer sizes and seeds, no baseline
+    python benchmarks/bench_growth.py --incremental-study 20   # the look-ahead between decisions: what it costs
     python benchmarks/bench_growth.py --protocol FILE.toml --schedulers alg2 edf --base 60ed0ea
 
 Days of a protocol (default ``tabsa-original``, TaBSA's day) on the synthetic backend,
@@ -190,6 +191,36 @@ def print_budget_study(protocol: str) -> None:
           f" best x{r['ratio_best']:.4f})")
 
 
+QUALITY_KEYS = ("completed", "dead_falls", "lateness_s", "completion_minus_deadline_s", "switches", "interruptions")
+
+
+def print_incremental_study(protocol: str, seeds: int) -> None:
+    """What deciding between searches costs: whole days of ``protocol`` (seeds 1..``seeds``) under the
+    look-ahead as shipped and with ``incremental = false`` (a full search at every decision), their day
+    metrics side by side, and the CPU seconds of each."""
+    from experiments.days.runner import run_day
+
+    rows: dict[str, list[dict[str, Any]]] = {"lookahead": [], "lookahead:incremental=false": []}
+    for seed in range(1, seeds + 1):
+        for name, out in rows.items():
+            start = time.process_time()
+            m = run_day(protocol, seed, name)
+            m["cpu_s"] = time.process_time() - start
+            out.append(m)
+    print(f"the look-ahead between decisions ({protocol}, seeds 1-{seeds}, whole days): as shipped (incremental) "
+          f"against a full search at every decision (incremental = false); commit {_head()}")
+    print(f"  {'metric':30s} {'incremental':>12s} {'full':>12s} {'diff mean':>10s} {'min':>9s} {'max':>9s}  same days")
+    inc, full = rows["lookahead"], rows["lookahead:incremental=false"]
+    for key in (*QUALITY_KEYS, "cpu_s"):
+        a, b = [float(m[key]) for m in inc], [float(m[key]) for m in full]
+        d = [x - y for x, y in zip(a, b, strict=True)]
+        print(f"  {key:30s} {sum(a) / len(a):12.2f} {sum(b) / len(b):12.2f} {sum(d) / len(d):10.2f} {min(d):9.2f} "
+              f"{max(d):9.2f}  {sum(1 for x in d if x == 0)}/{len(d)}")
+    decisions = sum(float(m["anytime_decisions"]) for m in full)
+    print(f"  decisions that hit the node budget: {decisions / len(full):.0f} a day with a full search at every "
+          f"decision, {sum(float(m['anytime_decisions']) for m in inc) / len(inc):.0f} as shipped")
+
+
 # -- the driver ---------------------------------------------------------------------------------------
 
 def series(tree: Path, protocol: str, scheduler: str, dimension: str, sizes: tuple[float, ...], seeds: int,
@@ -286,6 +317,8 @@ def main(argv: list[str]) -> int:
                    help="only: what the look-ahead's node budget does to a 4-hour day's decisions (seed 1)")
     p.add_argument("--eight-hours", action="store_true",
                    help="only: an 8-hour day of each scheduler of the README's `tasker day` (tabsa-original, tabsa)")
+    p.add_argument("--incremental-study", type=int, metavar="SEEDS", default=0,
+                   help="whole days, the look-ahead as shipped against a full search at every decision")
     p.add_argument("--queues", action="store_true",
                    help="only: the look-ahead's queue at its decisions in a 2-hour and an 8-hour day (seed 1)")
     p.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
@@ -308,6 +341,9 @@ def main(argv: list[str]) -> int:
         return 0
     if args.queues:
         print_queues(args.protocol)
+        return 0
+    if args.incremental_study:
+        print_incremental_study(args.protocol, args.incremental_study)
         return 0
     hours: tuple[float, ...] = HOURS
     requests: tuple[int, ...] = REQUESTS

@@ -10,7 +10,8 @@ days on the robot backend, and prints for each the SHA-256 of its trace
 (:func:`experiments.days.runner.run_day`, the host-dependent ``wall_time_s`` left out).
 ``diff`` the output of two commits.  The reference of the commit before the cost work
 is ``tests/experiments/data/day-answers-f6c867e.txt`` (made with ``--robot`` on f6c867e, main
-just before the cost work was merged);
+just before the cost work was merged; its 14 look-ahead lines re-made when the look-ahead learnt
+to decide between searches, issue 38);
 ``tests/experiments/test_day_answers.py`` compares against it.
 
 Like ``answers.py``, not a ``bench_*`` script.  It uses nothing newer than that commit,

@@ -23,7 +23,7 @@ finite one, so that the model stays feasible and avoids it.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from tasker.errors import ConfigError
@@ -41,17 +41,18 @@ class LookAheadCpSat(LookAhead):
 
     def __init__(self, time_limit: float = 0.2, node_budget: int = 2000, switch_penalty_s: float = 0.0,
                  lateness_weight: float = 1.0, hazard_weight: float = 1e4, budgets: Mapping[str, float] | None = None,
-                 hysteresis: float = 1.0) -> None:
+                 hysteresis: float = 1.0, incremental: bool = True) -> None:
         # the look-ahead's options, spelled out so that a misspelt one is named (tasker.schedulers.options)
         super().__init__(node_budget=node_budget, switch_penalty_s=switch_penalty_s, lateness_weight=lateness_weight,
-                         hazard_weight=hazard_weight, budgets=budgets, hysteresis=hysteresis)
+                         hazard_weight=hazard_weight, budgets=budgets, hysteresis=hysteresis, incremental=incremental)
         if isinstance(time_limit, bool) or not isinstance(time_limit, int | float) \
                 or not 0 < time_limit < math.inf:
             raise ConfigError(f"{self.name}: time_limit must be a finite number > 0, got {time_limit!r}")
         self.time_limit = float(time_limit)
 
     def solve(self, prob: Problem, budget: int, *, fixed_first: int | None = None,
-              exclude_first: int | None = None) -> tuple[list[int], float, int, bool]:
+              exclude_first: int | None = None,
+              starts: Sequence[Sequence[int]] = ()) -> tuple[list[int], float, int, bool]:
         return solve_cpsat(prob, self.time_limit, fixed_first=fixed_first, exclude_first=exclude_first)
 
 

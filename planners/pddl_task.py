@@ -283,7 +283,7 @@ class PddlTaskType(TaskType):
         after = request.args.get("after")
         c_time, _ = self.estimate(ctx, start, after=str(after) if after is not None else None)
         cc = self.spec.cps * (ctx.age + c_time) if math.isfinite(c_time) else math.inf
-        return CompletionCost(cc=cc, ccps=self.spec.cps)
+        return CompletionCost(cc=cc, ccps=self.spec.cps, c_time=c_time)
 
     # -- the original TaskER cost model (2019) --------------------------------------------
 

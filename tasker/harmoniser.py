@@ -141,6 +141,7 @@ class TaskHarmoniser:
         self.agents: dict[str, DynamicAgent] = {}  # A_da
         self._handovers: dict[tuple[str, str, float], Effects | None] = {}  # handover's answers
         self._suspensions: dict[tuple[float, str, str], float] = {}  # _suspension_of's answers
+        self._ahead_at: tuple[tuple[float, Candidate | None, int], float] | None = None  # _ahead's last sum
         self.exe_da: str | None = None
         self.irr_da: str | None = None
         self._idle = IdleAgents()  # D_r, in request order (its version counts changes: ScheduleView.generation)
@@ -517,8 +518,18 @@ class TaskHarmoniser:
         c_time = self._c_time(replacement)
         if c_time is None:
             return data
-        ahead = 0.0
+        data["expected_s"] = c_time + self._ahead()
+        return data
+
+    def _ahead(self) -> float:
+        """The cTime of every waiting agent the scheduler ranks ahead of ``exeDA``: one sum per moment,
+        ``exeDA`` and idle set, whoever the replacement."""
         exe = self._cands.get(self.exe_da) if self.exe_da is not None else None
+        key = (self.now, exe, self._idle.version)  # exeDA's report itself: its queue key is the bar
+        last = self._ahead_at
+        if last is not None and last[0][0] == key[0] and last[0][1] is exe and last[0][2] == key[2]:
+            return last[1]
+        ahead = 0.0
         if exe is not None:
             try:
                 mine = self.scheduler.queue_key(exe)
@@ -530,8 +541,8 @@ class TaskHarmoniser:
                         ahead += other
             except Exception:  # a queue key the parameters do not support: the replacement alone
                 ahead = 0.0
-        data["expected_s"] = c_time + ahead
-        return data
+        self._ahead_at = (key, ahead)
+        return ahead
 
     def _req_sp(self, agent_id: str, request: SPRequest) -> Any:
         return self.agents[agent_id].request_sp(request, self.now)

@@ -138,8 +138,13 @@ class CompletionCost:
     """Answer to :data:`SP_COMPLETION` (eq. 21): ``{cc, ccps}`` of Alg. 2.
 
     ``cc`` is the cost of completing the task if it were started from the pose given
-    in the request; ``ccps`` the cost per second while it waits to begin.
+    in the request; ``ccps`` the cost per second while it waits to begin.  ``c_time``
+    (optional) is the seconds that completion takes: a task that knows it says it, and
+    a whole-queue scheduler then reads the duration as the task computed it rather than
+    recovering it from two costs computed at different moments (and may keep it while the
+    task's estimate inputs hold, :attr:`tasker.schedulers.base.ScheduleView.generation`).
     """
 
     cc: float
     ccps: float
+    c_time: float | None = None

@@ -130,8 +130,8 @@ class SyntheticTask(TaskType):
         if request.sp_id != SP_COMPLETION:
             raise ConfigError(f"synthetic task {self.name!r}: unknown reqSP {request.sp_id!r}")
         pose = request.args.get("pose")
-        cost, _ = self._params(ctx, tuple(pose) if pose is not None else None)
-        return CompletionCost(cc=cost, ccps=ctx.args["weight"])
+        cost, c_time = self._params(ctx, tuple(pose) if pose is not None else None)
+        return CompletionCost(cc=cost, ccps=ctx.args["weight"], c_time=c_time)
 
     def update_task(self, ctx: TaskContext) -> StagePlan:
         """Alg. 3: the template minus completed stages, with ``resume_prefix`` after a suspension."""

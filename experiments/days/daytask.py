@@ -192,7 +192,7 @@ class DayTask(SyntheticTask):
         pose = request.args.get("pose")
         c_time = self._c_time(ctx, tuple(pose) if pose is not None else self._robot_pose(ctx))
         w = ctx.args["weight"]
-        return CompletionCost(cc=w * (ctx.age + c_time), ccps=w)
+        return CompletionCost(cc=w * (ctx.age + c_time), ccps=w, c_time=c_time)
 
 
 def task_types(protocol: Protocol) -> tuple[DayTask, ...]:

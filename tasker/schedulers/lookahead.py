@@ -33,9 +33,17 @@ Each decision solves a single-machine sequencing problem over the executing task
   out long before it gets near one.  The budget counts work, never wall time, so traces
   are reproducible.
 
+Between decisions (``incremental``): when the problem differs from the last one only in the
+clock, ``exeDA``'s progress and the switch penalties, the last orders are priced again instead
+of searched (rule ``incremental``): the order that continues ``exeDA`` keeps every completion
+where it was, and the switching orders are the last one and each waiting job moved to its
+front, with the penalties of now.  Otherwise the last orders, adapted (:func:`adapt`), join the
+search as incumbents.  A waiting job's duration after another waiting job is kept while
+``ScheduleView.generation`` holds, when the task answers in seconds (``CompletionCost.c_time``).
+
 The executing task keeps the robot unless the best order that starts with another
 task beats the best order that continues it by the factor ``hysteresis``.
-Every decision leaves a ``decision`` record: ``rule`` (``exact`` or ``anytime``),
+Every decision leaves a ``decision`` record: ``rule`` (``exact``, ``anytime`` or ``incremental``),
 ``order``, ``objective``, ``objective_continue``, ``nodes``; ``suspend_s`` (each
 candidate's plan-based switch penalty) when the view gives suspension estimates, and
 ``left_on`` (agent, hazard, due) when hazards are left on.
@@ -176,7 +184,8 @@ def _improve(p: Problem, order: list[int], allowed_first: set[int], budget: int)
 
 
 def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
-          exclude_first: int | None = None) -> tuple[list[int], float, int, bool]:
+          exclude_first: int | None = None,
+          starts: Sequence[Sequence[int]] = ()) -> tuple[list[int], float, int, bool]:
     """Best order: ``(order, objective, nodes expanded, exact)``.
 
     A greedy order, improved by insertion moves with up to half the budget, is the
@@ -184,7 +193,8 @@ def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
     when that search ended on its own.  When it did not, :func:`_smith`'s order improved
     by insertion moves (up to ``node_budget`` more) replaces the result if it is better.
     Every evaluated move and every expanded node counts against ``node_budget``.  ``fixed_first`` forces the first job;
-    ``exclude_first`` forbids one as first.
+    ``exclude_first`` forbids one as first.  ``starts`` are other orders of all the jobs (the last decision's,
+    :func:`adapt`): the best of them becomes the incumbent if it beats the improved greedy order (each costs ``n``).
     """
     n = p.n
     allowed = [j for j in range(n) if (fixed_first is None or j == fixed_first) and j != exclude_first]
@@ -192,6 +202,12 @@ def solve(p: Problem, *, node_budget: int, fixed_first: int | None = None,
         return [], (0.0 if n == 0 else math.inf), 0, True
     best_order, best, nodes = _improve(p, _greedy(p, allowed), set(allowed), node_budget // 2)
     nodes += n
+    for start in starts:  # the last decision's orders: a warm incumbent, so the bound prunes from the start
+        if len(start) == n and start[0] in allowed:
+            nodes += n
+            value = p.evaluate(start)
+            if value < best - 1e-9 * max(1.0, abs(best)):
+                best_order, best = list(start), value
     exhausted = False
     order: list[int] = []
     placed = [False] * n
@@ -249,6 +265,26 @@ def _smith(p: Problem, allowed_first: list[int]) -> list[int]:
     return [first, *sorted((j for j in range(p.n) if j != first), key=key)]
 
 
+def adapt(p: Problem, ids: Sequence[str], last: Sequence[str], *, fixed_first: int | None = None,
+          exclude_first: int | None = None) -> list[int]:
+    """The order ``last`` (agent ids of an earlier decision) over this problem's jobs ``ids``: the jobs it has,
+    in its order, then the new ones in Smith's order; ``fixed_first`` moved to the front, ``exclude_first``
+    moved to second place.  Empty when no such order exists."""
+    at = {x: k for k, x in enumerate(ids)}
+    order = [at[x] for x in last if x in at]
+    kept = set(order)
+    order += sorted((j for j in range(p.n) if j not in kept),
+                    key=lambda j: (p.dmin[j] / p.weight[j] if p.weight[j] > 0 else math.inf, j))
+    if fixed_first is not None:
+        order.remove(fixed_first)
+        order.insert(0, fixed_first)
+    if exclude_first is not None and order and order[0] == exclude_first:
+        if len(order) < 2:
+            return []
+        order[0], order[1] = order[1], order[0]
+    return order
+
+
 class LookAhead(Scheduler):
     """Whole-queue sequencing by branch and bound within a node budget; see the module docstring."""
 
@@ -258,7 +294,7 @@ class LookAhead(Scheduler):
 
     def __init__(self, node_budget: int = 2000, switch_penalty_s: float = 0.0, lateness_weight: float = 1.0,
                  hazard_weight: float = 1e4, budgets: Mapping[str, float] | None = None,
-                 hysteresis: float = 1.0) -> None:
+                 hysteresis: float = 1.0, incremental: bool = True) -> None:
         if isinstance(node_budget, bool) or not isinstance(node_budget, int) or node_budget < 1:
             raise ConfigError(f"lookahead: node_budget must be an integer >= 1, got {node_budget!r}")
         for key, value in (("switch_penalty_s", switch_penalty_s), ("lateness_weight", lateness_weight),
@@ -279,17 +315,36 @@ class LookAhead(Scheduler):
                                   f"got {value!r}")
         self.budgets = {str(k): float(v) for k, v in (budgets or {}).items()}
         self.hysteresis = float(hysteresis)
+        if not isinstance(incremental, bool):
+            raise ConfigError(f"lookahead: incremental must be true or false, got {incremental!r}")
+        self.incremental = incremental
         self._penalty: dict[str, float] = {}  # the last problem's switch penalty per candidate
+        # what one decision leaves the next (incremental search, module docstring):
+        self._generation: int | None = None  # ScheduleView.generation the kept durations belong to
+        self._durations: dict[tuple[str, str, Any], float] = {}  # (job, after, pose) -> seconds, idle jobs only
+        self._last: tuple[Any, list[str], list[str]] | None = None  # (signature, chosen order, other order)
 
-    def _duration(self, view: ScheduleView, c: Candidate, p: CostParams, pose: Any, after: str) -> float:
+    def _duration(self, view: ScheduleView, c: Candidate, p: CostParams, pose: Any, after: str,
+                  keep: bool = False) -> float:
         """Seconds ``c`` takes if started at ``pose`` once ``after`` is complete: its reqSP
-        answer back in seconds."""
+        answer's ``c_time``, or the answer back in seconds when the task gives none.  ``keep``:
+        ``c`` is idle and the answer may be kept while :attr:`ScheduleView.generation` holds (an
+        answer in seconds is; one recovered from two costs depends on when it was asked)."""
         if pose is None or p.cps == 0:
             return p.c_time
+        key = (c.id, after, pose)
+        if keep and key in self._durations:
+            return self._durations[key]
         answer = view.req_sp(c.id, SPRequest(SP_COMPLETION, {"pose": pose, "after": after}))
         if not isinstance(answer, CompletionCost):
             raise ConfigError(f"lookahead: task type {c.task_type!r} answered reqSP {SP_COMPLETION!r} with "
                               f"{type(answer).__name__}, expected CompletionCost")
+        if answer.c_time is not None:
+            d = float(answer.c_time)
+            d = max(0.0, d) if math.isfinite(d) else math.inf
+            if keep:
+                self._durations[key] = d
+            return d
         extra = (answer.cc - p.cost) / p.cps
         return max(0.0, p.c_time + extra) if math.isfinite(extra) else math.inf
 
@@ -311,8 +366,15 @@ class LookAhead(Scheduler):
         has_exe = view.exe is not None
         self._penalty = {c.id: self.switch_penalty(view, c) for c in jobs[1:]} if has_exe else {}
         first = [p.c_time + (self._penalty[jobs[k].id] if has_exe and k > 0 else 0.0) for k, p in enumerate(params)]
-        after = [[0.0 if i == j else self._duration(view, jobs[j], params[j], params[i].end_pose, jobs[i].id)
-                  for j in range(len(jobs))] for i in range(len(jobs))]
+        if view.generation is None or view.generation != self._generation:  # an idle agent's estimate may differ
+            self._durations.clear()
+            self._generation = view.generation
+        idle = view.generation is not None  # an entry between two idle jobs holds with the generation
+        kept, n = self._durations, len(jobs)
+        after = [[0.0 if i == j else d if (d := kept.get((jobs[j].id, jobs[i].id, params[i].end_pose))) is not None
+                  else self._duration(view, jobs[j], params[j], params[i].end_pose, jobs[i].id,
+                                      keep=idle and (not has_exe or (i > 0 and j > 0)))
+                  for j in range(n)] for i in range(n)]
         deadline = [math.inf if p.deadline is None else p.deadline for p in params]
         budget = [self.budgets.get(c.task_type, math.inf) for c in jobs]
         at = {c.id: k for k, c in enumerate(jobs)}
@@ -326,29 +388,72 @@ class LookAhead(Scheduler):
                        left_on=left_on), jobs
 
     def solve(self, prob: Problem, budget: int, *, fixed_first: int | None = None,
-              exclude_first: int | None = None) -> tuple[list[int], float, int, bool]:
+              exclude_first: int | None = None,
+              starts: Sequence[Sequence[int]] = ()) -> tuple[list[int], float, int, bool]:
         """The search one decision runs (:func:`solve`); a subclass may put another solver
         behind the same problem, budget split and record (``planners.cpsat``)."""
-        return solve(prob, node_budget=budget, fixed_first=fixed_first, exclude_first=exclude_first)
+        return solve(prob, node_budget=budget, fixed_first=fixed_first, exclude_first=exclude_first, starts=starts)
+
+    @staticmethod
+    def signature(prob: Problem, jobs: Sequence[Candidate]) -> tuple[Any, ...]:
+        """All of a problem but the clock, ``exeDA``'s progress and the switch penalties: the jobs, the
+        waiting ones' durations (their own, and after each job but a resumed ``exeDA``), weights, deadlines,
+        budgets and hazards."""
+        k = 1 if prob.has_exe else 0
+        own = tuple(LookAhead.cost_params(c, LookAhead.name).c_time for c in jobs[k:])
+        return (prob.has_exe, tuple(c.id for c in jobs), own,
+                tuple(prob.weight), tuple(prob.deadline), tuple(prob.budget), tuple(prob.left_on),
+                tuple(tuple(row[k:]) for row in prob.after))
 
     def schedule(self, view: ScheduleView) -> Decision:
         if not view.candidates:
             return NO_CHANGE
         prob, jobs = self.problem(view)
-        if view.exe is None:
-            order, obj, nodes, exact = self.solve(prob, self.node_budget)
-            keep_obj = math.inf
-        else:  # two searches share the budget: continue exeDA, or start with someone else
-            half = max(1, self.node_budget // 2)
-            keep, keep_obj, n1, e1 = self.solve(prob, half, fixed_first=0)
-            alt, alt_obj, n2, e2 = self.solve(prob, self.node_budget - n1, exclude_first=0)
-            nodes, exact = n1 + n2, e1 and e2
-            switch = alt_obj < self.hysteresis * keep_obj
-            order, obj = (alt, alt_obj) if switch else (keep, keep_obj)
+        ids = [c.id for c in jobs]
+        sig = self.signature(prob, jobs) if self.incremental else None
+        last = self._last
+        at = {x: k for k, x in enumerate(ids)}
+        if last is not None and last[0] == sig:  # only the clock and exeDA's progress moved: the last orders, again
+            rule = "incremental"
+            chosen, other = [at[x] for x in last[1]], [at[x] for x in last[2]]
+            nodes, exact = 2 * prob.n, False
+            if view.exe is None:
+                order, obj, keep_obj, alt_order = chosen, prob.evaluate(chosen), math.inf, other
+            else:  # continuing exeDA: every order shifts alike; switching: re-priced with the penalties of now
+                keep, alt = (chosen, other) if chosen[0] == 0 else (other, chosen)
+                keep_obj, alt_obj = prob.evaluate(keep), math.inf
+                for cand in ([alt] + [[j, *(x for x in alt if x != j)] for j in range(1, prob.n) if j != alt[0]]
+                             if alt else []):
+                    value = prob.evaluate(cand)
+                    nodes += 1
+                    if value < alt_obj:
+                        alt, alt_obj = cand, value
+                switch = alt_obj < self.hysteresis * keep_obj
+                order, obj = (alt, alt_obj) if switch else (keep, keep_obj)
+                alt_order = keep if switch else alt
+        else:
+            hints = [list(o) for o in last[1:]] if (self.incremental and last is not None) else []
+            if view.exe is None:
+                starts = [o for h in hints if (o := adapt(prob, ids, h))]
+                order, obj, nodes, exact = self.solve(prob, self.node_budget, starts=starts)
+                keep_obj, alt_order = math.inf, []
+            else:  # two searches share the budget: continue exeDA, or start with someone else
+                half = max(1, self.node_budget // 2)
+                starts = [o for h in hints if (o := adapt(prob, ids, h, fixed_first=0))]
+                keep, keep_obj, n1, e1 = self.solve(prob, half, fixed_first=0, starts=starts)
+                starts = [o for h in hints if (o := adapt(prob, ids, h, exclude_first=0))]
+                alt, alt_obj, n2, e2 = self.solve(prob, self.node_budget - n1, exclude_first=0, starts=starts)
+                nodes, exact = n1 + n2, e1 and e2
+                switch = alt_obj < self.hysteresis * keep_obj
+                order, obj = (alt, alt_obj) if switch else (keep, keep_obj)
+                alt_order = keep if switch else alt
+            rule = "exact" if exact else "anytime"
+        if self.incremental:
+            self._last = (sig, [ids[k] for k in order], [ids[k] for k in alt_order])
         first = jobs[order[0]].id
         switch = view.exe is None or first != view.exe.id
         record: dict[str, Any] = {
-            "algorithm": self.name, "rule": "exact" if exact else "anytime",
+            "algorithm": self.name, "rule": rule,
             "dac": first if switch else None, "exeDA": view.exe.id if view.exe is not None else None,
             "order": [jobs[k].id for k in order], "objective": obj, "objective_continue": keep_obj,
             "nodes": nodes, "switch": switch,

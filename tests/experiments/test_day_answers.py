@@ -4,8 +4,11 @@
 printed on f6c867e (main just before issue 38's work was merged): the SHA-256 of each day's trace
 (and, on the robot, trajectory) and of its day metrics.  (The cost work was done against 60ed0ea
 and matched it there; every synthetic day's metrics are still 60ed0ea's, while traces gained the
-run's true strategy in their first line and robot days changed with issue 36's judge.)  A few
-cheap days are checked at every run; every synthetic day, and the robot's, with ``-m slow``.
+run's true strategy in their first line and robot days changed with issue 36's judge.)  The 14
+look-ahead days were made again when the look-ahead learnt to decide between searches (issue 38,
+``incremental``: a behaviour change on purpose, in those days only); the other 170 lines are
+f6c867e's.  A few cheap days are checked at every run; every synthetic day, and the robot's, with
+``-m slow``.
 """
 
 from __future__ import annotations
