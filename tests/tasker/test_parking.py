@@ -70,7 +70,8 @@ def test_synthetic_days_same_trace_parked(protocol: str, seed: int, scheduler: s
     assert seen["park"] >= 3  # waiting agents were parked: the comparison compared something
 
 
-@pytest.mark.parametrize("scheduler", ["alg2", "edf", "tabsa-simple", "tabsa-scheduler", "atc", "simple2"])
+@pytest.mark.parametrize("scheduler", ["alg2", "edf", "tabsa-simple", "tabsa-scheduler", "atc", "simple2",
+                                       pytest.param("lookahead", marks=pytest.mark.slow)])  # kept durations, loaded
 def test_an_overloaded_day_same_trace_parked(scheduler: str) -> None:
     """TaBSA's day (one hour of it) piles work up: many agents wait, and are estimated anew as the robot moves."""
     import dataclasses
