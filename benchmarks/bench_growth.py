@@ -3,6 +3,8 @@
     python benchmarks/bench_growth.py                      # or: python benchmarks/run_all.py growth
     python benchmarks/bench_growth.py --quick              # fewer sizes and seeds, no baseline
     python benchmarks/bench_growth.py --incremental-study 20   # the look-ahead between decisions: what it costs
+    python benchmarks/bench_growth.py --budget-curve       # what smaller node budgets cost in optimality
+    python benchmarks/bench_growth.py --stepping           # the clock's own cost (what an event-driven one saves)
     python benchmarks/bench_growth.py --protocol FILE.toml --schedulers alg2 edf --base 60ed0ea
 
 Days of a protocol (default ``tabsa-original``, TaBSA's day) on the synthetic backend,
@@ -52,7 +54,8 @@ small against the noise of a shared machine."""
 
 # -- the worker: one series in one process, on whatever tree PYTHONPATH puts first ---------------------
 
-def _day(protocol: str, scheduler: str, seed: int, hours: float | None, requests: int | None) -> tuple[float, int]:
+def _day(protocol: str, scheduler: str, seed: int, hours: float | None,
+         requests: int | None) -> tuple[float, int, int]:
     sys.path.insert(0, str(HERE))
     from daysize import sized
 
@@ -61,17 +64,18 @@ def _day(protocol: str, scheduler: str, seed: int, hours: float | None, requests
     proto = sized(protocol, hours, requests)
     start = time.process_time()
     loop = pipeline.make(proto, seed, scheduler=scheduler).build()
-    events = len(loop.run().events)
-    return time.process_time() - start, events
+    trace = loop.run()
+    cpu = time.process_time() - start
+    return cpu, len(trace.events), len(trace.dumps().encode())  # the trace's bytes: not timed
 
 
 def worker(args: argparse.Namespace) -> int:
     sizes = [float(x) if args.dimension == "hours" else int(x) for x in args.sizes.split(",")]
     spent = 0.0
     for size in sizes:
-        cpu, work = 0.0, 0
+        cpu, work, output = 0.0, 0, 0
         for seed in range(1, args.seeds + 1):
-            runs: list[tuple[float, int]] = []
+            runs: list[tuple[float, int, int]] = []
             while len(runs) < args.repeat or (len(runs) < SHORT_REPEAT and min(r[0] for r in runs) < SHORT_S):
                 runs.append(_day(args.protocol, args.scheduler, seed, size if args.dimension == "hours" else None,
                                  int(size) if args.dimension == "requests" else None))
@@ -80,7 +84,8 @@ def worker(args: argparse.Namespace) -> int:
                     return 0
             cpu += min(r[0] for r in runs)
             work += runs[0][1]
-        print(json.dumps({"size": size, "cpu": cpu, "work": work}), flush=True)
+            output += runs[0][2]
+        print(json.dumps({"size": size, "cpu": cpu, "work": work, "bytes": output}), flush=True)
     return 0
 
 
@@ -191,6 +196,96 @@ def print_budget_study(protocol: str) -> None:
           f" best x{r['ratio_best']:.4f})")
 
 
+def budget_curve(protocol: str, hours: float, seed: int, every: int, budgets: tuple[int, ...],
+                 reference: int) -> tuple[int, int, float, list[dict[str, Any]]]:
+    """:func:`budget_study` for several node budgets against one larger ``reference`` budget, on the
+    searched decisions of a day (``rule`` exact or anytime, 3 jobs or more; every ``every``-th)."""
+    sys.path.insert(0, str(HERE))
+    from daysize import sized
+
+    from experiments.days import pipeline
+    from tasker.schedulers import lookahead
+
+    seen: list[Any] = []
+    build = lookahead.LookAhead.problem
+
+    def recording(self: Any, view: Any) -> Any:
+        prob, jobs = build(self, view)
+        seen.append((prob, self.hysteresis))
+        return prob, jobs
+
+    lookahead.LookAhead.problem = recording  # type: ignore[method-assign]
+    try:
+        pipeline.make(sized(protocol, hours), seed, scheduler="lookahead:incremental=false").build().run()
+    finally:
+        lookahead.LookAhead.problem = build  # type: ignore[method-assign]
+
+    def decide(prob: Any, budget: int, hysteresis: float) -> list[int]:
+        if not prob.has_exe:
+            return lookahead.solve(prob, node_budget=budget)[0]
+        keep, keep_obj, n1, _ = lookahead.solve(prob, node_budget=max(1, budget // 2), fixed_first=0)
+        alt, alt_obj, _, _ = lookahead.solve(prob, node_budget=budget - n1, exclude_first=0)
+        return alt if alt_obj < hysteresis * keep_obj else keep
+
+    sample = [x for x in seen if x[0].n >= 3][::every]
+    best = [decide(prob, reference, h) for prob, h in sample]
+    rows = []
+    for budget in budgets:
+        start = time.process_time()
+        chosen = [decide(prob, budget, h) for prob, h in sample]
+        cpu = time.process_time() - start
+        ratios = [prob.evaluate(c) / prob.evaluate(b) for (prob, _), c, b in zip(sample, chosen, best, strict=True)]
+        rows.append({"budget": budget, "first_differs": sum(c[0] != b[0] for c, b in zip(chosen, best, strict=True)),
+                     "ratio_mean": sum(ratios) / max(1, len(ratios)), "ratio_worst": max(ratios, default=1.0),
+                     "ms": 1000 * cpu / max(1, len(sample))})
+    jobs_mean = sum(p.n for p, _ in sample) / max(1, len(sample))
+    return len(seen), len(sample), jobs_mean, rows
+
+
+CURVE_BUDGETS = (125, 250, 500, 1000, 2000)
+
+
+def print_budget_curve(protocol: str) -> None:
+    print(f"look-ahead node budget against 10x the default (20000 nodes) on a day's decisions, each searched "
+          f"({protocol}, seed 1, incremental = false; every 5th decision with 3 jobs or more); commit {_head()}")
+    for hours in (4.0, 8.0):
+        decisions, sampled, jobs, rows = budget_curve(protocol, hours, 1, 5, CURVE_BUDGETS, 20000)
+        print(f"  {hours:g} h: {sampled} of {decisions} decisions, {jobs:.1f} jobs on average")
+        for r in rows:
+            print(f"    budget {r['budget']:5d}: first job differs in {r['first_differs']:3d}; order costs "
+                  f"x{r['ratio_mean']:.4f} the reference's on average (worst x{r['ratio_worst']:.4f}); "
+                  f"{r['ms']:.2f} CPU-ms a decision")
+
+
+def print_stepping(protocols: tuple[str, ...] = ("tabsa-original", "tabsa"), scheduler: str = "alg2") -> None:
+    """What an event-driven clock could save: the CPU seconds of a day against the same day with one request
+    of each type (the loop stepping through the day with almost nothing to do), best of three."""
+    import dataclasses
+
+    sys.path.insert(0, str(HERE))
+    from daysize import sized
+
+    from experiments.days import pipeline
+
+    def cpu(proto: Any) -> float:
+        best = math.inf
+        for _ in range(3):
+            start = time.process_time()
+            pipeline.make(proto, 1, scheduler=scheduler).build().run()
+            best = min(best, time.process_time() - start)
+        return best
+
+    print(f"the clock's own cost: a synthetic day under {scheduler} (seed 1) against the same day with one request "
+          f"of each type, CPU seconds (best of 3); commit {_head()}")
+    for name in protocols:
+        for hours in (2.0, 8.0):
+            proto = sized(name, hours)
+            one = dataclasses.replace(proto, tasks={k: dataclasses.replace(v, count=1) for k, v in proto.tasks.items()})
+            full, idle = cpu(proto), cpu(one)
+            print(f"  {name:15} {hours:g} h ({proto.length_s / proto.step_s:.0f} steps): day {full:.3f}, "
+                  f"stepping with one request a type {idle:.3f} ({100 * idle / full:.0f} %)")
+
+
 QUALITY_KEYS = ("completed", "dead_falls", "lateness_s", "completion_minus_deadline_s", "switches", "interruptions")
 
 
@@ -224,7 +319,7 @@ def print_incremental_study(protocol: str, seeds: int) -> None:
 # -- the driver ---------------------------------------------------------------------------------------
 
 def series(tree: Path, protocol: str, scheduler: str, dimension: str, sizes: tuple[float, ...], seeds: int,
-           repeat: int, budget: float) -> dict[float, tuple[float, int]]:
+           repeat: int, budget: float) -> dict[float, tuple[float, int, int]]:
     """``size -> (CPU s, work)`` of one series run on ``tree``."""
     env = {**os.environ, "PYTHONPATH": str(tree)}
     cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", "--protocol", protocol,
@@ -236,7 +331,7 @@ def series(tree: Path, protocol: str, scheduler: str, dimension: str, sizes: tup
     out = {}
     for line in done.stdout.splitlines():
         row = json.loads(line)
-        out[float(row["size"])] = (float(row["cpu"]), int(row["work"]))
+        out[float(row["size"])] = (float(row["cpu"]), int(row["work"]), int(row["bytes"]))
     return out
 
 
@@ -255,8 +350,8 @@ def checkout(commit: str, into: Path) -> Path:
     return into
 
 
-def report(name: str, dimension: str, now: dict[float, tuple[float, int]],
-           base: dict[float, tuple[float, int]] | None, sizes: tuple[float, ...]) -> bool:
+def report(name: str, dimension: str, now: dict[float, tuple[float, int, int]],
+           base: dict[float, tuple[float, int, int]] | None, sizes: tuple[float, ...]) -> bool:
     """Print one series; True if it meets the target (or cannot be judged)."""
     unit = "h" if dimension == "hours" else " req"
     print(f"  {name:14} {dimension:8} " + "  ".join(f"{s:>8g}{unit}" for s in sizes))
@@ -266,6 +361,8 @@ def report(name: str, dimension: str, now: dict[float, tuple[float, int]],
         print(f"  {'':14} {label:>14} " + "  ".join(cells))
     print(f"  {'':14} {'work (events)':>14} " + "  ".join(f"{now[s][1]:>10d}" if s in now else f"{'-':>10}"
                                                           for s in sizes))
+    print(f"  {'':14} {'trace (kB)':>14} " + "  ".join(f"{now[s][2] / 1000:>10.0f}" if s in now else f"{'-':>10}"
+                                                       for s in sizes))
     ok = True
     for label, data in rows:
         have = [s for s in sizes if s in data]
@@ -276,12 +373,13 @@ def report(name: str, dimension: str, now: dict[float, tuple[float, int]],
         big, small = sizes[-1], sizes[-1] / 4
         ratio = data[big][0] / data[small][0] if big in data and small in data else math.nan
         work = now[big][1] / now[small][1] if big in now and small in now else math.nan
+        output = now[big][2] / now[small][2] if big in now and small in now else math.nan
         verdict = ""
         if label == "now CPU s" and dimension == "hours" and not math.isnan(ratio):
             verdict = "OK" if ratio <= TARGET else f"ABOVE TARGET ({TARGET:g}x)"
             ok = ratio <= TARGET
         print(f"  {'':14} {label:>14} exponent {e_size:4.2f} against size, {e_work:4.2f} against work; "
-              f"x4 size ({small:g} -> {big:g}): cost x{ratio:.2f}, work x{work:.2f} {verdict}")
+              f"x4 size ({small:g} -> {big:g}): cost x{ratio:.2f}, work x{work:.2f}, trace x{output:.2f} {verdict}")
     return ok
 
 
@@ -317,6 +415,10 @@ def main(argv: list[str]) -> int:
                    help="only: what the look-ahead's node budget does to a 4-hour day's decisions (seed 1)")
     p.add_argument("--eight-hours", action="store_true",
                    help="only: an 8-hour day of each scheduler of the README's `tasker day` (tabsa-original, tabsa)")
+    p.add_argument("--stepping", action="store_true",
+                   help="the clock's own cost: a day against the same day with one request of each type")
+    p.add_argument("--budget-curve", action="store_true",
+                   help="the look-ahead's node budgets 125-2000 against 10x the default, on searched decisions")
     p.add_argument("--incremental-study", type=int, metavar="SEEDS", default=0,
                    help="whole days, the look-ahead as shipped against a full search at every decision")
     p.add_argument("--queues", action="store_true",
@@ -341,6 +443,12 @@ def main(argv: list[str]) -> int:
         return 0
     if args.queues:
         print_queues(args.protocol)
+        return 0
+    if args.stepping:
+        print_stepping()
+        return 0
+    if args.budget_curve:
+        print_budget_curve(args.protocol)
         return 0
     if args.incremental_study:
         print_incremental_study(args.protocol, args.incremental_study)

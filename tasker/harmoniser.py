@@ -524,11 +524,12 @@ class TaskHarmoniser:
     def _ahead(self) -> float:
         """The cTime of every waiting agent the scheduler ranks ahead of ``exeDA``: one sum per moment,
         ``exeDA`` and idle set, whoever the replacement."""
-        exe = self._cands.get(self.exe_da) if self.exe_da is not None else None
-        key = (self.now, exe, self._idle.version)  # exeDA's report itself: its queue key is the bar
+        reported = self._cands.raw.get(self.exe_da) if self.exe_da is not None else None
+        key = (self.now, reported, self._idle.version)  # exeDA's report itself: its queue key is the bar
         last = self._ahead_at
-        if last is not None and last[0][0] == key[0] and last[0][1] is exe and last[0][2] == key[2]:
+        if last is not None and last[0][0] == key[0] and last[0][1] is reported and last[0][2] == key[2]:
             return last[1]
+        exe = self._cands.get(self.exe_da) if self.exe_da is not None else None
         ahead = 0.0
         if exe is not None:
             try:

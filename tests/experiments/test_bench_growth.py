@@ -39,3 +39,26 @@ def test_the_queue_study_reads_the_look_aheads_decisions(capsys: pytest.CaptureF
     out = capsys.readouterr().out.splitlines()
     assert out[0].startswith("the look-ahead's queue at its decisions (tabsa-original, seed 1)")
     assert out[1].startswith("  0.5 h: ") and "decisions, queue" in out[1] and "ended on its own" in out[1]
+
+
+def test_a_series_is_reported_against_its_events_and_its_trace(capsys: pytest.CaptureFixture[str]) -> None:
+    now = {2.0: (1.0, 100, 10_000), 8.0: (6.0, 400, 80_000)}
+    assert not bench_growth.report("x", "hours", now, None, (2.0, 8.0))  # x6 for four times the day
+    out = capsys.readouterr().out
+    assert "trace (kB)" in out and "cost x6.00, work x4.00, trace x8.00 ABOVE TARGET" in out
+    assert bench_growth.report("x", "hours", {2.0: (1.0, 1, 1), 8.0: (5.0, 4, 4)}, None, (2.0, 8.0))
+
+
+def test_the_budget_curve_decides_a_days_problems_with_each_budget() -> None:
+    decisions, sampled, jobs, rows = bench_growth.budget_curve("tabsa-original", 0.5, 1, 1, (5, 50), 500)
+    assert decisions >= sampled > 0 and jobs >= 3
+    assert [r["budget"] for r in rows] == [5, 50]
+    for r in rows:
+        assert 0 <= r["first_differs"] <= sampled and r["ratio_worst"] >= r["ratio_mean"] > 0
+
+
+def test_the_stepping_study_prints_both_days(capsys: pytest.CaptureFixture[str]) -> None:
+    bench_growth.print_stepping(("tabsa-short",))
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("the clock's own cost") and len(out) == 3
+    assert all("stepping with one request a type" in line for line in out[1:])
