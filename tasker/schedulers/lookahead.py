@@ -396,11 +396,13 @@ class LookAhead(Scheduler):
 
     @staticmethod
     def signature(prob: Problem, jobs: Sequence[Candidate]) -> tuple[Any, ...]:
-        """All of a problem but the clock, ``exeDA``'s progress and the switch penalties: the jobs, the
-        waiting ones' durations (their own, and after each job but a resumed ``exeDA``), weights, deadlines,
-        budgets and hazards."""
+        """What the value of an order depends on beyond what an incremental decision prices anew: the jobs,
+        the durations after each job (but a resumed ``exeDA``'s), weights, deadlines, budgets and hazards —
+        and, when nothing executes, each job's duration as the first.  While ``exeDA`` executes, a waiting
+        job's duration as the first (from the robot's pose, with the switch penalty) matters to the switching
+        orders only, and an incremental decision prices those with the durations of now."""
         k = 1 if prob.has_exe else 0
-        own = tuple(LookAhead.cost_params(c, LookAhead.name).c_time for c in jobs[k:])
+        own = () if prob.has_exe else tuple(prob.first)
         return (prob.has_exe, tuple(c.id for c in jobs), own,
                 tuple(prob.weight), tuple(prob.deadline), tuple(prob.budget), tuple(prob.left_on),
                 tuple(tuple(row[k:]) for row in prob.after))
