@@ -396,9 +396,11 @@ def print_queues(protocol: str, hours: tuple[float, ...] = (2.0, 8.0), seed: int
         loop = pipeline.make(sized(protocol, h, None), seed, scheduler="lookahead").build()
         decisions = [e for e in loop.run().events if e.get("event") == "decision" and "order" in e]
         lengths = [len(e["order"]) for e in decisions]
-        exact = sum(1 for e in decisions if e.get("rule") == "exact")
+        rules = {r: sum(1 for e in decisions if e.get("rule") == r) for r in ("incremental", "exact", "anytime")}
+        searched = rules["exact"] + rules["anytime"]
         print(f"  {h:g} h: {len(decisions)} decisions, queue {sum(lengths) / len(lengths):.1f} jobs on average "
-              f"(at most {max(lengths)}); the search ended on its own in {exact} ({100 * exact / len(decisions):.0f} %)"
+              f"(at most {max(lengths)}); {rules['incremental']} priced without a search; of the {searched} searched, "
+              f"the search ended on its own in {rules['exact']} ({100 * rules['exact'] / max(1, searched):.0f} %)"
               if decisions else f"  {h:g} h: no decision")
 
 

@@ -265,6 +265,14 @@ def _smith(p: Problem, allowed_first: list[int]) -> list[int]:
     return [first, *sorted((j for j in range(p.n) if j != first), key=key)]
 
 
+def _hashable(value: Any) -> bool:
+    try:
+        hash(value)
+    except TypeError:
+        return False
+    return True
+
+
 def adapt(p: Problem, ids: Sequence[str], last: Sequence[str], *, fixed_first: int | None = None,
           exclude_first: int | None = None) -> list[int]:
     """The order ``last`` (agent ids of an earlier decision) over this problem's jobs ``ids``: the jobs it has,
@@ -369,9 +377,11 @@ class LookAhead(Scheduler):
         if view.generation is None or view.generation != self._generation:  # an idle agent's estimate may differ
             self._durations.clear()
             self._generation = view.generation
-        idle = view.generation is not None  # an entry between two idle jobs holds with the generation
+        # an entry between two idle jobs holds with the generation (kept by pose: poses that are values)
+        idle = view.generation is not None and all(_hashable(p.end_pose) for p in params)
         kept, n = self._durations, len(jobs)
-        after = [[0.0 if i == j else d if (d := kept.get((jobs[j].id, jobs[i].id, params[i].end_pose))) is not None
+        after = [[0.0 if i == j else d
+                  if idle and (d := kept.get((jobs[j].id, jobs[i].id, params[i].end_pose))) is not None
                   else self._duration(view, jobs[j], params[j], params[i].end_pose, jobs[i].id,
                                       keep=idle and (not has_exe or (i > 0 and j > 0)))
                   for j in range(n)] for i in range(n)]

@@ -39,6 +39,7 @@ def test_the_queue_study_reads_the_look_aheads_decisions(capsys: pytest.CaptureF
     out = capsys.readouterr().out.splitlines()
     assert out[0].startswith("the look-ahead's queue at its decisions (tabsa-original, seed 1)")
     assert out[1].startswith("  0.5 h: ") and "decisions, queue" in out[1] and "ended on its own" in out[1]
+    assert "priced without a search" in out[1]
 
 
 def test_a_series_is_reported_against_its_events_and_its_trace(capsys: pytest.CaptureFixture[str]) -> None:

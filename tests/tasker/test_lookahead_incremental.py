@@ -158,3 +158,13 @@ def test_a_warm_start_never_makes_the_search_worse() -> None:
             assert a.record is not None and b.record is not None and a.record["rule"] != "incremental"
             assert min(a.record["objective"], a.record["objective_continue"]) <= \
                 min(b.record["objective"], b.record["objective_continue"]) * (1 + 1e-9) or t == 0
+
+
+def test_a_pose_that_is_not_a_value_is_asked_again_not_kept() -> None:
+    waiting = [replace(c, params=replace(c.params, end_pose=[c.params.end_pose[0], 0.0]))  # type: ignore[index]
+               for c in queue(random.Random(8), 3)]
+    answers = Answers({})
+    s = LookAhead()
+    for t in range(2):
+        s.schedule(view(5.0 * t, cand("d1", 0, 100.0 - 5 * t), waiting, answers, generation=3))
+    assert answers.asked == 2 * 4 * 3  # nothing kept: every pair asked at both decisions
