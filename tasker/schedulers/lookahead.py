@@ -34,12 +34,14 @@ Each decision solves a single-machine sequencing problem over the executing task
   are reproducible.
 
 Between decisions (``incremental``): when the problem differs from the last one only in the
-clock, ``exeDA``'s progress and the switch penalties, the last orders are priced again instead
-of searched (rule ``incremental``): the order that continues ``exeDA`` keeps every completion
-where it was, and the switching orders are the last one and each waiting job moved to its
-front, with the penalties of now.  Otherwise the last orders, adapted (:func:`adapt`), join the
-search as incumbents.  A waiting job's duration after another waiting job is kept while
-``ScheduleView.generation`` holds, when the task answers in seconds (``CompletionCost.c_time``).
+clock, ``exeDA``'s progress, the switch penalties and (while ``exeDA`` executes) the waiting
+jobs' durations as the first (:meth:`LookAhead.signature`), the last orders are priced again
+instead of searched (rule ``incremental``): the order that continues ``exeDA`` keeps every
+completion where it was, and the switching orders are the last one and each waiting job moved
+to its front, with the penalties and first durations of now.  Otherwise the last orders,
+adapted (:func:`adapt`), join the search as incumbents.  A waiting job's duration after
+another waiting job is kept while ``ScheduleView.generation`` holds, when the task answers in
+seconds (``CompletionCost.c_time``).
 
 The executing task keeps the robot unless the best order that starts with another
 task beats the best order that continues it by the factor ``hysteresis``.
@@ -348,6 +350,9 @@ class LookAhead(Scheduler):
             raise ConfigError(f"lookahead: task type {c.task_type!r} answered reqSP {SP_COMPLETION!r} with "
                               f"{type(answer).__name__}, expected CompletionCost")
         if answer.c_time is not None:
+            if isinstance(answer.c_time, bool) or not isinstance(answer.c_time, int | float):
+                raise ConfigError(f"lookahead: task type {c.task_type!r} answered reqSP {SP_COMPLETION!r} with "
+                                  f"c_time {answer.c_time!r}, expected seconds (a number) or None")
             d = float(answer.c_time)
             d = max(0.0, d) if math.isfinite(d) else math.inf
             if keep:

@@ -168,3 +168,24 @@ def test_a_pose_that_is_not_a_value_is_asked_again_not_kept() -> None:
     for t in range(2):
         s.schedule(view(5.0 * t, cand("d1", 0, 100.0 - 5 * t), waiting, answers, generation=3))
     assert answers.asked == 2 * 4 * 3  # nothing kept: every pair asked at both decisions
+
+
+@pytest.mark.parametrize("bad", ["12", True, [3.0]])
+def test_an_answer_whose_seconds_are_not_a_number_is_refused_naming_the_task_type(bad: object) -> None:
+    exe, other = cand("d1", 0, 10.0), cand("d2", 1, 5.0, x=4.0)
+
+    def req_sp(agent: str, req: SPRequest) -> CompletionCost:
+        return CompletionCost(1.0, 1.0, bad)  # type: ignore[arg-type]
+
+    with pytest.raises(ConfigError, match=r"task type 't'.*c_time"):
+        LookAhead().problem(ScheduleView(0.0, exe, [other], req_sp))
+
+
+def test_a_non_finite_answer_in_seconds_is_a_job_that_cannot_follow() -> None:
+    exe, other = cand("d1", 0, 10.0), cand("d2", 1, 5.0, x=4.0)
+
+    def req_sp(agent: str, req: SPRequest) -> CompletionCost:
+        return CompletionCost(math.inf, 1.0, math.nan)
+
+    prob, _ = LookAhead().problem(ScheduleView(0.0, exe, [other], req_sp))
+    assert prob.after[0][1] == math.inf and prob.after[1][0] == math.inf
