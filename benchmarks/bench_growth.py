@@ -4,6 +4,7 @@
     python benchmarks/bench_growth.py --quick              # fewer sizes and seeds, no baseline
     python benchmarks/bench_growth.py --incremental-study 20   # the look-ahead between decisions: what it costs
     python benchmarks/bench_growth.py --budget-curve       # what smaller node budgets cost in optimality
+    python benchmarks/bench_growth.py --budget-days 20     # node_budget = 500 against the default, whole days
     python benchmarks/bench_growth.py --stepping           # the clock's own cost (what an event-driven one saves)
     python benchmarks/bench_growth.py --protocol FILE.toml --schedulers alg2 edf --base 60ed0ea
 
@@ -289,31 +290,39 @@ def print_stepping(protocols: tuple[str, ...] = ("tabsa-original", "tabsa"), sch
 QUALITY_KEYS = ("completed", "dead_falls", "lateness_s", "completion_minus_deadline_s", "switches", "interruptions")
 
 
-def print_incremental_study(protocol: str, seeds: int) -> None:
-    """What deciding between searches costs: whole days of ``protocol`` (seeds 1..``seeds``) under the
-    look-ahead as shipped and with ``incremental = false`` (a full search at every decision), their day
-    metrics side by side, and the CPU seconds of each."""
+def compare_days(protocol: str, seeds: int, first: str, second: str, title: str) -> None:
+    """Whole days of ``protocol`` (seeds 1..``seeds``) under two look-ahead specs, their day metrics side
+    by side (means, the paired difference, the days alike) and the CPU seconds of each."""
     from experiments.days.runner import run_day
 
-    rows: dict[str, list[dict[str, Any]]] = {"lookahead": [], "lookahead:incremental=false": []}
+    rows: dict[str, list[dict[str, Any]]] = {first: [], second: []}
     for seed in range(1, seeds + 1):
         for name, out in rows.items():
             start = time.process_time()
             m = run_day(protocol, seed, name)
             m["cpu_s"] = time.process_time() - start
             out.append(m)
-    print(f"the look-ahead between decisions ({protocol}, seeds 1-{seeds}, whole days): as shipped (incremental) "
-          f"against a full search at every decision (incremental = false); commit {_head()}")
-    print(f"  {'metric':30s} {'incremental':>12s} {'full':>12s} {'diff mean':>10s} {'min':>9s} {'max':>9s}  same days")
-    inc, full = rows["lookahead"], rows["lookahead:incremental=false"]
+    print(f"{title} ({protocol}, seeds 1-{seeds}, whole days): {first} against {second}; commit {_head()}")
+    print(f"  {'metric':30s} {'first':>12s} {'second':>12s} {'diff mean':>10s} {'min':>9s} {'max':>9s}  same days")
+    one, two = rows[first], rows[second]
     for key in (*QUALITY_KEYS, "cpu_s"):
-        a, b = [float(m[key]) for m in inc], [float(m[key]) for m in full]
-        d = [x - y for x, y in zip(a, b, strict=True)]
-        print(f"  {key:30s} {sum(a) / len(a):12.2f} {sum(b) / len(b):12.2f} {sum(d) / len(d):10.2f} {min(d):9.2f} "
-              f"{max(d):9.2f}  {sum(1 for x in d if x == 0)}/{len(d)}")
-    decisions = sum(float(m["anytime_decisions"]) for m in full)
-    print(f"  decisions that hit the node budget: {decisions / len(full):.0f} a day with a full search at every "
-          f"decision, {sum(float(m['anytime_decisions']) for m in inc) / len(inc):.0f} as shipped")
+        x, y = [float(m[key]) for m in one], [float(m[key]) for m in two]
+        d = [u - v for u, v in zip(x, y, strict=True)]
+        print(f"  {key:30s} {sum(x) / len(x):12.2f} {sum(y) / len(y):12.2f} {sum(d) / len(d):10.2f} {min(d):9.2f} "
+              f"{max(d):9.2f}  {sum(1 for u in d if u == 0)}/{len(d)}")
+    hit = [sum(float(m["anytime_decisions"]) for m in r) / len(r) for r in (one, two)]
+    print(f"  decisions that hit the node budget, a day: {hit[0]:.0f} against {hit[1]:.0f}")
+
+
+def print_incremental_study(protocol: str, seeds: int) -> None:
+    """What deciding between searches costs: the look-ahead as shipped against ``incremental = false``."""
+    compare_days(protocol, seeds, "lookahead", "lookahead:incremental=false", "the look-ahead between decisions")
+
+
+def print_budget_days(protocol: str, seeds: int, budget: int = 500) -> None:
+    """What a smaller node budget does to whole days: ``node_budget = budget`` against the default."""
+    compare_days(protocol, seeds, f"lookahead:node_budget={budget}", "lookahead",
+                 "the look-ahead's node budget on whole days")
 
 
 # -- the driver ---------------------------------------------------------------------------------------
@@ -421,6 +430,8 @@ def main(argv: list[str]) -> int:
                    help="the clock's own cost: a day against the same day with one request of each type")
     p.add_argument("--budget-curve", action="store_true",
                    help="the look-ahead's node budgets 125-2000 against 10x the default, on searched decisions")
+    p.add_argument("--budget-days", type=int, metavar="SEEDS", default=0,
+                   help="whole days, the look-ahead with node_budget = 500 against the default")
     p.add_argument("--incremental-study", type=int, metavar="SEEDS", default=0,
                    help="whole days, the look-ahead as shipped against a full search at every decision")
     p.add_argument("--queues", action="store_true",
@@ -451,6 +462,9 @@ def main(argv: list[str]) -> int:
         return 0
     if args.budget_curve:
         print_budget_curve(args.protocol)
+        return 0
+    if args.budget_days:
+        print_budget_days(args.protocol, args.budget_days)
         return 0
     if args.incremental_study:
         print_incremental_study(args.protocol, args.incremental_study)

@@ -63,3 +63,12 @@ def test_the_stepping_study_prints_both_days(capsys: pytest.CaptureFixture[str])
     out = capsys.readouterr().out.splitlines()
     assert out[0].startswith("the clock's own cost") and len(out) == 3
     assert all("stepping with one request a type" in line for line in out[1:])
+
+
+def test_two_look_aheads_are_compared_on_whole_days(capsys: pytest.CaptureFixture[str]) -> None:
+    bench_growth.compare_days("tabsa-short", 1, "lookahead", "lookahead:incremental=false", "a title")
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("a title (tabsa-short, seeds 1-1, whole days): lookahead against")
+    rows = {line.split()[0]: line.split() for line in out[2:-1]}
+    assert set(rows) == {*bench_growth.QUALITY_KEYS, "cpu_s"}
+    assert rows["completed"][-1] in ("0/1", "1/1") and out[-1].startswith("  decisions that hit the node budget")
