@@ -35,7 +35,6 @@ its ``strict`` safe state and waits again (``docs/model.md``).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from enum import StrEnum
@@ -47,7 +46,14 @@ from tasker.errors import AgentEnded, ConfigError, InvariantViolation, TaskerErr
 from tasker.messages import Command, Flag, FsmState, ScheduleParams, SPRequest
 from tasker.oscillation import OscillationGuard
 from tasker.schedulers.base import Candidate, Scheduler, ScheduleView, UnattendedHazard
-from tasker.schedulers.index import CandidateIndex, IdleAgents, IdleCandidates, ReportedCandidates
+from tasker.schedulers.index import (
+    CandidateIndex,
+    IdleAgents,
+    IdleCandidates,
+    QueueAhead,
+    ReportedCandidates,
+    reported_c_time,
+)
 from tasker.securing import HazardSource, HazardWatch, suspend_estimate
 from tasker.task import Effects
 from tasker.trace import Trace
@@ -141,7 +147,6 @@ class TaskHarmoniser:
         self.agents: dict[str, DynamicAgent] = {}  # A_da
         self._handovers: dict[tuple[str, str, float], Effects | None] = {}  # handover's answers
         self._suspensions: dict[tuple[float, str, str], float] = {}  # _suspension_of's answers
-        self._ahead_at: tuple[tuple[float, Candidate | None, int], float] | None = None  # _ahead's last sum
         self.exe_da: str | None = None
         self.irr_da: str | None = None
         self._idle = IdleAgents()  # D_r, in request order (its version counts changes: ScheduleView.generation)
@@ -151,6 +156,7 @@ class TaskHarmoniser:
         self._new_data = False
         self._in_cmd: set[str] = set()
         self._cands = ReportedCandidates(self.agents, self._idle)  # by agent; a parked agent's aged when read
+        self._queue_ahead = QueueAhead(self._cands, self._idle)  # a susp's expected_s, one sum per moment
         self._index: CandidateIndex | None = None  # built at the first indexed decision
         self._order: dict[str, int] = {}
         self._seq = 0
@@ -498,9 +504,7 @@ class TaskHarmoniser:
         return {} if c_time is None else {"predicted_s": c_time}
 
     def _c_time(self, agent_id: str) -> float | None:
-        cand = self._cands.raw.get(agent_id)  # a parked agent's cTime does not age: not aged to be read
-        c_time = getattr(cand.params, "c_time", None) if cand is not None else None
-        return float(c_time) if isinstance(c_time, int | float) else None
+        return reported_c_time(self._cands, agent_id)
 
     def _susp_data(self, replacement: str) -> dict[str, Any]:
         """``data`` of a ``susp``: who takes over (``by``) and how long the interruption is expected to last.
@@ -518,32 +522,8 @@ class TaskHarmoniser:
         c_time = self._c_time(replacement)
         if c_time is None:
             return data
-        data["expected_s"] = c_time + self._ahead()
+        data["expected_s"] = c_time + self._queue_ahead.of(self.scheduler, self.exe_da, self.now)
         return data
-
-    def _ahead(self) -> float:
-        """The cTime of every waiting agent the scheduler ranks ahead of ``exeDA``: one sum per moment,
-        ``exeDA`` and idle set, whoever the replacement."""
-        reported = self._cands.raw.get(self.exe_da) if self.exe_da is not None else None
-        key = (self.now, reported, self._idle.version)  # exeDA's report itself: its queue key is the bar
-        last = self._ahead_at
-        if last is not None and last[0][0] == key[0] and last[0][1] is reported and last[0][2] == key[2]:
-            return last[1]
-        exe = self._cands.get(self.exe_da) if self.exe_da is not None else None
-        ahead = 0.0
-        if exe is not None:
-            try:
-                mine = self.scheduler.queue_key(exe)
-                for agent in self._idle:
-                    cand = self._cands.get(agent)
-                    other = self._c_time(agent)
-                    if cand is not None and other is not None and math.isfinite(other) \
-                            and self.scheduler.queue_key(cand) < mine:
-                        ahead += other
-            except Exception:  # a queue key the parameters do not support: the replacement alone
-                ahead = 0.0
-        self._ahead_at = (key, ahead)
-        return ahead
 
     def _req_sp(self, agent_id: str, request: SPRequest) -> Any:
         return self.agents[agent_id].request_sp(request, self.now)

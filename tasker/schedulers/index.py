@@ -429,3 +429,42 @@ class IdleCandidates(Sequence[Candidate]):
 
     def __iter__(self) -> Iterator[Candidate]:
         return iter(self._list())
+
+
+def reported_c_time(cands: ReportedCandidates, agent: str | None) -> float | None:
+    """``agent``'s reported cTime (a parked agent's does not age: read as reported), None without one."""
+    cand = cands.raw.get(agent) if agent is not None else None
+    c_time = getattr(cand.params, "c_time", None) if cand is not None else None
+    return float(c_time) if isinstance(c_time, int | float) else None
+
+
+class QueueAhead:
+    """The cTime of every waiting agent a scheduler ranks ahead of ``exeDA`` (:meth:`Scheduler.queue_key`):
+    what runs before a suspended ``exeDA`` resumes.  One sum per moment, ``exeDA`` report and idle set,
+    whoever the replacement; 0 when a queue key is not defined on the parameters."""
+
+    def __init__(self, cands: ReportedCandidates, idle: IdleAgents) -> None:
+        self._cands, self._idle = cands, idle
+        self._at: tuple[float, Candidate | None, int] | None = None
+        self._sum = 0.0
+
+    def of(self, scheduler: Any, exe_da: str | None, now: float) -> float:
+        reported = self._cands.raw.get(exe_da) if exe_da is not None else None  # its queue key is the bar
+        at = self._at
+        if at is not None and at[0] == now and at[1] is reported and at[2] == self._idle.version:
+            return self._sum
+        exe = self._cands.get(exe_da) if exe_da is not None else None
+        ahead = 0.0
+        if exe is not None:
+            try:
+                mine = scheduler.queue_key(exe)
+                for agent in self._idle:
+                    cand = self._cands.get(agent)
+                    other = reported_c_time(self._cands, agent)
+                    if cand is not None and other is not None and math.isfinite(other) \
+                            and scheduler.queue_key(cand) < mine:
+                        ahead += other
+            except Exception:  # a queue key the parameters do not support: the replacement alone
+                ahead = 0.0
+        self._at, self._sum = (now, reported, self._idle.version), ahead
+        return ahead

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import pytest
 
 from tasker.errors import BadRequest, InvariantViolation, PlanningFailed, UnknownName
@@ -364,3 +366,34 @@ def test_a_leaves_hook_that_raises_assumes_nothing() -> None:
     tr = loop.run()
     assert seen and all(s == (None, None) for s in seen)
     assert [e["reason"] for e in tr.of("end")] == ["finished", "finished"]
+
+
+def test_the_queue_ahead_is_summed_once_a_moment_whoever_the_replacement() -> None:
+    """The look-ahead asks the executing task's suspension for every candidate at each decision; the queue
+    ahead of it (in each ``expected_s``) is read once for all of them, and the susp sent carries the same sum."""
+    tasks = [guide("guide"), *(SyntheticTask(f"w{k}", [st("s", 5.0 + k)]) for k in range(4)),
+             SyntheticTask("fell", [st("check", 2)])]
+    loop = make_loop(tasks, scheduler="lookahead")
+    loop.request(0.0, "guide")
+    for k in range(4):
+        loop.request(0.5, f"w{k}")
+    loop.request(3.0, "fell", {"priority": 3})
+    scheduler, calls = loop.harmoniser.scheduler, [0]
+    key = scheduler.queue_key
+
+    def counted(c: Any) -> Any:
+        calls[0] += 1
+        return key(c)
+
+    scheduler.queue_key = counted  # type: ignore[method-assign]
+    moments: set[float] = set()
+    ask = loop.harmoniser._suspension_of
+
+    def asked(by: str) -> float:
+        moments.add(loop.harmoniser.now)
+        return ask(by)
+
+    loop.harmoniser._suspension_of = asked  # type: ignore[method-assign]
+    tr = loop.run()
+    assert moments and calls[0] <= len(moments) * (len(tasks) + 1)  # not once per candidate and moment
+    assert all(s["expected_s"] >= 0 for s in tr.of("command", flag="susp") if "expected_s" in s)
