@@ -138,18 +138,16 @@ def _cell(value: float | None, limit: float) -> str:
     return f"{value:9.2f}" if value is not None else f"{'>' + format(limit, 'g'):>9}"
 
 
-def budget_study(protocol: str, hours: float, seed: int, every: int, factor: int) -> dict[str, Any]:
-    """What the look-ahead's node budget does to its decisions: the problems of every ``every``-th
-    decision of a day (as :meth:`LookAhead.problem` built them), decided again with ``factor`` times
-    the budget; prints how often the first job differs and the objective of the default's choice
-    over the larger budget's (both orders evaluated on the same problem: 1 means as good)."""
+def _day_problems(protocol: str, hours: float, seed: int, scheduler: str) -> list[tuple[Any, int, float]]:
+    """The look-ahead's problems of one synthetic day, as :meth:`LookAhead.problem` built them, each with the
+    deciding scheduler's node budget and hysteresis."""
     sys.path.insert(0, str(HERE))
     from daysize import sized
 
     from experiments.days import pipeline
     from tasker.schedulers import lookahead
 
-    seen: list[Any] = []
+    seen: list[tuple[Any, int, float]] = []
     build = lookahead.LookAhead.problem
 
     def recording(self: Any, view: Any) -> Any:
@@ -159,24 +157,37 @@ def budget_study(protocol: str, hours: float, seed: int, every: int, factor: int
 
     lookahead.LookAhead.problem = recording  # type: ignore[method-assign]
     try:
-        pipeline.make(sized(protocol, hours), seed, scheduler="lookahead").build().run()
+        pipeline.make(sized(protocol, hours), seed, scheduler=scheduler).build().run()
     finally:
         lookahead.LookAhead.problem = build  # type: ignore[method-assign]
+    return seen
 
-    def decide(prob: Any, budget: int, hysteresis: float) -> tuple[list[int], bool]:
-        if not prob.has_exe:
-            order, _, _, exact = lookahead.solve(prob, node_budget=budget)
-            return order, exact
-        keep, keep_obj, n1, e1 = lookahead.solve(prob, node_budget=max(1, budget // 2), fixed_first=0)
-        alt, alt_obj, _, e2 = lookahead.solve(prob, node_budget=budget - n1, exclude_first=0)
-        return (alt if alt_obj < hysteresis * keep_obj else keep), e1 and e2
 
+def _decide(prob: Any, budget: int, hysteresis: float) -> tuple[list[int], bool]:
+    """The order a look-ahead decision with ``budget`` nodes takes on ``prob`` (searched, as
+    :meth:`LookAhead.schedule` searches), and whether its search ended on its own."""
+    from tasker.schedulers import lookahead
+
+    if not prob.has_exe:
+        order, _, _, exact = lookahead.solve(prob, node_budget=budget)
+        return order, exact
+    keep, keep_obj, n1, e1 = lookahead.solve(prob, node_budget=max(1, budget // 2), fixed_first=0)
+    alt, alt_obj, _, e2 = lookahead.solve(prob, node_budget=budget - n1, exclude_first=0)
+    return (alt if alt_obj < hysteresis * keep_obj else keep), e1 and e2
+
+
+def budget_study(protocol: str, hours: float, seed: int, every: int, factor: int) -> dict[str, Any]:
+    """What the look-ahead's node budget does to its decisions: the problems of every ``every``-th
+    decision of a day (as :meth:`LookAhead.problem` built them), decided again with ``factor`` times
+    the budget; prints how often the first job differs and the objective of the default's choice
+    over the larger budget's (both orders evaluated on the same problem: 1 means as good)."""
+    seen = _day_problems(protocol, hours, seed, "lookahead")
     sample = [x for x in seen if x[0].n >= 3][::every]
     differ = exact = 0
     ratios = []
     for prob, budget, hysteresis in sample:
-        small, was_exact = decide(prob, budget, hysteresis)
-        big, _ = decide(prob, budget * factor, hysteresis)
+        small, was_exact = _decide(prob, budget, hysteresis)
+        big, _ = _decide(prob, budget * factor, hysteresis)
         exact += was_exact
         differ += small[0] != big[0]
         ratios.append(prob.evaluate(small) / prob.evaluate(big))
@@ -201,32 +212,10 @@ def budget_curve(protocol: str, hours: float, seed: int, every: int, budgets: tu
                  reference: int) -> tuple[int, int, float, list[dict[str, Any]]]:
     """:func:`budget_study` for several node budgets against one larger ``reference`` budget, on the
     searched decisions of a day (``rule`` exact or anytime, 3 jobs or more; every ``every``-th)."""
-    sys.path.insert(0, str(HERE))
-    from daysize import sized
-
-    from experiments.days import pipeline
-    from tasker.schedulers import lookahead
-
-    seen: list[Any] = []
-    build = lookahead.LookAhead.problem
-
-    def recording(self: Any, view: Any) -> Any:
-        prob, jobs = build(self, view)
-        seen.append((prob, self.hysteresis))
-        return prob, jobs
-
-    lookahead.LookAhead.problem = recording  # type: ignore[method-assign]
-    try:
-        pipeline.make(sized(protocol, hours), seed, scheduler="lookahead:incremental=false").build().run()
-    finally:
-        lookahead.LookAhead.problem = build  # type: ignore[method-assign]
+    seen = [(prob, h) for prob, _, h in _day_problems(protocol, hours, seed, "lookahead:incremental=false")]
 
     def decide(prob: Any, budget: int, hysteresis: float) -> list[int]:
-        if not prob.has_exe:
-            return lookahead.solve(prob, node_budget=budget)[0]
-        keep, keep_obj, n1, _ = lookahead.solve(prob, node_budget=max(1, budget // 2), fixed_first=0)
-        alt, alt_obj, _, _ = lookahead.solve(prob, node_budget=budget - n1, exclude_first=0)
-        return alt if alt_obj < hysteresis * keep_obj else keep
+        return _decide(prob, budget, hysteresis)[0]
 
     sample = [x for x in seen if x[0].n >= 3][::every]
     best = [decide(prob, reference, h) for prob, h in sample]
