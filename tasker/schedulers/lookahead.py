@@ -339,12 +339,10 @@ class LookAhead(Scheduler):
         """Seconds ``c`` takes if started at ``pose`` once ``after`` is complete: its reqSP
         answer's ``c_time``, or the answer back in seconds when the task gives none.  ``keep``:
         ``c`` is idle and the answer may be kept while :attr:`ScheduleView.generation` holds (an
-        answer in seconds is; one recovered from two costs depends on when it was asked)."""
+        answer in seconds is; one recovered from two costs depends on when it was asked).
+        :meth:`problem` reads the kept answers."""
         if pose is None or p.cps == 0:
             return p.c_time
-        key = (c.id, after, pose)
-        if keep and key in self._durations:
-            return self._durations[key]
         answer = view.req_sp(c.id, SPRequest(SP_COMPLETION, {"pose": pose, "after": after}))
         if not isinstance(answer, CompletionCost):
             raise ConfigError(f"lookahead: task type {c.task_type!r} answered reqSP {SP_COMPLETION!r} with "
@@ -356,7 +354,7 @@ class LookAhead(Scheduler):
             d = float(answer.c_time)
             d = max(0.0, d) if math.isfinite(d) else math.inf
             if keep:
-                self._durations[key] = d
+                self._durations[c.id, after, pose] = d
             return d
         extra = (answer.cc - p.cost) / p.cps
         return max(0.0, p.c_time + extra) if math.isfinite(extra) else math.inf
