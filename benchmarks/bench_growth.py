@@ -402,6 +402,17 @@ def print_queues(protocol: str, hours: tuple[float, ...] = (2.0, 8.0), seed: int
               if decisions else f"  {h:g} h: no decision")
 
 
+def _seeds(text: str) -> int:
+    """A number of days (seeds 1..N) for a day comparison: an integer of at least 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of days (an integer >= 1), got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a number of days (an integer >= 1), got {value}")
+    return value
+
+
 def main(argv: list[str]) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--protocol", default="tabsa-original")
@@ -419,9 +430,9 @@ def main(argv: list[str]) -> int:
                    help="the clock's own cost: a day against the same day with one request of each type")
     p.add_argument("--budget-curve", action="store_true",
                    help="the look-ahead's node budgets 125-2000 against 10x the default, on searched decisions")
-    p.add_argument("--budget-days", type=int, metavar="SEEDS", default=0,
+    p.add_argument("--budget-days", type=_seeds, metavar="SEEDS", default=0,
                    help="whole days, the look-ahead with node_budget = 500 against the default")
-    p.add_argument("--incremental-study", type=int, metavar="SEEDS", default=0,
+    p.add_argument("--incremental-study", type=_seeds, metavar="SEEDS", default=0,
                    help="whole days, the look-ahead as shipped against a full search at every decision")
     p.add_argument("--queues", action="store_true",
                    help="only: the look-ahead's queue at its decisions in a 2-hour and an 8-hour day (seed 1)")

@@ -72,3 +72,10 @@ def test_two_look_aheads_are_compared_on_whole_days(capsys: pytest.CaptureFixtur
     rows = {line.split()[0]: line.split() for line in out[2:-1]}
     assert set(rows) == {*bench_growth.QUALITY_KEYS, "cpu_s"}
     assert rows["completed"][-1] in ("0/1", "1/1") and out[-1].startswith("  decisions that hit the node budget")
+
+
+@pytest.mark.parametrize("bad", ["0", "-3", "many"])
+def test_a_day_comparison_needs_at_least_one_day(bad: str, capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exit_:
+        bench_growth.main(["--incremental-study", bad])
+    assert exit_.value.code == 2 and "a number of days (an integer >= 1)" in capsys.readouterr().err
