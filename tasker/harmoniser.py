@@ -146,7 +146,7 @@ class TaskHarmoniser:
         self._trace = trace
         self.agents: dict[str, DynamicAgent] = {}  # A_da
         self._handovers: dict[tuple[str, str, float], Effects | None] = {}  # handover's answers
-        self._suspensions: dict[tuple[float, str, str], float] = {}  # _suspension_of's answers
+        self._suspensions: dict[tuple[float, str, str | None], float] = {}  # _suspension_of's answers
         self.exe_da: str | None = None
         self.irr_da: str | None = None
         self._idle = IdleAgents()  # D_r, in request order (its version counts changes: ScheduleView.generation)
@@ -334,16 +334,20 @@ class TaskHarmoniser:
     def _suspension_of(self, by: str) -> float:
         """Seconds the executing agent needs to report ``wait`` if sent ``susp`` now with ``by`` as its
         replacement (:func:`tasker.securing.suspend_estimate`, for the interruption that ``susp`` would
-        announce); one estimate per replacement and moment."""
+        announce); one estimate per moment, or per replacement and moment if it read the interruption's length."""
         if self.exe_da is None:
             return 0.0
-        key = (self.now, self.exe_da, by)
-        if key not in self._suspensions:
-            if len(self._suspensions) > 256:
-                self._suspensions.clear()
-            expected = self._susp_data(by).get("expected_s")
-            self._suspensions[key] = suspend_estimate(self.agents[self.exe_da], self.now, expected)
-        return self._suspensions[key]
+        memo, key, any_by = self._suspensions, (self.now, self.exe_da, by), (self.now, self.exe_da, None)
+        if key not in memo:
+            if any_by in memo:  # this moment's suspension did not read how long the interruption lasts
+                return memo[any_by]
+            if len(memo) > 256:
+                memo.clear()
+            expected, reads = self._susp_data(by).get("expected_s"), set[str]()
+            memo[key] = suspend_estimate(self.agents[self.exe_da], self.now, expected, reads)
+            if "interruption_s" not in reads:
+                memo[any_by] = memo[key]
+        return memo[key]
 
     def _unattended(self) -> tuple[UnattendedHazard, ...]:
         """The hazards that hold now while their agent is out of ``cmd``, with when that stretch began

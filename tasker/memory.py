@@ -128,5 +128,33 @@ class AgentMemory(dict[str, Any]):
         return out
 
     def __repr__(self) -> str:
-        fields = ", ".join(f"{n}={getattr(self, n)!r}" for n in self.__slots__ if getattr(self, n) is not None)
+        fields = ", ".join(f"{n}={getattr(self, n)!r}" for n in AgentMemory.__slots__ if getattr(self, n) is not None)
         return f"AgentMemory({dict.__repr__(self)}{', ' + fields if fields else ''})"
+
+
+class WatchedMemory(AgentMemory):
+    """A copy of a memory, made for an estimate, that notes whether anything read ``interruption_s``
+    (:attr:`interruption_read`): any way of reading it goes through the one attribute — ``memory["interruption_s"]``,
+    :meth:`get`, ``in``, :meth:`copy`, ``repr``, :mod:`copy` and :mod:`pickle` included.  An estimate that
+    never read it holds for any expected interruption (:func:`tasker.securing.suspend_estimate`).  Writing it
+    is not reading it; reading it back after a write counts (conservatively)."""
+
+    __slots__ = ("_interruption", "interruption_read")
+
+    def __init__(self, of: AgentMemory, interruption_s: float | None) -> None:
+        self._interruption: float | None = None
+        super().__init__(dict.items(of))
+        self.planned_from = of.planned_from
+        self.restore_baseline = of.restore_baseline
+        self.suspension_ahead = of.suspension_ahead
+        self._interruption = interruption_s
+        self.interruption_read = False
+
+    @property
+    def interruption_s(self) -> float | None:
+        self.interruption_read = True
+        return self._interruption
+
+    @interruption_s.setter
+    def interruption_s(self, value: float | None) -> None:
+        self._interruption = value

@@ -27,6 +27,7 @@ from typing import Any, Protocol
 
 from tasker.errors import AgentEnded, ConfigError, InvariantViolation, PlanningFailed, WorldError
 from tasker.fsm import FsmState
+from tasker.memory import AgentMemory, WatchedMemory
 from tasker.stage import Stage, StagePlan
 from tasker.task import TaskContext, TaskType
 
@@ -169,7 +170,8 @@ def secure_estimate(agent: WatchedAgent, now: float) -> float:
     return suspension_estimate(agent, now, "strict", agent.ctx.interrupted, None)
 
 
-def suspend_estimate(agent: WatchedAgent, now: float, expected_s: float | None = None) -> float:
+def suspend_estimate(agent: WatchedAgent, now: float, expected_s: float | None = None,
+                     reads: set[str] | None = None) -> float:
     """Seconds from ``now`` until an agent in ``cmd`` reports ``wait`` if it is sent ``susp`` now.
 
     In ``exeTsk``: what is left of a blocking stage and the blocking stages after it
@@ -179,6 +181,10 @@ def suspend_estimate(agent: WatchedAgent, now: float, expected_s: float | None =
     blocking run, which it may enter right after this estimate.  In ``upTsk``: the
     planning time left, then the same from the first stage.  In ``genSusp``/``exeSusp``:
     what is left of the suspension.  0 outside ``cmd``.
+
+    ``reads``, when given, gets ``"interruption_s"`` added if the task's suspension read the
+    expected interruption (:class:`tasker.memory.WatchedMemory`): without it, the estimate is
+    the same for every ``expected_s``.
     """
     if agent.ended:
         raise AgentEnded(agent.id, agent.end_reason or "ended")
@@ -195,24 +201,24 @@ def suspend_estimate(agent: WatchedAgent, now: float, expected_s: float | None =
     else:
         return 0.0
     policy = agent.ctx.strategy.policy
-    estimate = left + _from(agent, now, stages, index, policy, expected_s)
+    estimate = left + _from(agent, now, stages, index, policy, expected_s, reads=reads)
     # the agent may enter its next blocking run just after this estimate: that run is the worst case
     # until the next estimate (re-made whenever the agent moves on), so the lead covers it already
     nxt = next((j for j in range(index + 1, len(stages)) if stages[j].blocking and not stages[j - 1].blocking), None)
     if nxt is not None:
-        estimate = max(estimate, _from(agent, now, stages, nxt, policy, expected_s, whole=True))
+        estimate = max(estimate, _from(agent, now, stages, nxt, policy, expected_s, whole=True, reads=reads))
     return estimate
 
 
 def _from(agent: WatchedAgent, now: float, stages: Sequence[Stage], index: int, policy: str,
-          expected_s: float | None, whole: bool = False) -> float:
+          expected_s: float | None, whole: bool = False, reads: set[str] | None = None) -> float:
     """Suspending from stage ``index``: its blocking run (eq. 25), then the suspension at the first
     suspendable stage (eq. 26) — none left: the task ends instead.  ``whole``: the run not yet begun."""
     left = _stages_left(agent, now, stages, index, lambda s: s.blocking, whole)
     at = next((s for s in stages[index:] if not s.blocking), None)
     if at is None:
         return left
-    return left + suspension_estimate(agent, now, policy, at, expected_s)
+    return left + suspension_estimate(agent, now, policy, at, expected_s, reads)
 
 
 def _stages_left(agent: WatchedAgent, now: float, stages: Sequence[Stage], index: int,
@@ -232,7 +238,7 @@ def _stages_left(agent: WatchedAgent, now: float, stages: Sequence[Stage], index
 
 
 def suspension_estimate(agent: WatchedAgent, now: float, policy: str, interrupted: Stage | None,
-                        expected_s: float | None) -> float:
+                        expected_s: float | None, reads: set[str] | None = None) -> float:
     """``generate_suspension`` on a copy of the agent's context (static strategy, ``policy``,
     interrupted at ``interrupted``): the seconds the plan takes, ``inf`` if it cannot be made.
 
@@ -241,11 +247,16 @@ def suspension_estimate(agent: WatchedAgent, now: float, policy: str, interrupte
     """
     if agent.ended:
         raise AgentEnded(agent.id, agent.end_reason or "ended")
+    memory: AgentMemory | None = None
     try:
         agent.refresh(now)
-        memory = agent.ctx.memory.copy()
-        if expected_s is not None:
-            memory.interruption_s = float(expected_s)
+        if reads is None:
+            memory = agent.ctx.memory.copy()
+            if expected_s is not None:
+                memory.interruption_s = float(expected_s)
+        else:  # the same copy, noting whether the suspension reads the interruption's length
+            own = agent.ctx.memory
+            memory = WatchedMemory(own, float(expected_s) if expected_s is not None else own.interruption_s)
         ctx = replace(agent.ctx, memory=memory, done=list(agent.ctx.done), interrupted=interrupted,
                       suspended=True, strategy=replace(agent.ctx.strategy, suspension="static", policy=policy))
         plan = agent.task.generate_suspension(ctx)
@@ -260,3 +271,6 @@ def suspension_estimate(agent: WatchedAgent, now: float, policy: str, interrupte
     except Exception as exc:
         agent.fail(now, exc)
         raise AgentEnded(agent.id, agent.end_reason or "error") from exc
+    finally:  # a failed plan may have read it too: inf for one expectation need not be inf for all
+        if reads is not None and isinstance(memory, WatchedMemory) and memory.interruption_read:
+            reads.add("interruption_s")

@@ -397,3 +397,41 @@ def test_the_queue_ahead_is_summed_once_a_moment_whoever_the_replacement() -> No
     tr = loop.run()
     assert moments and calls[0] <= len(moments) * (len(tasks) + 1)  # not once per candidate and moment
     assert all(s["expected_s"] >= 0 for s in tr.of("command", flag="susp") if "expected_s" in s)
+
+
+@pytest.mark.parametrize("reads", [False, True])
+def test_a_suspension_that_does_not_read_the_interruption_is_estimated_once_a_moment(reads: bool) -> None:
+    """The look-ahead asks the executing task's suspension for every candidate: a suspension that never reads how
+    long the interruption lasts is planned once a moment for all of them; one that reads it, once per candidate
+    (each candidate announces another interruption), and the decisions record the estimates that differ."""
+    calls: list[float] = []
+
+    class Guide(SyntheticTask):
+        def generate_suspension(self, ctx: TaskContext):  # type: ignore[no-untyped-def]
+            calls.append(ctx.memory.interruption_s if reads else 0.0)
+            plan = super().generate_suspension(ctx)
+            return plan if not reads or plan.stages else StagePlan(
+                (st("park", 1.0 + (ctx.memory.interruption_s or 0.0) / 100),), Purpose.GEN_SUSP, strategy="static")
+
+    tasks = [Guide("guide", [st("approach", 30), st("guide", 60)]),
+             *(Guide(f"w{k}", [st("s", 5.0 + 7 * k)]) for k in range(4))]
+    loop = make_loop(tasks, scheduler="lookahead", hysteresis=0.5)
+    loop.request(0.0, "guide")
+    for k in range(4):
+        loop.request(0.5, f"w{k}")
+    moments: set[float] = set()
+    ask = loop.harmoniser._suspension_of
+
+    def asked(by: str) -> float:
+        if loop.harmoniser.exe_da is not None:
+            moments.add(loop.harmoniser.now)
+        return ask(by)
+
+    loop.harmoniser._suspension_of = asked  # type: ignore[method-assign]
+    tr = loop.run()
+    suspend = [d["suspend_s"] for d in tr.of("decision") if "suspend_s" in d and len(d["suspend_s"]) > 1]
+    assert moments and suspend
+    if reads:
+        assert len(calls) > len(moments) and any(len(set(s.values())) > 1 for s in suspend)
+    else:
+        assert len(calls) <= 2 * len(moments) and all(len(set(s.values())) == 1 for s in suspend)

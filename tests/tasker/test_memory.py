@@ -87,3 +87,34 @@ def test_a_susp_with_expected_s_sets_the_field() -> None:
     agent._read_inbox()
     assert agent.ctx.memory.interruption_s == 42.0
     assert agent.ctx.memory["interruption_s"] == 42.0
+
+
+def test_a_watched_copy_notes_every_way_of_reading_the_interruption() -> None:
+    """An estimate's copy that notes whether its suspension read ``interruption_s`` (then the estimate is
+    made per expected interruption; otherwise one holds for all): every way of reading it is noted, writing
+    it is not, and the copy holds what :meth:`AgentMemory.copy` gives with the expectation set."""
+    import copy as copying
+
+    from tasker.memory import WatchedMemory
+
+    own = AgentMemory({"k": [1]})
+    own.planned_from = []
+    own.interruption_s = 3.0
+    reads = [lambda m: m.interruption_s, lambda m: m[INTERRUPTION_KEY], lambda m: m.get(INTERRUPTION_KEY),
+             lambda m: INTERRUPTION_KEY in m, lambda m: m.copy(), lambda m: repr(m), lambda m: copying.copy(m),
+             lambda m: copying.deepcopy(m), lambda m: pickle.dumps(m), lambda m: m.pop(INTERRUPTION_KEY, None),
+             lambda m: m.setdefault(INTERRUPTION_KEY, 1.0)]
+    for read in reads:
+        m = WatchedMemory(own, 12.0)
+        assert not m.interruption_read
+        read(m)
+        assert m.interruption_read, read
+    m = WatchedMemory(own, 12.0)
+    m["k2"] = 1
+    m[INTERRUPTION_KEY] = 4.0
+    m.interruption_s = 5.0
+    assert dict(m) == {"k": [1], "k2": 1} and m["k"] is own["k"] and m.planned_from is own.planned_from
+    assert not m.interruption_read
+    assert m.interruption_s == 5.0 and m.interruption_read
+    assert own.interruption_s == 3.0 and "k2" not in own  # a copy: the agent's own memory is untouched
+    assert WatchedMemory(own, None).copy().interruption_s is None
