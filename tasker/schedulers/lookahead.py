@@ -82,6 +82,9 @@ class Problem:
         self.lateness_weight, self.hazard_weight = lateness_weight, hazard_weight
         self.left_on = [tuple(x) for x in left_on] if left_on is not None else [()] * n
         self.hazards_left_on = any(self.left_on)  # without any, the search skips the term (its hot loop)
+        # every term grows with the time it is taken at: an order no earlier and no cheaper than another at some
+        # position, with the same jobs after it in the same order, is no better (used to drop moves early)
+        self.monotone = all(w >= 0 for w in self.weight) and lateness_weight >= 0 and hazard_weight >= 0
         self.dmin = [min([self.first[j], *(self.after[i][j] for i in range(n) if i != j)]) for j in range(n)]
 
     def cost(self, j: int, c: float) -> float:
@@ -119,11 +122,31 @@ class Problem:
     def evaluate_from(self, order: Sequence[int], m: int, state: tuple[float, float, int]) -> float:
         """:meth:`evaluate` of ``order`` from position ``m``, ``state`` being its ``(t, total, prev)`` there:
         the same operations in the same order, so the same float as evaluating it whole."""
+        return self._run(order, m, len(order), state)[1]
+
+    def evaluate_unless(self, order: Sequence[int], m: int, state: tuple[float, float, int], stop: int,
+                        other: tuple[float, float, int]) -> float:
+        """:meth:`evaluate_from`, or ``inf`` when the order cannot be better than another order whose state
+        before position ``stop`` is ``other`` and whose jobs from ``stop - 1`` on are this one's: there this
+        order is no earlier and no cheaper, and every later term can only grow with the time (:attr:`monotone`;
+        IEEE sums and products by weights >= 0 keep that order).  The value when not ``inf`` is
+        :meth:`evaluate_from`'s."""
+        n = len(order)
+        if not self.monotone or not m < stop < n:
+            return self._run(order, m, n, state)[1]
+        state = self._run(order, m, stop, state)
+        if state[0] >= other[0] and state[1] >= other[1]:
+            return math.inf
+        return self._run(order, stop, n, state)[1]
+
+    def _run(self, order: Sequence[int], m: int, end: int,
+             state: tuple[float, float, int]) -> tuple[float, float, int]:
+        """The state ``(t, total, prev)`` before position ``end`` of ``order``, from ``state`` before ``m``."""
         t, total, prev = state
         first, after, now, hazards = self.first, self.after, self.now, self.hazards_left_on
         weight, deadline, budget = self.weight, self.deadline, self.budget
         lw, hw = self.lateness_weight, self.hazard_weight
-        for k in range(m, len(order)):
+        for k in range(m, end):
             j = order[k]
             if hazards:
                 total += self.wait_cost(j, t)
@@ -137,7 +160,7 @@ class Problem:
                     out += hw * (late - budget[j])
             total += out
             prev = j
-        return total
+        return t, total, prev
 
 
 def _greedy(p: Problem, allowed_first: list[int]) -> list[int]:
@@ -175,8 +198,9 @@ def _improve(p: Problem, order: list[int], allowed_first: set[int], budget: int)
                 if used >= budget:
                     return order, best, used
                 used += 1
-                m = min(i, k)
-                v = p.evaluate_from(cand, m, prefix[m])
+                m, stop = min(i, k), max(i, k) + 2  # from stop on, cand's jobs (and the one before) are order's
+                v = p.evaluate_unless(cand, m, prefix[m], stop, prefix[stop]) if stop < p.n else \
+                    p.evaluate_from(cand, m, prefix[m])
                 if v < best - 1e-9 * max(1.0, abs(best)):
                     order, best, improved = cand, v, True
                     break

@@ -156,3 +156,55 @@ def test_distance_prefers_little_travel_per_second_of_work_and_priority_first() 
 def test_a_negative_hesitance_is_a_config_error(name: str) -> None:
     with pytest.raises(ConfigError, match="hesitance"):
         schedulers.create(name, hesitance=-0.1)
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_a_move_dropped_early_changes_no_search(seed: int) -> None:
+    """The local search drops a move once it is no earlier and no cheaper than the current order where their
+    jobs meet again (:meth:`Problem.evaluate_unless`); every search then returns what evaluating each move whole
+    returns — the same order, value, nodes and proof — budgets small and large, hazards left on or not."""
+    rng = random.Random(seed)
+    p = random_problem(rng, rng.randint(4, 14), has_exe=rng.random() < 0.5)
+    if seed % 3 == 0:
+        p = Problem(p.now, p.first, p.after, p.weight, p.deadline, p.budget, has_exe=p.has_exe,
+                    lateness_weight=p.lateness_weight, hazard_weight=p.hazard_weight,
+                    left_on=[[p.now + rng.uniform(0, 200)] if rng.random() < 0.3 else [] for _ in range(p.n)])
+    budget = rng.choice([20, 200, 2000])
+    kwargs = {"fixed_first": 0} if p.has_exe and seed % 2 else {}
+    fast = solve(p, node_budget=budget, **kwargs)
+    whole = Problem.evaluate_unless
+    try:
+        Problem.evaluate_unless = lambda self, order, m, state, stop, other: self.evaluate_from(  # type: ignore
+            order, m, state)
+        slow = solve(p, node_budget=budget, **kwargs)
+    finally:
+        Problem.evaluate_unless = whole  # type: ignore[method-assign]
+    assert fast == slow
+
+
+def test_evaluate_unless_is_evaluate_or_a_proof_that_the_order_is_no_better() -> None:
+    rng = random.Random(7)
+    dropped = 0
+    for _ in range(300):
+        p = random_problem(rng, rng.randint(4, 10))
+        order = list(range(p.n))
+        rng.shuffle(order)
+        cand = list(order)
+        i, k = rng.sample(range(p.n), 2)
+        cand.insert(k, cand.pop(i))
+        m, stop = min(i, k), max(i, k) + 2
+        prefix = p.prefixes(order)
+        v = p.evaluate_unless(cand, m, prefix[m], stop, prefix[stop] if stop <= p.n else prefix[-1])
+        if v == math.inf and p.evaluate(cand) != math.inf:
+            dropped += 1
+            assert p.evaluate(cand) >= p.evaluate(order)  # dropped: never better than the current order
+        else:
+            assert v == p.evaluate(cand)  # bit for bit
+    assert dropped > 0
+
+
+def test_negative_weights_drop_no_move() -> None:
+    p = Problem(0.0, [5, 5, 5, 5], [[0, 5, 5, 5]] * 4, [1.0, -1.0, 1.0, 1.0], [math.inf] * 4, [math.inf] * 4)
+    assert not p.monotone
+    prefix = p.prefixes([0, 1, 2, 3])
+    assert p.evaluate_unless([1, 0, 2, 3], 0, prefix[0], 3, prefix[3]) == p.evaluate([1, 0, 2, 3])
