@@ -6,6 +6,7 @@
     python benchmarks/bench_growth.py --budget-curve       # what smaller node budgets cost in optimality
     python benchmarks/bench_growth.py --budget-days 20     # node_budget = 500 against the default, whole days
     python benchmarks/bench_growth.py --stepping           # the clock's own cost (what an event-driven one saves)
+    python benchmarks/bench_growth.py --horizon-days 20    # the look-ahead with a rolling horizon, whole days
     python benchmarks/bench_growth.py --protocol FILE.toml --schedulers alg2 edf --base 60ed0ea
 
 Days of a protocol (default ``tabsa-original``, TaBSA's day) on the synthetic backend,
@@ -279,26 +280,34 @@ def print_stepping(protocols: tuple[str, ...] = ("tabsa-original", "tabsa"), sch
 QUALITY_KEYS = ("completed", "dead_falls", "lateness_s", "completion_minus_deadline_s", "switches", "interruptions")
 
 
-def compare_days(protocol: str, seeds: int, first: str, second: str, title: str) -> None:
-    """Whole days of ``protocol`` (seeds 1..``seeds``) under two look-ahead specs, their day metrics side
-    by side (means, the paired difference, the days alike) and the CPU seconds of each."""
+def compare_days(protocol: str, seeds: int, first: str, second: str, title: str, hours: float | None = None) -> None:
+    """Whole days of ``protocol`` (seeds 1..``seeds``; made ``hours`` long if given) under two look-ahead
+    specs, their day metrics side by side (means, the paired difference, the days alike, and the days the
+    first is lower and higher) and the CPU seconds of each."""
+    sys.path.insert(0, str(HERE))
+    from daysize import sized
+
     from experiments.days.runner import run_day
 
+    proto = sized(protocol, hours) if hours is not None else protocol
     rows: dict[str, list[dict[str, Any]]] = {first: [], second: []}
     for seed in range(1, seeds + 1):
         for name, out in rows.items():
             start = time.process_time()
-            m = run_day(protocol, seed, name)
+            m = run_day(proto, seed, name)
             m["cpu_s"] = time.process_time() - start
             out.append(m)
-    print(f"{title} ({protocol}, seeds 1-{seeds}, whole days): {first} against {second}; commit {_head()}")
-    print(f"  {'metric':30s} {'first':>12s} {'second':>12s} {'diff mean':>10s} {'min':>9s} {'max':>9s}  same days")
+    days = "whole days" + (f", {hours:g} h long" if hours is not None else "")
+    print(f"{title} ({protocol}, seeds 1-{seeds}, {days}): {first} against {second}; commit {_head()}")
+    print(f"  {'metric':30s} {'first':>12s} {'second':>12s} {'diff mean':>10s} {'min':>9s} {'max':>9s}  same days"
+          f"  lower/higher")
     one, two = rows[first], rows[second]
     for key in (*QUALITY_KEYS, "cpu_s"):
         x, y = [float(m[key]) for m in one], [float(m[key]) for m in two]
         d = [u - v for u, v in zip(x, y, strict=True)]
         print(f"  {key:30s} {sum(x) / len(x):12.2f} {sum(y) / len(y):12.2f} {sum(d) / len(d):10.2f} {min(d):9.2f} "
-              f"{max(d):9.2f}  {sum(1 for u in d if u == 0)}/{len(d)}")
+              f"{max(d):9.2f}  {sum(1 for u in d if u == 0):>5}/{len(d):<3}  {sum(1 for u in d if u < 0):>5}/"
+              f"{sum(1 for u in d if u > 0)}")
     hit = [sum(float(m["anytime_decisions"]) for m in r) / len(r) for r in (one, two)]
     print(f"  decisions that hit the node budget, a day: {hit[0]:.0f} against {hit[1]:.0f}")
 
@@ -312,6 +321,14 @@ def print_budget_days(protocol: str, seeds: int, budget: int = 500) -> None:
     """What a smaller node budget does to whole days: ``node_budget = budget`` against the default."""
     compare_days(protocol, seeds, f"lookahead:node_budget={budget}", "lookahead",
                  "the look-ahead's node budget on whole days")
+
+
+def print_horizon_days(protocol: str, seeds: int, horizons: tuple[int, ...] = (6, 8)) -> None:
+    """What a rolling horizon does to whole days: ``lookahead:horizon=h`` against the whole queue, on the
+    protocol's own days and on days four times as long as the growth table's 2 h (8 h)."""
+    for h in horizons:
+        for hours in (None, 8.0):
+            compare_days(protocol, seeds, f"lookahead:horizon={h}", "lookahead", "the look-ahead's horizon", hours)
 
 
 # -- the driver ---------------------------------------------------------------------------------------
@@ -434,6 +451,8 @@ def main(argv: list[str]) -> int:
                    help="whole days, the look-ahead with node_budget = 500 against the default")
     p.add_argument("--incremental-study", type=_seeds, metavar="SEEDS", default=0,
                    help="whole days, the look-ahead as shipped against a full search at every decision")
+    p.add_argument("--horizon-days", type=_seeds, metavar="SEEDS", default=0,
+                   help="whole days, the look-ahead with horizon = 6 and 8 against the whole queue (also 8 h long)")
     p.add_argument("--queues", action="store_true",
                    help="only: the look-ahead's queue at its decisions in a 2-hour and an 8-hour day (seed 1)")
     p.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
@@ -465,6 +484,9 @@ def main(argv: list[str]) -> int:
         return 0
     if args.budget_days:
         print_budget_days(args.protocol, args.budget_days)
+        return 0
+    if args.horizon_days:
+        print_horizon_days(args.protocol, args.horizon_days)
         return 0
     if args.incremental_study:
         print_incremental_study(args.protocol, args.incremental_study)

@@ -43,18 +43,24 @@ adapted (:func:`adapt`), join the search as incumbents.  A waiting job's duratio
 another waiting job is kept while ``ScheduleView.generation`` holds, when the task answers in
 seconds (``CompletionCost.c_time``).
 
+A rolling horizon (``horizon`` h > 0; 0, the default, orders the whole queue): a decision orders the
+executing task and at most h waiting jobs (:meth:`LookAhead.window`: the half whose lateness would start
+first, then Smith's order); the others wait beyond it, out of the problem, and the record says how many
+(``beyond``).
+
 The executing task keeps the robot unless the best order that starts with another
 task beats the best order that continues it by the factor ``hysteresis``.
 Every decision leaves a ``decision`` record: ``rule`` (``exact``, ``anytime`` or ``incremental``),
 ``order``, ``objective``, ``objective_continue``, ``nodes``; ``suspend_s`` (each
 candidate's plan-based switch penalty) when the view gives suspension estimates, and
-``left_on`` (agent, hazard, due) when hazards are left on.
+``left_on`` (agent, hazard, due) when hazards are left on; ``beyond`` when a horizon left jobs out.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 from tasker.errors import ConfigError
@@ -328,7 +334,7 @@ class LookAhead(Scheduler):
 
     def __init__(self, node_budget: int = 2000, switch_penalty_s: float = 0.0, lateness_weight: float = 1.0,
                  hazard_weight: float = 1e4, budgets: Mapping[str, float] | None = None,
-                 hysteresis: float = 1.0, incremental: bool = True) -> None:
+                 hysteresis: float = 1.0, incremental: bool = True, horizon: int = 0) -> None:
         if isinstance(node_budget, bool) or not isinstance(node_budget, int) or node_budget < 1:
             raise ConfigError(f"lookahead: node_budget must be an integer >= 1, got {node_budget!r}")
         for key, value in (("switch_penalty_s", switch_penalty_s), ("lateness_weight", lateness_weight),
@@ -352,6 +358,9 @@ class LookAhead(Scheduler):
         if not isinstance(incremental, bool):
             raise ConfigError(f"lookahead: incremental must be true or false, got {incremental!r}")
         self.incremental = incremental
+        if isinstance(horizon, bool) or not isinstance(horizon, int) or horizon < 0:
+            raise ConfigError(f"lookahead: horizon must be an integer >= 0 (0: the whole queue), got {horizon!r}")
+        self.horizon = horizon
         self._penalty: dict[str, float] = {}  # the last problem's switch penalty per candidate
         # what one decision leaves the next (incremental search, module docstring):
         self._generation: int | None = None  # ScheduleView.generation the kept durations belong to
@@ -444,9 +453,40 @@ class LookAhead(Scheduler):
                 tuple(prob.weight), tuple(prob.deadline), tuple(prob.budget), tuple(prob.left_on),
                 tuple(tuple(row[k:]) for row in prob.after))
 
+    def window(self, view: ScheduleView) -> tuple[ScheduleView, int]:
+        """The view a decision orders and how many waiting jobs it leaves beyond it.  With ``horizon`` h > 0 and
+        more than h candidates, the view keeps h of them (a rolling horizon): the half (rounded up) whose
+        lateness would start first — the earliest of deadline plus hazard budget and of a hazard left on's due
+        — then the rest in Smith's order on their own durations (``cTime / cps``), each rule taken in request
+        order on ties.  The others wait beyond the horizon, out of this decision's problem."""
+        if not self.horizon or len(view.candidates) <= self.horizon:
+            return view, 0
+        cands = list(view.candidates)
+        params = {c.id: self.cost_params(c, self.name) for c in cands}
+        due: dict[str, float] = {}
+        for hz in view.hazards:
+            if math.isfinite(hz.since + hz.budget_s):
+                due[hz.agent] = min(due.get(hz.agent, math.inf), hz.since + hz.budget_s)
+
+        def urgent(c: Candidate) -> tuple[float, int, str]:
+            p = params[c.id]
+            late = math.inf if p.deadline is None else p.deadline + self.budgets.get(c.task_type, 0.0)
+            return (min(late, due.get(c.id, math.inf)), c.order, c.id)
+
+        def smith(c: Candidate) -> tuple[float, int, str]:
+            p = params[c.id]
+            return (p.c_time / p.cps if p.cps > 0 else math.inf, c.order, c.id)
+
+        first = [c for c in sorted(cands, key=urgent)[:(self.horizon + 1) // 2] if math.isfinite(urgent(c)[0])]
+        taken = {c.id for c in first}
+        rest = [c for c in sorted(cands, key=smith) if c.id not in taken][:self.horizon - len(first)]
+        keep = {c.id for c in first + rest}
+        return replace(view, candidates=[c for c in cands if c.id in keep]), len(cands) - len(keep)
+
     def schedule(self, view: ScheduleView) -> Decision:
         if not view.candidates:
             return NO_CHANGE
+        view, beyond = self.window(view)
         prob, jobs = self.problem(view)
         ids = [c.id for c in jobs]
         sig = self.signature(prob, jobs) if self.incremental else None
@@ -499,6 +539,8 @@ class LookAhead(Scheduler):
         }
         if view.exe is not None and view.suspension is not None:  # the plan-based switch penalty
             record["suspend_s"] = {c.id: self._penalty[c.id] for c in view.candidates}
+        if beyond:
+            record["beyond"] = beyond
         if prob.hazards_left_on:
             record["left_on"] = [{"agent": hz.agent, "hazard": hz.name, "due": hz.since + hz.budget_s}
                                  for hz in view.hazards if hz.agent in {c.id for c in jobs}]

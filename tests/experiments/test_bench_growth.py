@@ -71,7 +71,17 @@ def test_two_look_aheads_are_compared_on_whole_days(capsys: pytest.CaptureFixtur
     assert out[0].startswith("a title (tabsa-short, seeds 1-1, whole days): lookahead against")
     rows = {line.split()[0]: line.split() for line in out[2:-1]}
     assert set(rows) == {*bench_growth.QUALITY_KEYS, "cpu_s"}
-    assert rows["completed"][-1] in ("0/1", "1/1") and out[-1].startswith("  decisions that hit the node budget")
+    assert rows["completed"][-2] in ("0/1", "1/1") and out[-1].startswith("  decisions that hit the node budget")
+    same, (lower, higher) = int(rows["cpu_s"][-2].split("/")[0]), map(int, rows["cpu_s"][-1].split("/"))
+    assert same + lower + higher == 1
+
+
+def test_the_horizon_study_compares_the_protocols_days_and_eight_hour_ones(capsys: pytest.CaptureFixture[str]) -> None:
+    bench_growth.print_horizon_days("tabsa-short", 1, horizons=(2,))
+    out = capsys.readouterr().out.splitlines()
+    titles = [line for line in out if line.startswith("the look-ahead's horizon")]
+    assert len(titles) == 2 and all("lookahead:horizon=2 against lookahead" in t for t in titles)
+    assert "whole days)" in titles[0] and "whole days, 8 h long)" in titles[1]
 
 
 @pytest.mark.parametrize("bad", ["0", "-3", "many"])
