@@ -89,3 +89,21 @@ def test_a_day_comparison_needs_at_least_one_day(bad: str, capsys: pytest.Captur
     with pytest.raises(SystemExit) as exit_:
         bench_growth.main(["--incremental-study", bad])
     assert exit_.value.code == 2 and "a number of days (an integer >= 1)" in capsys.readouterr().err
+
+
+def test_the_protocol_table_gives_each_schedulers_ratios(capsys: pytest.CaptureFixture[str]) -> None:
+    ok = bench_growth.print_protocols(("tabsa-short",), ("edf", "alg2"), 1, 1, 60.0)
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("a day four times as long") and len(out) == 4
+    for line, name in zip(out[2:], ("edf", "alg2"), strict=True):
+        cells = line.split()
+        assert cells[:2] == ["tabsa-short", name] and cells[-1] in ("met", "ABOVE")
+        cost, events, _, per_event = (float(c.rstrip("x")) for c in cells[2:6])
+        assert cost > 1 and events > 1 and per_event == pytest.approx(cost / events, abs=0.01)
+    assert ok == all(line.split()[-1] == "met" for line in out[2:])
+
+
+def test_an_unknown_protocol_is_refused_by_name(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exit_:
+        bench_growth.main(["--protocols", "tabsa", "no-such-protocol"])
+    assert exit_.value.code == 2 and "--protocols: no-such-protocol: no protocol" in capsys.readouterr().err
