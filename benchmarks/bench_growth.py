@@ -8,6 +8,7 @@
     python benchmarks/bench_growth.py --stepping           # the clock's own cost (what an event-driven one saves)
     python benchmarks/bench_growth.py --horizon-days 20    # the look-ahead with a rolling horizon, whole days
     python benchmarks/bench_growth.py --protocols          # the x4 ratio of each scheduler on each shipped protocol
+    python benchmarks/bench_growth.py --stale              # what re-estimating waiting agents costs (a measurement)
     python benchmarks/bench_growth.py --protocol FILE.toml --schedulers alg2 edf --base 60ed0ea
 
 Days of a protocol (default ``tabsa-original``, TaBSA's day) on the synthetic backend,
@@ -76,6 +77,10 @@ def _day(protocol: str, scheduler: str, seed: int, hours: float | None,
 
 def worker(args: argparse.Namespace) -> int:
     sizes = [float(x) if args.dimension == "hours" else int(x) for x in args.sizes.split(",")]
+    if args.stale:  # a diagnostic, not the model: parked agents keep their estimates when the robot moves
+        from tasker import parking
+
+        parking.Lot.changed = lambda self: []  # type: ignore[method-assign]
     spent = 0.0
     for size in sizes:
         cpu, work, output = 0.0, 0, 0
@@ -358,15 +363,34 @@ def print_protocols(protocols: tuple[str, ...], schedulers: tuple[str, ...], see
     return ok
 
 
+def print_stale(protocols: tuple[str, ...], schedulers: tuple[str, ...], seeds: int, repeat: int,
+                budget: float) -> None:
+    """Where the cost above the work goes: the x4 ratio (2 -> 8 h) as shipped against the same days with
+    parked agents never re-estimated when the robot moves.  The second is *not* the model — their estimates
+    go stale, and traces differ — only a measure of what re-estimation costs as the queue grows."""
+    print(f"re-estimating waiting agents when the robot moves: a day four times as long (2 -> 8 h, sum over "
+          f"seeds 1-{seeds}, best of {repeat}) as shipped, and with parked agents never re-estimated (stale "
+          f"estimates: a measurement, not the model); commit {_head()}")
+    print(f"  {'protocol':16} {'scheduler':14} {'as shipped':>11} {'stale':>8}")
+    for protocol in protocols:
+        for name in schedulers:
+            cells = []
+            for stale in (False, True):
+                data = series(ROOT, protocol, name, "hours", (2.0, 8.0), seeds, repeat, budget, stale)
+                cells.append(f"{data[8.0][0] / data[2.0][0]:7.2f}x" if 2.0 in data and 8.0 in data else "-")
+            print(f"  {protocol:16} {name:14} {cells[0]:>11} {cells[1]:>8}")
+
+
 # -- the driver ---------------------------------------------------------------------------------------
 
 def series(tree: Path, protocol: str, scheduler: str, dimension: str, sizes: tuple[float, ...], seeds: int,
-           repeat: int, budget: float) -> dict[float, tuple[float, int, int]]:
-    """``size -> (CPU s, work)`` of one series run on ``tree``."""
+           repeat: int, budget: float, stale: bool = False) -> dict[float, tuple[float, int, int]]:
+    """``size -> (CPU s, work)`` of one series run on ``tree``; ``stale``: with parked agents never
+    re-estimated (:func:`print_stale`)."""
     env = {**os.environ, "PYTHONPATH": str(tree)}
     cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", "--protocol", protocol,
            "--schedulers", scheduler, "--dimension", dimension, "--sizes", ",".join(f"{s:g}" for s in sizes),
-           "--seeds", str(seeds), "--repeat", str(repeat), "--budget", str(budget)]
+           "--seeds", str(seeds), "--repeat", str(repeat), "--budget", str(budget)] + (["--stale"] if stale else [])
     done = subprocess.run(cmd, env=env, cwd=tree, capture_output=True, text=True, preexec_fn=_cpu_cap(2 * budget))
     if done.returncode != 0 and not done.stdout.strip():  # a run past the cap ends the series where it is
         raise RuntimeError(f"{scheduler} on {tree}: {done.stderr[-1500:]}")
@@ -482,6 +506,9 @@ def main(argv: list[str]) -> int:
                    help="whole days, the look-ahead with horizon = 6 and 8 against the whole queue (also 8 h long)")
     p.add_argument("--protocols", nargs="*", metavar="PROTOCOL",
                    help="only: the x4 ratio of each scheduler on each protocol (default: every shipped one)")
+    p.add_argument("--stale", action="store_true",
+                   help="only: what re-estimating waiting agents costs, against days where they are never "
+                        "re-estimated (a measurement, not the model)")
     p.add_argument("--queues", action="store_true",
                    help="only: the look-ahead's queue at its decisions in a 2-hour and an 8-hour day (seed 1)")
     p.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
@@ -489,6 +516,10 @@ def main(argv: list[str]) -> int:
     p.add_argument("--dimension", help=argparse.SUPPRESS)
     p.add_argument("--sizes", help=argparse.SUPPRESS)
     args = p.parse_args(argv)
+    if args.stale and not args.worker:
+        print_stale(("tabsa-original", "tabsa-rush"), ("tabsa-simple", "alg2", "edf"), args.seeds, args.repeat,
+                    args.budget)
+        return 0
     if args.worker:
         args.scheduler = args.schedulers[0]
         if args.one_day:

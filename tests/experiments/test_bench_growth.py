@@ -107,3 +107,25 @@ def test_an_unknown_protocol_is_refused_by_name(capsys: pytest.CaptureFixture[st
     with pytest.raises(SystemExit) as exit_:
         bench_growth.main(["--protocols", "tabsa", "no-such-protocol"])
     assert exit_.value.code == 2 and "--protocols: no-such-protocol: no protocol" in capsys.readouterr().err
+
+
+def test_the_stale_measurement_runs_days_without_re_estimates(capsys: pytest.CaptureFixture[str]) -> None:
+    bench_growth.print_stale(("tabsa-short",), ("edf",), 1, 1, 60.0)
+    out = capsys.readouterr().out.splitlines()
+    assert "a measurement, not the model" in out[0] and len(out) == 3
+    cells = out[2].split()
+    assert cells[:2] == ["tabsa-short", "edf"] and all(c.endswith("x") and float(c[:-1]) > 0 for c in cells[2:])
+
+
+def test_a_stale_worker_re_estimates_no_parked_agent() -> None:
+    """The worker's --stale really turns re-estimation off (else the measurement would measure nothing)."""
+    import subprocess
+    import sys
+
+    code = ("import sys; sys.argv=['x','--worker','--stale','--protocol','tabsa-short','--schedulers','edf',"
+            "'--dimension','hours','--sizes','1','--seeds','1','--repeat','1'];"
+            "sys.path.insert(0,'benchmarks'); import bench_growth as b; from tasker import parking;"
+            "b.main(sys.argv[1:]); print(parking.Lot.changed(None))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                          cwd=bench_growth.ROOT)
+    assert done.stdout.strip().splitlines()[-1] == "[]"
