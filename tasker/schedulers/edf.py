@@ -15,6 +15,7 @@ class EarliestDeadlineFirst(Scheduler):
     preemptive = True
     indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
     key_cost = False  # select_key never reads the cost
+    reads_cost = False  # nor does schedule(): the candidates as reported, none aged for it
 
     def deadline(self, c: Candidate) -> float:
         d = self.cost_params(c, self.name).deadline

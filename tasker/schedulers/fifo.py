@@ -10,6 +10,7 @@ class Fifo(Scheduler):
     preemptive = False
     indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
     key_cost = False  # select_key never reads the cost
+    reads_cost = False  # nor does schedule(): the candidates as reported, none aged for it
 
     def schedule(self, view: ScheduleView) -> Decision:
         if view.exe is not None:

@@ -19,6 +19,7 @@ class FixedPriority(Scheduler):
     preemptive = True
     indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
     key_cost = False  # select_key never reads the cost
+    reads_cost = False  # nor does schedule(): the candidates as reported, none aged for it
 
     def __init__(self, priorities: Mapping[str, int] | None = None, default: int = 0) -> None:
         if priorities is not None and not isinstance(priorities, Mapping):

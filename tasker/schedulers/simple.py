@@ -32,6 +32,7 @@ class LongestFirst(Scheduler):
     preemptive = True
     indexed = True  # the lowest key runs: the harmoniser may find it without a scan
     key_cost = False  # select_key never reads the cost
+    reads_cost = False  # nor does schedule(): the candidates as reported, none aged for it
 
     def __init__(self, hesitance: float = 0.5) -> None:
         if not isinstance(hesitance, int | float) or not 0 <= hesitance:

@@ -10,6 +10,7 @@ class ShortestJobFirst(Scheduler):
     preemptive = False
     indexed = True  # the lowest queue_key runs: the harmoniser may find it without a scan
     key_cost = False  # select_key never reads the cost
+    reads_cost = False  # nor does schedule(): the candidates as reported, none aged for it
 
     def queue_key(self, c: Candidate) -> tuple[float, int]:
         return (self.cost_params(c, self.name).c_time, c.order)

@@ -41,6 +41,7 @@ class WeightedShortestFirst(Scheduler):
     preemptive = True
     indexed = True  # the lowest select_key runs: the harmoniser may find it without a scan
     key_cost = False  # select_key never reads the cost
+    reads_cost = False  # nor does schedule(): the candidates as reported, none aged for it
 
     def __init__(self, weight: str = "priority") -> None:
         self.weight = choice(self.name, "weight", weight, WEIGHTS)

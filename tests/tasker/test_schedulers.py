@@ -24,6 +24,31 @@ def v(exe: Candidate | None, cands: list[Candidate]) -> ScheduleView:
     return ScheduleView(0.0, exe, cands, answer)
 
 
+class Unaged(CostParams):
+    """Parameters whose ``cost`` must not be read: a waiting candidate's, as a scheduler that says it reads no
+    waiting cost (``Scheduler.reads_cost = False``) gets it — its agent's estimate, not aged to now."""
+
+    def __getattribute__(self, name: str) -> object:
+        if name == "cost" and super().__getattribute__("__dict__").get("armed"):
+            raise AssertionError("a scheduler with reads_cost = False read a waiting candidate's cost")
+        return super().__getattribute__(name)
+
+
+@pytest.mark.parametrize("name", [n for n in schedulers.names() if not schedulers.create(n).reads_cost])
+def test_a_scheduler_that_says_it_reads_no_waiting_cost_reads_none(name: str) -> None:
+    s = schedulers.create(name)
+
+    def unaged(agent: str, order: int, c_time: float, deadline: float | None, priority: int | None) -> Candidate:
+        params = Unaged("t", cost=c_time, cps=1.0 + order, c_time=c_time, end_pose=(order, 0.0), deadline=deadline,
+                        priority=priority)
+        object.__setattr__(params, "armed", True)  # built (its own check reads the cost): from now on, none may
+        return Candidate(agent, "t", params, float(order), order)
+
+    waiting = [unaged("d2", 1, 3.0, 9.0, 1), unaged("d3", 2, 2.0, None, 2), unaged("d4", 3, 7.0, 4.0, None)]
+    for exe in (None, cand("d1", 0, cost=9, c_time=9, deadline=99, priority=1)):
+        s.schedule(v(exe, waiting))  # decides on cTime, deadlines, priorities, poses and cps: never the cost
+
+
 @pytest.mark.parametrize("name", schedulers.names())
 def test_contract(name: str) -> None:
     s = schedulers.create(name)
