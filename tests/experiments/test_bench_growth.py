@@ -91,6 +91,7 @@ def test_a_day_comparison_needs_at_least_one_day(bad: str, capsys: pytest.Captur
     assert exit_.value.code == 2 and "a number of days (an integer >= 1)" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # runs days in subprocesses: the full lane
 def test_the_protocol_table_gives_each_schedulers_ratios(capsys: pytest.CaptureFixture[str]) -> None:
     ok = bench_growth.print_protocols(("tabsa-short",), ("edf", "alg2"), 1, 1, 60.0)
     out = capsys.readouterr().out.splitlines()
@@ -109,6 +110,7 @@ def test_an_unknown_protocol_is_refused_by_name(capsys: pytest.CaptureFixture[st
     assert exit_.value.code == 2 and "--protocols: no-such-protocol: no protocol" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # runs days in subprocesses: the full lane
 def test_the_stale_measurement_runs_days_without_re_estimates(capsys: pytest.CaptureFixture[str]) -> None:
     bench_growth.print_stale(("tabsa-short",), ("edf",), 1, 1, 60.0)
     out = capsys.readouterr().out.splitlines()
