@@ -121,11 +121,13 @@ class AgentMemory(dict[str, Any]):
     def copy(self) -> AgentMemory:
         """The keys and the fields, copied shallowly (what an estimate's copy of the context gets)."""
         out = AgentMemory(super().items())
-        out.interruption_s = self.interruption_s
-        out.planned_from = self.planned_from
-        out.restore_baseline = self.restore_baseline
-        out.suspension_ahead = self.suspension_ahead
+        out.copy_fields(self)
         return out
+
+    def copy_fields(self, of: AgentMemory) -> None:
+        """Take ``of``'s typed fields (shallowly): every field, so that no copy forgets a new one."""
+        for name in AgentMemory.__slots__:
+            setattr(self, name, getattr(of, name))
 
     def __repr__(self) -> str:
         fields = ", ".join(f"{n}={getattr(self, n)!r}" for n in AgentMemory.__slots__ if getattr(self, n) is not None)
@@ -141,13 +143,11 @@ class WatchedMemory(AgentMemory):
 
     __slots__ = ("_interruption", "interruption_read")
 
-    def __init__(self, of: AgentMemory, interruption_s: float | None) -> None:
+    def __init__(self, of: AgentMemory) -> None:
+        """What :meth:`AgentMemory.copy` gives of ``of``, watched from now on."""
         self._interruption: float | None = None
         super().__init__(dict.items(of))
-        self.planned_from = of.planned_from
-        self.restore_baseline = of.restore_baseline
-        self.suspension_ahead = of.suspension_ahead
-        self._interruption = interruption_s
+        self.copy_fields(of)
         self.interruption_read = False
 
     @property

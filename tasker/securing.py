@@ -27,7 +27,7 @@ from typing import Any, Protocol
 
 from tasker.errors import AgentEnded, ConfigError, InvariantViolation, PlanningFailed, WorldError
 from tasker.fsm import FsmState
-from tasker.memory import AgentMemory, WatchedMemory
+from tasker.memory import WatchedMemory
 from tasker.stage import Stage, StagePlan
 from tasker.task import TaskContext, TaskType
 
@@ -247,16 +247,12 @@ def suspension_estimate(agent: WatchedAgent, now: float, policy: str, interrupte
     """
     if agent.ended:
         raise AgentEnded(agent.id, agent.end_reason or "ended")
-    memory: AgentMemory | None = None
+    memory: WatchedMemory | None = None
     try:
         agent.refresh(now)
-        if reads is None:
-            memory = agent.ctx.memory.copy()
-            if expected_s is not None:
-                memory.interruption_s = float(expected_s)
-        else:  # the same copy, noting whether the suspension reads the interruption's length
-            own = agent.ctx.memory
-            memory = WatchedMemory(own, float(expected_s) if expected_s is not None else own.interruption_s)
+        memory = WatchedMemory(agent.ctx.memory)  # a copy that notes whether the suspension reads the expectation
+        if expected_s is not None:
+            memory.interruption_s = float(expected_s)
         ctx = replace(agent.ctx, memory=memory, done=list(agent.ctx.done), interrupted=interrupted,
                       suspended=True, strategy=replace(agent.ctx.strategy, suspension="static", policy=policy))
         plan = agent.task.generate_suspension(ctx)
@@ -272,5 +268,5 @@ def suspension_estimate(agent: WatchedAgent, now: float, policy: str, interrupte
         agent.fail(now, exc)
         raise AgentEnded(agent.id, agent.end_reason or "error") from exc
     finally:  # a failed plan may have read it too: inf for one expectation need not be inf for all
-        if reads is not None and isinstance(memory, WatchedMemory) and memory.interruption_read:
+        if reads is not None and memory is not None and memory.interruption_read:
             reads.add("interruption_s")

@@ -205,8 +205,7 @@ def _improve(p: Problem, order: list[int], allowed_first: set[int], budget: int)
                     return order, best, used
                 used += 1
                 m, stop = min(i, k), max(i, k) + 2  # from stop on, cand's jobs (and the one before) are order's
-                v = p.evaluate_unless(cand, m, prefix[m], stop, prefix[stop]) if stop < p.n else \
-                    p.evaluate_from(cand, m, prefix[m])
+                v = p.evaluate_unless(cand, m, prefix[m], stop, prefix[min(stop, p.n)])  # stop >= n: evaluated whole
                 if v < best - 1e-9 * max(1.0, abs(best)):
                     order, best, improved = cand, v, True
                     break

@@ -105,11 +105,12 @@ def test_a_watched_copy_notes_every_way_of_reading_the_interruption() -> None:
              lambda m: copying.deepcopy(m), lambda m: pickle.dumps(m), lambda m: m.pop(INTERRUPTION_KEY, None),
              lambda m: m.setdefault(INTERRUPTION_KEY, 1.0)]
     for read in reads:
-        m = WatchedMemory(own, 12.0)
+        m = WatchedMemory(own)
+        m.interruption_s = 12.0
         assert not m.interruption_read
         read(m)
         assert m.interruption_read, read
-    m = WatchedMemory(own, 12.0)
+    m = WatchedMemory(own)
     m["k2"] = 1
     m[INTERRUPTION_KEY] = 4.0
     m.interruption_s = 5.0
@@ -117,4 +118,5 @@ def test_a_watched_copy_notes_every_way_of_reading_the_interruption() -> None:
     assert not m.interruption_read
     assert m.interruption_s == 5.0 and m.interruption_read
     assert own.interruption_s == 3.0 and "k2" not in own  # a copy: the agent's own memory is untouched
-    assert WatchedMemory(own, None).copy().interruption_s is None
+    copied = WatchedMemory(own)
+    assert copied.copy().interruption_s == 3.0 and copied.interruption_read  # as AgentMemory.copy gives it
