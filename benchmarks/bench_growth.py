@@ -132,7 +132,7 @@ def eight_hours(tree: Path, protocol: str, scheduler: str, limit: float) -> floa
     return float(json.loads(done.stdout.splitlines()[-1])["cpu"])
 
 
-def print_eight_hours(base: Path | None, limit: float) -> None:
+def print_eight_hours(base: Path | None, limit: float, base_name: str = "") -> None:
     print(f"an 8-hour synthetic day (seed 1, run_day: draw, run, metrics) of each scheduler of the README's "
           f"`tasker day`, CPU seconds (> {limit:g}: stopped at that)")
     for protocol in ("tabsa-original", "tabsa"):
@@ -140,7 +140,7 @@ def print_eight_hours(base: Path | None, limit: float) -> None:
             now = eight_hours(ROOT, protocol, name, limit)
             old = eight_hours(base, protocol, name, limit) if base is not None else None
             print(f"  {protocol:15} {name:16} now {_cell(now, limit)}"
-                  + (f"   60ed0ea {_cell(old, limit)}" if base is not None else ""), flush=True)
+                  + (f"   {base_name} {_cell(old, limit)}" if base is not None else ""), flush=True)
 
 
 def _cell(value: float | None, limit: float) -> str:
@@ -350,17 +350,26 @@ def print_protocols(protocols: tuple[str, ...], schedulers: tuple[str, ...], see
     ok = True
     for protocol in protocols:
         for name in schedulers:
-            data = series(ROOT, protocol, name, "hours", (2.0, 8.0), seeds, repeat, budget)
-            if 2.0 not in data or 8.0 not in data:
+            x4 = _x4(protocol, name, seeds, repeat, budget)
+            if x4 is None:
                 print(f"  {protocol:16} {name:20} {'-':>7}  (past the {budget:g} CPU-s budget)")
                 ok = False
                 continue
-            (c2, w2, b2), (c8, w8, b8) = data[2.0], data[8.0]
-            cost, work = c8 / c2, w8 / w2
+            cost, work, output = x4
             ok = ok and cost <= TARGET
-            print(f"  {protocol:16} {name:20} {cost:6.2f}x {work:6.2f}x {b8 / b2:6.2f}x {cost / work:9.2f}x  "
+            print(f"  {protocol:16} {name:20} {cost:6.2f}x {work:6.2f}x {output:6.2f}x {cost / work:9.2f}x  "
                   + ("met" if cost <= TARGET else "ABOVE"))
     return ok
+
+
+def _x4(protocol: str, name: str, seeds: int, repeat: int, budget: float,
+        stale: bool = False) -> tuple[float, float, float] | None:
+    """The ratios of an 8-hour day to a 2-hour one (cost, events, trace bytes), None past the budget."""
+    data = series(ROOT, protocol, name, "hours", (2.0, 8.0), seeds, repeat, budget, stale)
+    if 2.0 not in data or 8.0 not in data:
+        return None
+    (c2, w2, b2), (c8, w8, b8) = data[2.0], data[8.0]
+    return c8 / c2, w8 / w2, b8 / b2
 
 
 def print_stale(protocols: tuple[str, ...], schedulers: tuple[str, ...], seeds: int, repeat: int,
@@ -374,10 +383,8 @@ def print_stale(protocols: tuple[str, ...], schedulers: tuple[str, ...], seeds: 
     print(f"  {'protocol':16} {'scheduler':14} {'as shipped':>11} {'stale':>8}")
     for protocol in protocols:
         for name in schedulers:
-            cells = []
-            for stale in (False, True):
-                data = series(ROOT, protocol, name, "hours", (2.0, 8.0), seeds, repeat, budget, stale)
-                cells.append(f"{data[8.0][0] / data[2.0][0]:7.2f}x" if 2.0 in data and 8.0 in data else "-")
+            cells = [f"{x4[0]:7.2f}x" if (x4 := _x4(protocol, name, seeds, repeat, budget, stale)) else "-"
+                     for stale in (False, True)]
             print(f"  {protocol:16} {name:14} {cells[0]:>11} {cells[1]:>8}")
 
 
@@ -417,11 +424,13 @@ def checkout(commit: str, into: Path) -> Path:
 
 
 def report(name: str, dimension: str, now: dict[float, tuple[float, int, int]],
-           base: dict[float, tuple[float, int, int]] | None, sizes: tuple[float, ...]) -> bool:
-    """Print one series; True if it meets the target (or cannot be judged)."""
+           base: dict[float, tuple[float, int, int]] | None, sizes: tuple[float, ...],
+           base_name: str = "60ed0ea") -> bool:
+    """Print one series (``base``: the series on commit ``base_name``); True if it meets the target (or cannot be
+    judged)."""
     unit = "h" if dimension == "hours" else " req"
     print(f"  {name:14} {dimension:8} " + "  ".join(f"{s:>8g}{unit}" for s in sizes))
-    rows = [("now CPU s", now)] + ([("60ed0ea CPU s" if base is not None else "", base)] if base is not None else [])
+    rows = [("now CPU s", now)] + ([(f"{base_name} CPU s", base)] if base is not None else [])
     for label, data in rows:
         cells = [f"{data[s][0]:>10.3f}" if s in data else f"{'-':>10}" for s in sizes]
         print(f"  {'':14} {label:>14} " + "  ".join(cells))
@@ -528,7 +537,7 @@ def main(argv: list[str]) -> int:
         return worker(args)
     if args.eight_hours:
         with tempfile.TemporaryDirectory(prefix="tasker-base-") as tmp:
-            print_eight_hours(checkout(args.base, Path(tmp)) if args.base else None, args.budget)
+            print_eight_hours(checkout(args.base, Path(tmp)) if args.base else None, args.budget, args.base)
         return 0
     if args.budget_study:
         print_budget_study(args.protocol)
@@ -577,7 +586,7 @@ def main(argv: list[str]) -> int:
                 now = series(ROOT, args.protocol, name, dimension, sizes_f, args.seeds, args.repeat, args.budget)
                 base = (series(base_tree, args.protocol, name, dimension, sizes_f, args.seeds, args.repeat,
                                args.budget) if base_tree is not None else None)
-                ok = report(name, dimension, now, base, sizes_f) and ok
+                ok = report(name, dimension, now, base, sizes_f, args.base) and ok
     print("target (a day four times as long costs at most 5 times as much): " + ("met" if ok else "NOT MET"))
     if "lookahead" in args.schedulers and not args.quick:
         print_budget_study(args.protocol)

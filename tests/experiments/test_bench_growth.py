@@ -131,3 +131,10 @@ def test_a_stale_worker_re_estimates_no_parked_agent() -> None:
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                           cwd=bench_growth.ROOT)
     assert done.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_the_baseline_is_labelled_with_the_commit_it_was_measured_on(capsys: pytest.CaptureFixture[str]) -> None:
+    series = {2.0: (1.0, 1, 1), 8.0: (4.0, 4, 4)}
+    bench_growth.report("x", "hours", series, series, (2.0, 8.0), "abc1234")
+    out = capsys.readouterr().out
+    assert "abc1234 CPU s" in out and "60ed0ea" not in out
